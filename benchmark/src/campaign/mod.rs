@@ -1,0 +1,1 @@
+//! Campaigns: configuration, the run matrix, running and storing results.

@@ -1,0 +1,213 @@
+//! The environments of the paper (Section 4.1; PAPER-NOTES.md section 1) and the renderer
+//! (PAPER-NOTES.md section 2).
+//!
+//! A rollout runs one 50-step DMP movement of the 7-joint arm from rest; the object (ball or
+//! arrow) is caught, stickily, as soon as the hand comes within `object_size` of it, and then
+//! follows the hand. The outcome is the object state at the last step, clipped to [-1,1].
+
+pub mod arm;
+pub mod armarrow;
+pub mod armball;
+pub mod dmp;
+pub mod render;
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+pub use arm::{ArmConfig, ArmPose, JOINTS};
+pub use armarrow::ArmArrow;
+pub use armball::ArmBall;
+pub use dmp::{DmpConfig, DmpTable, DmpWidths, PARAMS};
+
+/// Which environment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EnvKind {
+    /// A ball that the arm can catch and move (2-D outcome).
+    ArmBall,
+    /// An arrow that the arm can catch, move and orient (3-D outcome).
+    ArmArrow,
+}
+
+impl EnvKind {
+    /// All environments, in the report's order.
+    pub const ALL: [EnvKind; 2] = [EnvKind::ArmBall, EnvKind::ArmArrow];
+
+    /// The name used on the command line and in results.
+    pub fn name(self) -> &'static str {
+        match self {
+            EnvKind::ArmBall => "armball",
+            EnvKind::ArmArrow => "armarrow",
+        }
+    }
+
+    /// Dimension of the engineered outcome (and of the object state).
+    pub fn state_dim(self) -> usize {
+        match self {
+            EnvKind::ArmBall => 2,
+            EnvKind::ArmArrow => 3,
+        }
+    }
+}
+
+impl fmt::Display for EnvKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for EnvKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "armball" => Ok(EnvKind::ArmBall),
+            "armarrow" => Ok(EnvKind::ArmArrow),
+            other => Err(format!("unknown environment '{other}' (expected armball or armarrow)")),
+        }
+    }
+}
+
+/// Constants of the environments; the defaults are the paper's code's (PAPER-NOTES.md section 1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EnvConfig {
+    /// Arm geometry.
+    pub arm: ArmConfig,
+    /// Motor primitive.
+    pub dmp: DmpConfig,
+    /// Catch radius: the object is caught when the squared hand-object distance is below its square.
+    pub object_size: f64,
+    /// Initial ball position.
+    pub ball_initial: [f64; 2],
+    /// Initial arrow pose (x, y, angle in units of pi).
+    pub arrow_initial: [f64; 3],
+}
+
+impl Default for EnvConfig {
+    fn default() -> Self {
+        EnvConfig {
+            arm: ArmConfig::default(),
+            dmp: DmpConfig::default(),
+            object_size: 0.1,
+            ball_initial: [0.6, 0.6],
+            arrow_initial: [0.6, 0.6, 0.6],
+        }
+    }
+}
+
+/// The result of one episode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rollout {
+    /// Final object state (engineered outcome), clipped to [-1,1]; only the first
+    /// `state_dim` entries are meaningful.
+    pub state: [f64; 3],
+    /// Number of meaningful entries in `state`.
+    pub dim: usize,
+    /// The object was caught (and so moved with the hand) during the episode.
+    pub caught: bool,
+    /// Hand position at the last step.
+    pub hand: [f64; 2],
+}
+
+impl Rollout {
+    /// The engineered outcome.
+    pub fn outcome(&self) -> &[f64] {
+        &self.state[..self.dim]
+    }
+}
+
+/// An environment of the benchmark (DESIGN.md "Core abstractions").
+pub trait Environment: Send + Sync {
+    /// Which environment this is.
+    fn kind(&self) -> EnvKind;
+    /// Number of motor parameters (21).
+    fn param_dim(&self) -> usize {
+        PARAMS
+    }
+    /// Dimension of the engineered outcome.
+    fn state_dim(&self) -> usize {
+        self.kind().state_dim()
+    }
+    /// The object's initial state.
+    fn initial_state(&self) -> &[f64];
+    /// Run one episode with motor parameters `theta` (each clipped to [-1,1]).
+    fn rollout(&self, theta: &[f64; PARAMS]) -> Rollout;
+    /// Render an object state (engineered coordinates) into a 70x70 x-major buffer.
+    fn render_into(&self, state: &[f64], out: &mut [f32]);
+}
+
+/// Build an environment.
+pub fn make_env(kind: EnvKind, cfg: &EnvConfig) -> Box<dyn Environment> {
+    match kind {
+        EnvKind::ArmBall => Box::new(ArmBall::new(cfg)),
+        EnvKind::ArmArrow => Box::new(ArmArrow::new(cfg)),
+    }
+}
+
+/// What the arm and its motor primitive share between the two environments.
+#[derive(Clone, Debug)]
+pub(crate) struct Body {
+    pub arm: ArmConfig,
+    pub table: DmpTable,
+    pub size_sq: f64,
+}
+
+impl Body {
+    pub fn new(cfg: &EnvConfig) -> Self {
+        Body { arm: cfg.arm.clone(), table: cfg.dmp.table(), size_sq: cfg.object_size * cfg.object_size }
+    }
+
+    /// Run the movement; the object at `object_xy` is caught the first step the squared
+    /// hand-object distance is below `size^2` (that step already moves it). Returns whether it
+    /// was caught and the arm pose at the last step.
+    #[inline]
+    pub fn run(&self, theta: &[f64; PARAMS], object_xy: [f64; 2]) -> (bool, ArmPose) {
+        let mut dmp = dmp::DmpState::new(&self.table, theta);
+        let steps = self.table.x.len();
+        let mut caught = false;
+        let mut last = None;
+        for t in 0..steps {
+            let q = dmp.step(&self.table, t);
+            if !caught {
+                let pose = self.arm.forward(q);
+                let dx = pose.hand[0] - object_xy[0];
+                let dy = pose.hand[1] - object_xy[1];
+                caught = dx * dx + dy * dy < self.size_sq;
+                if t + 1 == steps {
+                    last = Some(pose);
+                }
+            } else if t + 1 == steps {
+                // Once caught, the object follows the hand: only the last pose matters.
+                last = Some(self.arm.forward(q));
+            }
+        }
+        let pose = last.unwrap_or_else(|| self.arm.forward(&[0.0; JOINTS]));
+        (caught, pose)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn env_names_round_trip() {
+        for k in EnvKind::ALL {
+            assert_eq!(k.name().parse::<EnvKind>().unwrap(), k);
+        }
+        assert!("armbal".parse::<EnvKind>().is_err());
+    }
+
+    #[test]
+    fn rest_pose_no_catch() {
+        for k in EnvKind::ALL {
+            let env = make_env(k, &EnvConfig::default());
+            let r = env.rollout(&[0.0; PARAMS]);
+            assert!(!r.caught);
+            assert!(r.hand[0].abs() < 1e-15 && (r.hand[1] - 1.0).abs() < 1e-15);
+            assert_eq!(r.outcome(), env.initial_state());
+        }
+    }
+}

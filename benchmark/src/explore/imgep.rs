@@ -1,0 +1,130 @@
+//! Random goal exploration (RGE; paper Appendix D, Algorithm 3, with the code's details of
+//! PAPER-NOTES.md section 3).
+//!
+//! One warm-up random episode, then `epochs` iterations. An iteration uses random parameters
+//! while no stored outcome differs from the initial state in every coordinate, while fewer than
+//! two distinct outcome encodings are stored, during the first `bootstrap_epochs` iterations, or
+//! with probability `random_ratio` (drawn only when the previous tests are false, a short-circuit
+//! `or` as in the original); otherwise it samples a goal, takes the parameters of the nearest
+//! stored outcome encoding, and perturbs them.
+
+use super::history::{ExplorationLog, Recorder};
+use super::meta_policy::{perturb, random_params};
+use super::nn::NnIndex;
+use super::ExploreConfig;
+use crate::env::{Environment, PARAMS};
+use crate::goals::GoalSampler;
+use crate::metrics::KlCoverage;
+use crate::seed::{stream, Component};
+use rand::RngExt;
+
+/// Maps an episode's final object state to its encoding in the goal space.
+pub trait OutcomeSpace {
+    /// Goal-space dimension.
+    fn dim(&self) -> usize;
+    /// Encode the engineered outcome `state` into `out` (length `dim`).
+    fn encode(&mut self, state: &[f64], out: &mut [f64]);
+}
+
+/// The engineered goal space of RGE-EFR: z = (s + 1) / 2 in [0,1]^d.
+#[derive(Clone, Debug)]
+pub struct EngineeredSpace {
+    dim: usize,
+}
+
+impl EngineeredSpace {
+    /// For outcomes of dimension `dim`.
+    pub fn new(dim: usize) -> Self {
+        EngineeredSpace { dim }
+    }
+}
+
+impl OutcomeSpace for EngineeredSpace {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn encode(&mut self, state: &[f64], out: &mut [f64]) {
+        for (o, s) in out.iter_mut().zip(state) {
+            *o = (s + 1.0) / 2.0;
+        }
+    }
+}
+
+/// Run RGE in the goal space `space` with goals from `sampler`.
+pub fn run_rge(
+    env: &dyn Environment,
+    space: &mut dyn OutcomeSpace,
+    sampler: &mut dyn GoalSampler,
+    cfg: &ExploreConfig,
+    run_seed: u64,
+) -> ExplorationLog {
+    assert_eq!(space.dim(), sampler.dim(), "goal sampler and outcome space dimensions differ");
+    let klc = KlCoverage::new(env.state_dim()).expect("environment dimension is 2 or 3");
+    let mut rec = Recorder::new(&klc, env.initial_state(), cfg.eval_epochs(), cfg.epochs + 1);
+    let mut params_rng = stream(run_seed, Component::Params);
+    let mut choice_rng = stream(run_seed, Component::ExploreChoice);
+    let mut goal_rng = stream(run_seed, Component::Goals);
+    let mut noise_rng = stream(run_seed, Component::Noise);
+
+    let mut h = History {
+        index: NnIndex::new(space.dim()),
+        thetas: Vec::with_capacity(cfg.epochs + 1),
+        z: vec![0.0; space.dim()],
+        initial: env.initial_state().to_vec(),
+        ever_moved: false,
+    };
+    let mut goal = vec![0.0; space.dim()];
+
+    // Warm-up episode.
+    let theta = random_params(&mut params_rng);
+    h.store(env, space, &mut rec, theta, 0, true);
+    rec.end_epoch(0);
+
+    for i in 0..cfg.epochs {
+        let epoch = i + 1;
+        let random = !h.ever_moved
+            || h.index.n_distinct() < 2
+            || i < cfg.bootstrap_epochs
+            || choice_rng.random::<f64>() < cfg.random_ratio;
+        let theta = if random {
+            random_params(&mut params_rng)
+        } else {
+            sampler.sample(&mut goal_rng, &mut goal);
+            let (j, _) = h.index.nearest(&goal).expect("history is not empty");
+            perturb(&h.thetas[j], cfg.noise_sigma, &mut noise_rng)
+        };
+        h.store(env, space, &mut rec, theta, epoch, random);
+        rec.end_epoch(epoch);
+    }
+    rec.finish()
+}
+
+/// The explorer's memory: parameters and outcome encodings, with the nearest-neighbour index.
+struct History {
+    index: NnIndex,
+    thetas: Vec<[f64; PARAMS]>,
+    z: Vec<f64>,
+    initial: Vec<f64>,
+    /// Some outcome differs from the initial state in every coordinate.
+    ever_moved: bool,
+}
+
+impl History {
+    fn store(
+        &mut self,
+        env: &dyn Environment,
+        space: &mut dyn OutcomeSpace,
+        rec: &mut Recorder,
+        theta: [f64; PARAMS],
+        epoch: usize,
+        random: bool,
+    ) {
+        let r = env.rollout(&theta);
+        let s = r.outcome();
+        self.ever_moved |= s.iter().zip(&self.initial).all(|(a, b)| a != b);
+        space.encode(s, &mut self.z);
+        self.index.insert(&self.z);
+        self.thetas.push(theta);
+        rec.push(epoch, &r, random);
+    }
+}

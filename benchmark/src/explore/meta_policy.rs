@@ -1,0 +1,56 @@
+//! The meta-policy of RGE (PAPER-NOTES.md section 3): nearest stored outcome to the goal, its
+//! parameters plus independent Gaussian noise, clipped to [-1,1].
+
+use rand::RngExt;
+use rand_distr::StandardNormal;
+
+use crate::env::PARAMS;
+use crate::seed::Stream;
+
+/// Uniform random motor parameters in [-1, 1) (explauto `rand_bounds`).
+pub fn random_params(rng: &mut Stream) -> [f64; PARAMS] {
+    std::array::from_fn(|_| rng.random_range(-1.0..1.0))
+}
+
+/// `theta + N(0, sigma^2)` per dimension, clipped to [-1, 1].
+pub fn perturb(theta: &[f64; PARAMS], sigma: f64, rng: &mut Stream) -> [f64; PARAMS] {
+    std::array::from_fn(|k| {
+        let n: f64 = rng.sample(StandardNormal);
+        (theta[k] + sigma * n).clamp(-1.0, 1.0)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seed::{stream, Component};
+
+    #[test]
+    fn random_params_in_range_and_noise_statistics() {
+        let mut rng = stream(1, Component::Params);
+        let mut sum = 0.0;
+        for _ in 0..1000 {
+            let t = random_params(&mut rng);
+            assert!(t.iter().all(|v| (-1.0..1.0).contains(v)));
+            sum += t.iter().sum::<f64>();
+        }
+        assert!((sum / 21_000.0).abs() < 0.02);
+        let mut rng = stream(1, Component::Noise);
+        let zero = [0.0; PARAMS];
+        let (mut s1, mut s2) = (0.0, 0.0);
+        let n = 4000;
+        for _ in 0..n {
+            for v in perturb(&zero, 0.1, &mut rng) {
+                s1 += v;
+                s2 += v * v;
+            }
+        }
+        let m = s1 / (n * PARAMS) as f64;
+        let sd = (s2 / (n * PARAMS) as f64 - m * m).sqrt();
+        assert!(m.abs() < 0.003, "{m}");
+        assert!((sd - 0.1).abs() < 0.003, "{sd}");
+        // Clipping.
+        let ones = [1.0; PARAMS];
+        assert!(perturb(&ones, 0.5, &mut rng).iter().all(|v| *v <= 1.0));
+    }
+}

@@ -1,0 +1,13 @@
+//! ugl-bench: the science of the benchmark.
+//!
+//! Reproduces Péré et al. (ICLR 2018), *Unsupervised Learning of Goal Spaces for
+//! Intrinsically Motivated Goal Exploration*: the ArmBall / ArmArrow environments,
+//! the 70x70 renderer, the explorers (RPE, RGE-EFR), the KL-coverage metric and
+//! the campaign machinery that writes the results store.
+
+pub mod campaign;
+pub mod env;
+pub mod explore;
+pub mod goals;
+pub mod metrics;
+pub mod seed;

@@ -1,0 +1,7 @@
+//! Exploration measures (paper Section 4.2; PAPER-NOTES.md section 4).
+
+pub mod klc;
+pub mod moved;
+
+pub use klc::{CoverageHistogram, KlCoverage};
+pub use moved::moved;

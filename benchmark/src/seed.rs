@@ -1,0 +1,103 @@
+//! Seeding (DESIGN.md "Seeding"): one campaign seed, a stable hash per run identity, and one
+//! independent ChaCha stream per component, so that adding a draw in one component never shifts
+//! another.
+//!
+//! Specification (fixed; changing it changes every result):
+//! - run seed = first 8 bytes, little-endian, of
+//!   `BLAKE3("ugl-bench/run-seed/v1\0" || campaign_seed as u64 LE || identity UTF-8)`;
+//! - stream seed for component `c` = `BLAKE3("ugl-bench/stream/v1\0" || run_seed LE || c UTF-8)`
+//!   (all 32 bytes), used as the key of a `ChaCha8Rng`.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// A component's random stream.
+pub type Stream = ChaCha8Rng;
+
+/// The named components that draw random numbers. Each gets its own stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Component {
+    /// Random motor parameters (RPE, bootstrap and random-ratio episodes, warm-up).
+    Params,
+    /// The draw that decides between random exploration and goal babbling.
+    ExploreChoice,
+    /// Goal sampling in the goal space.
+    Goals,
+    /// The meta-policy's Gaussian exploration noise.
+    Noise,
+    /// The passive observation data set of the UGL stage.
+    Dataset,
+    /// Learner initialisation and mini-batches.
+    Learner,
+}
+
+impl Component {
+    /// The component's name as it enters the stream hash.
+    pub fn name(self) -> &'static str {
+        match self {
+            Component::Params => "params",
+            Component::ExploreChoice => "explore-choice",
+            Component::Goals => "goals",
+            Component::Noise => "noise",
+            Component::Dataset => "dataset",
+            Component::Learner => "learner",
+        }
+    }
+}
+
+/// The seed of a run, derived from the campaign seed and the run's canonical identity.
+pub fn run_seed(campaign_seed: u64, identity: &str) -> u64 {
+    let mut h = blake3::Hasher::new();
+    h.update(b"ugl-bench/run-seed/v1\0");
+    h.update(&campaign_seed.to_le_bytes());
+    h.update(identity.as_bytes());
+    let bytes = h.finalize();
+    u64::from_le_bytes(bytes.as_bytes()[..8].try_into().expect("8 bytes"))
+}
+
+/// The random stream of one component of a run.
+pub fn stream(run_seed: u64, component: Component) -> Stream {
+    stream_named(run_seed, component.name())
+}
+
+/// A stream for a free-form component name (for plug-ins that need their own stream).
+pub fn stream_named(run_seed: u64, component: &str) -> Stream {
+    let mut h = blake3::Hasher::new();
+    h.update(b"ugl-bench/stream/v1\0");
+    h.update(&run_seed.to_le_bytes());
+    h.update(component.as_bytes());
+    ChaCha8Rng::from_seed(*h.finalize().as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::Rng;
+
+    #[test]
+    fn run_seed_is_stable_and_sensitive() {
+        let a = run_seed(0, "env=armball/algo=rpe/seed=0");
+        assert_eq!(a, run_seed(0, "env=armball/algo=rpe/seed=0"));
+        assert_ne!(a, run_seed(1, "env=armball/algo=rpe/seed=0"));
+        assert_ne!(a, run_seed(0, "env=armball/algo=rpe/seed=1"));
+        // Pinned value: the hash is part of the specification; a change here changes every result.
+        let expected = {
+            let mut h = blake3::Hasher::new();
+            h.update(b"ugl-bench/run-seed/v1\0");
+            h.update(&0u64.to_le_bytes());
+            h.update(b"env=armball/algo=rpe/seed=0");
+            u64::from_le_bytes(h.finalize().as_bytes()[..8].try_into().unwrap())
+        };
+        assert_eq!(a, expected);
+    }
+
+    #[test]
+    fn component_streams_are_independent() {
+        let mut p = stream(7, Component::Params);
+        let mut q = stream(7, Component::Noise);
+        let mut p2 = stream(7, Component::Params);
+        let a: u64 = p.next_u64();
+        assert_eq!(a, p2.next_u64());
+        assert_ne!(a, q.next_u64());
+    }
+}

@@ -1,0 +1,135 @@
+//! From runs to conditions: the mean KL-coverage curve over seeds with its 90% bootstrap band,
+//! and the final values of the table.
+
+use std::collections::BTreeMap;
+
+use crate::load::{ConditionKey, Store};
+use crate::paper::{PaperTable, PaperValue};
+use crate::stats::{self, Summary};
+
+/// The statistics of one condition at one epoch, over the runs that have that epoch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveStat {
+    pub epoch: i64,
+    pub n: usize,
+    pub mean: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// One condition (env, algo, sampler, latents, variant) over its seeds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConditionSummary {
+    pub key: ConditionKey,
+    /// Indices into `Store::runs`, in seed order.
+    pub runs: Vec<usize>,
+    pub seeds: Vec<i64>,
+    /// Distinct store sub-directories the runs came from, sorted.
+    pub campaigns: Vec<String>,
+    /// Sorted by epoch: every epoch any run of the condition evaluated.
+    pub curve: Vec<CurveStat>,
+    /// Distinct last epochs of the runs, sorted (one value unless budgets differ).
+    pub final_epochs: Vec<i64>,
+    /// KL-coverage at each run's last epoch.
+    pub final_klc: Summary,
+    pub final_moved_mean: f64,
+    pub final_outcomes_mean: f64,
+    pub final_coverage_mean: f64,
+    pub paper: Option<PaperValue>,
+}
+
+impl ConditionSummary {
+    pub fn last_epoch(&self) -> i64 {
+        *self.final_epochs.last().expect("a condition has runs")
+    }
+}
+
+/// Groups the runs by condition (in the report's condition order) and computes the statistics.
+pub fn aggregate(
+    store: &Store,
+    paper: &PaperTable,
+    bootstrap_seed: u64,
+    n_boot: usize,
+) -> Vec<ConditionSummary> {
+    let mut groups: BTreeMap<ConditionKey, Vec<usize>> = BTreeMap::new();
+    for (i, run) in store.runs.iter().enumerate() {
+        groups.entry(run.key.clone()).or_default().push(i);
+    }
+    let mut out: Vec<ConditionSummary> = groups
+        .into_iter()
+        .map(|(key, runs)| summarize_condition(store, paper, key, runs, bootstrap_seed, n_boot))
+        .collect();
+    out.sort_by_key(|c| c.key.order_key());
+    out
+}
+
+fn summarize_condition(
+    store: &Store,
+    paper: &PaperTable,
+    key: ConditionKey,
+    runs: Vec<usize>,
+    bootstrap_seed: u64,
+    n_boot: usize,
+) -> ConditionSummary {
+    let slug = key.slug();
+    let rs: Vec<&crate::load::Run> = runs.iter().map(|&i| &store.runs[i]).collect();
+
+    let mut by_epoch: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
+    for r in &rs {
+        for p in &r.curve {
+            by_epoch.entry(p.epoch).or_default().push(p.klc);
+        }
+    }
+    let curve = by_epoch
+        .iter()
+        .map(|(&epoch, xs)| {
+            let s = stats::summarize(xs, n_boot, epoch_seed(bootstrap_seed, &slug, epoch));
+            CurveStat {
+                epoch,
+                n: s.n,
+                mean: s.mean,
+                lo: s.ci_lo,
+                hi: s.ci_hi,
+            }
+        })
+        .collect();
+
+    let finals: Vec<_> = rs.iter().map(|r| r.final_point()).collect();
+    let mut final_epochs: Vec<i64> = finals.iter().map(|p| p.epoch).collect();
+    final_epochs.sort_unstable();
+    final_epochs.dedup();
+    let final_seed = if final_epochs.len() == 1 {
+        // The same stream as the curve's last point: figure and table agree exactly.
+        epoch_seed(bootstrap_seed, &slug, final_epochs[0])
+    } else {
+        stats::derive_seed(bootstrap_seed, &format!("{slug}|final"))
+    };
+    let klcs: Vec<f64> = finals.iter().map(|p| p.klc).collect();
+    let final_klc = stats::summarize(&klcs, n_boot, final_seed);
+    let n = finals.len() as f64;
+    let final_moved_mean = finals.iter().map(|p| p.n_moved as f64).sum::<f64>() / n;
+    let final_outcomes_mean = finals.iter().map(|p| p.n_outcomes as f64).sum::<f64>() / n;
+    let final_coverage_mean = finals.iter().map(|p| p.coverage).sum::<f64>() / n;
+
+    let mut campaigns: Vec<String> = rs.iter().map(|r| r.campaign.clone()).collect();
+    campaigns.sort();
+    campaigns.dedup();
+
+    ConditionSummary {
+        paper: paper.lookup(&key).cloned(),
+        seeds: rs.iter().map(|r| r.seed).collect(),
+        key,
+        runs,
+        campaigns,
+        curve,
+        final_epochs,
+        final_klc,
+        final_moved_mean,
+        final_outcomes_mean,
+        final_coverage_mean,
+    }
+}
+
+fn epoch_seed(base: u64, slug: &str, epoch: i64) -> u64 {
+    stats::derive_seed(base, &format!("{slug}|epoch={epoch}"))
+}

@@ -1,0 +1,62 @@
+//! The report's error type: every variant names the file (and column or line) at fault.
+
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("results directory {0} does not exist or is not a directory")]
+    NoResultsDir(PathBuf),
+
+    #[error(
+        "no runs found in {0}: expected <run_id>.parquet, <run_id>.outcomes.parquet and \
+         <run_id>.json at its top level or in its sub-directories (one per campaign)"
+    )]
+    EmptyResults(PathBuf),
+
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    #[error("{path}: not a readable parquet file: {message}")]
+    Parquet { path: PathBuf, message: String },
+
+    #[error("{path}: column `{column}`: {problem}")]
+    Column {
+        path: PathBuf,
+        column: String,
+        problem: String,
+    },
+
+    #[error("{path}: {problem}")]
+    Invalid { path: PathBuf, problem: String },
+
+    #[error("{path}: not a valid JSON manifest: {source}")]
+    Manifest {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+
+    #[error("run `{run_id}` appears twice in the results: {first} and {second}")]
+    DuplicateRun {
+        run_id: String,
+        first: PathBuf,
+        second: PathBuf,
+    },
+
+    #[error("{path}, line {line}: {problem}")]
+    Paper {
+        path: PathBuf,
+        line: usize,
+        problem: String,
+    },
+
+    #[error("{path}: drawing failed: {message}")]
+    Plot { path: PathBuf, message: String },
+
+    #[error("invalid report options: {0}")]
+    Options(String),
+}

@@ -1,0 +1,293 @@
+//! KL-coverage against exploration epochs, like the paper's Figure 4: one figure per environment,
+//! one panel per latent size of the learned goal spaces (the baselines RPE and RGE-EFR, which have
+//! no latent size, appear in every panel, as in the paper), one curve per condition: the mean over
+//! seeds with its shaded 90% bootstrap band. The paper's final value is a hollow star at the
+//! condition's last epoch.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+
+use super::{
+    FONT, FigureFile, algo_name, algo_slot, colour, dash_pattern, env_name, file_safe, fmt_epoch,
+    icon_parts, klc_max, marker, marker_points, star_points, write_svg,
+};
+use crate::ReportError;
+use crate::aggregate::ConditionSummary;
+
+const PANEL_W: u32 = 620;
+const PANEL_H: u32 = 470;
+const TITLE_H: u32 = 36;
+/// A dash this long never ends within a panel: a solid line drawn by the dashed-path element.
+const SOLID: i32 = 1_000_000;
+
+/// One panel: a title and the conditions drawn in it.
+struct Panel<'a> {
+    title: String,
+    members: Vec<&'a ConditionSummary>,
+}
+
+/// Draws `klc_<env>.svg` for every environment, in the report's order.
+pub fn draw_all(
+    conditions: &[ConditionSummary],
+    fig_dir: &Path,
+) -> Result<Vec<FigureFile>, ReportError> {
+    let mut envs: Vec<&str> = Vec::new();
+    for c in conditions {
+        if !envs.contains(&c.key.env.as_str()) {
+            envs.push(&c.key.env);
+        }
+    }
+    let mut out = Vec::new();
+    for env in envs {
+        let of_env: Vec<&ConditionSummary> =
+            conditions.iter().filter(|c| c.key.env == env).collect();
+        let panels = panels_of(env, &of_env);
+        let name = format!("klc_{}.svg", file_safe(env));
+        let path = fig_dir.join(&name);
+        let width = PANEL_W * panels.len() as u32;
+        write_svg(&path, (width, PANEL_H + TITLE_H), |root| {
+            let title = format!(
+                "{}: KL-coverage during exploration (mean over seeds, 90% bootstrap CI)",
+                env_name(env)
+            );
+            let area = root.titled(&title, (FONT, 20))?;
+            let areas = area.split_evenly((1, panels.len()));
+            for (panel, a) in panels.iter().zip(areas.iter()) {
+                draw_panel(a, env, panel)?;
+            }
+            Ok(())
+        })?;
+        let panel_list: Vec<&str> = panels.iter().map(|p| p.title.as_str()).collect();
+        out.push(FigureFile {
+            path,
+            link: format!("figures/{name}"),
+            caption: format!(
+                "{}: KL-coverage vs exploration epochs ({})",
+                env_name(env),
+                panel_list.join("; ")
+            ),
+            env: env.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+/// Baselines (latents 0) in every panel; one panel per latent size of the learned spaces.
+fn panels_of<'a>(env: &str, conds: &[&'a ConditionSummary]) -> Vec<Panel<'a>> {
+    let base: Vec<&ConditionSummary> = conds.iter().copied().filter(|c| c.key.latents == 0).collect();
+    let mut by_latents: BTreeMap<i64, Vec<&ConditionSummary>> = BTreeMap::new();
+    for c in conds.iter().copied().filter(|c| c.key.latents != 0) {
+        by_latents.entry(c.key.latents).or_default().push(c);
+    }
+    if by_latents.is_empty() {
+        return vec![Panel {
+            title: format!("{}, baselines", env_name(env)),
+            members: base,
+        }];
+    }
+    by_latents
+        .into_iter()
+        .map(|(l, learned)| {
+            let mut members = base.clone();
+            members.extend(learned);
+            members.sort_by_key(|c| c.key.order_key());
+            Panel {
+                title: format!("{}, {l} latents", env_name(env)),
+                members,
+            }
+        })
+        .collect()
+}
+
+/// Style of each member: (colour/marker slot, dash pattern), stable within the panel.
+fn styles(members: &[&ConditionSummary]) -> Vec<(usize, Option<(i32, i32)>)> {
+    let mut unknown: Vec<&str> = members
+        .iter()
+        .map(|c| c.key.algo.as_str())
+        .filter(|a| !super::ALGOS.contains(a))
+        .collect();
+    unknown.sort_unstable();
+    unknown.dedup();
+    let mut per_algo: BTreeMap<&str, usize> = BTreeMap::new();
+    members
+        .iter()
+        .map(|c| {
+            let ui = unknown.iter().position(|a| *a == c.key.algo).unwrap_or(0);
+            let slot = algo_slot(&c.key.algo, ui);
+            let k = per_algo.entry(c.key.algo.as_str()).or_insert(0);
+            let dash = dash_pattern(*k);
+            *k += 1;
+            (slot, dash)
+        })
+        .collect()
+}
+
+/// The legend label of a condition within a panel.
+fn label(c: &ConditionSummary) -> String {
+    let mut s = algo_name(&c.key.algo);
+    let default_sampler = matches!(c.key.sampler.as_str(), "none" | "uniform" | "kde");
+    if !default_sampler {
+        s.push_str(&format!(", {} goals", c.key.sampler));
+    } else if c.key.sampler == "kde" {
+        s.push_str(", kde");
+    }
+    if c.key.variant != "none" {
+        s.push_str(&format!(", {}", c.key.variant));
+    }
+    s.push_str(&format!(" (n={})", c.seeds.len()));
+    s
+}
+
+fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    env: &str,
+    panel: &Panel<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let x_last = panel
+        .members
+        .iter()
+        .map(|c| c.last_epoch())
+        .max()
+        .unwrap_or(1)
+        .max(1) as f64;
+    let y_max = klc_max(env).unwrap_or_else(|| {
+        let m = panel
+            .members
+            .iter()
+            .flat_map(|c| c.curve.iter().map(|p| p.hi).chain(c.paper.iter().map(|p| p.klc)))
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max);
+        if m > 0.0 { m * 1.05 } else { 1.0 }
+    });
+    let x_range = -0.01 * x_last..x_last * 1.04;
+
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 17))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(56)
+        .build_cartesian_2d(x_range, 0.0..y_max)?;
+    chart
+        .configure_mesh()
+        .x_desc("exploration epochs")
+        .y_desc("KL-coverage (nats, lower is better)")
+        .x_label_formatter(&fmt_epoch)
+        .y_label_formatter(&|v| format!("{v:.1}"))
+        .x_labels(8)
+        .y_labels(8)
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .light_line_style(RGBColor(0xEE, 0xEE, 0xEE))
+        .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
+        .draw()?;
+
+    let clamp = |v: f64| {
+        if v.is_nan() {
+            v
+        } else {
+            v.clamp(0.0, y_max)
+        }
+    };
+    let styles = styles(&panel.members);
+
+    // Bands first, so that every line is drawn over every band.
+    for (c, &(slot, _)) in panel.members.iter().zip(&styles) {
+        let pts: Vec<_> = c
+            .curve
+            .iter()
+            .filter(|p| !p.lo.is_nan() && !p.hi.is_nan())
+            .collect();
+        if pts.len() < 2 || pts.iter().all(|p| p.lo == p.hi) {
+            continue;
+        }
+        let mut poly: Vec<(f64, f64)> = pts.iter().map(|p| (p.epoch as f64, clamp(p.hi))).collect();
+        poly.extend(pts.iter().rev().map(|p| (p.epoch as f64, clamp(p.lo))));
+        chart.draw_series(std::iter::once(Polygon::new(
+            poly,
+            colour(slot).mix(0.14).filled(),
+        )))?;
+    }
+
+    for (i, (c, &(slot, dash))) in panel.members.iter().zip(&styles).enumerate() {
+        let col = colour(slot);
+        let (mpts, filled) = marker_points(slot, 4.0);
+        let (dash_len, gap) = dash.unwrap_or((SOLID, 0));
+        let line_style = col.stroke_width(2);
+
+        // Finite means only; an infinite mean breaks the line.
+        let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for p in &c.curve {
+            if p.mean.is_finite() {
+                segments.last_mut().unwrap().push((p.epoch as f64, clamp(p.mean)));
+            } else if !segments.last().unwrap().is_empty() {
+                segments.push(Vec::new());
+            }
+        }
+        segments.retain(|s| !s.is_empty());
+        for (k, seg) in segments.iter().enumerate() {
+            let series = chart.draw_series(std::iter::once(DashedPathElement::new(
+                seg.clone(),
+                dash_len,
+                gap,
+                line_style,
+            )))?;
+            if k == 0 {
+                let lpts = mpts.clone();
+                series.label(label(c)).legend(move |(x, y)| {
+                    let (fill, outline) = icon_parts(&lpts, 13, filled, col, 1);
+                    EmptyElement::at((x, y))
+                        + DashedPathElement::new(vec![(0, 0), (26, 0)], dash_len, gap, line_style)
+                        + fill
+                        + outline
+                });
+            }
+        }
+
+        // Markers on about 8 points per curve, staggered between curves.
+        let finite: Vec<(f64, f64)> = segments.iter().flatten().copied().collect();
+        let step = (finite.len() / 8).max(1);
+        let offset = if step > 1 { (i * step / panel.members.len().max(1)) % step } else { 0 };
+        chart.draw_series(
+            finite
+                .iter()
+                .skip(offset)
+                .step_by(step)
+                .map(|&pt| marker(pt, &mpts, filled, col, 1)),
+        )?;
+    }
+
+    // The paper's single-run values, at the last epoch of each condition.
+    let star = star_points(8.0, 3.5);
+    let mut any_paper = false;
+    for (c, &(slot, _)) in panel.members.iter().zip(&styles) {
+        if let Some(p) = &c.paper {
+            any_paper = true;
+            let at = (c.last_epoch() as f64, clamp(p.klc));
+            chart.draw_series(std::iter::once(marker(at, &star, false, colour(slot), 2)))?;
+        }
+    }
+    if any_paper {
+        let star = star.clone();
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+            .label("paper: final value (1 run, read off plot)")
+            .legend(move |(x, y)| {
+                let (fill, outline) = icon_parts(&star, 13, false, BLACK, 2);
+                EmptyElement::at((x, y)) + fill + outline
+            });
+    }
+
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .legend_area_size(32)
+        .margin(8)
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(0x99, 0x99, 0x99))
+        .draw()?;
+    Ok(())
+}

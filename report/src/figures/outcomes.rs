@@ -1,0 +1,195 @@
+//! Where the object went, like the paper's Figure 3: for each condition, the outcomes (object x, y)
+//! of one representative run (seed 0, else the smallest seed) at three epochs, side by side, with
+//! the unit disk (the reachable set) and the object's initial position (0.6, 0.6).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{FONT, FigureFile, algo_name, algo_slot, colour, env_name, file_safe, write_svg};
+use crate::ReportError;
+use crate::aggregate::ConditionSummary;
+use crate::load::{Run, Store};
+
+const PANEL_W: u32 = 360;
+const PANEL_H: u32 = 380;
+const TITLE_H: u32 = 34;
+/// The object's initial position in both environments (PAPER-NOTES section 1).
+pub const INITIAL: (f64, f64) = (0.6, 0.6);
+
+/// The run shown for a condition: seed 0 if present, else the smallest seed.
+pub fn representative<'a>(store: &'a Store, c: &ConditionSummary) -> &'a Run {
+    let runs: Vec<&Run> = c.runs.iter().map(|&i| &store.runs[i]).collect();
+    runs.iter()
+        .find(|r| r.seed == 0)
+        .or_else(|| runs.iter().min_by_key(|r| (r.seed, r.campaign.clone())))
+        .copied()
+        .expect("a condition has runs")
+}
+
+/// The epochs shown for a run whose last epoch is `last`: last/50, last/5 and last
+/// (100, 1000, 5000 for the paper's budget), distinct and positive where possible.
+pub fn snapshot_epochs(last: i64) -> Vec<i64> {
+    let mut e: Vec<i64> = [
+        (last as f64 / 50.0).round() as i64,
+        (last as f64 / 5.0).round() as i64,
+        last,
+    ]
+    .into_iter()
+    .filter(|&e| e > 0 || last == 0)
+    .collect();
+    e.dedup();
+    e
+}
+
+/// Outcomes at `epoch` (rows with `epoch <=` it): (episodes, episodes that moved the object).
+pub fn counts_at(run: &Run, epoch: i64) -> (usize, usize) {
+    let upto = run.outcomes.iter().filter(|o| o.epoch <= epoch);
+    let (mut n, mut moved) = (0, 0);
+    for o in upto {
+        n += 1;
+        moved += usize::from(o.moved);
+    }
+    (n, moved)
+}
+
+/// Draws `outcomes_<condition>.svg` for every condition.
+pub fn draw_all(
+    store: &Store,
+    conditions: &[ConditionSummary],
+    fig_dir: &Path,
+) -> Result<Vec<FigureFile>, ReportError> {
+    let mut out = Vec::new();
+    for c in conditions {
+        let run = representative(store, c);
+        let last = run
+            .outcomes
+            .iter()
+            .map(|o| o.epoch)
+            .max()
+            .unwrap_or(0)
+            .max(run.final_point().epoch);
+        let epochs = snapshot_epochs(last);
+        let name = format!("outcomes_{}.svg", file_safe(&c.key.slug()));
+        let path = fig_dir.join(&name);
+        let col = colour(algo_slot(&c.key.algo, 0));
+        let object = if c.key.env == "armarrow" { "arrow" } else { "object" };
+        let title = format!(
+            "{}, {}: {} positions reached, run {} (seed {})",
+            env_name(&c.key.env),
+            describe(c),
+            object,
+            run.run_id,
+            run.seed
+        );
+        write_svg(
+            &path,
+            (PANEL_W * epochs.len() as u32, PANEL_H + TITLE_H),
+            |root| {
+                let area = root.titled(&title, (FONT, 17))?;
+                let areas = area.split_evenly((1, epochs.len()));
+                for (&e, a) in epochs.iter().zip(areas.iter()) {
+                    draw_panel(a, run, e, col)?;
+                }
+                Ok(())
+            },
+        )?;
+        out.push(FigureFile {
+            path,
+            link: format!("figures/{name}"),
+            caption: format!("{}, {}: outcomes of {} at epochs {:?}", env_name(&c.key.env), describe(c), run.run_id, epochs),
+            env: c.key.env.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// `RGE-VAE, kde, 10 latents, faithful` etc.
+pub fn describe(c: &ConditionSummary) -> String {
+    let mut s = algo_name(&c.key.algo);
+    if !matches!(c.key.sampler.as_str(), "none") {
+        s.push_str(&format!(", {}", c.key.sampler));
+    }
+    if c.key.latents != 0 {
+        s.push_str(&format!(", {} latents", c.key.latents));
+    }
+    if c.key.variant != "none" {
+        s.push_str(&format!(", {}", c.key.variant));
+    }
+    s
+}
+
+fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    run: &Run,
+    epoch: i64,
+    col: RGBColor,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (n, moved) = counts_at(run, epoch);
+    let caption = format!("epoch {epoch}: {moved} of {n} episodes moved it");
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FONT, 14))
+        .margin(10)
+        .x_label_area_size(34)
+        .y_label_area_size(40)
+        .build_cartesian_2d(-1.1..1.1, -1.1..1.1)?;
+    chart
+        .configure_mesh()
+        .x_desc("x")
+        .y_desc("y")
+        .x_labels(5)
+        .y_labels(5)
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        .y_label_formatter(&|v| format!("{v:.1}"))
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .light_line_style(RGBColor(0xF2, 0xF2, 0xF2))
+        .bold_line_style(RGBColor(0xE2, 0xE2, 0xE2))
+        .draw()?;
+
+    // The reachable set: the unit disk.
+    let circle: Vec<(f64, f64)> = (0..=180)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::PI / 90.0;
+            (a.cos(), a.sin())
+        })
+        .collect();
+    chart.draw_series(std::iter::once(PathElement::new(
+        circle,
+        RGBColor(0x60, 0x60, 0x60).stroke_width(1),
+    )))?;
+
+    chart.draw_series(
+        run.outcomes
+            .iter()
+            .filter(|o| o.epoch <= epoch && o.moved)
+            .map(|o| Circle::new((o.x, o.y), 2, col.mix(0.45).filled())),
+    )?;
+
+    // The initial position, where every episode that did not move the object ends.
+    chart.draw_series(std::iter::once(
+        EmptyElement::at(INITIAL)
+            + Circle::new((0, 0), 6, WHITE.filled())
+            + Circle::new((0, 0), 6, RED.stroke_width(2))
+            + Cross::new((0, 0), 3, RED.stroke_width(2)),
+    ))?;
+    chart.draw_series(std::iter::once(Text::new(
+        "start",
+        (INITIAL.0 - 0.12, INITIAL.1 + 0.16),
+        (FONT, 12).into_font().color(&RED),
+    )))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn snapshot_epochs_follow_the_paper_for_its_budget() {
+        assert_eq!(snapshot_epochs(5000), vec![100, 1000, 5000]);
+        assert_eq!(snapshot_epochs(500), vec![10, 100, 500]);
+        assert_eq!(snapshot_epochs(10), vec![2, 10]);
+        assert_eq!(snapshot_epochs(0), vec![0]);
+    }
+}

@@ -1,0 +1,587 @@
+//! Reading the results store (`data/results/README.md`): the curve and outcome parquet files of
+//! every run through polars, and the JSON manifests through serde_json.
+//!
+//! Every column is checked against the schema (presence, type, no nulls where none are allowed,
+//! constant identity columns within a file); any problem is a [`ReportError`] naming the file and
+//! the column. A run whose three files are not all present is *incomplete* (a campaign still
+//! running, or one that was killed): it is skipped and listed in the report, not an error.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::*;
+use serde_json::Value;
+
+use crate::ReportError;
+
+const CURVE_SUFFIX: &str = ".parquet";
+const OUTCOMES_SUFFIX: &str = ".outcomes.parquet";
+const MANIFEST_SUFFIX: &str = ".json";
+
+/// A condition: everything that identifies a curve in the figures, except the seed.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ConditionKey {
+    pub env: String,
+    pub algo: String,
+    pub sampler: String,
+    pub latents: i64,
+    pub variant: String,
+}
+
+impl ConditionKey {
+    /// A stable canonical string, used for file names and bootstrap seeds.
+    pub fn slug(&self) -> String {
+        format!(
+            "{}_{}_{}_{}_{}",
+            self.env, self.algo, self.sampler, self.latents, self.variant
+        )
+    }
+
+    /// The order of conditions everywhere in the report: environments, then latent sizes, then
+    /// the paper's algorithm order, samplers and variants; unknown names after known ones,
+    /// alphabetically.
+    pub fn order_key(&self) -> impl Ord + use<> {
+        (
+            rank(&self.env, &["armball", "armarrow"]),
+            self.env.clone(),
+            self.latents,
+            rank(
+                &self.algo,
+                &[
+                    "rpe",
+                    "rge-efr",
+                    "rge-pca",
+                    "rge-isomap",
+                    "rge-ae",
+                    "rge-vae",
+                    "rge-rfvae",
+                ],
+            ),
+            self.algo.clone(),
+            rank(&self.sampler, &["none", "uniform", "kde", "gaussian"]),
+            self.sampler.clone(),
+            rank(&self.variant, &["none", "faithful", "corrected"]),
+            self.variant.clone(),
+        )
+    }
+}
+
+/// Position of `name` in `known`, or `known.len()` for unknown names.
+pub fn rank(name: &str, known: &[&str]) -> usize {
+    known.iter().position(|k| *k == name).unwrap_or(known.len())
+}
+
+/// One row of `<run_id>.parquet`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvePoint {
+    pub epoch: i64,
+    pub n_outcomes: i64,
+    pub klc: f64,
+    pub n_moved: i64,
+    pub coverage: f64,
+}
+
+/// One row of `<run_id>.outcomes.parquet`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    pub index: i64,
+    pub epoch: i64,
+    pub x: f64,
+    pub y: f64,
+    pub angle: Option<f64>,
+    pub moved: bool,
+}
+
+/// The manifest, kept as JSON: its schema belongs to the runner. The report reads the fields
+/// it knows through [`Manifest::get`] (several spellings accepted, one level of nesting).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Manifest {
+    pub raw: Value,
+}
+
+impl Manifest {
+    /// The first of `names` found at the top level, else inside a top-level object (e.g.
+    /// `budgets.epochs`), looked up in sorted key order. Nulls count as absent.
+    pub fn get(&self, names: &[&str]) -> Option<&Value> {
+        let obj = self.raw.as_object()?;
+        for name in names {
+            if let Some(v) = obj.get(*name).filter(|v| !v.is_null()) {
+                return Some(v);
+            }
+        }
+        let mut keys: Vec<&String> = obj.keys().collect();
+        keys.sort();
+        for name in names {
+            for k in &keys {
+                if let Some(inner) = obj[k.as_str()].as_object()
+                    && let Some(v) = inner.get(*name).filter(|v| !v.is_null())
+                {
+                    return Some(v);
+                }
+            }
+        }
+        None
+    }
+
+    /// A field rendered as text: strings as they are, anything else as compact JSON.
+    pub fn text(&self, names: &[&str]) -> Option<String> {
+        self.get(names).map(value_text)
+    }
+
+    pub fn number(&self, names: &[&str]) -> Option<f64> {
+        self.get(names).and_then(Value::as_f64)
+    }
+
+    pub fn flag(&self, names: &[&str]) -> bool {
+        self.get(names).and_then(Value::as_bool).unwrap_or(false)
+    }
+
+    pub fn profile(&self) -> Option<String> {
+        self.text(&["profile"])
+    }
+    pub fn git_revision(&self) -> Option<String> {
+        self.text(&["git_revision", "git_rev", "git_commit", "git"])
+    }
+    pub fn toolchain(&self) -> Option<String> {
+        self.text(&["toolchain", "rustc", "rustc_version"])
+    }
+    pub fn host(&self) -> Option<String> {
+        self.text(&["host", "hostname"])
+    }
+    pub fn threads(&self) -> Option<String> {
+        self.text(&["threads", "n_threads", "thread_count"])
+    }
+    /// Wall time of the run, in seconds.
+    pub fn wall_time_s(&self) -> Option<f64> {
+        self.number(&["wall_time_s", "wall_s", "wall_seconds", "wall_time"])
+    }
+    pub fn reduced_budget(&self) -> bool {
+        self.flag(&["reduced_budget"])
+    }
+    pub fn budget_note(&self) -> Option<String> {
+        self.text(&["budget_note"])
+    }
+}
+
+/// Strings as they are, other JSON values compactly.
+pub fn value_text(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// One complete run.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub run_id: String,
+    /// Sub-directory of the store holding the run ("" for the top level).
+    pub campaign: String,
+    pub key: ConditionKey,
+    /// Repetition index (`seed` column).
+    pub seed: i64,
+    /// Sorted by epoch, epochs distinct.
+    pub curve: Vec<CurvePoint>,
+    /// In history order.
+    pub outcomes: Vec<Outcome>,
+    pub manifest: Manifest,
+    /// The curve file (`<run_id>.parquet`).
+    pub curve_path: PathBuf,
+    pub outcomes_path: PathBuf,
+    pub manifest_path: PathBuf,
+}
+
+impl Run {
+    pub fn final_point(&self) -> &CurvePoint {
+        self.curve.last().expect("curves are never empty")
+    }
+}
+
+/// The whole store.
+#[derive(Debug, Clone)]
+pub struct Store {
+    /// Sorted by condition order, then seed, then campaign.
+    pub runs: Vec<Run>,
+    /// Runs missing one of their three files: (stem path without suffix, missing file names).
+    pub incomplete: Vec<(PathBuf, Vec<String>)>,
+}
+
+/// Reads every run under `dir` (top level and one sub-directory down).
+pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
+    if !dir.is_dir() {
+        return Err(ReportError::NoResultsDir(dir.to_path_buf()));
+    }
+    let mut dirs = vec![(String::new(), dir.to_path_buf())];
+    for entry in sorted_entries(dir)? {
+        if entry.is_dir() {
+            let name = entry
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            if !name.starts_with('.') {
+                dirs.push((name, entry));
+            }
+        }
+    }
+
+    // stem path -> which of the three files exist
+    let mut stems: BTreeMap<PathBuf, (String, [bool; 3])> = BTreeMap::new();
+    for (campaign, d) in &dirs {
+        for path in sorted_entries(d)? {
+            if !path.is_file() {
+                continue;
+            }
+            let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+                continue;
+            };
+            if name.starts_with('.') {
+                continue; // temporary files of the atomic writer, editor files
+            }
+            let (stem, slot) = if let Some(s) = name.strip_suffix(OUTCOMES_SUFFIX) {
+                (s, 1)
+            } else if let Some(s) = name.strip_suffix(CURVE_SUFFIX) {
+                (s, 0)
+            } else if let Some(s) = name.strip_suffix(MANIFEST_SUFFIX) {
+                (s, 2)
+            } else {
+                continue;
+            };
+            if stem.is_empty() {
+                continue;
+            }
+            let entry = stems
+                .entry(d.join(stem))
+                .or_insert_with(|| (campaign.clone(), [false; 3]));
+            entry.1[slot] = true;
+        }
+    }
+
+    let mut runs = Vec::new();
+    let mut incomplete = Vec::new();
+    let mut seen: BTreeMap<String, PathBuf> = BTreeMap::new();
+    for (stem, (campaign, present)) in stems {
+        let [curve, outcomes, manifest] = present;
+        if !(curve && outcomes && manifest) {
+            let missing: Vec<String> = [
+                (curve, CURVE_SUFFIX),
+                (outcomes, OUTCOMES_SUFFIX),
+                (manifest, MANIFEST_SUFFIX),
+            ]
+            .iter()
+            .filter(|(p, _)| !p)
+            .map(|(_, s)| format!("{}{s}", stem_name(&stem)))
+            .collect();
+            tracing::warn!(run = %stem.display(), ?missing, "incomplete run skipped");
+            incomplete.push((stem, missing));
+            continue;
+        }
+        let run = load_run(&stem, campaign)?;
+        if let Some(first) = seen.get(&run.run_id) {
+            return Err(ReportError::DuplicateRun {
+                run_id: run.run_id.clone(),
+                first: first.clone(),
+                second: run.curve_path.clone(),
+            });
+        }
+        seen.insert(run.run_id.clone(), run.curve_path.clone());
+        runs.push(run);
+    }
+    if runs.is_empty() {
+        return Err(ReportError::EmptyResults(dir.to_path_buf()));
+    }
+    runs.sort_by(|a, b| {
+        (a.key.order_key(), a.seed, &a.campaign).cmp(&(b.key.order_key(), b.seed, &b.campaign))
+    });
+    Ok(Store { runs, incomplete })
+}
+
+fn stem_name(stem: &Path) -> String {
+    stem.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_owned();
+    s.push(suffix);
+    PathBuf::from(s)
+}
+
+fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+    let io = |source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        out.push(entry.map_err(io)?.path());
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Reads one run from its three files.
+pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
+    let curve_path = with_suffix(stem, CURVE_SUFFIX);
+    let outcomes_path = with_suffix(stem, OUTCOMES_SUFFIX);
+    let manifest_path = with_suffix(stem, MANIFEST_SUFFIX);
+
+    let df = read_parquet(&curve_path)?;
+    let c = Cols {
+        df: &df,
+        path: &curve_path,
+    };
+    let run_id = c.constant_str("run_id")?;
+    let key = ConditionKey {
+        env: c.constant_str("env")?,
+        algo: c.constant_str("algo")?,
+        sampler: c.constant_str("sampler")?,
+        latents: c.constant_i64("latents")?,
+        variant: c.constant_str("variant")?,
+    };
+    let seed = c.constant_i64("seed")?;
+    let epoch = c.i64s("epoch")?;
+    let n_outcomes = c.i64s("n_outcomes")?;
+    let klc = c.f64s("klc")?;
+    let n_moved = c.i64s("n_moved")?;
+    let coverage = c.f64s("coverage")?;
+    if let Some(i) = klc.iter().position(|k| k.is_nan()) {
+        return Err(column_error(&curve_path, "klc", format!("NaN at row {i}")));
+    }
+    let mut curve: Vec<CurvePoint> = (0..df.height())
+        .map(|i| CurvePoint {
+            epoch: epoch[i],
+            n_outcomes: n_outcomes[i],
+            klc: klc[i],
+            n_moved: n_moved[i],
+            coverage: coverage[i],
+        })
+        .collect();
+    curve.sort_by_key(|p| p.epoch);
+    if let Some(w) = curve.windows(2).find(|w| w[0].epoch == w[1].epoch) {
+        return Err(column_error(
+            &curve_path,
+            "epoch",
+            format!("epoch {} appears twice", w[0].epoch),
+        ));
+    }
+    let expected_stem = stem_name(stem);
+    if run_id != expected_stem {
+        return Err(column_error(
+            &curve_path,
+            "run_id",
+            format!("holds `{run_id}` but the file is named `{expected_stem}`"),
+        ));
+    }
+
+    let odf = read_parquet(&outcomes_path)?;
+    let o = Cols {
+        df: &odf,
+        path: &outcomes_path,
+    };
+    if odf.height() > 0 {
+        let orun = o.constant_str("run_id")?;
+        if orun != run_id {
+            return Err(column_error(
+                &outcomes_path,
+                "run_id",
+                format!("holds `{orun}`, the curve file holds `{run_id}`"),
+            ));
+        }
+    } else {
+        o.require("run_id")?;
+    }
+    let index = o.i64s("index")?;
+    let oepoch = o.i64s("epoch")?;
+    let x = o.f64s("x")?;
+    let y = o.f64s("y")?;
+    let angle = o.f64s_nullable("angle")?;
+    let moved = o.bools("moved")?;
+    let outcomes = (0..odf.height())
+        .map(|i| Outcome {
+            index: index[i],
+            epoch: oepoch[i],
+            x: x[i],
+            y: y[i],
+            angle: angle[i],
+            moved: moved[i],
+        })
+        .collect();
+
+    let text = std::fs::read_to_string(&manifest_path).map_err(|source| ReportError::Io {
+        path: manifest_path.clone(),
+        source,
+    })?;
+    let raw: Value = serde_json::from_str(&text).map_err(|source| ReportError::Manifest {
+        path: manifest_path.clone(),
+        source,
+    })?;
+    if !raw.is_object() {
+        return Err(ReportError::Invalid {
+            path: manifest_path,
+            problem: "the manifest is not a JSON object".into(),
+        });
+    }
+
+    Ok(Run {
+        run_id,
+        campaign,
+        key,
+        seed,
+        curve,
+        outcomes,
+        manifest: Manifest { raw },
+        curve_path,
+        outcomes_path,
+        manifest_path,
+    })
+}
+
+/// Reads a parquet file into a DataFrame. Errors (and panics inside the reader, which a corrupt
+/// file can trigger) become a [`ReportError::Parquet`] naming the file.
+pub fn read_parquet(path: &Path) -> Result<DataFrame, ReportError> {
+    let file = File::open(path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        ParquetReader::new(file).finish()
+    }));
+    match result {
+        Ok(Ok(df)) => Ok(df),
+        Ok(Err(e)) => Err(ReportError::Parquet {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }),
+        Err(_) => Err(ReportError::Parquet {
+            path: path.to_path_buf(),
+            message: "the parquet reader panicked (corrupt file?)".into(),
+        }),
+    }
+}
+
+fn column_error(path: &Path, column: &str, problem: impl Into<String>) -> ReportError {
+    ReportError::Column {
+        path: path.to_path_buf(),
+        column: column.to_string(),
+        problem: problem.into(),
+    }
+}
+
+/// Typed, checked access to the columns of one file.
+struct Cols<'a> {
+    df: &'a DataFrame,
+    path: &'a Path,
+}
+
+impl Cols<'_> {
+    fn require(&self, name: &str) -> Result<&Column, ReportError> {
+        self.df.column(name).map_err(|_| {
+            let mut present: Vec<String> = self
+                .df
+                .get_column_names()
+                .iter()
+                .map(|n| n.to_string())
+                .collect();
+            present.sort();
+            column_error(
+                self.path,
+                name,
+                format!("missing (columns present: {})", present.join(", ")),
+            )
+        })
+    }
+
+    fn typed<'c, T>(
+        &self,
+        name: &str,
+        col: &'c Column,
+        expected: &str,
+        get: impl Fn(&'c Column) -> PolarsResult<&'c T>,
+    ) -> Result<&'c T, ReportError> {
+        get(col).map_err(|_| {
+            column_error(
+                self.path,
+                name,
+                format!("has type {}, expected {expected}", col.dtype()),
+            )
+        })
+    }
+
+    fn no_nulls(&self, name: &str, col: &Column) -> Result<(), ReportError> {
+        let nulls = col.null_count();
+        if nulls > 0 {
+            return Err(column_error(self.path, name, format!("{nulls} null value(s)")));
+        }
+        Ok(())
+    }
+
+    fn strs(&self, name: &str) -> Result<Vec<String>, ReportError> {
+        let col = self.require(name)?;
+        let ca = self.typed(name, col, "str", Column::str)?;
+        self.no_nulls(name, col)?;
+        Ok(ca.iter().map(|v| v.unwrap_or_default().to_string()).collect())
+    }
+
+    fn i64s(&self, name: &str) -> Result<Vec<i64>, ReportError> {
+        let col = self.require(name)?;
+        let ca = self.typed(name, col, "i64", Column::i64)?;
+        self.no_nulls(name, col)?;
+        Ok(ca.iter().map(|v| v.unwrap_or_default()).collect())
+    }
+
+    fn f64s(&self, name: &str) -> Result<Vec<f64>, ReportError> {
+        let col = self.require(name)?;
+        let ca = self.typed(name, col, "f64", Column::f64)?;
+        self.no_nulls(name, col)?;
+        Ok(ca.iter().map(|v| v.unwrap_or_default()).collect())
+    }
+
+    fn f64s_nullable(&self, name: &str) -> Result<Vec<Option<f64>>, ReportError> {
+        let col = self.require(name)?;
+        // An all-null column may have been written with the Null type.
+        if col.dtype() == &DataType::Null {
+            return Ok(vec![None; col.len()]);
+        }
+        let ca = self.typed(name, col, "f64", Column::f64)?;
+        Ok(ca.iter().collect())
+    }
+
+    fn bools(&self, name: &str) -> Result<Vec<bool>, ReportError> {
+        let col = self.require(name)?;
+        let ca = self.typed(name, col, "bool", Column::bool)?;
+        self.no_nulls(name, col)?;
+        Ok(ca.iter().map(|v| v.unwrap_or_default()).collect())
+    }
+
+    fn constant_str(&self, name: &str) -> Result<String, ReportError> {
+        let v = self.strs(name)?;
+        let Some(first) = v.first() else {
+            return Err(column_error(self.path, name, "the file has no rows"));
+        };
+        if let Some(other) = v.iter().find(|s| *s != first) {
+            return Err(column_error(
+                self.path,
+                name,
+                format!("not constant within the run (`{first}` and `{other}`)"),
+            ));
+        }
+        Ok(first.clone())
+    }
+
+    fn constant_i64(&self, name: &str) -> Result<i64, ReportError> {
+        let v = self.i64s(name)?;
+        let Some(&first) = v.first() else {
+            return Err(column_error(self.path, name, "the file has no rows"));
+        };
+        if let Some(other) = v.iter().find(|s| **s != first) {
+            return Err(column_error(
+                self.path,
+                name,
+                format!("not constant within the run ({first} and {other})"),
+            ));
+        }
+        Ok(first)
+    }
+}
