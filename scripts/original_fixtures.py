@@ -129,8 +129,8 @@ def fetch_sdist(dest_dir):
         if not os.path.exists(path):
             # pip saves the sdist only after building its metadata, and explauto's setup.py uses
             # use_2to3, which setuptools >= 58 rejects: retry from a venv with an old setuptools.
-            print("plain pip download failed (%s); retrying with setuptools<58 in a venv"
-                  % r.stderr.strip().splitlines()[-1:], file=sys.stderr)
+            print("plain pip download failed (exit %d; explauto's setup.py needs setuptools<58); "
+                  "retrying from a venv with setuptools<58" % r.returncode, file=sys.stderr)
             venv = os.path.join(dest_dir, "venv-setuptools57")
             subprocess.run([sys.executable, "-m", "venv", venv], check=True)
             vpip = os.path.join(venv, "bin", "pip")

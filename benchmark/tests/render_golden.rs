@@ -62,9 +62,8 @@ struct Stats {
     vertex_mismatches: usize,
 }
 
-#[test]
-fn renderer_matches_pygame_pixel_for_pixel() {
-    let fx = load();
+/// Compares every case with the renderer; prints the statistics, returns the failures.
+fn compare(fx: &Fixture) -> ([Stats; 2], Vec<String>) {
     assert_eq!(fx.side, SIDE);
     let mut stats = [Stats::default(), Stats::default()];
     let mut gray = vec![0u8; PIXELS];
@@ -151,9 +150,16 @@ fn renderer_matches_pygame_pixel_for_pixel() {
             st.vertex_mismatches
         );
     }
-    for f in &failures {
+    for f in failures.iter().take(50) {
         println!("MISMATCH {f}");
     }
+    (stats, failures)
+}
+
+#[test]
+fn renderer_matches_pygame_pixel_for_pixel() {
+    let fx = load();
+    let (stats, failures) = compare(&fx);
     assert!(
         stats[0].cases >= 40 && stats[1].cases >= 100,
         "fixture too small"
@@ -164,6 +170,19 @@ fn renderer_matches_pygame_pixel_for_pixel() {
         assert_eq!(st.exact_cases, st.cases);
         assert_eq!(st.normalised_exact_cases, st.cases);
     }
+}
+
+/// A one-off large comparison against a file written by
+/// `scripts/golden_render.py --big N --out PATH` (too big to keep in the repo):
+/// `UGL_RENDER_GOLDEN_BIG=PATH cargo test -p ugl-bench --test render_golden -- --ignored`.
+#[test]
+#[ignore = "needs UGL_RENDER_GOLDEN_BIG, a large file written by scripts/golden_render.py --big"]
+fn renderer_matches_pygame_large_random_set() {
+    let path = std::env::var("UGL_RENDER_GOLDEN_BIG").expect("set UGL_RENDER_GOLDEN_BIG");
+    let text = std::fs::read_to_string(&path).expect("read the large golden file");
+    let fx: Fixture = serde_json::from_str(&text).expect("parse the large golden file");
+    let (_, failures) = compare(&fx);
+    assert!(failures.is_empty(), "{} mismatching cases", failures.len());
 }
 
 #[test]

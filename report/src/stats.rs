@@ -239,3 +239,25 @@ mod tests {
         assert_ne!(derive_seed(0, "a"), derive_seed(0, "b"));
     }
 }
+
+#[cfg(test)]
+mod bench_tmp {
+    use super::*;
+    use rand::Rng;
+    #[test]
+    #[ignore]
+    fn rng_speed() {
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let t = std::time::Instant::now();
+        let mut acc = 0u64;
+        for _ in 0..10_000_000 { acc = acc.wrapping_add(u64::from(rng.next_u32())); }
+        eprintln!("next_u32 x1e7: {:?} {acc}", t.elapsed());
+        let t = std::time::Instant::now();
+        let mut buf = vec![0u8; 40_000_000];
+        rng.fill_bytes(&mut buf);
+        eprintln!("fill_bytes 4e7: {:?}", t.elapsed());
+        let t = std::time::Instant::now();
+        for _ in 0..10_000_000 { acc = acc.wrapping_add(rng.random_range(0..5usize) as u64); }
+        eprintln!("random_range x1e7: {:?} {acc}", t.elapsed());
+    }
+}

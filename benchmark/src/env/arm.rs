@@ -35,15 +35,17 @@ impl ArmConfig {
     /// Forward kinematics for a joint command `q` (units of pi, clipped to [-1,1] first, as
     /// explauto's `compute_motor_command` does).
     ///
-    /// The absolute angle of link k is `pi * (shift + q_1 + ... + q_k)`; the hand is the sum of
+    /// The absolute angle of link k is `pi * (shift + (q_1 + ... + q_k))` (the original adds the
+    /// shift to the cumulative sum, `a = 0.5 + cumsum(q)`); the hand is the sum of
     /// `L_k (cos, sin)` of those angles, accumulated base to hand.
     #[inline]
     pub fn forward(&self, q: &[f64; JOINTS]) -> ArmPose {
-        let mut a = self.angle_shift;
+        let mut cum = 0.0f64;
         let (mut x, mut y) = (0.0f64, 0.0f64);
         let mut angle_std = 0.0;
         for k in 0..JOINTS {
-            a += q[k].clamp(-1.0, 1.0);
+            cum += q[k].clamp(-1.0, 1.0);
+            let a = self.angle_shift + cum;
             angle_std = a;
             let (s, c) = (std::f64::consts::PI * a).sin_cos();
             x += c * self.lengths[k];

@@ -1,0 +1,215 @@
+//! Campaign configuration (TOML; `data/campaigns/NAME.toml`). Every budget lives here, never in
+//! code; the defaults of the `explore` and `env` sections are the paper's values.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::env::{EnvConfig, EnvKind};
+use crate::explore::{Algo, ExploreConfig};
+
+/// Errors reading or validating a configuration.
+#[derive(Debug, Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read config {path}: {source}")]
+    Read { path: PathBuf, source: std::io::Error },
+    /// TOML syntax or schema error (unknown key, wrong type...).
+    #[error("invalid config {path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    /// A value is out of range or contradictory.
+    #[error("invalid config {path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    /// A profile name that matches no file.
+    #[error("unknown profile '{name}': no file {tried}")]
+    UnknownProfile { name: String, tried: PathBuf },
+}
+
+/// The `[campaign]` section.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignSection {
+    /// Name of the campaign (also the default results sub-directory).
+    pub name: String,
+    /// The campaign seed; every run seed derives from it and the run identity.
+    #[serde(default)]
+    pub seed: u64,
+    /// Repetitions (seeds) per cell of the matrix.
+    pub reps: usize,
+    /// Free text shown in the report.
+    #[serde(default)]
+    pub description: String,
+}
+
+/// The `[matrix]` section: which cells to run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Matrix {
+    /// Environments.
+    pub envs: Vec<EnvKind>,
+    /// Algorithms.
+    pub algos: Vec<Algo>,
+}
+
+/// A whole campaign configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignConfig {
+    pub campaign: CampaignSection,
+    pub matrix: Matrix,
+    #[serde(default)]
+    pub explore: ExploreConfig,
+    #[serde(default)]
+    pub env: EnvConfig,
+}
+
+impl CampaignConfig {
+    /// Parse and validate TOML text; `path` is only used in error messages.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let cfg: CampaignConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+            path: path.to_path_buf(),
+            message: one_line(&e.to_string()),
+        })?;
+        cfg.validate().map_err(|message| ConfigError::Invalid { path: path.to_path_buf(), message })?;
+        Ok(cfg)
+    }
+
+    /// Read and validate a file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+        Self::from_toml(&text, path)
+    }
+
+    /// Check every value; the message names the key.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.campaign.name.is_empty()
+            || !self.campaign.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
+            return Err(format!(
+                "campaign.name must be non-empty and use only letters, digits, '-' and '_', got '{}'",
+                self.campaign.name
+            ));
+        }
+        if self.campaign.reps == 0 {
+            return Err("campaign.reps must be at least 1".into());
+        }
+        if self.matrix.envs.is_empty() {
+            return Err("matrix.envs must name at least one environment".into());
+        }
+        if self.matrix.algos.is_empty() {
+            return Err("matrix.algos must name at least one algorithm".into());
+        }
+        for (k, list) in [("matrix.envs", dup(&self.matrix.envs)), ("matrix.algos", dup(&self.matrix.algos))] {
+            if let Some(d) = list {
+                return Err(format!("{k} lists '{d}' twice"));
+            }
+        }
+        self.explore.validate()?;
+        validate_env(&self.env)
+    }
+}
+
+fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
+    v.iter().enumerate().find(|(i, a)| v[..*i].contains(a)).map(|(_, a)| a.to_string())
+}
+
+fn validate_env(e: &EnvConfig) -> Result<(), String> {
+    if e.arm.lengths.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
+        return Err("env.arm.lengths must be finite and >= 0".into());
+    }
+    if !(e.object_size.is_finite() && e.object_size > 0.0) {
+        return Err(format!("env.object_size must be > 0, got {}", e.object_size));
+    }
+    if e.dmp.timesteps == 0 {
+        return Err("env.dmp.timesteps must be at least 1".into());
+    }
+    if !(e.dmp.run_time.is_finite() && e.dmp.run_time > 0.0) {
+        return Err("env.dmp.run_time must be > 0".into());
+    }
+    for (k, v) in [("env.dmp.ay", e.dmp.ay), ("env.dmp.ax", e.dmp.ax), ("env.dmp.max_params", e.dmp.max_params)] {
+        if !v.is_finite() {
+            return Err(format!("{k} must be finite"));
+        }
+    }
+    let inside = |p: &[f64]| p.iter().all(|v| (-1.0..=1.0).contains(v));
+    if !inside(&e.ball_initial) || !inside(&e.arrow_initial) {
+        return Err("env.ball_initial / env.arrow_initial must lie in [-1,1]".into());
+    }
+    Ok(())
+}
+
+/// First line of a (possibly multi-line) message, trimmed.
+pub(crate) fn one_line(s: &str) -> String {
+    let mut parts = s.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('|'));
+    let first = parts.next().unwrap_or("").to_string();
+    // toml's messages are "TOML parse error at line L, column C" + a snippet + the reason.
+    match s.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('|') && !l.starts_with("TOML parse error")).last() {
+        Some(reason) if first.starts_with("TOML parse error") => format!("{reason} ({})", first.trim_start_matches("TOML parse error ").trim()),
+        _ => first,
+    }
+}
+
+/// Where profiles live: `data/campaigns/` under the current directory if it exists, else under
+/// the source checkout this binary was built from.
+pub fn campaigns_dir() -> PathBuf {
+    let local = PathBuf::from("data/campaigns");
+    if local.is_dir() {
+        return local;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/campaigns")
+}
+
+/// Resolve `--profile NAME` (a name in `data/campaigns/` or a path to a .toml file).
+pub fn resolve_profile(name: &str) -> Result<PathBuf, ConfigError> {
+    let p = Path::new(name);
+    if name.ends_with(".toml") || name.contains('/') {
+        return Ok(p.to_path_buf());
+    }
+    let path = campaigns_dir().join(format!("{name}.toml"));
+    if path.is_file() { Ok(path) } else { Err(ConfigError::UnknownProfile { name: name.into(), tried: path }) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+[campaign]
+name = "t"
+reps = 2
+[matrix]
+envs = ["armball"]
+algos = ["rpe", "rge-efr"]
+[explore]
+epochs = 50
+"#;
+
+    #[test]
+    fn parses_with_paper_defaults() {
+        let c = CampaignConfig::from_toml(GOOD, Path::new("t.toml")).unwrap();
+        assert_eq!(c.explore.epochs, 50);
+        assert_eq!(c.explore.bootstrap_epochs, 100);
+        assert_eq!(c.explore.random_ratio, 0.2);
+        assert_eq!(c.env, EnvConfig::default());
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let cases = [
+            (GOOD.replace("reps = 2", "reps = 0"), "campaign.reps"),
+            (GOOD.replace("epochs = 50", "epochs = 50\nbogus = 1"), "bogus"),
+            (GOOD.replace("\"rpe\"", "\"rge-foo\""), "rge-foo"),
+            (GOOD.replace("epochs = 50", "epochs = -5"), "epochs"),
+            (GOOD.replace("epochs = 50", "epochs = \"many\""), "epochs"),
+            (GOOD.replace("epochs = 50", "random_ratio = 1.5"), "explore.random_ratio"),
+            (GOOD.replace("\"rpe\", ", "\"rge-efr\", "), "matrix.algos"),
+        ];
+        for (text, key) in cases {
+            let e = CampaignConfig::from_toml(&text, Path::new("t.toml")).unwrap_err().to_string();
+            assert!(e.contains(key), "{e} should name {key}");
+            assert!(!e.contains('\n'), "one line: {e}");
+        }
+    }
+}

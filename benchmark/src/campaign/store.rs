@@ -1,0 +1,192 @@
+//! The results store (`data/results/README.md` documents the schema): per run a curve parquet,
+//! an outcomes parquet and a JSON manifest, each written to a temporary file and renamed.
+//! A run is complete when its manifest exists (it is written last).
+
+use std::fs::File;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::plan::RunSpec;
+use crate::explore::ExplorationLog;
+
+/// Errors of the results store.
+#[derive(Debug, Error)]
+pub enum StoreError {
+    #[error("cannot write {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("cannot encode {path}: {message}")]
+    Encode { path: PathBuf, message: String },
+    #[error("cannot read {path}: {message}")]
+    Read { path: PathBuf, message: String },
+}
+
+/// The final numbers of a run, also printed by `ugl run` as its last line.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub run: String,
+    /// Final KL-coverage; JSON has no infinity, so +inf is written as the string "inf".
+    #[serde(with = "inf_as_string")]
+    pub final_klc: f64,
+    pub n_moved: usize,
+    pub coverage: f64,
+}
+
+/// Everything about a run that is not its data (DESIGN.md "Results store").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub run_id: String,
+    pub identity: String,
+    pub env: String,
+    pub algo: String,
+    pub sampler: String,
+    pub seed: u64,
+    /// The RNG seed derived from (campaign seed, identity).
+    pub run_seed: u64,
+    pub campaign: String,
+    pub campaign_seed: u64,
+    pub profile: String,
+    /// BLAKE3 of everything the run's results depend on.
+    pub config_hash: String,
+    /// The exploration budget and constants actually used.
+    pub explore: serde_json::Value,
+    pub env_config: serde_json::Value,
+    /// Whether the budget is below the paper's, and how.
+    pub reduced_budget: bool,
+    pub budget_note: String,
+    pub git_revision: String,
+    pub crate_versions: serde_json::Value,
+    pub toolchain: String,
+    pub threads: usize,
+    pub wall_s: f64,
+    pub host: String,
+    pub summary: Summary,
+}
+
+mod inf_as_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_infinite() && *v > 0.0 { s.serialize_str("inf") } else { s.serialize_f64(*v) }
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum V {
+            N(f64),
+            S(String),
+        }
+        match V::deserialize(d)? {
+            V::N(x) => Ok(x),
+            V::S(s) if s == "inf" => Ok(f64::INFINITY),
+            V::S(s) => Err(serde::de::Error::custom(format!("expected a number or \"inf\", got {s:?}"))),
+        }
+    }
+}
+
+/// Paths of a run's files in a results directory.
+pub fn run_paths(dir: &Path, run_id: &str) -> [PathBuf; 3] {
+    [
+        dir.join(format!("{run_id}.parquet")),
+        dir.join(format!("{run_id}.outcomes.parquet")),
+        dir.join(format!("{run_id}.json")),
+    ]
+}
+
+/// The curve table of a run.
+pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
+    let n = log.checkpoints.len();
+    let c = &log.checkpoints;
+    df!(
+        "run_id" => vec![spec.run_id(); n],
+        "env" => vec![spec.env.name(); n],
+        "algo" => vec![spec.algo.name(); n],
+        "sampler" => vec![spec.sampler(); n],
+        "latents" => vec![0i64; n],
+        "variant" => vec!["none"; n],
+        "seed" => vec![spec.seed as i64; n],
+        "epoch" => c.iter().map(|p| p.epoch as i64).collect::<Vec<_>>(),
+        "n_outcomes" => c.iter().map(|p| p.n_outcomes as i64).collect::<Vec<_>>(),
+        "klc" => c.iter().map(|p| p.klc).collect::<Vec<_>>(),
+        "n_moved" => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
+        "coverage" => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
+    )
+}
+
+/// The outcomes table of a run.
+pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
+    let n = log.outcomes.len();
+    let angle: Vec<Option<f64>> =
+        log.outcomes.iter().map(|s| if log.dim == 3 { Some(s[2]) } else { None }).collect();
+    df!(
+        "run_id" => vec![spec.run_id(); n],
+        "index" => (0..n as i64).collect::<Vec<_>>(),
+        "epoch" => log.epochs.iter().map(|&e| e as i64).collect::<Vec<_>>(),
+        "x" => log.outcomes.iter().map(|s| s[0]).collect::<Vec<_>>(),
+        "y" => log.outcomes.iter().map(|s| s[1]).collect::<Vec<_>>(),
+        "angle" => angle,
+        "moved" => log.moved.clone(),
+    )
+}
+
+/// Write `bytes` to `path` atomically (temporary file in the same directory, then rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
+    let tmp = tmp_path(path);
+    let io = |source| StoreError::Io { path: path.to_path_buf(), source };
+    let mut f = File::create(&tmp).map_err(io)?;
+    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    name.push(format!(".{}.tmp", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Encode a frame as parquet bytes (deterministic for the same frame).
+pub fn parquet_bytes(df: &mut DataFrame, path: &Path) -> Result<Vec<u8>, StoreError> {
+    let mut buf = Vec::new();
+    ParquetWriter::new(&mut buf)
+        .finish(df)
+        .map_err(|e| StoreError::Encode { path: path.to_path_buf(), message: e.to_string() })?;
+    Ok(buf)
+}
+
+/// Write a run's three files; the manifest last.
+pub fn write_run(dir: &Path, spec: &RunSpec, log: &ExplorationLog, manifest: &Manifest) -> Result<(), StoreError> {
+    std::fs::create_dir_all(dir).map_err(|source| StoreError::Io { path: dir.to_path_buf(), source })?;
+    let [curve_p, outcomes_p, manifest_p] = run_paths(dir, &spec.run_id());
+    let enc = |p: &Path, e: PolarsError| StoreError::Encode { path: p.to_path_buf(), message: e.to_string() };
+    let mut curve = curve_frame(spec, log).map_err(|e| enc(&curve_p, e))?;
+    let mut outcomes = outcomes_frame(spec, log).map_err(|e| enc(&outcomes_p, e))?;
+    write_atomic(&curve_p, &parquet_bytes(&mut curve, &curve_p)?)?;
+    write_atomic(&outcomes_p, &parquet_bytes(&mut outcomes, &outcomes_p)?)?;
+    let mut json = serde_json::to_vec_pretty(manifest)
+        .map_err(|e| StoreError::Encode { path: manifest_p.clone(), message: e.to_string() })?;
+    json.push(b'\n');
+    write_atomic(&manifest_p, &json)
+}
+
+/// Read a run's manifest, if it exists and parses.
+pub fn read_manifest(path: &Path) -> Result<Manifest, StoreError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| StoreError::Read { path: path.to_path_buf(), message: e.to_string() })?;
+    serde_json::from_str(&text).map_err(|e| StoreError::Read { path: path.to_path_buf(), message: e.to_string() })
+}
+
+/// Whether a run is complete in `dir` with the given config hash: manifest present, matching,
+/// and both data files present.
+pub fn is_complete(dir: &Path, run_id: &str, config_hash: &str) -> bool {
+    let [c, o, m] = run_paths(dir, run_id);
+    c.is_file() && o.is_file() && read_manifest(&m).map(|m| m.config_hash == config_hash).unwrap_or(false)
+}

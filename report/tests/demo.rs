@@ -1,0 +1,162 @@
+//! A paper-sized synthetic store (every condition of the paper's matrix, 5 seeds, 5000 epochs),
+//! rendered with the default options: checks that a full report renders in reasonable time and
+//! gives something to look at. Ignored by default (a few seconds in an optimised build):
+//!
+//! `UGL_REPORT_DEMO_OUT=/tmp/demo cargo test -p ugl-report --test demo -- --ignored`
+//! keeps the store and the report under that directory.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::*;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use ugl_report::{ReportOptions, render_report};
+
+struct Cond {
+    env: &'static str,
+    algo: &'static str,
+    sampler: &'static str,
+    latents: i64,
+    variant: &'static str,
+    final_klc: f64,
+}
+
+fn conditions() -> Vec<Cond> {
+    let mut v = Vec::new();
+    for (env, lats, rpe, efr) in [("armball", [2, 10], 6.51, 4.58), ("armarrow", [3, 10], 9.91, 7.46)] {
+        v.push(Cond { env, algo: "rpe", sampler: "none", latents: 0, variant: "none", final_klc: rpe });
+        v.push(Cond { env, algo: "rge-efr", sampler: "uniform", latents: 0, variant: "none", final_klc: efr });
+        for (k, l) in lats.into_iter().enumerate() {
+            for (j, algo) in ["rge-pca", "rge-isomap", "rge-ae", "rge-vae", "rge-rfvae"].into_iter().enumerate() {
+                let variant = if matches!(algo, "rge-ae" | "rge-vae" | "rge-rfvae") { "faithful" } else { "none" };
+                let f = efr - 0.3 + 0.15 * j as f64 + 0.2 * k as f64;
+                v.push(Cond { env, algo, sampler: "kde", latents: l, variant, final_klc: f });
+            }
+        }
+    }
+    v.push(Cond { env: "armball", algo: "rge-vae", sampler: "gaussian", latents: 10, variant: "faithful", final_klc: 3.9 });
+    v.push(Cond { env: "armball", algo: "rge-vae", sampler: "kde", latents: 10, variant: "corrected", final_klc: 4.1 });
+    v
+}
+
+fn write(path: &Path, df: &mut DataFrame) {
+    let mut f = File::create(path).unwrap();
+    ParquetWriter::new(&mut f).finish(df).unwrap();
+}
+
+fn write_store(root: &Path) {
+    let dir = root.join("paper-like");
+    std::fs::create_dir_all(&dir).unwrap();
+    for c in conditions() {
+        let kmax = if c.env == "armball" { 756f64.ln() } else { 22680f64.ln() };
+        for seed in 0..5i64 {
+            let id = format!("{}.{}.{}.{}.{}.s{seed}", c.env, c.algo, c.sampler, c.latents, c.variant);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed as u64 * 7919 + id.len() as u64);
+            let off: f64 = rng.random_range(-0.15..0.15);
+            let epochs: Vec<i64> = (0..=50).map(|i| i * 100).collect();
+            let rge = c.algo != "rpe";
+            let n = epochs.len();
+            let klc: Vec<f64> = epochs
+                .iter()
+                .map(|&e| {
+                    let f = c.final_klc + off;
+                    f + (kmax - f) * (-(e as f64) / 700.0).exp()
+                })
+                .collect();
+            let n_out: Vec<i64> = epochs.iter().map(|&e| e + i64::from(rge)).collect();
+            let moved_frac = if rge { 0.35 } else { 0.02 };
+            let n_moved: Vec<i64> = n_out.iter().map(|&o| (o as f64 * moved_frac) as i64).collect();
+            let cov: Vec<f64> = klc.iter().map(|k| (1.0 - k / kmax).max(0.0)).collect();
+            let mut df = df!(
+                "run_id" => vec![id.as_str(); n],
+                "env" => vec![c.env; n],
+                "algo" => vec![c.algo; n],
+                "sampler" => vec![c.sampler; n],
+                "latents" => vec![c.latents; n],
+                "variant" => vec![c.variant; n],
+                "seed" => vec![seed; n],
+                "epoch" => epochs,
+                "n_outcomes" => n_out,
+                "klc" => klc,
+                "n_moved" => n_moved,
+                "coverage" => cov,
+            )
+            .unwrap();
+            write(&dir.join(format!("{id}.parquet")), &mut df);
+
+            let oe: Vec<i64> = if rge { (0..=5000).collect() } else { (1..=5000).collect() };
+            let m = oe.len();
+            let (mut x, mut y, mut mv, mut ang) = (vec![], vec![], vec![], vec![]);
+            for _ in 0..m {
+                let moved = rng.random_range(0.0..1.0) < moved_frac;
+                if moved {
+                    let r: f64 = rng.random_range(0.0f64..1.0).sqrt() * 0.98;
+                    let a: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                    x.push(r * a.cos());
+                    y.push(r * a.sin());
+                } else {
+                    x.push(0.6);
+                    y.push(0.6);
+                }
+                mv.push(moved);
+                ang.push((c.env == "armarrow").then(|| rng.random_range(-1.0..1.0)));
+            }
+            let mut odf = df!(
+                "run_id" => vec![id.as_str(); m],
+                "index" => (0..m as i64).collect::<Vec<_>>(),
+                "epoch" => oe,
+                "x" => x,
+                "y" => y,
+                "angle" => ang,
+                "moved" => mv,
+            )
+            .unwrap();
+            write(&dir.join(format!("{id}.outcomes.parquet")), &mut odf);
+            let manifest = serde_json::json!({
+                "run_id": id, "profile": "demo", "git_revision": "0000000", "toolchain": "rustc 1.95.0",
+                "threads": 2, "host": "demo", "wall_time_s": 600.0 + 10.0 * seed as f64,
+                "reduced_budget": false,
+            });
+            std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
+        }
+    }
+}
+
+#[test]
+#[ignore = "paper-sized demo; run with --ignored (set UGL_REPORT_DEMO_OUT to keep the output)"]
+fn paper_sized_demo_renders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root: PathBuf = std::env::var_os("UGL_REPORT_DEMO_OUT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| tmp.path().to_path_buf());
+    let results = root.join("results");
+    write_store(&results);
+    let mut opts = ReportOptions::new(results, root.join("report"));
+    opts.paper_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper");
+    let t = std::time::Instant::now();
+    let s = render_report(&opts).unwrap();
+    eprintln!("rendered {} runs, {} files in {:?}", s.n_runs, s.files.len(), t.elapsed());
+    assert_eq!(s.n_runs, 26 * 5);
+}
+
+#[test]
+#[ignore = "timing breakdown of the demo"]
+fn demo_timing() {
+    let root = PathBuf::from(std::env::var_os("UGL_REPORT_DEMO_OUT").unwrap());
+    let t = std::time::Instant::now();
+    let store = ugl_report::load::load_store(&root.join("results")).unwrap();
+    eprintln!("load {:?}", t.elapsed());
+    let t = std::time::Instant::now();
+    let paper = ugl_report::paper::load_paper(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper")).unwrap();
+    let conds = ugl_report::aggregate::aggregate(&store, &paper, 0, 10_000);
+    eprintln!("aggregate {:?}", t.elapsed());
+    let t = std::time::Instant::now();
+    let d = root.join("tfig");
+    std::fs::create_dir_all(&d).unwrap();
+    ugl_report::figures::klc_curves::draw_all(&conds, &d).unwrap();
+    eprintln!("klc figs {:?}", t.elapsed());
+    let t = std::time::Instant::now();
+    ugl_report::figures::outcomes::draw_all(&store, &conds, &d).unwrap();
+    eprintln!("outcome figs {:?}", t.elapsed());
+}
