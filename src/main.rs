@@ -1,1 +1,310 @@
-fn main() {}
+//! `ugl`: the command line of ugl-bench. Thin: parses arguments and calls the crates.
+//!
+//! Every error is one line on stderr and exit code 2.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use ugl_bench::campaign::config::{resolve_profile, CampaignConfig};
+use ugl_bench::campaign::{plan, run_campaign, CampaignOptions, Progress, RunContext, RunSpec};
+use ugl_bench::env::render::{write_npy, write_png, Image70, PIXELS};
+use ugl_bench::env::{make_env, EnvConfig, EnvKind, PARAMS};
+use ugl_bench::explore::Algo;
+use ugl_bench::metrics::csv::read_outcomes_csv;
+use ugl_bench::metrics::KlCoverage;
+
+/// ugl-bench: reproduce "Unsupervised Learning of Goal Spaces for Intrinsically Motivated Goal
+/// Exploration" (Péré et al., ICLR 2018) deterministically on a CPU.
+#[derive(Parser, Debug)]
+#[command(name = "ugl", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run episodes: prints a JSON array with, per parameter vector, the final object state,
+    /// whether the object was caught, and the hand position.
+    Rollout {
+        /// armball or armarrow.
+        #[arg(long)]
+        env: EnvKind,
+        /// JSON file: an array of arrays of 21 numbers (motor parameters; clipped to [-1,1]).
+        #[arg(long)]
+        params: PathBuf,
+    },
+    /// KL-coverage of a set of engineered outcomes (prints the value, or `inf`).
+    Klc {
+        /// armball (CSV header `x,y`) or armarrow (`x,y,angle`).
+        #[arg(long)]
+        env: EnvKind,
+        /// CSV file of outcomes in [-1,1].
+        #[arg(long)]
+        outcomes: PathBuf,
+    },
+    /// Render an object state as the 70x70 image the learners see.
+    Render {
+        /// armball or armarrow.
+        #[arg(long)]
+        env: EnvKind,
+        /// Engineered state: `x,y` (ball) or `x,y,angle` (arrow), each in [-1,1].
+        #[arg(long, allow_hyphen_values = true)]
+        state: String,
+        /// Output file: `.npy` (float32 70x70 indexed [x][y]) or `.png` (for people).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// One exploration run; writes DIR/<run-id>.parquet (+ .outcomes.parquet, .json) and prints
+    /// a JSON summary as its last line.
+    Run {
+        /// armball or armarrow.
+        #[arg(long)]
+        env: EnvKind,
+        /// rpe or rge-efr.
+        #[arg(long)]
+        algo: Algo,
+        /// Repetition index; the RNG seed derives from it, the run identity and the campaign seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Override the profile's number of exploration epochs.
+        #[arg(long)]
+        epochs: Option<usize>,
+        /// Budget profile: a name in data/campaigns/ or a path to a .toml file.
+        #[arg(long, default_value = "paper")]
+        profile: String,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// List the run ids of a campaign, one per line.
+    Plan {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+    },
+    /// Run a campaign matrix in parallel; resumable (finished runs are skipped).
+    Campaign {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+        /// Results directory (default: data/results/<campaign name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Runs in parallel (default: the number of cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Render the report (markdown + SVG figures) from a results store.
+    Report {
+        /// Results directory (run files, or one sub-directory per campaign).
+        #[arg(long, default_value = "data/results")]
+        results: PathBuf,
+        /// Output directory for REPORT.md and figures/.
+        #[arg(long, default_value = "report/out")]
+        out: PathBuf,
+        /// The paper's reference values.
+        #[arg(long, default_value = "data/paper")]
+        paper: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_env("UGL_LOG"))
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand { ExitCode::from(2) } else { ExitCode::SUCCESS };
+            }
+            let text = e.render().to_string();
+            let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: invalid arguments");
+            eprintln!("{} (see 'ugl --help')", first.trim());
+            return ExitCode::from(2);
+        }
+    };
+    match dispatch(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn dispatch(cmd: Command) -> Result<()> {
+    match cmd {
+        Command::Rollout { env, params } => rollout(env, &params),
+        Command::Klc { env, outcomes } => klc(env, &outcomes),
+        Command::Render { env, state, out } => render(env, &state, &out),
+        Command::Run { env, algo, seed, epochs, profile, out } => run(env, algo, seed, epochs, &profile, &out),
+        Command::Plan { config } => {
+            let cfg = CampaignConfig::load(&config)?;
+            for spec in plan(&cfg) {
+                println!("{}", spec.run_id());
+            }
+            Ok(())
+        }
+        Command::Campaign { config, out, jobs, quiet } => campaign(&config, out, jobs, quiet),
+        Command::Report { results, out, paper } => {
+            let mut opts = ugl_report::ReportOptions::new(results, out);
+            opts.paper_dir = paper;
+            let s = ugl_report::render_report(&opts)?;
+            eprintln!("report: {} runs -> {} files in {}", s.n_runs, s.files.len(), opts.out.display());
+            Ok(())
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct RolloutOut {
+    object: Vec<f64>,
+    moved: bool,
+    hand: [f64; 2],
+}
+
+fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
+    let text = std::fs::read_to_string(params).with_context(|| format!("cannot read {}", params.display()))?;
+    let v: Vec<Vec<f64>> = serde_json::from_str(&text)
+        .with_context(|| format!("{}: expected a JSON array of arrays of {PARAMS} numbers", params.display()))?;
+    let env = make_env(kind, &EnvConfig::default());
+    let mut out = Vec::with_capacity(v.len());
+    for (i, theta) in v.iter().enumerate() {
+        let theta: [f64; PARAMS] = theta.as_slice().try_into().map_err(|_| {
+            anyhow::anyhow!("{}: entry {i} has {} numbers, expected {PARAMS}", params.display(), theta.len())
+        })?;
+        if theta.iter().any(|x| !x.is_finite()) {
+            bail!("{}: entry {i} has a non-finite number", params.display());
+        }
+        let r = env.rollout(&theta);
+        out.push(RolloutOut { object: r.outcome().to_vec(), moved: r.caught, hand: r.hand });
+    }
+    println!("{}", serde_json::to_string(&out)?);
+    Ok(())
+}
+
+fn klc(kind: EnvKind, path: &Path) -> Result<()> {
+    let pts = read_outcomes_csv(path, kind.state_dim())?;
+    let k = KlCoverage::new(kind.state_dim())?;
+    let v = k.evaluate(pts.iter().map(|p| &p[..]))?;
+    if v.is_infinite() { println!("inf") } else { println!("{v}") }
+    Ok(())
+}
+
+fn render(kind: EnvKind, state: &str, out: &Path) -> Result<()> {
+    let vals: Vec<f64> = state
+        .split(',')
+        .map(|s| s.trim().parse::<f64>().map_err(|_| anyhow::anyhow!("--state: '{s}' is not a number")))
+        .collect::<Result<_>>()?;
+    if vals.len() != kind.state_dim() {
+        bail!("--state for {kind} needs {} comma-separated values, got {}", kind.state_dim(), vals.len());
+    }
+    if let Some(v) = vals.iter().find(|v| !(-1.0..=1.0).contains(*v)) {
+        bail!("--state: {v} is outside [-1,1]");
+    }
+    let env = make_env(kind, &EnvConfig::default());
+    let mut buf = vec![0f32; PIXELS];
+    env.render_into(&vals, &mut buf);
+    let img = Image70(buf);
+    match out.extension().and_then(|e| e.to_str()) {
+        Some("npy") => write_npy(&img, out)?,
+        Some("png") => write_png(&img, out)?,
+        _ => bail!("--out {}: the extension must be .npy or .png", out.display()),
+    }
+    Ok(())
+}
+
+fn run(kind: EnvKind, algo: Algo, seed: u64, epochs: Option<usize>, profile: &str, out: &Path) -> Result<()> {
+    let path = resolve_profile(profile)?;
+    let mut cfg = CampaignConfig::load(&path)?;
+    if let Some(e) = epochs {
+        cfg.explore.epochs = e;
+        cfg.explore.validate().map_err(|m| anyhow::anyhow!("--epochs: {m}"))?;
+    }
+    check_out_dir(out)?;
+    let spec = RunSpec { env: kind, algo, seed };
+    let ctx = RunContext {
+        campaign: &cfg.campaign.name,
+        campaign_seed: cfg.campaign.seed,
+        profile,
+        explore: &cfg.explore,
+        env: &cfg.env,
+        threads: 1,
+    };
+    let summary = ugl_bench::campaign::execute(&spec, &ctx, out)?;
+    println!("{}", serde_json::to_string(&summary)?);
+    Ok(())
+}
+
+/// An output directory must be a directory (created if missing).
+fn check_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        bail!("--out {}: exists and is not a directory", out.display());
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
+}
+
+fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<()> {
+    let cfg = CampaignConfig::load(config)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    check_out_dir(&out)?;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || {
+            if stop.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("\ninterrupt: finishing the runs in flight (Ctrl-C again to abort now)");
+        })
+        .context("cannot install the Ctrl-C handler")?;
+    }
+    let bar = ProgressBar::new(0);
+    if quiet || !std::io::stderr().is_terminal() {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} elapsed, ETA {eta}  {msg}")
+            .expect("valid template"),
+    );
+    let profile = config.file_stem().and_then(|s| s.to_str()).unwrap_or("custom").to_string();
+    let t0 = std::time::Instant::now();
+    let on = |p: Progress| match p {
+        Progress::Planned { total, skipped } => {
+            bar.set_length(total as u64);
+            bar.set_position(skipped as u64);
+            if skipped > 0 {
+                bar.println(format!("{skipped} of {total} runs already complete in {}; resuming", out.display()));
+            }
+        }
+        Progress::Finished(s) => {
+            bar.inc(1);
+            bar.set_message(format!("{} klc={:.3}", s.run, s.final_klc));
+        }
+    };
+    let opts = CampaignOptions { jobs, profile: &profile, stop: &stop };
+    let done = run_campaign(&cfg, &out, &opts, &on)?;
+    bar.finish_and_clear();
+    eprintln!("campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}", cfg.campaign.name, done.len(), t0.elapsed().as_secs_f64(), jobs, out.display());
+    Ok(())
+}

@@ -140,23 +140,3 @@ fn paper_sized_demo_renders() {
     assert_eq!(s.n_runs, 26 * 5);
 }
 
-#[test]
-#[ignore = "timing breakdown of the demo"]
-fn demo_timing() {
-    let root = PathBuf::from(std::env::var_os("UGL_REPORT_DEMO_OUT").unwrap());
-    let t = std::time::Instant::now();
-    let store = ugl_report::load::load_store(&root.join("results")).unwrap();
-    eprintln!("load {:?}", t.elapsed());
-    let t = std::time::Instant::now();
-    let paper = ugl_report::paper::load_paper(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper")).unwrap();
-    let conds = ugl_report::aggregate::aggregate(&store, &paper, 0, 10_000);
-    eprintln!("aggregate {:?}", t.elapsed());
-    let t = std::time::Instant::now();
-    let d = root.join("tfig");
-    std::fs::create_dir_all(&d).unwrap();
-    ugl_report::figures::klc_curves::draw_all(&conds, &d).unwrap();
-    eprintln!("klc figs {:?}", t.elapsed());
-    let t = std::time::Instant::now();
-    ugl_report::figures::outcomes::draw_all(&store, &conds, &d).unwrap();
-    eprintln!("outcome figs {:?}", t.elapsed());
-}

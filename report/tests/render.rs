@@ -176,6 +176,10 @@ fn renders_report_and_figures_with_the_right_numbers() {
     synthetic_store(&results);
     let summary = render_report(&opts(&results, &out)).unwrap();
     assert_eq!(summary.n_runs, 12);
+    if let Some(keep) = std::env::var_os("UGL_REPORT_TEST_KEEP") {
+        // To look at the output: UGL_REPORT_TEST_KEEP=/tmp/small cargo test -p ugl-report --test render
+        render_report(&opts(&results, Path::new(&keep))).unwrap();
+    }
 
     let report = out.join("REPORT.md");
     assert_eq!(summary.files[0], report);

@@ -1,5 +1,6 @@
 //! Exploration measures (paper Section 4.2; PAPER-NOTES.md section 4).
 
+pub mod csv;
 pub mod klc;
 pub mod moved;
 
