@@ -145,6 +145,8 @@ def main():
         for ang in (-1.0, 0.0, 0.6, 0.999, -0.4, 0.3):
             arrow_states.append((pos[0], pos[1], ang))
     arrow_states += [tuple(float(v) for v in rng.uniform(-1, 1, 3)) for _ in range(80)]
+    # Entirely off-canvas at s_x = 1 (blank; the original normalisation gives NaN there).
+    arrow_states.append((1.0, 0.9724602631732802, -0.8066633765791165))
 
     if args.big:
         ball_states, arrow_states = big_states(args.big, 7)

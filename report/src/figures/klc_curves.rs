@@ -50,10 +50,10 @@ pub fn draw_all(
         let width = PANEL_W * panels.len() as u32;
         write_svg(&path, (width, PANEL_H + TITLE_H), |root| {
             let title = format!(
-                "{}: KL-coverage during exploration (mean over seeds, 90% bootstrap CI)",
+                "{}: KL-coverage, mean over seeds with 90% bootstrap CI",
                 env_name(env)
             );
-            let area = root.titled(&title, (FONT, 20))?;
+            let area = root.titled(&title, (FONT, 18))?;
             let areas = area.split_evenly((1, panels.len()));
             for (panel, a) in panels.iter().zip(areas.iter()) {
                 draw_panel(a, env, panel)?;
@@ -180,6 +180,7 @@ fn draw_panel(
         .y_labels(8)
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
+        .max_light_lines(4)
         .light_line_style(RGBColor(0xEE, 0xEE, 0xEE))
         .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
         .draw()?;

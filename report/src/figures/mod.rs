@@ -215,7 +215,14 @@ pub fn write_svg(
         draw(&root).map_err(|e| plot_err(&e))?;
         root.present().map_err(|e| plot_err(&e))?;
     }
-    crate::write_file(path, svg.as_bytes())
+    crate::write_file(path, compact_svg(&svg).as_bytes())
+}
+
+/// Drops attributes plotters writes with their SVG default values (`opacity="1"`, and the stroke
+/// width of an element without stroke): the same picture in a third fewer bytes for scatters.
+pub fn compact_svg(svg: &str) -> String {
+    svg.replace(" stroke=\"none\" stroke-width=\"1\"", " stroke=\"none\"")
+        .replace(" opacity=\"1\" ", " ")
 }
 
 /// Characters safe in a file name; anything else becomes `-`.

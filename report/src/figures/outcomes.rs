@@ -2,6 +2,7 @@
 //! of one representative run (seed 0, else the smallest seed) at three epochs, side by side, with
 //! the unit disk (the reachable set) and the object's initial position (0.6, 0.6).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use plotters::prelude::*;
@@ -14,6 +15,8 @@ use crate::load::{Run, Store};
 const PANEL_W: u32 = 360;
 const PANEL_H: u32 = 380;
 const TITLE_H: u32 = 34;
+/// Opacity of one outcome dot.
+const DOT_ALPHA: f64 = 0.6;
 /// The object's initial position in both environments (PAPER-NOTES section 1).
 pub const INITIAL: (f64, f64) = (0.6, 0.6);
 
@@ -73,9 +76,9 @@ pub fn draw_all(
         let name = format!("outcomes_{}.svg", file_safe(&c.key.slug()));
         let path = fig_dir.join(&name);
         let col = colour(algo_slot(&c.key.algo, 0));
-        let object = if c.key.env == "armarrow" { "arrow" } else { "object" };
+        let object = object_word(&c.key.env);
         let title = format!(
-            "{}, {}: {} positions reached, run {} (seed {})",
+            "{}, {}: {} positions, run {} (seed {})",
             env_name(&c.key.env),
             describe(c),
             object,
@@ -89,7 +92,7 @@ pub fn draw_all(
                 let area = root.titled(&title, (FONT, 17))?;
                 let areas = area.split_evenly((1, epochs.len()));
                 for (&e, a) in epochs.iter().zip(areas.iter()) {
-                    draw_panel(a, run, e, col)?;
+                    draw_panel(a, run, e, col, object_word(&c.key.env))?;
                 }
                 Ok(())
             },
@@ -102,6 +105,15 @@ pub fn draw_all(
         });
     }
     Ok(out)
+}
+
+/// What the object is called in titles.
+fn object_word(env: &str) -> &'static str {
+    match env {
+        "armball" => "ball",
+        "armarrow" => "arrow",
+        _ => "object",
+    }
 }
 
 /// `RGE-VAE, kde, 10 latents, faithful` etc.
@@ -124,9 +136,10 @@ fn draw_panel(
     run: &Run,
     epoch: i64,
     col: RGBColor,
+    object: &str,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (n, moved) = counts_at(run, epoch);
-    let caption = format!("epoch {epoch}: {moved} of {n} episodes moved it");
+    let caption = format!("epoch {epoch}: {moved} of {n} episodes moved the {object}");
     let mut chart = ChartBuilder::on(area)
         .caption(caption, (FONT, 14))
         .margin(10)
@@ -143,6 +156,7 @@ fn draw_panel(
         .y_label_formatter(&|v| format!("{v:.1}"))
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 13))
+        .max_light_lines(1)
         .light_line_style(RGBColor(0xF2, 0xF2, 0xF2))
         .bold_line_style(RGBColor(0xE2, 0xE2, 0xE2))
         .draw()?;
@@ -159,12 +173,17 @@ fn draw_panel(
         RGBColor(0x60, 0x60, 0x60).stroke_width(1),
     )))?;
 
-    chart.draw_series(
-        run.outcomes
-            .iter()
-            .filter(|o| o.epoch <= epoch && o.moved)
-            .map(|o| Circle::new((o.x, o.y), 2, col.mix(0.45).filled())),
-    )?;
+    // Outcomes that land on the same pixel are drawn once, with the opacity of that many
+    // stacked dots (1 - (1 - a)^k): the same picture, far fewer SVG elements.
+    let mut dots: BTreeMap<(i32, i32), ((f64, f64), i32)> = BTreeMap::new();
+    for o in run.outcomes.iter().filter(|o| o.epoch <= epoch && o.moved) {
+        let px = chart.backend_coord(&(o.x, o.y));
+        dots.entry(px).or_insert(((o.x, o.y), 0)).1 += 1;
+    }
+    chart.draw_series(dots.values().map(|&(at, k)| {
+        let alpha = 1.0 - (1.0 - DOT_ALPHA).powi(k);
+        Circle::new(at, 2, col.mix(alpha).filled())
+    }))?;
 
     // The initial position, where every episode that did not move the object ends.
     chart.draw_series(std::iter::once(

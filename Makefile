@@ -1,0 +1,44 @@
+# ugl-bench — the two commands a new user types: `make report` and `make test`.
+# One build profile everywhere (cargo's dev profile, with the science crates optimised; see
+# Cargo.toml), so tests, campaigns and the report share one build.
+
+SHELL := /bin/bash
+CARGO ?= cargo
+PROFILE ?= baselines
+RESULTS ?= data/results
+REPORT_OUT ?= report/out
+JOBS ?=
+MIN_RUST := 1.95
+UGL := $(CARGO) run --quiet --bin ugl --
+
+.PHONY: help report test campaign bench check-toolchain clean-report
+
+help:
+	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
+	@echo "make test                the test suite (what CI runs)"
+	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
+	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC)"
+
+check-toolchain:
+	@command -v $(CARGO) >/dev/null 2>&1 || { echo "error: cargo not found. Install Rust $(MIN_RUST) or newer: https://rustup.rs" >&2; exit 1; }
+	@v=$$(rustc --version | awk '{print $$2}'); \
+	if [ "$$(printf '%s\n%s\n' "$(MIN_RUST)" "$$v" | sort -V | head -1)" != "$(MIN_RUST)" ]; then \
+	  echo "error: rustc $$v is too old; ugl-bench needs Rust $(MIN_RUST) or newer (rustup update)" >&2; exit 1; fi
+
+# The report renders from the committed results; if there are none yet, the baselines campaign
+# (about 10 s on 2 cores) is run first.
+report: check-toolchain
+	@if ! ls $(RESULTS)/*/*.json >/dev/null 2>&1; then \
+	  echo "no results in $(RESULTS): running the baselines campaign first"; \
+	  $(UGL) campaign --config data/campaigns/baselines.toml --out $(RESULTS)/baselines $(if $(JOBS),--jobs $(JOBS)); fi
+	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT)
+	@echo "report: $(REPORT_OUT)/REPORT.md"
+
+test: check-toolchain
+	$(CARGO) test --workspace
+
+campaign: check-toolchain
+	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))
+
+bench: check-toolchain
+	$(CARGO) bench -p ugl-bench

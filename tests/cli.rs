@@ -1,0 +1,172 @@
+//! Integration tests of the `ugl` command line: the contract other tools depend on.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn ugl(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("ugl runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A usage or input error: exit code 2 and exactly one line on stderr.
+fn assert_one_line_error(o: &Output, needle: &str) {
+    assert_eq!(o.status.code(), Some(2), "stderr: {}", stderr(o));
+    let err = stderr(o);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err:?}");
+    assert!(err.contains(needle), "{err:?} should mention {needle:?}");
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+#[test]
+fn rollout_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("params.json");
+    std::fs::write(&f, format!("[{z}, {o}]", z = serde_json::to_string(&[0.0; 21]).unwrap(), o = serde_json::to_string(&[0.3; 21]).unwrap())).unwrap();
+    for env in ["armball", "armarrow"] {
+        let o = ugl(&["rollout", "--env", env, "--params", p(&f)]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+        let first = &v[0];
+        assert_eq!(first["moved"], false);
+        let hand: Vec<f64> = serde_json::from_value(first["hand"].clone()).unwrap();
+        assert!(hand[0].abs() < 1e-12 && (hand[1] - 1.0).abs() < 1e-12);
+        let object: Vec<f64> = serde_json::from_value(first["object"].clone()).unwrap();
+        let expected: &[f64] = if env == "armball" { &[0.6, 0.6] } else { &[0.6, 0.6, 0.6] };
+        assert_eq!(object, expected);
+        assert_eq!(v.as_array().unwrap().len(), 2);
+    }
+    std::fs::write(&f, "[[0.1, 0.2]]").unwrap();
+    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", p(&f)]), "21");
+    std::fs::write(&f, "not json").unwrap();
+    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", p(&f)]), "params.json");
+    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", "/nonexistent/x.json"]), "/nonexistent/x.json");
+    assert_one_line_error(&ugl(&["rollout", "--env", "armbal", "--params", p(&f)]), "armbal");
+}
+
+#[test]
+fn klc_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("o.csv");
+    std::fs::write(&f, "x,y\n0.62,0.62\n0.63,0.63\n").unwrap();
+    let o = ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: f64 = stdout(&o).trim().parse().unwrap();
+    assert!((v - 756f64.ln()).abs() < 1e-12);
+    std::fs::write(&f, "x,y\n0.99,0.99\n").unwrap();
+    assert_eq!(stdout(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)])).trim(), "inf");
+    std::fs::write(&f, "x,y,angle\n0.1,0.1,0.5\n").unwrap();
+    let o = ugl(&["klc", "--env", "armarrow", "--outcomes", p(&f)]);
+    assert!((stdout(&o).trim().parse::<f64>().unwrap() - 22680f64.ln()).abs() < 1e-12);
+    assert_one_line_error(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]), "header");
+    std::fs::write(&f, "x,y\n0.1,zz\n").unwrap();
+    assert_one_line_error(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]), "zz");
+}
+
+#[test]
+fn render_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    let npy = dir.path().join("ball.npy");
+    let o = ugl(&["render", "--env", "armball", "--state", "0.2,-0.4", "--out", p(&npy)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&npy).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    assert!(bytes.len() >= 4900 * 4 + 64);
+    let png = dir.path().join("arrow.png");
+    let o = ugl(&["render", "--env", "armarrow", "--state", "-0.3,0.1,0.5", "--out", p(&png)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "0.2", "--out", p(&npy)]), "2 comma-separated");
+    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "1.2,0", "--out", p(&npy)]), "outside");
+    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "0,0", "--out", "x.jpg"]), ".npy or .png");
+}
+
+#[test]
+fn run_contract_and_determinism() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let args = |out: &Path, seed: &str| {
+        ugl(&["run", "--env", "armarrow", "--algo", "rge-efr", "--seed", seed, "--epochs", "400", "--out", p(out)])
+    };
+    let o = args(&a, "1");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let last = stdout(&o).lines().last().unwrap().to_string();
+    let s: serde_json::Value = serde_json::from_str(&last).unwrap();
+    assert_eq!(s["run"], "armarrow.rge-efr.s1");
+    for key in ["final_klc", "n_moved", "coverage"] {
+        assert!(s[key].is_number(), "{key} in {last}");
+    }
+    // Same inputs -> byte-identical result files.
+    assert!(args(&b, "1").status.success());
+    for f in ["armarrow.rge-efr.s1.parquet", "armarrow.rge-efr.s1.outcomes.parquet"] {
+        assert_eq!(std::fs::read(a.join(f)).unwrap(), std::fs::read(b.join(f)).unwrap(), "{f}");
+    }
+    // A different seed gives different results.
+    assert!(args(&b, "2").status.success());
+    assert_ne!(
+        std::fs::read(a.join("armarrow.rge-efr.s1.outcomes.parquet")).unwrap(),
+        std::fs::read(b.join("armarrow.rge-efr.s2.outcomes.parquet")).unwrap()
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("armarrow.rge-efr.s1.json")).unwrap()).unwrap();
+    assert_eq!(m["reduced_budget"], true);
+    assert_eq!(m["explore"]["epochs"], 400);
+}
+
+#[test]
+fn run_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("f");
+    std::fs::write(&file, "").unwrap();
+    let out = p(dir.path());
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rge-nope", "--out", out]), "rge-nope");
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--epochs", "0", "--out", out]), "epochs");
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--epochs", "-3", "--out", out]), "-3");
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--profile", "nosuch", "--out", out]), "nosuch");
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--out", p(&file)]), "not a directory");
+    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--bogus", "--out", out]), "--bogus");
+    assert_one_line_error(&ugl(&["frobnicate"]), "frobnicate");
+}
+
+#[test]
+fn campaign_plan_and_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("tiny.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"tiny\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 150\neval_every = 50\n",
+    )
+    .unwrap();
+    let o = ugl(&["plan", "--config", p(&cfg)]);
+    assert_eq!(stdout(&o).lines().collect::<Vec<_>>(), ["armball.rpe.s0", "armball.rpe.s1", "armball.rge-efr.s0", "armball.rge-efr.s1"]);
+    let out = dir.path().join("res");
+    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet", "--jobs", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 12);
+    // The campaign's run equals the single run with the same seed.
+    let single = dir.path().join("single");
+    let prof = p(&cfg);
+    assert!(ugl(&["run", "--env", "armball", "--algo", "rge-efr", "--seed", "1", "--profile", prof, "--out", p(&single)]).status.success());
+    assert_eq!(
+        std::fs::read(out.join("armball.rge-efr.s1.outcomes.parquet")).unwrap(),
+        std::fs::read(single.join("armball.rge-efr.s1.outcomes.parquet")).unwrap()
+    );
+    // A rerun skips everything.
+    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    assert!(stderr(&o).contains("0 runs executed"), "{}", stderr(&o));
+    std::fs::write(&cfg, "[campaign]\nname = \"tiny\"\nreps = 0\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n").unwrap();
+    assert_one_line_error(&ugl(&["campaign", "--config", p(&cfg)]), "campaign.reps");
+}
