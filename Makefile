@@ -41,4 +41,4 @@ campaign: check-toolchain
 	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))
 
 bench: check-toolchain
-	$(CARGO) bench -p ugl-bench
+	$(CARGO) bench -p ugl-bench --profile dev

@@ -1,1 +1,30 @@
-fn main() {}
+//! Rollout throughput: one 50-step DMP episode of the 7-joint arm (target: >= 100,000/s/core).
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use std::hint::black_box;
+use ugl_bench::env::{make_env, EnvConfig, EnvKind};
+use ugl_bench::explore::meta_policy::random_params;
+use ugl_bench::seed::{stream, Component};
+
+fn bench(c: &mut Criterion) {
+    let mut rng = stream(0, Component::Params);
+    let thetas: Vec<_> = (0..1024).map(|_| random_params(&mut rng)).collect();
+    let mut g = c.benchmark_group("rollout");
+    g.throughput(Throughput::Elements(thetas.len() as u64));
+    for kind in EnvKind::ALL {
+        let env = make_env(kind, &EnvConfig::default());
+        g.bench_function(format!("{kind}_x1024"), |b| {
+            b.iter(|| {
+                let mut acc = 0.0;
+                for t in &thetas {
+                    acc += env.rollout(black_box(t)).hand[0];
+                }
+                acc
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -13,6 +13,12 @@ pub enum ReportError {
     )]
     EmptyResults(PathBuf),
 
+    #[error(
+        "no complete run in {dir}: {incomplete} run(s) lack one of their three files \
+         (<run_id>.parquet, <run_id>.outcomes.parquet, <run_id>.json); is the campaign still running?"
+    )]
+    NoCompleteRuns { dir: PathBuf, incomplete: usize },
+
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,

@@ -122,8 +122,8 @@ fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), Repor
         let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
             continue;
         };
-        let ours = name.ends_with(".svg")
-            && (name.starts_with("klc_") || name.starts_with("outcomes_"));
+        let ours =
+            name.ends_with(".svg") && (name.starts_with("klc_") || name.starts_with("outcomes_"));
         if ours && !written.contains(&path) {
             stale.push(path);
         }

@@ -288,6 +288,12 @@ pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
         runs.push(run);
     }
     if runs.is_empty() {
+        if !incomplete.is_empty() {
+            return Err(ReportError::NoCompleteRuns {
+                dir: dir.to_path_buf(),
+                incomplete: incomplete.len(),
+            });
+        }
         return Err(ReportError::EmptyResults(dir.to_path_buf()));
     }
     runs.sort_by(|a, b| {
@@ -512,7 +518,11 @@ impl Cols<'_> {
     fn no_nulls(&self, name: &str, col: &Column) -> Result<(), ReportError> {
         let nulls = col.null_count();
         if nulls > 0 {
-            return Err(column_error(self.path, name, format!("{nulls} null value(s)")));
+            return Err(column_error(
+                self.path,
+                name,
+                format!("{nulls} null value(s)"),
+            ));
         }
         Ok(())
     }
@@ -521,7 +531,10 @@ impl Cols<'_> {
         let col = self.require(name)?;
         let ca = self.typed(name, col, "str", Column::str)?;
         self.no_nulls(name, col)?;
-        Ok(ca.iter().map(|v| v.unwrap_or_default().to_string()).collect())
+        Ok(ca
+            .iter()
+            .map(|v| v.unwrap_or_default().to_string())
+            .collect())
     }
 
     fn i64s(&self, name: &str) -> Result<Vec<i64>, ReportError> {

@@ -115,12 +115,19 @@ pub fn render(inp: &Inputs<'_>) -> String {
     );
 
     // --- Reduced budget: prominently, before anything else.
-    let reduced: Vec<&crate::load::Run> = runs.iter().filter(|r| r.manifest.reduced_budget()).collect();
+    let reduced: Vec<&crate::load::Run> = runs
+        .iter()
+        .filter(|r| r.manifest.reduced_budget())
+        .collect();
     if !reduced.is_empty() {
         let mut notes: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         for r in &reduced {
             notes
-                .entry(r.manifest.budget_note().unwrap_or_else(|| "(no budget note given)".into()))
+                .entry(
+                    r.manifest
+                        .budget_note()
+                        .unwrap_or_else(|| "(no budget note given)".into()),
+                )
                 .or_default()
                 .insert(campaign_name(&r.campaign));
         }
@@ -147,7 +154,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
     }
     let reduced_keys: BTreeSet<_> = reduced.iter().map(|r| r.key.slug()).collect();
     let dagger = |c: &ConditionSummary| {
-        if reduced_keys.contains(&c.key.slug()) { " †" } else { "" }
+        if reduced_keys.contains(&c.key.slug()) {
+            " †"
+        } else {
+            ""
+        }
     };
 
     // --- What was run.
@@ -180,8 +191,15 @@ pub fn render(inp: &Inputs<'_>) -> String {
         "- **Exploration epochs:** {} (the paper: 5000).",
         fmt_epochs(&last_epochs)
     );
-    let _ = writeln!(w, "- **Profile:** {}.", distinct(runs.iter().map(|r| r.manifest.profile())));
-    let walls: Vec<f64> = runs.iter().filter_map(|r| r.manifest.wall_time_s()).collect();
+    let _ = writeln!(
+        w,
+        "- **Profile:** {}.",
+        distinct(runs.iter().map(|r| r.manifest.profile()))
+    );
+    let walls: Vec<f64> = runs
+        .iter()
+        .filter_map(|r| r.manifest.wall_time_s())
+        .collect();
     if walls.is_empty() {
         let _ = writeln!(w, "- **Wall time:** not recorded.");
     } else {
@@ -203,8 +221,16 @@ pub fn render(inp: &Inputs<'_>) -> String {
             }
         );
     }
-    let _ = writeln!(w, "- **Host:** {}.", distinct(runs.iter().map(|r| r.manifest.host())));
-    let _ = writeln!(w, "- **Threads:** {}.", distinct(runs.iter().map(|r| r.manifest.threads())));
+    let _ = writeln!(
+        w,
+        "- **Host:** {}.",
+        distinct(runs.iter().map(|r| r.manifest.host()))
+    );
+    let _ = writeln!(
+        w,
+        "- **Threads:** {}.",
+        distinct(runs.iter().map(|r| r.manifest.threads()))
+    );
     let _ = writeln!(
         w,
         "- **Git revision:** {}.",
@@ -216,7 +242,10 @@ pub fn render(inp: &Inputs<'_>) -> String {
         distinct(runs.iter().map(|r| r.manifest.toolchain()))
     );
 
-    let _ = writeln!(w, "| env | algorithm | goal sampler | latents | variant | seeds | epochs | wall time per run (mean) |");
+    let _ = writeln!(
+        w,
+        "| env | algorithm | goal sampler | latents | variant | seeds | epochs | wall time per run (mean) |"
+    );
     let _ = writeln!(w, "|---|---|---|---:|---|---|---:|---:|");
     for c in inp.conditions {
         let ws: Vec<f64> = c
@@ -236,7 +265,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
             c.key.algo,
             dagger(c),
             c.key.sampler,
-            if c.key.latents == 0 { "—".to_string() } else { c.key.latents.to_string() },
+            if c.key.latents == 0 {
+                "—".to_string()
+            } else {
+                c.key.latents.to_string()
+            },
             c.key.variant,
             c.seeds.len(),
             fmt_seeds(&c.seeds),
@@ -279,19 +312,28 @@ pub fn render(inp: &Inputs<'_>) -> String {
     }
     for env in &envs {
         let _ = writeln!(w, "### {}\n", env_name(env));
-        let _ = writeln!(w, "| condition | n | epochs | KLC mean ± sd | 90% CI | moved | coverage | paper | Δ |");
+        let _ = writeln!(
+            w,
+            "| condition | n | epochs | KLC mean ± sd | 90% CI | moved | coverage | paper | Δ |"
+        );
         let _ = writeln!(w, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
         for c in inp.conditions.iter().filter(|c| c.key.env == *env) {
             let s = &c.final_klc;
             let mean_sd = match s.std {
                 Some(sd) => format!("{} ± {sd:.3}", fmt_klc(s.mean)),
-                None if s.n_inf > 0 => format!("{} ({} of {} runs inf)", fmt_klc(s.mean), s.n_inf, s.n),
+                None if s.n_inf > 0 => {
+                    format!("{} ({} of {} runs inf)", fmt_klc(s.mean), s.n_inf, s.n)
+                }
                 None => fmt_klc(s.mean),
             };
             let (paper, delta) = match &c.paper {
                 Some(p) => {
                     let d = s.mean - p.klc;
-                    let d = if d.is_finite() { format!("{d:+.3}") } else { fmt_klc(d) };
+                    let d = if d.is_finite() {
+                        format!("{d:+.3}")
+                    } else {
+                        fmt_klc(d)
+                    };
                     (format!("{:.2}", p.klc), d)
                 }
                 None => ("—".into(), "—".into()),
@@ -380,7 +422,14 @@ pub fn render(inp: &Inputs<'_>) -> String {
         .conditions
         .iter()
         .filter(|c| c.final_epochs.len() > 1)
-        .map(|c| format!("{} {} ({})", env_name(&c.key.env), describe(c), fmt_epochs(&c.final_epochs)))
+        .map(|c| {
+            format!(
+                "{} {} ({})",
+                env_name(&c.key.env),
+                describe(c),
+                fmt_epochs(&c.final_epochs)
+            )
+        })
         .collect();
     if !mixed.is_empty() {
         let _ = writeln!(
@@ -396,11 +445,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         .map(|c| format!("{} {}", env_name(&c.key.env), describe(c)))
         .collect();
     if !no_paper.is_empty() && inp.paper.path.is_some() {
-        let _ = writeln!(
-            w,
-            "- No paper value for: {}.",
-            no_paper.join("; ")
-        );
+        let _ = writeln!(w, "- No paper value for: {}.", no_paper.join("; "));
     }
     let not_run: Vec<String> = inp
         .paper
@@ -415,7 +460,10 @@ pub fn render(inp: &Inputs<'_>) -> String {
             })
         })
         .map(|p| {
-            let lat = p.latents.map(|l| format!(", {l} latents")).unwrap_or_default();
+            let lat = p
+                .latents
+                .map(|l| format!(", {l} latents"))
+                .unwrap_or_default();
             format!("{} {} ({}{lat})", env_name(&p.env), p.algo, p.sampler)
         })
         .collect();

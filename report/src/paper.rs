@@ -90,10 +90,12 @@ pub fn parse_klc_csv(text: &str, path: &Path) -> Result<Vec<PaperValue>, ReportE
     };
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let idx = |name: &str| {
-        names
-            .iter()
-            .position(|n| *n == name)
-            .ok_or_else(|| err(hline, format!("header has no column `{name}` (expected {COLUMNS:?})")))
+        names.iter().position(|n| *n == name).ok_or_else(|| {
+            err(
+                hline,
+                format!("header has no column `{name}` (expected {COLUMNS:?})"),
+            )
+        })
     };
     let [ienv, ilat, ialgo, isamp, iklc, isrc] = [
         idx("env")?,
@@ -114,10 +116,12 @@ pub fn parse_klc_csv(text: &str, path: &Path) -> Result<Vec<PaperValue>, ReportE
         }
         let latents = match f[ilat] {
             "" | "any" => None,
-            s => Some(
-                s.parse::<i64>()
-                    .map_err(|_| err(n, format!("latents `{s}` is not an integer, empty or `any`")))?,
-            ),
+            s => Some(s.parse::<i64>().map_err(|_| {
+                err(
+                    n,
+                    format!("latents `{s}` is not an integer, empty or `any`"),
+                )
+            })?),
         };
         let klc = f[iklc]
             .parse::<f64>()
@@ -170,8 +174,11 @@ mod tests {
     #[test]
     fn malformed_lines_name_the_line() {
         let p = Path::new("x.csv");
-        let e = parse_klc_csv("env,latents,algo,sampler,klc,source\narmball,2,rpe,none,abc,s\n", p)
-            .unwrap_err();
+        let e = parse_klc_csv(
+            "env,latents,algo,sampler,klc,source\narmball,2,rpe,none,abc,s\n",
+            p,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("line 2"), "{e}");
         let e = parse_klc_csv("env,algo\n", p).unwrap_err();
         assert!(e.to_string().contains("latents"), "{e}");

@@ -32,8 +32,8 @@ pub fn mean(xs: &[f64]) -> f64 {
     if xs.is_empty() {
         return f64::NAN;
     }
-    let pos_inf = xs.iter().any(|&x| x == f64::INFINITY);
-    let neg_inf = xs.iter().any(|&x| x == f64::NEG_INFINITY);
+    let pos_inf = xs.contains(&f64::INFINITY);
+    let neg_inf = xs.contains(&f64::NEG_INFINITY);
     match (pos_inf, neg_inf) {
         (true, true) => f64::NAN,
         (true, false) => f64::INFINITY,
@@ -75,10 +75,18 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
 
 /// Percentile-bootstrap CI of the mean at confidence `level` (e.g. 0.90 → 5th and 95th
 /// percentiles of `n_boot` resampled means). One value gives a zero-width interval on it.
-pub fn bootstrap_mean_ci(xs: &[f64], level: f64, n_boot: usize, rng: &mut ChaCha8Rng) -> (f64, f64) {
+pub fn bootstrap_mean_ci(
+    xs: &[f64],
+    level: f64,
+    n_boot: usize,
+    rng: &mut ChaCha8Rng,
+) -> (f64, f64) {
     assert!(!xs.is_empty(), "bootstrap of an empty sample");
     assert!(n_boot > 0, "n_boot must be positive");
-    assert!(level > 0.0 && level < 1.0, "confidence level {level} outside (0, 1)");
+    assert!(
+        level > 0.0 && level < 1.0,
+        "confidence level {level} outside (0, 1)"
+    );
     let n = xs.len();
     if n == 1 || xs.iter().all(|&x| x == xs[0]) {
         return (xs[0], xs[0]);
@@ -121,7 +129,7 @@ impl IndexSampler {
         assert!(n > 0, "no index to draw");
         let n = n as u64;
         let k_min = (64 - (n - 1).leading_zeros()).max(1);
-        let k_max = k_min.max(16).min(63);
+        let k_max = k_min.clamp(16, 63);
         let (mut best_k, mut best_cost) = (k_min, f64::INFINITY);
         for k in k_min..=k_max {
             let span = 1u64 << k;
@@ -228,7 +236,10 @@ mod tests {
         assert_eq!((s.ci_lo, s.ci_hi), (4.25, 4.25));
         assert_eq!(s.std, Some(0.0));
         let one = summarize(&[3.0], 100, 0);
-        assert_eq!((one.mean, one.ci_lo, one.ci_hi, one.std), (3.0, 3.0, 3.0, None));
+        assert_eq!(
+            (one.mean, one.ci_lo, one.ci_hi, one.std),
+            (3.0, 3.0, 3.0, None)
+        );
     }
 
     #[test]
@@ -262,7 +273,11 @@ mod tests {
         let (lo2, hi2) = ci(&shifted, 2_000, 3);
         assert!((lo2 - lo - 1.5).abs() < 1e-12 && (hi2 - hi - 1.5).abs() < 1e-12);
         // Increasing every value never lowers either bound.
-        let bigger: Vec<f64> = xs.iter().enumerate().map(|(i, x)| x + 0.1 * i as f64).collect();
+        let bigger: Vec<f64> = xs
+            .iter()
+            .enumerate()
+            .map(|(i, x)| x + 0.1 * i as f64)
+            .collect();
         let (lo3, hi3) = ci(&bigger, 2_000, 3);
         assert!(lo3 >= lo && hi3 >= hi);
         // The interval lies within the data range.
@@ -287,7 +302,10 @@ mod tests {
         assert!(s.ci_lo.is_finite());
         assert_eq!(s.ci_hi, f64::INFINITY);
         let all = summarize(&[f64::INFINITY, f64::INFINITY], 100, 1);
-        assert_eq!((all.mean, all.ci_lo, all.ci_hi), (f64::INFINITY, f64::INFINITY, f64::INFINITY));
+        assert_eq!(
+            (all.mean, all.ci_lo, all.ci_hi),
+            (f64::INFINITY, f64::INFINITY, f64::INFINITY)
+        );
     }
 
     #[test]

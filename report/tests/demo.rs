@@ -24,19 +24,64 @@ struct Cond {
 
 fn conditions() -> Vec<Cond> {
     let mut v = Vec::new();
-    for (env, lats, rpe, efr) in [("armball", [2, 10], 6.51, 4.58), ("armarrow", [3, 10], 9.91, 7.46)] {
-        v.push(Cond { env, algo: "rpe", sampler: "none", latents: 0, variant: "none", final_klc: rpe });
-        v.push(Cond { env, algo: "rge-efr", sampler: "uniform", latents: 0, variant: "none", final_klc: efr });
+    for (env, lats, rpe, efr) in [
+        ("armball", [2, 10], 6.51, 4.58),
+        ("armarrow", [3, 10], 9.91, 7.46),
+    ] {
+        v.push(Cond {
+            env,
+            algo: "rpe",
+            sampler: "none",
+            latents: 0,
+            variant: "none",
+            final_klc: rpe,
+        });
+        v.push(Cond {
+            env,
+            algo: "rge-efr",
+            sampler: "uniform",
+            latents: 0,
+            variant: "none",
+            final_klc: efr,
+        });
         for (k, l) in lats.into_iter().enumerate() {
-            for (j, algo) in ["rge-pca", "rge-isomap", "rge-ae", "rge-vae", "rge-rfvae"].into_iter().enumerate() {
-                let variant = if matches!(algo, "rge-ae" | "rge-vae" | "rge-rfvae") { "faithful" } else { "none" };
+            for (j, algo) in ["rge-pca", "rge-isomap", "rge-ae", "rge-vae", "rge-rfvae"]
+                .into_iter()
+                .enumerate()
+            {
+                let variant = if matches!(algo, "rge-ae" | "rge-vae" | "rge-rfvae") {
+                    "faithful"
+                } else {
+                    "none"
+                };
                 let f = efr - 0.3 + 0.15 * j as f64 + 0.2 * k as f64;
-                v.push(Cond { env, algo, sampler: "kde", latents: l, variant, final_klc: f });
+                v.push(Cond {
+                    env,
+                    algo,
+                    sampler: "kde",
+                    latents: l,
+                    variant,
+                    final_klc: f,
+                });
             }
         }
     }
-    v.push(Cond { env: "armball", algo: "rge-vae", sampler: "gaussian", latents: 10, variant: "faithful", final_klc: 3.9 });
-    v.push(Cond { env: "armball", algo: "rge-vae", sampler: "kde", latents: 10, variant: "corrected", final_klc: 4.1 });
+    v.push(Cond {
+        env: "armball",
+        algo: "rge-vae",
+        sampler: "gaussian",
+        latents: 10,
+        variant: "faithful",
+        final_klc: 3.9,
+    });
+    v.push(Cond {
+        env: "armball",
+        algo: "rge-vae",
+        sampler: "kde",
+        latents: 10,
+        variant: "corrected",
+        final_klc: 4.1,
+    });
     v
 }
 
@@ -49,9 +94,16 @@ fn write_store(root: &Path) {
     let dir = root.join("paper-like");
     std::fs::create_dir_all(&dir).unwrap();
     for c in conditions() {
-        let kmax = if c.env == "armball" { 756f64.ln() } else { 22680f64.ln() };
+        let kmax = if c.env == "armball" {
+            756f64.ln()
+        } else {
+            22680f64.ln()
+        };
         for seed in 0..5i64 {
-            let id = format!("{}.{}.{}.{}.{}.s{seed}", c.env, c.algo, c.sampler, c.latents, c.variant);
+            let id = format!(
+                "{}.{}.{}.{}.{}.s{seed}",
+                c.env, c.algo, c.sampler, c.latents, c.variant
+            );
             let mut rng = ChaCha8Rng::seed_from_u64(seed as u64 * 7919 + id.len() as u64);
             let off: f64 = rng.random_range(-0.15..0.15);
             let epochs: Vec<i64> = (0..=50).map(|i| i * 100).collect();
@@ -66,7 +118,10 @@ fn write_store(root: &Path) {
                 .collect();
             let n_out: Vec<i64> = epochs.iter().map(|&e| e + i64::from(rge)).collect();
             let moved_frac = if rge { 0.35 } else { 0.02 };
-            let n_moved: Vec<i64> = n_out.iter().map(|&o| (o as f64 * moved_frac) as i64).collect();
+            let n_moved: Vec<i64> = n_out
+                .iter()
+                .map(|&o| (o as f64 * moved_frac) as i64)
+                .collect();
             let cov: Vec<f64> = klc.iter().map(|k| (1.0 - k / kmax).max(0.0)).collect();
             let mut df = df!(
                 "run_id" => vec![id.as_str(); n],
@@ -85,7 +140,11 @@ fn write_store(root: &Path) {
             .unwrap();
             write(&dir.join(format!("{id}.parquet")), &mut df);
 
-            let oe: Vec<i64> = if rge { (0..=5000).collect() } else { (1..=5000).collect() };
+            let oe: Vec<i64> = if rge {
+                (0..=5000).collect()
+            } else {
+                (1..=5000).collect()
+            };
             let m = oe.len();
             let (mut x, mut y, mut mv, mut ang) = (vec![], vec![], vec![], vec![]);
             for _ in 0..m {
@@ -136,7 +195,11 @@ fn paper_sized_demo_renders() {
     opts.paper_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper");
     let t = std::time::Instant::now();
     let s = render_report(&opts).unwrap();
-    eprintln!("rendered {} runs, {} files in {:?}", s.n_runs, s.files.len(), t.elapsed());
+    eprintln!(
+        "rendered {} runs, {} files in {:?}",
+        s.n_runs,
+        s.files.len(),
+        t.elapsed()
+    );
     assert_eq!(s.n_runs, 26 * 5);
 }
-

@@ -17,7 +17,11 @@ fn paper_dir() -> PathBuf {
 }
 
 fn kmax(env: &str) -> f64 {
-    if env == "armball" { 756f64.ln() } else { 22680f64.ln() }
+    if env == "armball" {
+        756f64.ln()
+    } else {
+        22680f64.ln()
+    }
 }
 
 /// The synthetic KLC of a run at an epoch: falls linearly from the maximum.
@@ -32,7 +36,11 @@ fn sampler(algo: &str) -> &'static str {
 
 fn dir_of(root: &Path, env: &str) -> PathBuf {
     // ArmBall runs in a campaign sub-directory, ArmArrow ones at the top level.
-    if env == "armball" { root.join("camp-a") } else { root.to_path_buf() }
+    if env == "armball" {
+        root.join("camp-a")
+    } else {
+        root.to_path_buf()
+    }
 }
 
 fn run_id(env: &str, algo: &str, seed: i64) -> String {
@@ -69,7 +77,11 @@ fn curve_frame(env: &str, algo: &str, seed: i64) -> DataFrame {
 
 fn outcomes_frame(env: &str, algo: &str, seed: i64) -> DataFrame {
     let rge = algo != "rpe";
-    let epochs: Vec<i64> = if rge { (0..=500).collect() } else { (1..=500).collect() };
+    let epochs: Vec<i64> = if rge {
+        (0..=500).collect()
+    } else {
+        (1..=500).collect()
+    };
     let n = epochs.len();
     let mut x = Vec::with_capacity(n);
     let mut y = Vec::with_capacity(n);
@@ -125,7 +137,10 @@ fn write_run(root: &Path, env: &str, algo: &str, seed: i64) {
     let dir = dir_of(root, env);
     std::fs::create_dir_all(&dir).unwrap();
     let id = run_id(env, algo, seed);
-    write_parquet(&dir.join(format!("{id}.parquet")), &mut curve_frame(env, algo, seed));
+    write_parquet(
+        &dir.join(format!("{id}.parquet")),
+        &mut curve_frame(env, algo, seed),
+    );
     write_parquet(
         &dir.join(format!("{id}.outcomes.parquet")),
         &mut outcomes_frame(env, algo, seed),
@@ -197,8 +212,13 @@ fn renders_report_and_figures_with_the_right_numbers() {
         assert!(f.is_file(), "{}", f.display());
     }
     let svg = std::fs::read_to_string(out.join("figures/klc_armball.svg")).unwrap();
-    assert!(svg.contains("exploration epochs") && svg.contains("KL-coverage (nats, lower is better)"));
-    assert!(!svg.contains("100.0<") && !svg.contains(">500.0"), "epoch ticks printed as floats");
+    assert!(
+        svg.contains("exploration epochs") && svg.contains("KL-coverage (nats, lower is better)")
+    );
+    assert!(
+        !svg.contains("100.0<") && !svg.contains(">500.0"),
+        "epoch ticks printed as floats"
+    );
 
     let md = std::fs::read_to_string(&report).unwrap();
     // Final means over seeds 0, 1, 2: drop = base + 0.1 * seed, mean drop = base + 0.1.
@@ -217,7 +237,10 @@ fn renders_report_and_figures_with_the_right_numbers() {
         .find(|l| l.starts_with("| RPE †") && l.contains(&format!("{rpe_mean:.3}")))
         .unwrap_or_else(|| panic!("no ArmBall RPE row in\n{md}"));
     assert!(rpe_row.contains("| 6.51 |"), "{rpe_row}");
-    assert!(rpe_row.contains(&format!("{:+.3}", rpe_mean - 6.51)), "{rpe_row}");
+    assert!(
+        rpe_row.contains(&format!("{:+.3}", rpe_mean - 6.51)),
+        "{rpe_row}"
+    );
     // moved: n_moved = n_outcomes / 3 at epoch 500: RPE 500/3 = 166, EFR 501/3 = 167.
     assert!(rpe_row.contains("| 166 / 500 |"), "{rpe_row}");
     assert!(md.contains("| 167 / 501 |"));
@@ -231,7 +254,9 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("single runs"));
     assert!(md.contains("`abc1234` (12 runs)"));
     assert!(md.contains("`testhost` (12 runs)"));
-    assert!(md.contains("- **Wall time:** 2.2 min in total; per run 11.0 s on average (min 10.0 s, max 12.0 s)."));
+    assert!(md.contains(
+        "- **Wall time:** 2.2 min in total; per run 11.0 s on average (min 10.0 s, max 12.0 s)."
+    ));
     assert!(md.contains("| 3 (0–2) |"));
     // Paper conditions not run are listed.
     assert!(md.contains("Paper conditions not in these results (21)"));
@@ -278,14 +303,19 @@ fn missing_column_names_the_file_and_column() {
     write_parquet(&path, &mut df);
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
     match &err {
-        ReportError::Column { path: p, column, .. } => {
+        ReportError::Column {
+            path: p, column, ..
+        } => {
             assert_eq!(p, &path);
             assert_eq!(column, "coverage");
         }
         other => panic!("unexpected error {other:?}"),
     }
     let msg = err.to_string();
-    assert!(msg.contains("armarrow.rpe.s1.parquet") && msg.contains("coverage"), "{msg}");
+    assert!(
+        msg.contains("armarrow.rpe.s1.parquet") && msg.contains("coverage"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -301,7 +331,9 @@ fn wrong_column_type_names_the_file_and_column() {
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
     let msg = err.to_string();
     assert!(
-        msg.contains("armball.rge-efr.s2.outcomes.parquet") && msg.contains("`moved`") && msg.contains("bool"),
+        msg.contains("armball.rge-efr.s2.outcomes.parquet")
+            && msg.contains("`moved`")
+            && msg.contains("bool"),
         "{msg}"
     );
 }
@@ -315,7 +347,11 @@ fn corrupt_parquet_is_an_error_naming_the_file() {
     std::fs::write(&path, b"PAR1 this is not parquet at all PAR1").unwrap();
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
     assert!(matches!(err, ReportError::Parquet { .. }), "{err:?}");
-    assert!(err.to_string().contains("armball.rpe.s0.outcomes.parquet"), "{err}");
+    eprintln!("{err}");
+    assert!(
+        err.to_string().contains("armball.rpe.s0.outcomes.parquet"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -325,7 +361,10 @@ fn corrupt_manifest_is_an_error_naming_the_file() {
     synthetic_store(&results);
     std::fs::write(results.join("armarrow.rge-efr.s0.json"), "{ not json").unwrap();
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
-    assert!(err.to_string().contains("armarrow.rge-efr.s0.json"), "{err}");
+    assert!(
+        err.to_string().contains("armarrow.rge-efr.s0.json"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -339,6 +378,19 @@ fn empty_or_missing_results_dir_is_a_clear_error() {
 
     let err = render_report(&opts(&tmp.path().join("nope"), &tmp.path().join("out"))).unwrap_err();
     assert!(matches!(err, ReportError::NoResultsDir(_)), "{err:?}");
+
+    // Only an incomplete run: a campaign that has not finished its first run.
+    let partial = tmp.path().join("partial");
+    std::fs::create_dir_all(&partial).unwrap();
+    write_parquet(
+        &partial.join("armball.rpe.s0.parquet"),
+        &mut curve_frame("armball", "rpe", 0),
+    );
+    let err = render_report(&opts(&partial, &tmp.path().join("out"))).unwrap_err();
+    assert!(
+        matches!(err, ReportError::NoCompleteRuns { incomplete: 1, .. }),
+        "{err:?}"
+    );
 }
 
 #[test]
@@ -352,7 +404,10 @@ fn incomplete_runs_are_skipped_and_listed() {
     assert_eq!(s.n_runs, 11);
     let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
     assert!(md.contains("Incomplete runs skipped"), "{md}");
-    assert!(md.contains("`camp-a/armball.rpe.s2`: missing armball.rpe.s2.json"), "{md}");
+    assert!(
+        md.contains("`camp-a/armball.rpe.s2`: missing armball.rpe.s2.json"),
+        "{md}"
+    );
 }
 
 #[test]
@@ -377,7 +432,10 @@ fn infinite_klc_is_reported_as_inf_not_nan() {
     let results = tmp.path().join("results");
     synthetic_store(&results);
     let mut df = curve_frame("armarrow", "rge-efr", 1);
-    let mut k: Vec<f64> = EPOCHS.iter().map(|&e| klc("armarrow", "rge-efr", 1, e)).collect();
+    let mut k: Vec<f64> = EPOCHS
+        .iter()
+        .map(|&e| klc("armarrow", "rge-efr", 1, e))
+        .collect();
     *k.last_mut().unwrap() = f64::INFINITY;
     df.with_column(Column::new("klc".into(), k)).unwrap();
     write_parquet(&results.join("armarrow.rge-efr.s1.parquet"), &mut df);

@@ -162,29 +162,62 @@ impl Body {
     /// Run the movement; the object at `object_xy` is caught the first step the squared
     /// hand-object distance is below `size^2` (that step already moves it). Returns whether it
     /// was caught and the arm pose at the last step.
+    ///
+    /// Exact shortcut: the forward kinematics is skipped at a step when a rigorous lower bound
+    /// on the hand-object distance exceeds the catch radius. Since `|u(a) - u(b)| <= pi |a - b|`
+    /// for unit vectors at angles `pi a`, `pi b`, the hand has moved at most
+    /// `pi * sum_k L_k |A_k - A'_k|` (A = cumulative joint angles, units of pi) since the last
+    /// pose computed exactly; the catch decisions are those of the step-by-step computation.
     #[inline]
     pub fn run(&self, theta: &[f64; PARAMS], object_xy: [f64; 2]) -> (bool, ArmPose) {
+        const MARGIN: f64 = 1e-9;
         let mut dmp = dmp::DmpState::new(&self.table, theta);
         let steps = self.table.x.len();
+        let size = self.size_sq.sqrt();
         let mut caught = false;
-        let mut last = None;
+        // Cumulative angles and hand-object distance at the last exactly computed pose.
+        let mut ref_cum = [f64::NAN; JOINTS];
+        let mut ref_dist = 0.0;
         for t in 0..steps {
             let q = dmp.step(&self.table, t);
-            if !caught {
+            if t + 1 == steps {
                 let pose = self.arm.forward(q);
-                let dx = pose.hand[0] - object_xy[0];
-                let dy = pose.hand[1] - object_xy[1];
-                caught = dx * dx + dy * dy < self.size_sq;
-                if t + 1 == steps {
-                    last = Some(pose);
+                if !caught {
+                    caught = self.within(&pose, object_xy);
                 }
-            } else if t + 1 == steps {
-                // Once caught, the object follows the hand: only the last pose matters.
-                last = Some(self.arm.forward(q));
+                return (caught, pose);
             }
+            if caught {
+                continue;
+            }
+            let mut cum = [0.0; JOINTS];
+            let mut acc = 0.0;
+            let mut moved = 0.0;
+            for k in 0..JOINTS {
+                acc += q[k].clamp(-1.0, 1.0);
+                cum[k] = acc;
+                moved += self.arm.lengths[k] * (acc - ref_cum[k]).abs();
+            }
+            // NaN (no reference yet) fails the comparison and forces the exact computation.
+            if ref_dist - std::f64::consts::PI * moved > size + MARGIN {
+                continue;
+            }
+            let pose = self.arm.forward(q);
+            caught = self.within(&pose, object_xy);
+            ref_cum = cum;
+            let (dx, dy) = (pose.hand[0] - object_xy[0], pose.hand[1] - object_xy[1]);
+            ref_dist = (dx * dx + dy * dy).sqrt();
         }
-        let pose = last.unwrap_or_else(|| self.arm.forward(&[0.0; JOINTS]));
-        (caught, pose)
+        // Zero steps: the arm never moves.
+        (false, self.arm.forward(&[0.0; JOINTS]))
+    }
+
+    /// The catch test of the original: squared hand-object distance strictly below size^2.
+    #[inline]
+    fn within(&self, pose: &ArmPose, object_xy: [f64; 2]) -> bool {
+        let dx = pose.hand[0] - object_xy[0];
+        let dy = pose.hand[1] - object_xy[1];
+        dx * dx + dy * dy < self.size_sq
     }
 }
 
@@ -198,6 +231,38 @@ mod tests {
             assert_eq!(k.name().parse::<EnvKind>().unwrap(), k);
         }
         assert!("armbal".parse::<EnvKind>().is_err());
+    }
+
+    /// The step-by-step computation of the original, without the distance-bound shortcut.
+    fn naive(body: &Body, theta: &[f64; PARAMS], obj: [f64; 2]) -> (bool, ArmPose) {
+        let mut dmp = dmp::DmpState::new(&body.table, theta);
+        let mut caught = false;
+        let mut pose = body.arm.forward(&[0.0; JOINTS]);
+        for t in 0..body.table.x.len() {
+            pose = body.arm.forward(dmp.step(&body.table, t));
+            caught = caught || body.within(&pose, obj);
+        }
+        (caught, pose)
+    }
+
+    #[test]
+    fn shortcut_gives_the_exact_catch_decisions() {
+        use rand::RngExt;
+        let cfg = EnvConfig::default();
+        let body = Body::new(&cfg);
+        let mut rng = crate::seed::stream_named(5, "test");
+        let mut catches = 0;
+        for i in 0..20_000 {
+            // Random parameters, and small ones that keep the hand near the object for long.
+            let scale = if i % 2 == 0 { 1.0 } else { 0.05 };
+            let theta: [f64; PARAMS] = std::array::from_fn(|_| scale * rng.random_range(-1.0..1.0));
+            for obj in [cfg.ball_initial, [0.0, 0.95], [0.3, -0.2]] {
+                let fast = body.run(&theta, obj);
+                assert_eq!(fast, naive(&body, &theta, obj), "theta {theta:?} object {obj:?}");
+                catches += fast.0 as usize;
+            }
+        }
+        assert!(catches > 500, "the test must exercise catches: {catches}");
     }
 
     #[test]

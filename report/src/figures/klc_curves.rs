@@ -77,7 +77,11 @@ pub fn draw_all(
 
 /// Baselines (latents 0) in every panel; one panel per latent size of the learned spaces.
 fn panels_of<'a>(env: &str, conds: &[&'a ConditionSummary]) -> Vec<Panel<'a>> {
-    let base: Vec<&ConditionSummary> = conds.iter().copied().filter(|c| c.key.latents == 0).collect();
+    let base: Vec<&ConditionSummary> = conds
+        .iter()
+        .copied()
+        .filter(|c| c.key.latents == 0)
+        .collect();
     let mut by_latents: BTreeMap<i64, Vec<&ConditionSummary>> = BTreeMap::new();
     for c in conds.iter().copied().filter(|c| c.key.latents != 0) {
         by_latents.entry(c.key.latents).or_default().push(c);
@@ -157,7 +161,12 @@ fn draw_panel(
         let m = panel
             .members
             .iter()
-            .flat_map(|c| c.curve.iter().map(|p| p.hi).chain(c.paper.iter().map(|p| p.klc)))
+            .flat_map(|c| {
+                c.curve
+                    .iter()
+                    .map(|p| p.hi)
+                    .chain(c.paper.iter().map(|p| p.klc))
+            })
             .filter(|v| v.is_finite())
             .fold(0.0f64, f64::max);
         if m > 0.0 { m * 1.05 } else { 1.0 }
@@ -186,11 +195,7 @@ fn draw_panel(
         .draw()?;
 
     let clamp = |v: f64| {
-        if v.is_nan() {
-            v
-        } else {
-            v.clamp(0.0, y_max)
-        }
+        if v.is_nan() { v } else { v.clamp(0.0, y_max) }
     };
     let styles = styles(&panel.members);
 
@@ -222,7 +227,10 @@ fn draw_panel(
         let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for p in &c.curve {
             if p.mean.is_finite() {
-                segments.last_mut().unwrap().push((p.epoch as f64, clamp(p.mean)));
+                segments
+                    .last_mut()
+                    .unwrap()
+                    .push((p.epoch as f64, clamp(p.mean)));
             } else if !segments.last().unwrap().is_empty() {
                 segments.push(Vec::new());
             }
@@ -250,7 +258,11 @@ fn draw_panel(
         // Markers on about 8 points per curve, staggered between curves.
         let finite: Vec<(f64, f64)> = segments.iter().flatten().copied().collect();
         let step = (finite.len() / 8).max(1);
-        let offset = if step > 1 { (i * step / panel.members.len().max(1)) % step } else { 0 };
+        let offset = if step > 1 {
+            (i * step / panel.members.len().max(1)) % step
+        } else {
+            0
+        };
         chart.draw_series(
             finite
                 .iter()

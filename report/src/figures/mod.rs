@@ -28,6 +28,11 @@ pub struct FigureFile {
     pub env: String,
 }
 
+/// A pixel offset.
+pub type Px = (i32, i32);
+/// A marker: its filled polygon and its outline, at a point.
+pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<Px>>;
+
 pub const FONT: &str = "sans-serif";
 
 /// Known algorithms, in the report's order; they index [`ALGO_COLOURS`] and the marker shapes.
@@ -86,7 +91,11 @@ pub fn klc_max(env: &str) -> Option<f64> {
 /// take the following slots in the order given by `unknown_index`.
 pub fn algo_slot(algo: &str, unknown_index: usize) -> usize {
     let r = rank(algo, &ALGOS);
-    if r < ALGOS.len() { r } else { ALGOS.len() + unknown_index }
+    if r < ALGOS.len() {
+        r
+    } else {
+        ALGOS.len() + unknown_index
+    }
 }
 
 pub fn colour(slot: usize) -> RGBColor {
@@ -94,11 +103,11 @@ pub fn colour(slot: usize) -> RGBColor {
 }
 
 /// Marker outlines, in pixels around (0, 0): circle, square, triangle up, diamond, triangle down,
-/// plus, hexagon-ish star; then the same shapes hollow.
+/// plus, x; then the same shapes hollow. (Stars are kept for the paper's values.)
 pub fn marker_points(slot: usize, size: f64) -> (Vec<(i32, i32)>, bool) {
     const N_SHAPES: usize = 7;
     let shape = slot % N_SHAPES;
-    let filled = (slot / N_SHAPES) % 2 == 0;
+    let filled = (slot / N_SHAPES).is_multiple_of(2);
     let s = size;
     let poly = |pts: &[(f64, f64)]| -> Vec<(i32, i32)> {
         pts.iter()
@@ -116,21 +125,34 @@ pub fn marker_points(slot: usize, size: f64) -> (Vec<(i32, i32)>, bool) {
         2 => poly(&[(0.0, -1.15), (1.0, 0.75), (-1.0, 0.75)]),
         3 => poly(&[(0.0, -1.25), (1.0, 0.0), (0.0, 1.25), (-1.0, 0.0)]),
         4 => poly(&[(0.0, 1.15), (1.0, -0.75), (-1.0, -0.75)]),
-        5 => poly(&[
-            (-0.35, -1.1),
-            (0.35, -1.1),
-            (0.35, -0.35),
-            (1.1, -0.35),
-            (1.1, 0.35),
-            (0.35, 0.35),
-            (0.35, 1.1),
-            (-0.35, 1.1),
-            (-0.35, 0.35),
-            (-1.1, 0.35),
-            (-1.1, -0.35),
-            (-0.35, -0.35),
-        ]),
-        _ => star_points(s * 1.2, s * 0.5),
+        5 | 6 => {
+            // A plus; rotated by 45 degrees it is the "x" of slot 6.
+            let plus = [
+                (-0.35, -1.1),
+                (0.35, -1.1),
+                (0.35, -0.35),
+                (1.1, -0.35),
+                (1.1, 0.35),
+                (0.35, 0.35),
+                (0.35, 1.1),
+                (-0.35, 1.1),
+                (-0.35, 0.35),
+                (-1.1, 0.35),
+                (-1.1, -0.35),
+                (-0.35, -0.35),
+            ];
+            if shape == 5 {
+                poly(&plus)
+            } else {
+                let r = std::f64::consts::FRAC_1_SQRT_2;
+                let rotated: Vec<(f64, f64)> = plus
+                    .iter()
+                    .map(|&(x, y)| (r * (x - y), r * (x + y)))
+                    .collect();
+                poly(&rotated)
+            }
+        }
+        _ => unreachable!("shape < N_SHAPES"),
     };
     (pts, filled)
 }
@@ -154,7 +176,7 @@ pub fn marker<C, DB: DrawingBackend>(
     filled: bool,
     col: RGBColor,
     stroke: u32,
-) -> ComposedElement<C, DB, Polygon<(i32, i32)>, PathElement<(i32, i32)>> {
+) -> MarkerElement<C, DB> {
     let fill = if filled { col.filled() } else { WHITE.filled() };
     let mut outline = pts.to_vec();
     if let Some(&first) = pts.first() {
@@ -172,7 +194,7 @@ pub fn icon_parts(
     filled: bool,
     col: RGBColor,
     stroke: u32,
-) -> (Polygon<(i32, i32)>, PathElement<(i32, i32)>) {
+) -> (Polygon<Px>, PathElement<Px>) {
     let shifted: Vec<(i32, i32)> = pts.iter().map(|&(a, b)| (a + dx, b)).collect();
     let fill = if filled { col.filled() } else { WHITE.filled() };
     let mut outline = shifted.clone();

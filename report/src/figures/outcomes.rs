@@ -100,7 +100,13 @@ pub fn draw_all(
         out.push(FigureFile {
             path,
             link: format!("figures/{name}"),
-            caption: format!("{}, {}: outcomes of {} at epochs {:?}", env_name(&c.key.env), describe(c), run.run_id, epochs),
+            caption: format!(
+                "{}, {}: outcomes of {} at epochs {:?}",
+                env_name(&c.key.env),
+                describe(c),
+                run.run_id,
+                epochs
+            ),
             env: c.key.env.clone(),
         });
     }
