@@ -10,4 +10,5 @@ pub mod env;
 pub mod explore;
 pub mod goals;
 pub mod metrics;
+pub mod repr;
 pub mod seed;

@@ -459,3 +459,25 @@ fn missing_paper_dir_is_reported_not_fatal() {
     let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
     assert!(md.contains("Paper reference values not found"));
 }
+
+#[test]
+fn damaged_parquet_pages_are_an_error_not_a_panic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    synthetic_store(&results);
+    let path = results.join("armarrow.rge-efr.s2.outcomes.parquet");
+    let mut bytes = std::fs::read(&path).unwrap();
+    // Overwrite the data pages but keep the magic bytes and the footer.
+    let n = bytes.len();
+    for b in &mut bytes[8..n / 2] {
+        *b = 0xFF;
+    }
+    std::fs::write(&path, &bytes).unwrap();
+    let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
+    eprintln!("{err}");
+    assert!(
+        err.to_string()
+            .contains("armarrow.rge-efr.s2.outcomes.parquet"),
+        "{err}"
+    );
+}

@@ -1,0 +1,140 @@
+//! Representation learners: the UGL stage of IMGEP-UGL (paper Section 3, Algorithm 1;
+//! PAPER-NOTES.md section 5). A learner is fitted on passively observed images and returns an
+//! encoder that maps images to latent vectors, the goal space of RGE-REP.
+//!
+//! Adding a learner = one file implementing [`RepresentationLearner`] + one entry in
+//! [`registry`]. The conformance suite (`benchmark/tests/learner_conformance.rs`) runs against
+//! every registered learner.
+
+pub mod dataset;
+pub mod external;
+pub mod isomap;
+pub mod pca;
+
+use thiserror::Error;
+
+use crate::seed::Stream;
+
+/// A set of images, row-major `n x dim` (dim = 4900 for the 70x70 renderer, pixel (x, y) of
+/// image i at `i * dim + x * 70 + y`), values in [0,1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSet {
+    pub n: usize,
+    pub dim: usize,
+    pub data: Vec<f32>,
+}
+
+impl ImageSet {
+    /// Wrap row-major data; `data.len()` must be `n * dim`.
+    pub fn new(n: usize, dim: usize, data: Vec<f32>) -> Result<Self, ReprError> {
+        if data.len() != n * dim {
+            return Err(ReprError::InvalidInput(format!("image data has {} values, expected {n} x {dim}", data.len())));
+        }
+        Ok(ImageSet { n, dim, data })
+    }
+
+    /// Image `i` as a slice of `dim` pixels.
+    pub fn row(&self, i: usize) -> &[f32] {
+        &self.data[i * self.dim..(i + 1) * self.dim]
+    }
+}
+
+/// Latent vectors, row-major `n x latents`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Latents {
+    pub n: usize,
+    pub latents: usize,
+    pub data: Vec<f64>,
+}
+
+impl Latents {
+    /// Row `i`.
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.latents..(i + 1) * self.latents]
+    }
+}
+
+/// Errors of learners and encoders.
+#[derive(Debug, Error)]
+pub enum ReprError {
+    /// Bad input (shape, empty set, latents out of range...).
+    #[error("{0}")]
+    InvalidInput(String),
+    /// The fit failed numerically (disconnected graph, NaN, no convergence...).
+    #[error("{0}")]
+    Numerical(String),
+    /// An external learner program failed or broke the protocol.
+    #[error("external learner: {0}")]
+    External(String),
+    /// I/O.
+    #[error("{0}")]
+    Io(String),
+}
+
+/// A Gaussian prior over the latent space (for Gaussian-prior goal sampling, "-GP").
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaussianPrior {
+    pub mean: Vec<f64>,
+    pub std: Vec<f64>,
+}
+
+/// Maps images to latent vectors.
+pub trait Encoder: Send {
+    /// Latent dimension.
+    fn latents(&self) -> usize;
+    /// Encode a batch of images.
+    fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError>;
+    /// Encode one image (`dim` pixels) into `out` (`latents` values). The default wraps
+    /// [`Encoder::encode`]; learners with a cheaper single-image path override it.
+    fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
+        let set = ImageSet::new(1, image.len(), image.to_vec())?;
+        let z = self.encode(&set)?;
+        out.copy_from_slice(&z.data);
+        Ok(())
+    }
+    /// The model's prior over latents, where it has one (VAE-type models).
+    fn prior(&self) -> Option<GaussianPrior> {
+        None
+    }
+}
+
+/// A representation learner (the UGL stage).
+pub trait RepresentationLearner: Send + Sync {
+    /// Name in results and on the command line (`pca`, `isomap`, ...).
+    fn name(&self) -> &str;
+    /// Fit on `images` with `latents` output dimensions. `rng` is the learner's own stream
+    /// (initialisation, mini-batches, randomized solvers): same stream, same encoder.
+    /// Returns the encoder and the encodings of the training images.
+    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError>;
+}
+
+/// Check the common preconditions of a fit.
+pub fn check_fit_input(images: &ImageSet, latents: usize) -> Result<(), ReprError> {
+    if latents == 0 {
+        return Err(ReprError::InvalidInput("latents must be at least 1".into()));
+    }
+    if images.n < 2 {
+        return Err(ReprError::InvalidInput(format!("need at least 2 training images, got {}", images.n)));
+    }
+    if latents > images.dim || latents >= images.n {
+        return Err(ReprError::InvalidInput(format!(
+            "latents = {latents} must be below the number of images ({}) and at most the image size ({})",
+            images.n, images.dim
+        )));
+    }
+    if images.data.iter().any(|v| !v.is_finite()) {
+        return Err(ReprError::InvalidInput("training images contain a non-finite value".into()));
+    }
+    Ok(())
+}
+
+/// Check an encoder's output: right shape, finite.
+pub fn check_latents(z: &Latents, who: &str) -> Result<(), ReprError> {
+    if z.data.len() != z.n * z.latents {
+        return Err(ReprError::Numerical(format!("{who}: latents have {} values, expected {} x {}", z.data.len(), z.n, z.latents)));
+    }
+    if let Some(i) = z.data.iter().position(|v| !v.is_finite()) {
+        return Err(ReprError::Numerical(format!("{who}: non-finite latent (image {}, dimension {})", i / z.latents.max(1), i % z.latents.max(1))));
+    }
+    Ok(())
+}
