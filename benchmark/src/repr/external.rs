@@ -1,0 +1,1146 @@
+//! External representation learners: a model written in anything (PyTorch, JAX, ...) competes
+//! through a small process protocol (protocol v1, specified in `docs/external-learners.md`).
+//!
+//! One long-running process per fitted model:
+//!
+//! 1. The harness creates a work directory, writes `train.npy` (float32, shape `(n, dim)`,
+//!    C order; dim = 4900 = 70 x 70, pixel (x, y) at `x * 70 + y`) and starts the configured
+//!    command with `sh -c` in its own process group, with the caller's working directory and
+//!    environment plus `UGL_PROTOCOL=1`, `UGL_TRAIN`, `UGL_TRAIN_LATENTS`, `UGL_LATENTS`,
+//!    `UGL_SEED` (drawn from the learner stream given to `fit`) and `UGL_WORKDIR`.
+//! 2. The program fits, writes `train_latents.npy` (float32 or float64, shape `(n, latents)`),
+//!    optionally `prior.npy` (shape `(2, latents)`: mean row, std row), and prints the line
+//!    `READY` on stdout. Its stderr is forwarded to `tracing` and its last lines are kept for
+//!    error messages.
+//! 3. Encode requests: the harness writes one npy array (float32, `(m, dim)`, C order,
+//!    `1 <= m <=` [`MAX_ROWS_PER_REQUEST`]) to the program's stdin; the program answers with
+//!    one npy array (float32 or float64, `(m, latents)`) on stdout. npy frames itself (magic,
+//!    header length, header with dtype and shape), so no other framing is needed.
+//! 4. Closing stdin means shutdown: the program exits with status 0.
+//!
+//! Every answer is validated (magic, dtype, shape, finite values); a failure, a timeout or a
+//! premature exit becomes [`ReprError::External`] with the exit status and the last lines of
+//! the program's stderr, after which the process group is killed and the encoder refuses
+//! further requests. Dropping the encoder closes stdin, waits a short grace period and kills
+//! the process group; the child is always reaped and the work directory removed.
+
+use std::collections::VecDeque;
+use std::fs::{self, File};
+use std::io::{self, BufRead, BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStderr, ChildStdin, ChildStdout, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::thread;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use rand::Rng;
+
+use super::{
+    Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
+    check_latents,
+};
+use crate::seed::Stream;
+
+/// The protocol version, passed to the program as `UGL_PROTOCOL`.
+pub const PROTOCOL_VERSION: u32 = 1;
+/// Largest number of images in one encode request; bigger batches are split.
+pub const MAX_ROWS_PER_REQUEST: usize = 1024;
+/// Default time allowed from the start of the program to its `READY` line (the whole fit).
+pub const DEFAULT_READY_TIMEOUT: Duration = Duration::from_secs(3600);
+/// Default time allowed for each encode request (write the request, read the answer).
+pub const DEFAULT_ANSWER_TIMEOUT: Duration = Duration::from_secs(300);
+/// How long a dropped encoder waits for the program to exit after closing its stdin.
+const SHUTDOWN_GRACE: Duration = Duration::from_secs(5);
+/// After the program closed its stdout, how long to wait for its exit status.
+const EXIT_WAIT_ON_EOF: Duration = Duration::from_secs(2);
+/// After the process exited or was killed, how long to wait for the rest of its stderr.
+const STDERR_DRAIN: Duration = Duration::from_millis(500);
+/// Lines of stderr kept for error messages, and the longest line kept.
+const STDERR_TAIL_LINES: usize = 20;
+const STDERR_LINE_MAX: usize = 1000;
+/// Longest `READY` line and npy header accepted (protection against garbage).
+const READY_LINE_MAX: u64 = 4096;
+const NPY_HEADER_MAX: usize = 1 << 20;
+
+/// A representation learner run as an external program (protocol v1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExternalLearner {
+    /// Name in results and on the command line.
+    pub name: String,
+    /// The command line, run with `sh -c` (so quoting, `cd dir && ...` and variables work).
+    pub command: String,
+    /// Time allowed from the start of the program to `READY` (fit included).
+    pub ready_timeout: Duration,
+    /// Time allowed for each encode request.
+    pub answer_timeout: Duration,
+}
+
+impl ExternalLearner {
+    /// A learner with the default timeouts ([`DEFAULT_READY_TIMEOUT`], [`DEFAULT_ANSWER_TIMEOUT`]).
+    pub fn new(name: impl Into<String>, command: impl Into<String>) -> Self {
+        ExternalLearner {
+            name: name.into(),
+            command: command.into(),
+            ready_timeout: DEFAULT_READY_TIMEOUT,
+            answer_timeout: DEFAULT_ANSWER_TIMEOUT,
+        }
+    }
+}
+
+impl RepresentationLearner for ExternalLearner {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let (encoder, z) = self.fit_external(images, latents, rng)?;
+        Ok((Box::new(encoder), z))
+    }
+}
+
+impl ExternalLearner {
+    /// [`RepresentationLearner::fit`] with the concrete encoder type (for
+    /// [`ExternalEncoder::shutdown`] and [`ExternalEncoder::process_id`]).
+    pub fn fit_external(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(ExternalEncoder, Latents), ReprError> {
+        check_fit_input(images, latents)?;
+        let seed = rng.next_u64();
+        let workdir = WorkDir::create()?;
+        let train = workdir.path.join("train.npy");
+        let train_latents = workdir.path.join("train_latents.npy");
+        let prior_path = workdir.path.join("prior.npy");
+        write_npy_f32_file(&train, images.n, images.dim, &images.data)
+            .map_err(|e| ReprError::Io(format!("writing {}: {e}", train.display())))?;
+
+        let mut cmd = Command::new("sh");
+        cmd.arg("-c")
+            .arg(&self.command)
+            .env("UGL_PROTOCOL", PROTOCOL_VERSION.to_string())
+            .env("UGL_TRAIN", &train)
+            .env("UGL_TRAIN_LATENTS", &train_latents)
+            .env("UGL_LATENTS", latents.to_string())
+            .env("UGL_SEED", seed.to_string())
+            .env("UGL_WORKDIR", &workdir.path);
+        tracing::info!(learner = %self.name, command = %self.command, n = images.n, latents, seed,
+            workdir = %workdir.path.display(), "starting external learner");
+        let mut session = Session::spawn(self, cmd, workdir)?;
+        session.wait_ready(self.ready_timeout)?;
+
+        let z = match read_npy_file(&train_latents, Some(images.n), latents) {
+            Ok(data) => Latents {
+                n: images.n,
+                latents,
+                data,
+            },
+            Err(e) => return Err(session.fail(format!("after READY: {e}"), false)),
+        };
+        if let Err(e) = check_latents(
+            &z,
+            &format!("external learner '{}' (train_latents.npy)", self.name),
+        ) {
+            let _ = session.fail(e.to_string(), false);
+            return Err(e);
+        }
+        let prior = if prior_path.exists() {
+            match read_npy_file(&prior_path, Some(2), latents).and_then(|p| prior_from(&p, latents))
+            {
+                Ok(p) => Some(p),
+                Err(e) => return Err(session.fail(format!("after READY: {e}"), false)),
+            }
+        } else {
+            None
+        };
+        let encoder = ExternalEncoder {
+            session,
+            dim: images.dim,
+            latents,
+            prior,
+            request: Vec::new(),
+            answer: Vec::new(),
+        };
+        Ok((encoder, z))
+    }
+}
+
+fn prior_from(p: &[f64], latents: usize) -> Result<GaussianPrior, String> {
+    let (mean, std) = p.split_at(latents);
+    if p.iter().any(|v| !v.is_finite()) || std.iter().any(|&s| s <= 0.0) {
+        return Err("prior.npy: values must be finite and the std row (row 1) positive".into());
+    }
+    Ok(GaussianPrior {
+        mean: mean.to_vec(),
+        std: std.to_vec(),
+    })
+}
+
+/// The encoder of an [`ExternalLearner`]: the running program, asked through its stdin/stdout.
+pub struct ExternalEncoder {
+    session: Session,
+    dim: usize,
+    latents: usize,
+    prior: Option<GaussianPrior>,
+    /// Reused request bytes (npy header + little-endian float32 pixels).
+    request: Vec<u8>,
+    /// Reused answer values.
+    answer: Vec<f64>,
+}
+
+impl ExternalEncoder {
+    /// The process id of the program (`sh`, leader of the program's process group).
+    pub fn process_id(&self) -> u32 {
+        self.session.child.id()
+    }
+
+    /// Close the program's stdin and wait (up to the answer timeout) for it to exit; an exit
+    /// status other than 0 is an error. Dropping the encoder does the same without reporting.
+    pub fn shutdown(mut self) -> Result<(), ReprError> {
+        if let Some(b) = &self.session.broken {
+            return Err(ReprError::External(b.clone()));
+        }
+        let grace = self.session.answer_timeout;
+        match self.session.close(grace) {
+            Some(s) if s.success() => Ok(()),
+            Some(s) => Err(ReprError::External(self.session.describe(
+                "non-zero exit after stdin was closed",
+                Some(s),
+                false,
+            ))),
+            None => Err(ReprError::External(self.session.describe(
+                &format!("did not exit within {grace:?} after stdin was closed; killed"),
+                None,
+                true,
+            ))),
+        }
+    }
+
+    /// One request of `rows` images (`pixels.len() == rows * dim`); the answer lands in `self.answer`.
+    fn round_trip(&mut self, rows: usize, pixels: &[f32]) -> Result<(), ReprError> {
+        self.request.clear();
+        push_npy_f32(&mut self.request, rows, self.dim, pixels);
+        self.session
+            .round_trip(rows, self.latents, &mut self.request, &mut self.answer)?;
+        if let Some(i) = self.answer.iter().position(|v| !v.is_finite()) {
+            let msg = format!(
+                "answer has a non-finite latent (image {} of the request, dimension {})",
+                i / self.latents,
+                i % self.latents
+            );
+            return Err(self.session.fail(msg, false));
+        }
+        Ok(())
+    }
+}
+
+impl Encoder for ExternalEncoder {
+    fn latents(&self) -> usize {
+        self.latents
+    }
+
+    fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        if images.dim != self.dim {
+            return Err(ReprError::InvalidInput(format!(
+                "images have {} pixels, the learner was fitted on {}",
+                images.dim, self.dim
+            )));
+        }
+        if images.data.len() != images.n * images.dim {
+            return Err(ReprError::InvalidInput(
+                "image data does not match n x dim".into(),
+            ));
+        }
+        let mut data = Vec::with_capacity(images.n * self.latents);
+        for start in (0..images.n).step_by(MAX_ROWS_PER_REQUEST) {
+            let rows = MAX_ROWS_PER_REQUEST.min(images.n - start);
+            self.round_trip(
+                rows,
+                &images.data[start * self.dim..(start + rows) * self.dim],
+            )?;
+            data.extend_from_slice(&self.answer);
+        }
+        let z = Latents {
+            n: images.n,
+            latents: self.latents,
+            data,
+        };
+        check_latents(&z, &format!("external learner '{}'", self.session.name))?;
+        Ok(z)
+    }
+
+    fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
+        if image.len() != self.dim || out.len() != self.latents {
+            return Err(ReprError::InvalidInput(format!(
+                "encode_one: image has {} pixels (expected {}), output {} values (expected {})",
+                image.len(),
+                self.dim,
+                out.len(),
+                self.latents
+            )));
+        }
+        self.round_trip(1, image)?;
+        out.copy_from_slice(&self.answer);
+        Ok(())
+    }
+
+    fn prior(&self) -> Option<GaussianPrior> {
+        self.prior.clone()
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The process and its three I/O threads.
+
+/// A request to the stdout thread: read one answer of `rows x cols` into `buf`.
+struct ReadRequest {
+    rows: usize,
+    cols: usize,
+    buf: Vec<f64>,
+}
+
+enum FromReader {
+    Ready,
+    Answer(Vec<f64>),
+    /// Protocol violation or end of stdout; the thread has stopped.
+    Failed(String, bool),
+}
+
+#[derive(Default)]
+struct StderrTail {
+    lines: VecDeque<String>,
+    closed: bool,
+}
+
+/// The temporary work directory, removed on drop.
+struct WorkDir {
+    path: PathBuf,
+}
+
+impl WorkDir {
+    fn create() -> Result<Self, ReprError> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let base = std::env::temp_dir();
+        let nanos = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map(|d| d.subsec_nanos())
+            .unwrap_or(0);
+        let mut last_err = None;
+        for _ in 0..16 {
+            let k = COUNTER.fetch_add(1, Ordering::Relaxed);
+            let path = base.join(format!(
+                "ugl-external-{}-{k}-{nanos:08x}",
+                std::process::id()
+            ));
+            match fs::create_dir(&path) {
+                Ok(()) => return Ok(WorkDir { path }),
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last_err = Some(e),
+                Err(e) => return Err(ReprError::Io(format!("creating {}: {e}", path.display()))),
+            }
+        }
+        Err(ReprError::Io(format!(
+            "creating a work directory in {}: {last_err:?}",
+            base.display()
+        )))
+    }
+}
+
+impl Drop for WorkDir {
+    fn drop(&mut self) {
+        let _ = fs::remove_dir_all(&self.path);
+    }
+}
+
+struct Session {
+    name: String,
+    command: String,
+    answer_timeout: Duration,
+    child: Child,
+    to_writer: Option<Sender<Vec<u8>>>,
+    from_writer: Receiver<Result<Vec<u8>, String>>,
+    to_reader: Option<Sender<ReadRequest>>,
+    from_reader: Receiver<FromReader>,
+    stderr: Arc<Mutex<StderrTail>>,
+    /// Exit status once reaped.
+    status: Option<ExitStatus>,
+    /// Set after a failure: the message, returned for every later request.
+    broken: Option<String>,
+    // Dropped last, after the process is gone.
+    _workdir: WorkDir,
+}
+
+fn spawn_thread<F: FnOnce() + Send + 'static>(name: &str, f: F) -> Result<(), ReprError> {
+    thread::Builder::new()
+        .name(name.into())
+        .spawn(f)
+        .map(|_| ())
+        .map_err(|e| ReprError::Io(format!("spawning thread {name}: {e}")))
+}
+
+impl Session {
+    fn spawn(
+        learner: &ExternalLearner,
+        mut cmd: Command,
+        workdir: WorkDir,
+    ) -> Result<Session, ReprError> {
+        cmd.stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        #[cfg(unix)]
+        {
+            use std::os::unix::process::CommandExt;
+            cmd.process_group(0);
+        }
+        let mut child = cmd.spawn().map_err(|e| {
+            ReprError::External(format!(
+                "learner '{}': could not start `sh -c {:?}`: {e}",
+                learner.name, learner.command
+            ))
+        })?;
+        let stdin = child.stdin.take().expect("piped stdin");
+        let stdout = child.stdout.take().expect("piped stdout");
+        let stderr = child.stderr.take().expect("piped stderr");
+        let (to_writer, writer_rx) = mpsc::channel();
+        let (writer_tx, from_writer) = mpsc::channel();
+        let (to_reader, reader_rx) = mpsc::channel();
+        let (reader_tx, from_reader) = mpsc::channel();
+        let tail = Arc::new(Mutex::new(StderrTail::default()));
+        let session = Session {
+            name: learner.name.clone(),
+            command: learner.command.clone(),
+            answer_timeout: learner.answer_timeout,
+            child,
+            to_writer: Some(to_writer),
+            from_writer,
+            to_reader: Some(to_reader),
+            from_reader,
+            stderr: tail.clone(),
+            status: None,
+            broken: None,
+            _workdir: workdir,
+        };
+        // On a thread-spawn failure the session drops here, which kills and reaps the child.
+        let name = learner.name.clone();
+        spawn_thread("ugl-ext-stderr", move || stderr_loop(stderr, tail, name))?;
+        spawn_thread("ugl-ext-stdin", move || {
+            writer_loop(stdin, writer_rx, writer_tx)
+        })?;
+        spawn_thread("ugl-ext-stdout", move || {
+            reader_loop(stdout, reader_rx, reader_tx)
+        })?;
+        Ok(session)
+    }
+
+    fn wait_ready(&mut self, timeout: Duration) -> Result<(), ReprError> {
+        match self.from_reader.recv_timeout(timeout) {
+            Ok(FromReader::Ready) => Ok(()),
+            Ok(FromReader::Failed(m, eof)) => Err(self.fail(m, eof)),
+            Ok(FromReader::Answer(_)) => {
+                Err(self.fail("unexpected answer before READY".into(), false))
+            }
+            Err(RecvTimeoutError::Timeout) => Err(self.fail(
+                format!("no READY line within the ready timeout ({timeout:?})"),
+                false,
+            )),
+            Err(RecvTimeoutError::Disconnected) => {
+                Err(self.fail("stdout reader stopped".into(), true))
+            }
+        }
+    }
+
+    /// Send `request` (a complete npy array of `rows` images) and read a `rows x cols` answer
+    /// into `answer`. Both buffers are lent to the I/O threads and come back.
+    fn round_trip(
+        &mut self,
+        rows: usize,
+        cols: usize,
+        request: &mut Vec<u8>,
+        answer: &mut Vec<f64>,
+    ) -> Result<(), ReprError> {
+        if let Some(b) = &self.broken {
+            return Err(ReprError::External(format!(
+                "unusable after an earlier failure: {b}"
+            )));
+        }
+        let start = Instant::now();
+        let deadline = start + self.answer_timeout;
+        let req = ReadRequest {
+            rows,
+            cols,
+            buf: std::mem::take(answer),
+        };
+        let sent = self.to_reader.as_ref().is_some_and(|t| t.send(req).is_ok())
+            && self
+                .to_writer
+                .as_ref()
+                .is_some_and(|t| t.send(std::mem::take(request)).is_ok());
+        if !sent {
+            return Err(self.fail("the I/O threads have stopped".into(), true));
+        }
+        let remaining = |now: Instant| deadline.saturating_duration_since(now);
+        match self.from_reader.recv_timeout(remaining(Instant::now())) {
+            Ok(FromReader::Answer(buf)) => *answer = buf,
+            Ok(FromReader::Failed(m, eof)) => return Err(self.fail(m, eof)),
+            Ok(FromReader::Ready) => unreachable!("READY is sent once"),
+            Err(RecvTimeoutError::Timeout) => {
+                let what = match self.from_writer.try_recv() {
+                    Err(TryRecvError::Empty) => "did not read the whole request",
+                    _ => "did not answer",
+                };
+                let msg = format!(
+                    "{what} within the answer timeout ({:?}; request of {rows} images)",
+                    self.answer_timeout
+                );
+                return Err(self.fail(msg, false));
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(self.fail("stdout reader stopped".into(), true));
+            }
+        }
+        match self.from_writer.recv_timeout(remaining(Instant::now())) {
+            Ok(Ok(buf)) => *request = buf,
+            Ok(Err(e)) => {
+                return Err(self.fail(format!("writing the request to its stdin: {e}"), true));
+            }
+            Err(_) => {
+                return Err(self.fail("answered before reading the whole request".into(), false));
+            }
+        }
+        Ok(())
+    }
+
+    /// Record a failure: wait briefly for the exit status if the program closed its stdout
+    /// (`eof`), else kill it at once; reap it; return the error with status and stderr tail.
+    fn fail(&mut self, what: String, eof: bool) -> ReprError {
+        let mut killed = false;
+        if self.status.is_none() {
+            let grace = if eof {
+                EXIT_WAIT_ON_EOF
+            } else {
+                Duration::ZERO
+            };
+            killed = self.terminate(grace);
+        }
+        let msg = self.describe(&what, self.status, killed);
+        tracing::warn!(learner = %self.name, "external learner failed: {msg}");
+        self.broken = Some(msg.clone());
+        ReprError::External(msg)
+    }
+
+    /// The error text: who, what, exit status, last stderr lines.
+    fn describe(&self, what: &str, status: Option<ExitStatus>, killed: bool) -> String {
+        // Let the stderr thread catch the program's last words.
+        let until = Instant::now() + STDERR_DRAIN;
+        while !self.stderr.lock().map(|t| t.closed).unwrap_or(true) && Instant::now() < until {
+            thread::sleep(Duration::from_millis(2));
+        }
+        let mut msg = format!(
+            "learner '{}' (command `{}`): {what}",
+            self.name, self.command
+        );
+        match status {
+            _ if killed => msg.push_str("; the harness killed the program"),
+            Some(s) => {
+                msg.push_str(&format!("; the program exited with {s}"));
+                if s.code() == Some(127) {
+                    msg.push_str(" (command not found?)");
+                } else if s.code() == Some(126) {
+                    msg.push_str(" (command not executable?)");
+                }
+            }
+            None => {}
+        }
+        let lines: Vec<String> = self
+            .stderr
+            .lock()
+            .map(|t| t.lines.iter().cloned().collect())
+            .unwrap_or_default();
+        if lines.is_empty() {
+            msg.push_str("; its stderr was empty");
+        } else {
+            msg.push_str("; last lines of its stderr:");
+            for l in lines {
+                msg.push_str("\n  | ");
+                msg.push_str(&l);
+            }
+        }
+        msg
+    }
+
+    /// Close stdin, wait up to `grace` for the program to exit, else kill its process group.
+    /// Reaps the child. Returns the exit status if it exited by itself.
+    fn close(&mut self, grace: Duration) -> Option<ExitStatus> {
+        if self.status.is_none() {
+            let killed = self.terminate(grace);
+            if killed {
+                return None;
+            }
+        }
+        self.status
+    }
+
+    /// Stop the I/O (closing stdin), wait up to `grace`, kill the group if still running, reap.
+    /// Returns whether it had to kill.
+    fn terminate(&mut self, grace: Duration) -> bool {
+        self.to_writer = None; // the stdin thread ends and closes the pipe
+        self.to_reader = None;
+        let until = Instant::now() + grace;
+        loop {
+            match self.child.try_wait() {
+                Ok(Some(s)) => {
+                    // Exited by itself (and reaped: its group id may be reused, so no group kill).
+                    self.status = Some(s);
+                    return false;
+                }
+                Ok(None) if Instant::now() < until => thread::sleep(Duration::from_millis(2)),
+                _ => break,
+            }
+        }
+        // The leader is not reaped yet, so the group id is still ours.
+        kill_group(self.child.id());
+        let _ = self.child.kill();
+        self.status = self.child.wait().ok();
+        true
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        if self.status.is_none() {
+            self.terminate(SHUTDOWN_GRACE);
+        }
+    }
+}
+
+/// Kill the process group `pgid` (the program was started as a group leader), so that
+/// programs started by the shell die too. Errors (group already gone) are ignored.
+fn kill_group(pgid: u32) {
+    #[cfg(unix)]
+    {
+        let target = format!("-{pgid}");
+        let quiet = |c: &mut Command| {
+            c.stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+        };
+        if quiet(Command::new("kill").args(["-9", "--", &target])).is_err() {
+            // No `kill` executable: the shell builtin (dash does not accept `--`).
+            let _ = quiet(Command::new("sh").args(["-c", &format!("kill -9 {target}")]));
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = pgid;
+}
+
+fn writer_loop(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>, tx: Sender<Result<Vec<u8>, String>>) {
+    while let Ok(buf) = rx.recv() {
+        match stdin.write_all(&buf).and_then(|()| stdin.flush()) {
+            Ok(()) => {
+                if tx.send(Ok(buf)).is_err() {
+                    return;
+                }
+            }
+            Err(e) => {
+                let _ = tx.send(Err(e.to_string()));
+                return;
+            }
+        }
+    }
+    // Dropping `stdin` closes the pipe: the program's shutdown signal.
+}
+
+fn reader_loop(stdout: ChildStdout, rx: Receiver<ReadRequest>, tx: Sender<FromReader>) {
+    let mut r = BufReader::with_capacity(1 << 16, stdout);
+    let mut line = Vec::new();
+    let msg = match (&mut r).take(READY_LINE_MAX).read_until(b'\n', &mut line) {
+        Ok(0) => Err((
+            "closed its stdout (exited?) before printing READY".to_string(),
+            true,
+        )),
+        Ok(_) => {
+            let text = String::from_utf8_lossy(&line);
+            if text.trim() == "READY" {
+                Ok(())
+            } else {
+                Err((
+                    format!(
+                        "expected the line READY on stdout, got {:?} (stdout is reserved for the \
+                         protocol: log to stderr)",
+                        truncate(&text, 200)
+                    ),
+                    false,
+                ))
+            }
+        }
+        Err(e) => Err((format!("reading stdout: {e}"), true)),
+    };
+    match msg {
+        Ok(()) => {
+            if tx.send(FromReader::Ready).is_err() {
+                return;
+            }
+        }
+        Err((m, eof)) => {
+            let _ = tx.send(FromReader::Failed(m, eof));
+            return;
+        }
+    }
+    let mut raw = Vec::new();
+    while let Ok(req) = rx.recv() {
+        let mut buf = req.buf;
+        match read_npy(
+            &mut r,
+            &mut raw,
+            &mut buf,
+            Some(req.rows),
+            req.cols,
+            "answer",
+        ) {
+            Ok(_) => {
+                if tx.send(FromReader::Answer(buf)).is_err() {
+                    return;
+                }
+            }
+            Err(e) => {
+                let _ = tx.send(FromReader::Failed(e.message, e.eof));
+                return;
+            }
+        }
+    }
+}
+
+fn stderr_loop(stderr: ChildStderr, tail: Arc<Mutex<StderrTail>>, name: String) {
+    let mut r = BufReader::new(stderr);
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        match (&mut r).take(64 * 1024).read_until(b'\n', &mut line) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {
+                let text = String::from_utf8_lossy(&line);
+                let text = text.trim_end();
+                tracing::info!(learner = %name, "{text}");
+                if let Ok(mut t) = tail.lock() {
+                    if t.lines.len() == STDERR_TAIL_LINES {
+                        t.lines.pop_front();
+                    }
+                    t.lines.push_back(truncate(text, STDERR_LINE_MAX));
+                }
+            }
+        }
+    }
+    if let Ok(mut t) = tail.lock() {
+        t.closed = true;
+    }
+}
+
+fn truncate(s: &str, max: usize) -> String {
+    match s.char_indices().nth(max) {
+        Some((i, _)) => format!("{}...", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// npy: just what the protocol needs. Written: version 1.0, '<f4', C order. Read: versions
+// 1.0/2.0/3.0, f4 or f8 of either byte order, C or Fortran order, two dimensions.
+
+const NPY_MAGIC: &[u8; 6] = b"\x93NUMPY";
+
+/// Append a complete npy array (float32, shape (rows, cols), C order) to `buf`.
+fn push_npy_f32(buf: &mut Vec<u8>, rows: usize, cols: usize, data: &[f32]) {
+    debug_assert_eq!(data.len(), rows * cols);
+    push_npy_header(buf, "<f4", rows, cols);
+    buf.reserve(data.len() * 4);
+    for v in data {
+        buf.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+fn push_npy_header(buf: &mut Vec<u8>, descr: &str, rows: usize, cols: usize) {
+    let mut header =
+        format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    // Total length (10-byte preamble + header + '\n') a multiple of 64, as numpy writes it.
+    let unpadded = 10 + header.len() + 1;
+    header.extend(std::iter::repeat_n(
+        ' ',
+        unpadded.next_multiple_of(64) - unpadded,
+    ));
+    header.push('\n');
+    buf.extend_from_slice(NPY_MAGIC);
+    buf.extend_from_slice(&[1, 0]);
+    buf.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    buf.extend_from_slice(header.as_bytes());
+}
+
+fn write_npy_f32_file(path: &Path, rows: usize, cols: usize, data: &[f32]) -> io::Result<()> {
+    let mut w = BufWriter::with_capacity(1 << 20, File::create(path)?);
+    let mut header = Vec::new();
+    push_npy_header(&mut header, "<f4", rows, cols);
+    w.write_all(&header)?;
+    let mut chunk = Vec::with_capacity(64 * 1024);
+    for block in data.chunks(16 * 1024) {
+        chunk.clear();
+        for v in block {
+            chunk.extend_from_slice(&v.to_le_bytes());
+        }
+        w.write_all(&chunk)?;
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()
+}
+
+struct NpyError {
+    message: String,
+    /// The stream ended (the program probably exited).
+    eof: bool,
+}
+
+fn npy_err(what: &str, msg: impl std::fmt::Display) -> NpyError {
+    NpyError {
+        message: format!("{what}: {msg}"),
+        eof: false,
+    }
+}
+
+fn io_err(what: &str, e: io::Error) -> NpyError {
+    let eof = e.kind() == io::ErrorKind::UnexpectedEof;
+    let msg = if eof {
+        "stream ended in the middle of an npy array (program exited?)".to_string()
+    } else {
+        e.to_string()
+    };
+    NpyError {
+        message: format!("{what}: {msg}"),
+        eof,
+    }
+}
+
+fn read_npy_file(path: &Path, rows: Option<usize>, cols: usize) -> Result<Vec<f64>, String> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let file =
+        File::open(path).map_err(|e| format!("cannot open {name} ({}): {e}", path.display()))?;
+    let mut r = BufReader::new(file);
+    let mut out = Vec::new();
+    read_npy(&mut r, &mut Vec::new(), &mut out, rows, cols, &name).map_err(|e| e.message)?;
+    let mut probe = [0u8; 1];
+    if r.read(&mut probe).map_err(|e| format!("{name}: {e}"))? != 0 {
+        return Err(format!("{name}: trailing bytes after the array"));
+    }
+    Ok(out)
+}
+
+/// Read one npy array of shape (rows, cols) (rows checked when given) into `out` as f64.
+/// `raw` is a reusable byte buffer. Returns the number of rows.
+fn read_npy<R: Read>(
+    r: &mut BufReader<R>,
+    raw: &mut Vec<u8>,
+    out: &mut Vec<f64>,
+    rows: Option<usize>,
+    cols: usize,
+    what: &str,
+) -> Result<usize, NpyError> {
+    let mut magic = [0u8; 6];
+    let mut got = 0;
+    while got < 6 {
+        match r.read(&mut magic[got..]) {
+            Ok(0) if got == 0 => {
+                return Err(NpyError {
+                    message: format!(
+                        "{what}: stream closed (program exited?) instead of an npy array"
+                    ),
+                    eof: true,
+                });
+            }
+            Ok(0) => return Err(io_err(what, io::ErrorKind::UnexpectedEof.into())),
+            Ok(k) => got += k,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(io_err(what, e)),
+        }
+    }
+    if &magic != NPY_MAGIC {
+        // Show what came instead: the 6 bytes plus whatever is already buffered (no blocking).
+        let mut seen = magic.to_vec();
+        seen.extend_from_slice(&r.buffer()[..r.buffer().len().min(200)]);
+        return Err(npy_err(
+            what,
+            format!(
+                "not an npy array: starts with {:?} (stdout is reserved for the protocol: log to stderr)",
+                String::from_utf8_lossy(&seen)
+            ),
+        ));
+    }
+    let mut version = [0u8; 2];
+    r.read_exact(&mut version).map_err(|e| io_err(what, e))?;
+    let header_len = match version[0] {
+        1 => {
+            let mut b = [0u8; 2];
+            r.read_exact(&mut b).map_err(|e| io_err(what, e))?;
+            u16::from_le_bytes(b) as usize
+        }
+        2 | 3 => {
+            let mut b = [0u8; 4];
+            r.read_exact(&mut b).map_err(|e| io_err(what, e))?;
+            u32::from_le_bytes(b) as usize
+        }
+        v => {
+            return Err(npy_err(
+                what,
+                format!("unsupported npy version {v}.{}", version[1]),
+            ));
+        }
+    };
+    if header_len > NPY_HEADER_MAX {
+        return Err(npy_err(
+            what,
+            format!("npy header of {header_len} bytes is too long"),
+        ));
+    }
+    raw.clear();
+    raw.resize(header_len, 0);
+    r.read_exact(raw).map_err(|e| io_err(what, e))?;
+    let text = std::str::from_utf8(raw).map_err(|_| npy_err(what, "npy header is not UTF-8"))?;
+    let header = parse_header(text)
+        .map_err(|m| npy_err(what, format!("bad npy header {:?}: {m}", text.trim_end())))?;
+    let (size, big) = match header.descr.as_str() {
+        "<f4" | "f4" => (4, false),
+        "<f8" | "f8" => (8, false),
+        ">f4" => (4, true),
+        ">f8" => (8, true),
+        "=f4" => (4, cfg!(target_endian = "big")),
+        "=f8" => (8, cfg!(target_endian = "big")),
+        d => {
+            return Err(npy_err(
+                what,
+                format!("dtype {d:?} not supported (use float32 '<f4' or float64 '<f8')"),
+            ));
+        }
+    };
+    let shape_ok = header.shape.len() == 2
+        && header.shape[1] == cols
+        && rows.is_none_or(|m| header.shape[0] == m);
+    if !shape_ok {
+        let expected = match rows {
+            Some(m) => format!("({m}, {cols})"),
+            None => format!("(n, {cols})"),
+        };
+        return Err(npy_err(
+            what,
+            format!("shape {:?}, expected {expected}", header.shape),
+        ));
+    }
+    let m = header.shape[0];
+    let count = m
+        .checked_mul(cols)
+        .ok_or_else(|| npy_err(what, "shape overflows"))?;
+    let bytes = count
+        .checked_mul(size)
+        .ok_or_else(|| npy_err(what, "shape overflows"))?;
+    raw.clear();
+    raw.resize(bytes, 0);
+    r.read_exact(raw).map_err(|e| io_err(what, e))?;
+    out.clear();
+    out.resize(count, 0.0);
+    let value = |k: usize| -> f64 {
+        let b = &raw[k * size..(k + 1) * size];
+        match (size, big) {
+            (4, false) => f32::from_le_bytes(b.try_into().expect("4 bytes")) as f64,
+            (4, true) => f32::from_be_bytes(b.try_into().expect("4 bytes")) as f64,
+            (_, false) => f64::from_le_bytes(b.try_into().expect("8 bytes")),
+            (_, true) => f64::from_be_bytes(b.try_into().expect("8 bytes")),
+        }
+    };
+    if header.fortran_order {
+        for k in 0..count {
+            out[(k % m.max(1)) * cols + k / m.max(1)] = value(k);
+        }
+    } else {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = value(k);
+        }
+    }
+    Ok(m)
+}
+
+struct NpyHeader {
+    descr: String,
+    fortran_order: bool,
+    shape: Vec<usize>,
+}
+
+/// Parse the Python dict literal of an npy header.
+fn parse_header(text: &str) -> Result<NpyHeader, String> {
+    let b = text.as_bytes();
+    let mut i = 0;
+    let skip = |i: &mut usize| {
+        while *i < b.len() && b[*i].is_ascii_whitespace() {
+            *i += 1;
+        }
+    };
+    let string = |i: &mut usize| -> Result<String, String> {
+        let q = b[*i];
+        let start = *i + 1;
+        let end = b[start..]
+            .iter()
+            .position(|&c| c == q)
+            .ok_or("unterminated string")?
+            + start;
+        *i = end + 1;
+        Ok(text[start..end].to_string())
+    };
+    skip(&mut i);
+    if b.get(i) != Some(&b'{') {
+        return Err("expected '{'".into());
+    }
+    i += 1;
+    let (mut descr, mut fortran, mut shape) = (None, None, None);
+    loop {
+        skip(&mut i);
+        match b.get(i) {
+            Some(b'}') => {
+                i += 1;
+                break;
+            }
+            Some(b'\'' | b'"') => {}
+            _ => return Err("expected a quoted key or '}'".into()),
+        }
+        let key = string(&mut i)?;
+        skip(&mut i);
+        if b.get(i) != Some(&b':') {
+            return Err(format!("expected ':' after {key:?}"));
+        }
+        i += 1;
+        skip(&mut i);
+        match (key.as_str(), b.get(i)) {
+            ("descr", Some(b'\'' | b'"')) => descr = Some(string(&mut i)?),
+            ("fortran_order", _) if b[i..].starts_with(b"True") => {
+                fortran = Some(true);
+                i += 4;
+            }
+            ("fortran_order", _) if b[i..].starts_with(b"False") => {
+                fortran = Some(false);
+                i += 5;
+            }
+            ("shape", Some(b'(')) => {
+                let end = b[i..]
+                    .iter()
+                    .position(|&c| c == b')')
+                    .ok_or("unterminated shape")?
+                    + i;
+                let dims = text[i + 1..end]
+                    .split(',')
+                    .map(|s| s.trim().trim_end_matches('L'))
+                    .filter(|s| !s.is_empty())
+                    .map(|s| {
+                        s.parse::<usize>()
+                            .map_err(|_| format!("bad dimension {s:?}"))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                shape = Some(dims);
+                i = end + 1;
+            }
+            (k, _) => return Err(format!("unexpected key or value for {k:?}")),
+        }
+        skip(&mut i);
+        if b.get(i) == Some(&b',') {
+            i += 1;
+        }
+    }
+    skip(&mut i);
+    if i != b.len() {
+        return Err("trailing characters after the header dict".into());
+    }
+    Ok(NpyHeader {
+        descr: descr.ok_or("missing 'descr'")?,
+        fortran_order: fortran.ok_or("missing 'fortran_order'")?,
+        shape: shape.ok_or("missing 'shape'")?,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn roundtrip_bytes(bytes: &[u8], rows: Option<usize>, cols: usize) -> Result<Vec<f64>, String> {
+        let mut r = BufReader::new(bytes);
+        let mut out = Vec::new();
+        read_npy(&mut r, &mut Vec::new(), &mut out, rows, cols, "test")
+            .map(|_| out)
+            .map_err(|e| e.message)
+    }
+
+    #[test]
+    fn npy_written_header_is_aligned_and_reads_back() {
+        let data: Vec<f32> = (0..6).map(|v| v as f32 * 0.5).collect();
+        let mut buf = Vec::new();
+        push_npy_f32(&mut buf, 2, 3, &data);
+        assert_eq!(
+            (buf.len() - 24) % 64,
+            0,
+            "preamble + header is a multiple of 64"
+        );
+        let back = roundtrip_bytes(&buf, Some(2), 3).unwrap();
+        assert_eq!(back, vec![0.0, 0.5, 1.0, 1.5, 2.0, 2.5]);
+        assert!(
+            roundtrip_bytes(&buf, Some(3), 3)
+                .unwrap_err()
+                .contains("shape [2, 3], expected (3, 3)")
+        );
+        assert!(roundtrip_bytes(&buf, None, 2).is_err());
+    }
+
+    #[test]
+    fn npy_reads_fortran_big_endian_and_v2() {
+        // (2, 3) float64 big-endian, Fortran order, version 2.0, double-quoted keys.
+        let header = "{\"descr\": \">f8\", \"fortran_order\": True, \"shape\": (2L, 3L)}\n";
+        let mut buf = NPY_MAGIC.to_vec();
+        buf.extend_from_slice(&[2, 0]);
+        buf.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        buf.extend_from_slice(header.as_bytes());
+        // Column-major: (0,0) (1,0) (0,1) (1,1) (0,2) (1,2) with value 10 r + c.
+        for v in [0.0f64, 10.0, 1.0, 11.0, 2.0, 12.0] {
+            buf.extend_from_slice(&v.to_be_bytes());
+        }
+        assert_eq!(
+            roundtrip_bytes(&buf, Some(2), 3).unwrap(),
+            vec![0.0, 1.0, 2.0, 10.0, 11.0, 12.0]
+        );
+    }
+
+    #[test]
+    fn npy_rejects_garbage_and_other_dtypes() {
+        let e = roundtrip_bytes(b"hello world\n", Some(1), 1).unwrap_err();
+        assert!(
+            e.contains("not an npy array") && e.contains("hello world"),
+            "{e}"
+        );
+        let mut buf = Vec::new();
+        push_npy_header(&mut buf, "<i8", 1, 1);
+        buf.extend_from_slice(&[0; 8]);
+        assert!(
+            roundtrip_bytes(&buf, Some(1), 1)
+                .unwrap_err()
+                .contains("dtype")
+        );
+        let mut short = Vec::new();
+        push_npy_f32(&mut short, 1, 2, &[1.0, 2.0]);
+        short.truncate(short.len() - 1);
+        assert!(
+            roundtrip_bytes(&short, Some(1), 2)
+                .unwrap_err()
+                .contains("middle")
+        );
+        assert!(parse_header("{'descr': '<f4', 'shape': (1, 2), }").is_err());
+    }
+}

@@ -10,6 +10,7 @@ pub mod dataset;
 pub mod external;
 pub mod isomap;
 pub mod pca;
+pub mod sparse;
 
 use thiserror::Error;
 

@@ -1,0 +1,328 @@
+//! PCA learners (PAPER-NOTES.md section 5, "PCA").
+//!
+//! - [`TruncatedSvd`] (`pca`): what the paper's code used, `sklearn.decomposition.TruncatedSVD`
+//!   — **not mean-centred** — with its randomized solver (10 oversamples, 5 power iterations).
+//!   Encoding = `x V` (V: the top right singular vectors). Works on sparse rows, so a 10,000 x
+//!   4900 image set costs O(non-zeros).
+//! - [`CentredPca`] (`pca-centred`): ordinary PCA (mean-centred), by `linfa-reduction`.
+
+use linfa::traits::{Fit, Predict};
+use linfa::DatasetBase;
+use ndarray::Array2;
+use rand_distr::{Distribution, StandardNormal};
+
+use super::sparse::SparseRows;
+use super::{check_fit_input, check_latents, Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use crate::seed::Stream;
+
+/// Non-centred truncated SVD with the randomized range finder (Halko et al. 2011), as
+/// scikit-learn's `TruncatedSVD(algorithm="randomized", n_iter=5)`.
+#[derive(Clone, Debug)]
+pub struct TruncatedSvd {
+    /// Extra random directions of the range finder (sklearn: 10).
+    pub n_oversamples: usize,
+    /// Power iterations (sklearn: 5).
+    pub n_iter: usize,
+}
+
+impl Default for TruncatedSvd {
+    fn default() -> Self {
+        TruncatedSvd { n_oversamples: 10, n_iter: 5 }
+    }
+}
+
+/// The fitted projection: `z = x V`.
+#[derive(Clone, Debug)]
+pub struct ProjectionEncoder {
+    /// p x d, row-major.
+    pub components: Vec<f64>,
+    pub dim: usize,
+    pub latents: usize,
+    /// Singular values, descending.
+    pub singular_values: Vec<f64>,
+}
+
+impl Encoder for ProjectionEncoder {
+    fn latents(&self) -> usize {
+        self.latents
+    }
+    fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        if images.dim != self.dim {
+            return Err(ReprError::InvalidInput(format!("images have {} pixels, the model {}", images.dim, self.dim)));
+        }
+        let z = SparseRows::from_images(images).mul_dense(&self.components, self.latents);
+        let z = Latents { n: images.n, latents: self.latents, data: z };
+        check_latents(&z, "pca")?;
+        Ok(z)
+    }
+    fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
+        if image.len() != self.dim || out.len() != self.latents {
+            return Err(ReprError::InvalidInput("encode_one: wrong image or output size".into()));
+        }
+        out.fill(0.0);
+        for (j, &v) in image.iter().enumerate() {
+            if v != 0.0 {
+                let row = &self.components[j * self.latents..(j + 1) * self.latents];
+                for (o, c) in out.iter_mut().zip(row) {
+                    *o += v as f64 * c;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl RepresentationLearner for TruncatedSvd {
+    fn name(&self) -> &str {
+        "pca"
+    }
+
+    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        check_fit_input(images, latents)?;
+        let x = SparseRows::from_images(images);
+        let (n, p) = (images.n, images.dim);
+        let k = (latents + self.n_oversamples).min(n).min(p);
+        let omega: Vec<f64> = (0..p * k).map(|_| StandardNormal.sample(rng)).collect();
+        let mut y = x.mul_dense(&omega, k);
+        orthonormalize(&mut y, n, k);
+        for _ in 0..self.n_iter {
+            let mut z = x.tmul_dense(&y, k);
+            orthonormalize(&mut z, p, k);
+            y = x.mul_dense(&z, k);
+            orthonormalize(&mut y, n, k);
+        }
+        // B^T = X^T Q (p x k); B B^T = (B^T)^T B^T (k x k).
+        let bt = x.tmul_dense(&y, k);
+        let mut c = vec![0.0; k * k];
+        for r in 0..p {
+            let row = &bt[r * k..(r + 1) * k];
+            for a in 0..k {
+                for b in 0..k {
+                    c[a * k + b] += row[a] * row[b];
+                }
+            }
+        }
+        let (vals, vecs) = jacobi_eigen(&c, k);
+        let mut components = vec![0.0; p * latents];
+        let mut singular_values = Vec::with_capacity(latents);
+        for (t, &(lambda, col)) in vals.iter().take(latents).enumerate() {
+            let sigma = lambda.max(0.0).sqrt();
+            singular_values.push(sigma);
+            if sigma <= f64::EPSILON * vals[0].0.max(1.0).sqrt() {
+                continue; // rank-deficient data: this component is zero
+            }
+            // Sign: the largest |u| entry positive (sklearn's svd_flip, u-based); u = Q w.
+            let w: Vec<f64> = (0..k).map(|a| vecs[a * k + col]).collect();
+            let mut best = (0.0f64, 1.0f64);
+            for i in 0..n {
+                let u: f64 = (0..k).map(|a| y[i * k + a] * w[a]).sum();
+                if u.abs() > best.0 {
+                    best = (u.abs(), u.signum());
+                }
+            }
+            for r in 0..p {
+                let v: f64 = (0..k).map(|a| bt[r * k + a] * w[a]).sum();
+                components[r * latents + t] = best.1 * v / sigma;
+            }
+        }
+        let mut enc = ProjectionEncoder { components, dim: p, latents, singular_values };
+        let z = enc.encode(images)?;
+        Ok((Box::new(enc), z))
+    }
+}
+
+/// Modified Gram-Schmidt, twice, on the k columns of a row-major m x k matrix. A column that
+/// vanishes relative to its norm before projection (rank deficiency) is set to zero.
+fn orthonormalize(a: &mut [f64], m: usize, k: usize) {
+    let mut before = vec![0.0; k];
+    for (j, b) in before.iter_mut().enumerate() {
+        *b = (0..m).map(|i| a[i * k + j] * a[i * k + j]).sum::<f64>().sqrt();
+    }
+    for pass in 0..2 {
+        for j in 0..k {
+            for q in 0..j {
+                let dot: f64 = (0..m).map(|i| a[i * k + j] * a[i * k + q]).sum();
+                for i in 0..m {
+                    a[i * k + j] -= dot * a[i * k + q];
+                }
+            }
+            let norm = (0..m).map(|i| a[i * k + j] * a[i * k + j]).sum::<f64>().sqrt();
+            let dead = norm <= 1e-300 || (pass == 0 && norm <= 1e-10 * before[j]);
+            let inv = if dead { 0.0 } else { 1.0 / norm };
+            for i in 0..m {
+                a[i * k + j] *= inv;
+            }
+        }
+    }
+}
+
+/// Eigen-decomposition of a small symmetric matrix by cyclic Jacobi rotations. Returns
+/// (eigenvalue, column index) sorted by decreasing eigenvalue, and the eigenvector matrix
+/// (row-major, eigenvectors in columns).
+pub fn jacobi_eigen(a: &[f64], k: usize) -> (Vec<(f64, usize)>, Vec<f64>) {
+    let mut m = a.to_vec();
+    let mut v = vec![0.0; k * k];
+    for i in 0..k {
+        v[i * k + i] = 1.0;
+    }
+    for _sweep in 0..100 {
+        let off: f64 = (0..k).flat_map(|i| (0..k).filter(move |&j| j != i).map(move |j| (i, j))).map(|(i, j)| m[i * k + j].powi(2)).sum();
+        let total: f64 = m.iter().map(|x| x * x).sum();
+        if off <= 1e-30 * total.max(1e-300) {
+            break;
+        }
+        for p in 0..k {
+            for q in p + 1..k {
+                let apq = m[p * k + q];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (m[q * k + q] - m[p * k + p]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for r in 0..k {
+                    let (mrp, mrq) = (m[r * k + p], m[r * k + q]);
+                    m[r * k + p] = c * mrp - s * mrq;
+                    m[r * k + q] = s * mrp + c * mrq;
+                }
+                for r in 0..k {
+                    let (mpr, mqr) = (m[p * k + r], m[q * k + r]);
+                    m[p * k + r] = c * mpr - s * mqr;
+                    m[q * k + r] = s * mpr + c * mqr;
+                }
+                for r in 0..k {
+                    let (vrp, vrq) = (v[r * k + p], v[r * k + q]);
+                    v[r * k + p] = c * vrp - s * vrq;
+                    v[r * k + q] = s * vrp + c * vrq;
+                }
+            }
+        }
+    }
+    let mut vals: Vec<(f64, usize)> = (0..k).map(|i| (m[i * k + i], i)).collect();
+    vals.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    (vals, v)
+}
+
+/// Ordinary (mean-centred) PCA by `linfa-reduction` (deterministic: linfa seeds its own solver).
+#[derive(Clone, Debug, Default)]
+pub struct CentredPca;
+
+/// The fitted linfa model.
+pub struct CentredPcaEncoder {
+    model: linfa_reduction::Pca<f64>,
+    dim: usize,
+    latents: usize,
+}
+
+fn to_array(images: &ImageSet) -> Array2<f64> {
+    Array2::from_shape_fn((images.n, images.dim), |(i, j)| images.data[i * images.dim + j] as f64)
+}
+
+impl Encoder for CentredPcaEncoder {
+    fn latents(&self) -> usize {
+        self.latents
+    }
+    fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        if images.dim != self.dim {
+            return Err(ReprError::InvalidInput(format!("images have {} pixels, the model {}", images.dim, self.dim)));
+        }
+        let z: Array2<f64> = self.model.predict(&to_array(images));
+        let z = Latents { n: images.n, latents: self.latents, data: z.iter().copied().collect() };
+        check_latents(&z, "pca-centred")?;
+        Ok(z)
+    }
+}
+
+impl RepresentationLearner for CentredPca {
+    fn name(&self) -> &str {
+        "pca-centred"
+    }
+    fn fit(&self, images: &ImageSet, latents: usize, _rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        check_fit_input(images, latents)?;
+        let ds = DatasetBase::from(to_array(images));
+        let model = linfa_reduction::Pca::params(latents)
+            .fit(&ds)
+            .map_err(|e| ReprError::Numerical(format!("pca-centred: {e}")))?;
+        let mut enc = CentredPcaEncoder { model, dim: images.dim, latents };
+        let z = enc.encode(images)?;
+        Ok((Box::new(enc), z))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seed::stream_named;
+
+    /// A hand-computable case: rows (3,0), (0,1), (3,0), (0,1) (plus a zero pixel). X^T X =
+    /// diag(18, 2): singular values sqrt(18), sqrt(2), right singular vectors e1, e2.
+    fn toy() -> ImageSet {
+        ImageSet::new(4, 3, vec![3.0, 0.0, 0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 1.0, 0.0]).unwrap()
+    }
+
+    #[test]
+    fn truncated_svd_hand_case_is_not_centred() {
+        let (mut enc, z) = TruncatedSvd::default().fit(&toy(), 2, &mut stream_named(0, "t")).unwrap();
+        // Non-centred: the first latent of row 0 is its projection on e1 = 3 (sign fixed positive).
+        let expected = [3.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0];
+        for (a, b) in z.data.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-9, "{:?}", z.data);
+        }
+        let mut out = [0.0; 2];
+        enc.encode_one(&[0.0, 2.0, 0.0], &mut out).unwrap();
+        assert!((out[0]).abs() < 1e-9 && (out[1] - 2.0).abs() < 1e-9, "{out:?}");
+    }
+
+    #[test]
+    fn centred_pca_hand_case() {
+        // Centred data: rows (1.5,-0.5), (-1.5,0.5) ... all variance along (3,-1)/sqrt(10).
+        let (_, z) = CentredPca.fit(&toy(), 1, &mut stream_named(0, "t")).unwrap();
+        let s = 1.5f64.hypot(0.5);
+        for (i, v) in z.data.iter().enumerate() {
+            assert!((v.abs() - s).abs() < 1e-9, "{:?}", z.data);
+            // Rows 0 and 2 are equal, 1 and 3 opposite to them.
+            let sign0 = z.data[0].signum();
+            let want = if i % 2 == 0 { sign0 } else { -sign0 };
+            assert_eq!(v.signum(), want);
+        }
+    }
+
+    #[test]
+    fn jacobi_recovers_eigenpairs() {
+        let a = [4.0, 1.0, 0.0, 1.0, 3.0, 0.5, 0.0, 0.5, 1.0];
+        let (vals, v) = jacobi_eigen(&a, 3);
+        for &(l, c) in &vals {
+            for r in 0..3 {
+                let av: f64 = (0..3).map(|j| a[r * 3 + j] * v[j * 3 + c]).sum();
+                assert!((av - l * v[r * 3 + c]).abs() < 1e-12);
+            }
+        }
+        assert!(vals[0].0 >= vals[1].0 && vals[1].0 >= vals[2].0);
+    }
+
+    #[test]
+    fn randomized_matches_exact_on_low_rank_data() {
+        // 60 images that are mixtures of 3 fixed patterns: the top-3 subspace is exact.
+        let mut rng = stream_named(3, "t");
+        let pats: Vec<Vec<f32>> = (0..3).map(|k| (0..50).map(|j| if j % (k + 2) == 0 { 1.0 } else { 0.0 }).collect()).collect();
+        let mut data = Vec::new();
+        for _ in 0..60 {
+            let w: Vec<f64> = (0..3).map(|_| StandardNormal.sample(&mut rng)).collect();
+            for j in 0..50 {
+                data.push((0..3).map(|k| w[k] * pats[k][j] as f64).sum::<f64>() as f32);
+            }
+        }
+        let set = ImageSet::new(60, 50, data).unwrap();
+        let (enc, z) = TruncatedSvd::default().fit(&set, 3, &mut stream_named(1, "t")).unwrap();
+        let _ = enc;
+        // Energy is preserved: ||X||_F^2 == ||Z||_F^2 for rank-3 data.
+        let ex: f64 = set.data.iter().map(|v| (*v as f64).powi(2)).sum();
+        let ez: f64 = z.data.iter().map(|v| v * v).sum();
+        assert!((ex - ez).abs() < 1e-6 * ex, "{ex} {ez}");
+        // Deterministic for a stream.
+        let (_, z2) = TruncatedSvd::default().fit(&set, 3, &mut stream_named(1, "t")).unwrap();
+        assert_eq!(z, z2);
+    }
+}

@@ -1,0 +1,428 @@
+//! External learners (protocol v1, docs/external-learners.md).
+//!
+//! The Python example (`scripts/external_learners/random_projection.py`) runs when
+//! `python3 -c "import numpy"` works; otherwise those tests print `SKIPPED: ...` and pass.
+//! The error cases use `sh -c` one-liners and need no Python.
+//!
+//! Per-image round-trip time: `cargo test -p ugl-bench --test external_learner -- --ignored
+//! --nocapture round_trip_timing`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use ugl_bench::env::render::render_ball_into;
+use ugl_bench::repr::external::{ExternalEncoder, ExternalLearner};
+use ugl_bench::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use ugl_bench::seed::stream_named;
+
+const DIM: usize = 4900;
+
+fn script() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/external_learners/random_projection.py")
+}
+
+fn python_learner() -> Option<ExternalLearner> {
+    let ok = Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !ok {
+        eprintln!("SKIPPED: python3 with numpy not found");
+        return None;
+    }
+    let mut l = ExternalLearner::new(
+        "random-projection",
+        format!("python3 '{}'", script().display()),
+    );
+    l.ready_timeout = Duration::from_secs(60);
+    l.answer_timeout = Duration::from_secs(30);
+    Some(l)
+}
+
+/// `n` ball images on a grid over [-0.9, 0.9]^2.
+fn images(n: usize) -> ImageSet {
+    let mut data = vec![0.0f32; n * DIM];
+    for (i, img) in data.chunks_exact_mut(DIM).enumerate() {
+        let x = -0.9 + 1.8 * (i % 7) as f64 / 6.0;
+        let y = -0.9 + 1.8 * ((i / 7) % 8) as f64 / 7.0 + 0.01 * (i / 56) as f64;
+        render_ball_into(x, y, img);
+    }
+    ImageSet::new(n, DIM, data).unwrap()
+}
+
+fn close(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs())))
+}
+
+fn fit_external(
+    l: &ExternalLearner,
+    set: &ImageSet,
+    latents: usize,
+    seed: u64,
+) -> Result<(ExternalEncoder, Latents), ReprError> {
+    l.fit_external(set, latents, &mut stream_named(seed, "learner"))
+}
+
+#[test]
+fn python_random_projection_protocol() {
+    let Some(learner) = python_learner() else {
+        return;
+    };
+    let set = images(50);
+    let (mut enc, z) = fit_external(&learner, &set, 5, 42).expect("fit");
+    assert_eq!((z.n, z.latents, z.data.len()), (50, 5, 250));
+    assert_eq!(enc.latents(), 5);
+    assert!(enc.prior().is_none());
+
+    // encode_one of a training image = its training latent (deterministic projection).
+    let mut out = [0.0f64; 5];
+    for i in [0, 7, 49] {
+        enc.encode_one(set.row(i), &mut out).unwrap();
+        assert!(
+            close(&out, z.row(i)),
+            "image {i}: {out:?} vs {:?}",
+            z.row(i)
+        );
+    }
+    // Batch encode agrees with the training latents.
+    let again = enc.encode(&set).unwrap();
+    assert_eq!((again.n, again.latents), (50, 5));
+    assert!(close(&again.data, &z.data));
+    // Wrong image size is refused on our side and does not break the encoder.
+    assert!(matches!(
+        enc.encode_one(&[0.0; 10], &mut out),
+        Err(ReprError::InvalidInput(_))
+    ));
+    enc.encode_one(set.row(3), &mut out).unwrap();
+
+    // Same stream, same model; another stream, another model.
+    let (enc2, z2) = fit_external(&learner, &set, 5, 42).unwrap();
+    assert_eq!(z.data, z2.data, "same seed, same latents");
+    let (_, z3) = fit_external(&learner, &set, 5, 43).unwrap();
+    assert_ne!(z.data, z3.data, "another seed, another projection");
+
+    // Clean shutdown (exit 0); dropping the other one reaps it too.
+    enc.shutdown().expect("exit 0 on closed stdin");
+    let pid = enc2.process_id();
+    drop(enc2);
+    assert!(gone(pid), "process {pid} still running after drop");
+}
+
+#[test]
+fn python_through_the_trait_object() {
+    let Some(learner) = python_learner() else {
+        return;
+    };
+    let learner: Box<dyn RepresentationLearner> = Box::new(learner);
+    assert_eq!(learner.name(), "random-projection");
+    let set = images(12);
+    let (mut enc, z) = learner
+        .fit(&set, 3, &mut stream_named(1, "learner"))
+        .unwrap();
+    let big = images(1100); // more than one request (1024 rows per request)
+    let all = enc.encode(&big).unwrap();
+    assert_eq!((all.n, all.latents), (1100, 3));
+    assert!(
+        close(&all.data[..12 * 3], &z.data),
+        "the first 12 images are the training set"
+    );
+    let mut out = [0.0; 3];
+    enc.encode_one(big.row(1099), &mut out).unwrap();
+    assert!(close(&out, all.row(1099)));
+}
+
+/// Not running any more (absent, or a zombie of a process we do not own).
+fn gone(pid: u32) -> bool {
+    match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+        Err(_) => true,
+        Ok(s) => s
+            .rsplit(')')
+            .next()
+            .is_some_and(|rest| rest.trim_start().starts_with('Z')),
+    }
+}
+
+fn sh(name: &str, command: &str) -> ExternalLearner {
+    let mut l = ExternalLearner::new(name, command);
+    l.ready_timeout = Duration::from_secs(10);
+    l.answer_timeout = Duration::from_secs(10);
+    l
+}
+
+fn external_msg(r: Result<impl Sized, ReprError>) -> String {
+    match r {
+        Err(ReprError::External(m)) => m,
+        Err(e) => panic!("expected an External error, got {e:?}"),
+        Ok(_) => panic!("expected an error"),
+    }
+}
+
+/// An npy file (version 1.0, '<f8', C order).
+fn npy_f64(rows: usize, cols: usize, data: &[f64]) -> Vec<u8> {
+    let mut header =
+        format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut b = b"\x93NUMPY\x01\x00".to_vec();
+    b.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    b.extend_from_slice(header.as_bytes());
+    for v in data {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b
+}
+
+/// A scripted "learner": copies `train` to the train latents, says READY, then `after`.
+fn scripted(dir: &Path, train: &[u8], after: &str) -> String {
+    let t = dir.join("train_latents.npy");
+    std::fs::write(&t, train).unwrap();
+    format!(
+        "cat '{}' > \"$UGL_TRAIN_LATENTS\"; echo READY; {after}",
+        t.display()
+    )
+}
+
+#[test]
+fn exit_with_message_before_ready() {
+    let l = sh(
+        "failing",
+        "echo 'loading model... boom: CUDA out of memory' >&2; exit 1",
+    );
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(m.contains("boom: CUDA out of memory"), "{m}");
+    assert!(m.contains("exit status: 1"), "{m}");
+    assert!(m.contains("before printing READY"), "{m}");
+}
+
+#[test]
+fn garbage_instead_of_ready_is_fast_and_kills_the_group() {
+    let dir = tempfile::tempdir().unwrap();
+    let pidfile = dir.path().join("pid");
+    let cmd = format!(
+        "sleep 30 & echo $! > '{}'; echo 'epoch 1 loss 0.3'; sleep 30",
+        pidfile.display()
+    );
+    let t = Instant::now();
+    let m = external_msg(sh("chatty", &cmd).fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(
+        t.elapsed() < Duration::from_secs(5),
+        "took {:?}",
+        t.elapsed()
+    );
+    assert!(m.contains("epoch 1 loss 0.3") && m.contains("READY"), "{m}");
+    assert!(m.contains("killed"), "{m}");
+    let bg: u32 = std::fs::read_to_string(&pidfile)
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let until = Instant::now() + Duration::from_secs(2);
+    while !gone(bg) && Instant::now() < until {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(gone(bg), "background process {bg} of the learner survived");
+}
+
+#[test]
+fn command_not_found() {
+    let l = sh("missing", "ugl-no-such-learner-program --fit");
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(m.contains("127") && m.contains("not found"), "{m}");
+}
+
+#[test]
+fn zero_latents_is_invalid_input_and_starts_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let marker = dir.path().join("started");
+    let l = sh("zero", &format!("touch '{}'", marker.display()));
+    let r = l.fit(&images(3), 0, &mut stream_named(0, "learner"));
+    assert!(matches!(r, Err(ReprError::InvalidInput(_))));
+    assert!(!marker.exists());
+}
+
+#[test]
+fn ready_timeout() {
+    let mut l = sh("slow", "sleep 30");
+    l.ready_timeout = Duration::from_millis(200);
+    let t = Instant::now();
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(t.elapsed() < Duration::from_secs(5));
+    assert!(m.contains("ready timeout"), "{m}");
+}
+
+#[test]
+fn missing_or_wrong_train_latents() {
+    let l = sh("no-latents", "echo READY; cat > /dev/null");
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(m.contains("train_latents.npy"), "{m}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let l = sh(
+        "wrong-n",
+        &scripted(dir.path(), &npy_f64(2, 2, &[0.0; 4]), "cat > /dev/null"),
+    );
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
+    assert!(m.contains("shape [2, 2], expected (3, 2)"), "{m}");
+
+    let l = sh(
+        "nan",
+        &scripted(
+            dir.path(),
+            &npy_f64(3, 2, &[0.0, 1.0, f64::NAN, 0.0, 0.0, 0.0]),
+            "cat > /dev/null",
+        ),
+    );
+    let r = l.fit(&images(3), 2, &mut stream_named(0, "learner"));
+    assert!(
+        matches!(&r, Err(ReprError::Numerical(m)) if m.contains("non-finite")),
+        "{:?}",
+        r.err()
+    );
+}
+
+#[test]
+fn wrong_answer_shape_breaks_the_encoder_and_reaps_the_process() {
+    let dir = tempfile::tempdir().unwrap();
+    let wrong = dir.path().join("wrong.npy");
+    std::fs::write(&wrong, npy_f64(1, 3, &[1.0, 2.0, 3.0])).unwrap();
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0; 6]),
+        &format!("cat '{}'; cat > /dev/null", wrong.display()),
+    );
+    let (mut enc, z) = sh("wrong-shape", &cmd)
+        .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
+        .unwrap();
+    assert_eq!(z.data, vec![0.0; 6]);
+    let pid = enc.process_id();
+    let mut out = [0.0; 2];
+    let m = external_msg(enc.encode_one(images(1).row(0), &mut out));
+    assert!(m.contains("shape [1, 3], expected (1, 2)"), "{m}");
+    assert!(gone(pid), "process {pid} not reaped after the failure");
+    let m = external_msg(enc.encode_one(images(1).row(0), &mut out));
+    assert!(m.contains("earlier failure"), "{m}");
+}
+
+#[test]
+fn non_finite_answer() {
+    let dir = tempfile::tempdir().unwrap();
+    let nan = dir.path().join("nan.npy");
+    std::fs::write(&nan, npy_f64(1, 2, &[0.5, f64::INFINITY])).unwrap();
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0; 6]),
+        &format!("cat '{}'; cat > /dev/null", nan.display()),
+    );
+    let (mut enc, _) = sh("inf", &cmd)
+        .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
+        .unwrap();
+    let m = external_msg(enc.encode_one(images(1).row(0), &mut [0.0; 2]));
+    assert!(m.contains("non-finite"), "{m}");
+}
+
+#[test]
+fn crash_during_encode_reports_status_and_stderr() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0; 6]),
+        "head -c 10 > /dev/null; echo 'Segmentation fault in encoder' >&2; exit 3",
+    );
+    let (mut enc, _) = sh("crash", &cmd)
+        .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
+        .unwrap();
+    let m = external_msg(enc.encode(&images(2)));
+    assert!(
+        m.contains("exit status: 3") && m.contains("Segmentation fault in encoder"),
+        "{m}"
+    );
+}
+
+#[test]
+fn answer_timeout() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = scripted(dir.path(), &npy_f64(3, 2, &[0.0; 6]), "sleep 30");
+    let mut l = sh("mute", &cmd);
+    l.answer_timeout = Duration::from_millis(300);
+    let (mut enc, _) = l
+        .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
+        .unwrap();
+    let t = Instant::now();
+    let m = external_msg(enc.encode_one(images(1).row(0), &mut [0.0; 2]));
+    assert!(t.elapsed() < Duration::from_secs(5));
+    assert!(m.contains("answer timeout"), "{m}");
+}
+
+#[test]
+fn shutdown_reports_non_zero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0; 6]),
+        "cat > /dev/null; echo 'bye' >&2; exit 4",
+    );
+    let (enc, _) = sh("bad-exit", &cmd)
+        .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
+        .unwrap();
+    let m = external_msg(enc.shutdown());
+    assert!(m.contains("exit status: 4") && m.contains("bye"), "{m}");
+}
+
+#[test]
+fn the_environment_of_the_program() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = dir.path().join("env.txt");
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0; 6]),
+        &format!(
+            "echo \"$UGL_PROTOCOL $UGL_LATENTS $UGL_SEED $(basename \"$UGL_TRAIN\") $(test -d \"$UGL_WORKDIR\" && echo dir) $(head -c 6 \"$UGL_TRAIN\" | tail -c 5)\" > '{}'; cat > /dev/null",
+            env.display()
+        ),
+    );
+    let (enc, _) = sh("env", &cmd)
+        .fit_external(&images(3), 2, &mut stream_named(9, "learner"))
+        .unwrap();
+    enc.shutdown().unwrap();
+    let got = std::fs::read_to_string(&env).unwrap();
+    let seed = {
+        use rand::Rng;
+        stream_named(9, "learner").next_u64()
+    };
+    assert_eq!(got.trim(), format!("1 2 {seed} train.npy dir NUMPY"));
+}
+
+#[test]
+#[ignore = "timing; run with --ignored --nocapture"]
+fn round_trip_timing() {
+    let Some(learner) = python_learner() else {
+        return;
+    };
+    let set = images(200);
+    let (mut enc, _) = fit_external(&learner, &set, 10, 0).unwrap();
+    let mut out = [0.0; 10];
+    for i in 0..200 {
+        enc.encode_one(set.row(i), &mut out).unwrap();
+    }
+    let reps = 5000;
+    let t = Instant::now();
+    for i in 0..reps {
+        enc.encode_one(set.row(i % 200), &mut out).unwrap();
+    }
+    let one = t.elapsed() / reps as u32;
+    let big = images(1000);
+    let t = Instant::now();
+    let _ = enc.encode(&big).unwrap();
+    let batch = t.elapsed() / 1000;
+    eprintln!(
+        "external random projection (python3 + numpy), latents 10: encode_one round trip {one:?} per image ({reps} calls); batch encode of 1000 images {batch:?} per image"
+    );
+    enc.shutdown().unwrap();
+}
