@@ -17,7 +17,7 @@ use ugl_bench::campaign::config::{resolve_profile, CampaignConfig};
 use ugl_bench::campaign::{plan, run_campaign, CampaignOptions, Progress, RunContext, RunSpec};
 use ugl_bench::env::render::{write_npy, write_png, Image70, PIXELS};
 use ugl_bench::env::{make_env, EnvConfig, EnvKind, PARAMS};
-use ugl_bench::explore::Algo;
+use ugl_bench::explore::{Algo, Learner, SamplerKind};
 use ugl_bench::metrics::csv::read_outcomes_csv;
 use ugl_bench::metrics::KlCoverage;
 
@@ -69,9 +69,19 @@ enum Command {
         /// armball or armarrow.
         #[arg(long)]
         env: EnvKind,
-        /// rpe or rge-efr.
+        /// rpe, rge-efr, or a learned goal space: rge-pca (the paper's non-centred PCA),
+        /// rge-pca-centred, rge-isomap, rge-external (needs [learners.external] in the profile).
         #[arg(long)]
         algo: Algo,
+        /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (N(0, I)).
+        #[arg(long, default_value = "kde")]
+        sampler: SamplerKind,
+        /// Latent size of a learned goal space.
+        #[arg(long, default_value_t = 10)]
+        latents: usize,
+        /// Override the profile's number of UGL training images.
+        #[arg(long)]
+        images: Option<usize>,
         /// Repetition index; the RNG seed derives from it, the run identity and the campaign seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -153,7 +163,9 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Rollout { env, params } => rollout(env, &params),
         Command::Klc { env, outcomes } => klc(env, &outcomes),
         Command::Render { env, state, out } => render(env, &state, &out),
-        Command::Run { env, algo, seed, epochs, profile, out } => run(env, algo, seed, epochs, &profile, &out),
+        Command::Run { env, algo, sampler, latents, images, seed, epochs, profile, out } => {
+            run(RunArgs { env, algo, sampler, latents, images, seed, epochs }, &profile, &out)
+        }
         Command::Plan { config } => {
             let cfg = CampaignConfig::load(&config)?;
             for spec in plan(&cfg) {
@@ -230,24 +242,56 @@ fn render(kind: EnvKind, state: &str, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn run(kind: EnvKind, algo: Algo, seed: u64, epochs: Option<usize>, profile: &str, out: &Path) -> Result<()> {
+struct RunArgs {
+    env: EnvKind,
+    algo: Algo,
+    sampler: SamplerKind,
+    latents: usize,
+    images: Option<usize>,
+    seed: u64,
+    epochs: Option<usize>,
+}
+
+fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
     let path = resolve_profile(profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
-    if let Some(e) = epochs {
+    if let Some(e) = a.epochs {
         cfg.explore.epochs = e;
         cfg.explore.validate().map_err(|m| anyhow::anyhow!("--epochs: {m}"))?;
     }
+    if let Some(n) = a.images {
+        if n < 2 {
+            bail!("--images must be at least 2, got {n}");
+        }
+        cfg.ugl.images = n;
+    }
+    let spec = match a.algo.learner() {
+        None => RunSpec::baseline(a.env, a.algo, a.seed),
+        Some(_) => {
+            if !matches!(a.sampler, SamplerKind::Kde | SamplerKind::Gaussian) {
+                bail!("--sampler must be kde or gaussian for {}", a.algo);
+            }
+            if a.latents == 0 || a.latents >= cfg.ugl.images {
+                bail!("--latents must be between 1 and the number of images - 1 ({}), got {}", cfg.ugl.images - 1, a.latents);
+            }
+            RunSpec { env: a.env, algo: a.algo, sampler: a.sampler, latents: a.latents, seed: a.seed }
+        }
+    };
+    if a.algo.learner() == Some(Learner::External) && cfg.learners.external.is_none() {
+        bail!("--algo rge-external needs a [learners.external] section (name, command) in the profile {}", path.display());
+    }
     check_out_dir(out)?;
-    let spec = RunSpec { env: kind, algo, seed };
     let ctx = RunContext {
         campaign: &cfg.campaign.name,
         campaign_seed: cfg.campaign.seed,
         profile,
         explore: &cfg.explore,
         env: &cfg.env,
+        ugl: &cfg.ugl,
+        learners: &cfg.learners,
         threads: 1,
     };
-    let summary = ugl_bench::campaign::execute(&spec, &ctx, out)?;
+    let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
     println!("{}", serde_json::to_string(&summary)?);
     Ok(())
 }

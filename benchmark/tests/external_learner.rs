@@ -383,7 +383,7 @@ fn the_environment_of_the_program() {
         dir.path(),
         &npy_f64(3, 2, &[0.0; 6]),
         &format!(
-            "echo \"$UGL_PROTOCOL $UGL_LATENTS $UGL_SEED $(basename \"$UGL_TRAIN\") $(test -d \"$UGL_WORKDIR\" && echo dir) $(head -c 6 \"$UGL_TRAIN\" | tail -c 5)\" > '{}'; cat > /dev/null",
+            "echo \"$UGL_PROTOCOL $UGL_LATENTS $UGL_SEED $(basename \"$UGL_TRAIN\") $(basename \"$UGL_PRIOR\") $UGL_HARNESS_PID $(test -d \"$UGL_WORKDIR\" && echo dir) $(head -c 6 \"$UGL_TRAIN\" | tail -c 5)\" > '{}'; cat > /dev/null",
             env.display()
         ),
     );
@@ -396,7 +396,13 @@ fn the_environment_of_the_program() {
         use rand::Rng;
         stream_named(9, "learner").next_u64()
     };
-    assert_eq!(got.trim(), format!("1 2 {seed} train.npy dir NUMPY"));
+    assert_eq!(
+        got.trim(),
+        format!(
+            "1 2 {seed} train.npy prior.npy {} dir NUMPY",
+            std::process::id()
+        )
+    );
 }
 
 #[test]

@@ -45,13 +45,19 @@ def read_npy(f):
     major, _minor = read_exact(f, 2)
     hlen_bytes = read_exact(f, 2 if major == 1 else 4)
     hlen = int.from_bytes(hlen_bytes, "little")
-    header = ast.literal_eval(read_exact(f, hlen).decode("latin1"))
-    dtype = np.dtype(header["descr"])
-    shape = tuple(header["shape"])
-    count = int(np.prod(shape))
+    raw = read_exact(f, hlen)
+    parsed = _HEADERS.get(raw)
+    if parsed is None:  # parse each distinct header once (saves ~25 us per request)
+        header = ast.literal_eval(raw.decode("latin1"))
+        shape = tuple(header["shape"])
+        order = "F" if header["fortran_order"] else "C"
+        parsed = _HEADERS[raw] = (np.dtype(header["descr"]), shape, int(np.prod(shape)), order)
+    dtype, shape, count, order = parsed
     data = read_exact(f, count * dtype.itemsize) if count else b""
-    order = "F" if header["fortran_order"] else "C"
     return np.frombuffer(data, dtype=dtype).reshape(shape, order=order)
+
+
+_HEADERS = {}
 
 
 def write_npy(f, a):

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::env::{EnvConfig, EnvKind};
-use crate::explore::{Algo, ExploreConfig};
+use crate::explore::{Algo, ExploreConfig, Learner, SamplerKind};
 
 /// Errors reading or validating a configuration.
 #[derive(Debug, Error)]
@@ -42,7 +42,8 @@ pub struct CampaignSection {
     pub description: String,
 }
 
-/// The `[matrix]` section: which cells to run.
+/// The `[matrix]` section: which cells to run. Learned goal spaces (`rge-*` except `rge-efr`)
+/// are crossed with `samplers` and `latents`; the baselines ignore those two lists.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Matrix {
@@ -50,6 +51,101 @@ pub struct Matrix {
     pub envs: Vec<EnvKind>,
     /// Algorithms.
     pub algos: Vec<Algo>,
+    /// Goal samplers of the learned goal spaces (`kde`, `gaussian`).
+    #[serde(default = "default_samplers")]
+    pub samplers: Vec<SamplerKind>,
+    /// Latent sizes: numbers, or `"true"` for the environment's true dimension (2 / 3).
+    #[serde(default = "default_latents")]
+    pub latents: Vec<LatentSize>,
+}
+
+fn default_samplers() -> Vec<SamplerKind> {
+    vec![SamplerKind::Kde]
+}
+
+fn default_latents() -> Vec<LatentSize> {
+    vec![LatentSize::N(10)]
+}
+
+/// A latent size in the matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LatentSize {
+    /// A fixed size.
+    N(usize),
+    /// The environment's true dimension: 2 (ArmBall) or 3 (ArmArrow).
+    TrueDim,
+}
+
+impl Serialize for LatentSize {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            LatentSize::N(n) => s.serialize_u64(*n as u64),
+            LatentSize::TrueDim => s.serialize_str("true"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for LatentSize {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            N(i64),
+            S(String),
+        }
+        match Raw::deserialize(d)? {
+            Raw::N(n) if n >= 1 => Ok(LatentSize::N(n as usize)),
+            Raw::N(n) => Err(serde::de::Error::custom(format!("matrix.latents: {n} must be at least 1"))),
+            Raw::S(s) if s == "true" => Ok(LatentSize::TrueDim),
+            Raw::S(s) => Err(serde::de::Error::custom(format!("matrix.latents: '{s}' is neither a number nor \"true\""))),
+        }
+    }
+}
+
+/// The `[ugl]` section: the unsupervised goal-space learning stage.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UglConfig {
+    /// Images in the passive observation data set (the paper: 10,000).
+    pub images: usize,
+}
+
+impl Default for UglConfig {
+    fn default() -> Self {
+        UglConfig { images: 10_000 }
+    }
+}
+
+/// The `[learners]` section: hyperparameters of each learner.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct LearnersConfig {
+    pub isomap: IsomapConfig,
+    pub external: Option<ExternalConfig>,
+}
+
+/// `[learners.isomap]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IsomapConfig {
+    /// Neighbours of the kNN graph (sklearn's default, used by the paper: 5).
+    pub n_neighbors: usize,
+}
+
+impl Default for IsomapConfig {
+    fn default() -> Self {
+        IsomapConfig { n_neighbors: 5 }
+    }
+}
+
+/// `[learners.external]`: a learner program speaking the protocol of `docs/external-learners.md`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalConfig {
+    /// A short name for results and the report.
+    pub name: String,
+    /// The command line (run with `sh -c`).
+    pub command: String,
 }
 
 /// A whole campaign configuration.
@@ -62,6 +158,10 @@ pub struct CampaignConfig {
     pub explore: ExploreConfig,
     #[serde(default)]
     pub env: EnvConfig,
+    #[serde(default)]
+    pub ugl: UglConfig,
+    #[serde(default)]
+    pub learners: LearnersConfig,
 }
 
 impl CampaignConfig {
@@ -104,6 +204,33 @@ impl CampaignConfig {
         for (k, list) in [("matrix.envs", dup(&self.matrix.envs)), ("matrix.algos", dup(&self.matrix.algos))] {
             if let Some(d) = list {
                 return Err(format!("{k} lists '{d}' twice"));
+            }
+        }
+        if self.matrix.samplers.is_empty() {
+            return Err("matrix.samplers must name at least one goal sampler".into());
+        }
+        if let Some(s) = self.matrix.samplers.iter().find(|s| !matches!(s, SamplerKind::Kde | SamplerKind::Gaussian)) {
+            return Err(format!("matrix.samplers: '{s}' is not a sampler of learned goal spaces (kde, gaussian)"));
+        }
+        if self.matrix.latents.is_empty() {
+            return Err("matrix.latents must list at least one latent size".into());
+        }
+        let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
+        if learned && self.ugl.images < 2 {
+            return Err(format!("ugl.images must be at least 2, got {}", self.ugl.images));
+        }
+        if let Some(LatentSize::N(n)) = self.matrix.latents.iter().find(|l| matches!(l, LatentSize::N(n) if *n >= self.ugl.images)) {
+            return Err(format!("matrix.latents: {n} must be below ugl.images ({})", self.ugl.images));
+        }
+        if self.learners.isomap.n_neighbors == 0 {
+            return Err("learners.isomap.n_neighbors must be at least 1".into());
+        }
+        if self.matrix.algos.contains(&Algo::Rge(Learner::External)) && self.learners.external.is_none() {
+            return Err("matrix.algos has rge-external but there is no [learners.external] section (name, command)".into());
+        }
+        if let Some(e) = &self.learners.external {
+            if e.command.trim().is_empty() || e.name.trim().is_empty() {
+                return Err("learners.external.name and learners.external.command must not be empty".into());
             }
         }
         self.explore.validate()?;

@@ -9,13 +9,20 @@ use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
-use super::config::CampaignConfig;
+use super::config::{CampaignConfig, LearnersConfig, UglConfig};
 use super::plan::{plan, RunSpec};
 use super::store::{self, Manifest, StoreError, Summary};
-use crate::env::{make_env, EnvConfig};
-use crate::explore::{run_rge, run_rpe, Algo, EngineeredSpace, ExplorationLog, ExploreConfig};
-use crate::goals::UniformGoals;
-use crate::seed::run_seed;
+use crate::env::{make_env, EnvConfig, Environment};
+use crate::explore::{
+    run_rge, run_rpe, Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
+};
+use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
+use crate::repr::dataset::{dataset_identity, generate};
+use crate::repr::external::ExternalLearner;
+use crate::repr::isomap::Isomap;
+use crate::repr::pca::{CentredPca, TruncatedSvd};
+use crate::repr::{Encoder, Latents, ReprError, RepresentationLearner};
+use crate::seed::{run_seed, stream, Component};
 
 /// Bumped whenever a change alters results for the same configuration.
 pub const RESULTS_VERSION: u32 = 1;
@@ -27,6 +34,8 @@ pub enum RunError {
     Store(#[from] StoreError),
     #[error("cannot start the worker pool: {0}")]
     Pool(String),
+    #[error("run {run}: {source}")]
+    Repr { run: String, source: ReprError },
     #[error("interrupted: {done} of {total} runs finished and stored; rerun the same command to resume")]
     Interrupted { done: usize, total: usize },
 }
@@ -39,6 +48,10 @@ struct HashInput<'a> {
     campaign_seed: u64,
     explore: &'a ExploreConfig,
     env: &'a EnvConfig,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ugl: Option<&'a UglConfig>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    learners: Option<&'a LearnersConfig>,
 }
 
 /// Everything needed to execute one run.
@@ -49,6 +62,8 @@ pub struct RunContext<'a> {
     pub profile: &'a str,
     pub explore: &'a ExploreConfig,
     pub env: &'a EnvConfig,
+    pub ugl: &'a UglConfig,
+    pub learners: &'a LearnersConfig,
     pub threads: usize,
 }
 
@@ -62,23 +77,92 @@ impl RunContext<'_> {
             campaign_seed: self.campaign_seed,
             explore: self.explore,
             env: self.env,
+            // Learned goal spaces also depend on the UGL stage; baseline hashes do not.
+            ugl: spec.algo.learner().map(|_| self.ugl),
+            learners: spec.algo.learner().map(|_| self.learners),
         };
         let json = serde_json::to_vec(&input).expect("config serialises");
         blake3::hash(&json).to_hex().to_string()
     }
 }
 
-/// Run the exploration of one spec (no I/O).
-pub fn explore(spec: &RunSpec, explore: &ExploreConfig, env_cfg: &EnvConfig, campaign_seed: u64) -> ExplorationLog {
-    let seed = run_seed(campaign_seed, &spec.identity());
-    let env = make_env(spec.env, env_cfg);
-    match spec.algo {
-        Algo::Rpe => run_rpe(env.as_ref(), explore, seed),
-        Algo::RgeEfr => {
-            let d = env.state_dim();
-            run_rge(env.as_ref(), &mut EngineeredSpace::new(d), &mut UniformGoals::unit(d), explore, seed)
+/// A fitted representation, shared by the runs that use it (every sampler of a cell).
+pub struct Representation {
+    pub encoder: Box<dyn Encoder>,
+    /// Encodings of the training images (the KDE is fitted on them).
+    pub train: Latents,
+    /// Seconds to generate the data set and fit.
+    pub fit_s: f64,
+    /// Name of the learner (the external program's configured name for `external`).
+    pub learner_name: String,
+}
+
+/// Build the learner of an algorithm from the configuration.
+pub fn make_learner(learner: Learner, cfg: &LearnersConfig) -> Result<Box<dyn RepresentationLearner>, ReprError> {
+    Ok(match learner {
+        Learner::Pca => Box::new(TruncatedSvd::default()),
+        Learner::PcaCentred => Box::new(CentredPca),
+        Learner::Isomap => Box::new(Isomap { n_neighbors: cfg.isomap.n_neighbors, ..Default::default() }),
+        Learner::External => {
+            let e = cfg.external.as_ref().ok_or_else(|| {
+                ReprError::InvalidInput("rge-external needs a [learners.external] section (name, command)".into())
+            })?;
+            Box::new(ExternalLearner::new(e.name.clone(), e.command.clone()))
         }
-    }
+    })
+}
+
+/// Generate the UGL data set of the spec's repetition and fit its learner.
+pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representation, ReprError> {
+    let learner = spec.algo.learner().ok_or_else(|| ReprError::InvalidInput(format!("{} learns no representation", spec.algo)))?;
+    let t0 = Instant::now();
+    let env = make_env(spec.env, ctx.env);
+    let ds_seed = run_seed(ctx.campaign_seed, &dataset_identity(spec.env, ctx.ugl.images, spec.seed));
+    let data = generate(env.as_ref(), ctx.ugl.images, &mut stream(ds_seed, Component::Dataset))?;
+    let repr_id = spec.representation_identity(ctx.ugl.images).expect("learned algorithm");
+    let mut rng = stream(run_seed(ctx.campaign_seed, &repr_id), Component::Learner);
+    let l = make_learner(learner, ctx.learners)?;
+    let (encoder, train) = l.fit(&data.images, spec.latents, &mut rng)?;
+    let learner_name = match learner {
+        Learner::External => ctx.learners.external.as_ref().map(|e| e.name.clone()).unwrap_or_default(),
+        _ => learner.name().to_string(),
+    };
+    Ok(Representation { encoder, train, fit_s: t0.elapsed().as_secs_f64(), learner_name })
+}
+
+/// What an exploration produced, with its timings.
+pub struct Explored {
+    pub log: ExplorationLog,
+    /// Seconds spent rendering and encoding outcomes (learned goal spaces).
+    pub encode_s: Option<f64>,
+}
+
+/// Run the exploration of one spec (no I/O). Learned goal spaces need their representation.
+pub fn explore(spec: &RunSpec, ctx: &RunContext, repr: Option<&mut Representation>) -> Result<Explored, RunError> {
+    let seed = run_seed(ctx.campaign_seed, &spec.identity());
+    let env = make_env(spec.env, ctx.env);
+    let env: &dyn Environment = env.as_ref();
+    let d = env.state_dim();
+    let log = match spec.algo {
+        Algo::Rpe => run_rpe(env, ctx.explore, seed),
+        Algo::RgeEfr => run_rge(env, &mut EngineeredSpace::new(d), &mut UniformGoals::unit(d), ctx.explore, seed),
+        Algo::Rge(_) => {
+            let repr_err = |source| RunError::Repr { run: spec.run_id(), source };
+            let repr = repr.ok_or_else(|| repr_err(ReprError::InvalidInput("no representation was fitted".into())))?;
+            let mut sampler: Box<dyn GoalSampler> = match spec.sampler {
+                SamplerKind::Kde => Box::new(KdeGoals::fit(&repr.train).map_err(repr_err)?),
+                SamplerKind::Gaussian => Box::new(GaussianGoals::new(spec.latents)),
+                other => return Err(repr_err(ReprError::InvalidInput(format!("sampler {other} is not for learned goal spaces")))),
+            };
+            let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
+            let log = run_rge(env, &mut space, sampler.as_mut(), ctx.explore, seed);
+            if let Some(e) = space.error.take() {
+                return Err(repr_err(e));
+            }
+            return Ok(Explored { log, encode_s: Some(space.encode_s) });
+        }
+    };
+    Ok(Explored { log, encode_s: None })
 }
 
 /// The summary of a finished log.
@@ -87,20 +171,42 @@ pub fn summarize(spec: &RunSpec, log: &ExplorationLog) -> Summary {
     Summary { run: spec.run_id(), final_klc: last.klc, n_moved: last.n_moved, coverage: last.coverage }
 }
 
-/// Execute one run and store it in `out`; returns its summary.
-pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path) -> Result<Summary, RunError> {
+/// Execute one run and store it in `out`; returns its summary. A learned goal space is fitted
+/// first unless `repr` is given (campaigns share one fit between samplers).
+pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path, repr: Option<&mut Representation>) -> Result<Summary, RunError> {
+    let mut own: Option<Representation> = None;
+    let repr = match (spec.algo.learner(), repr) {
+        (None, _) => None,
+        (Some(_), Some(r)) => Some(r),
+        (Some(_), None) => {
+            let fitted = fit_representation(spec, ctx).map_err(|source| RunError::Repr { run: spec.run_id(), source })?;
+            Some(own.insert(fitted))
+        }
+    };
+    let fit_s = repr.as_ref().map(|r| r.fit_s);
+    let learner_name = repr.as_ref().map(|r| r.learner_name.clone());
     let t0 = Instant::now();
-    let log = explore(spec, ctx.explore, ctx.env, ctx.campaign_seed);
+    let explored = explore(spec, ctx, repr)?;
     let wall_s = t0.elapsed().as_secs_f64();
+    let log = explored.log;
     let summary = summarize(spec, &log);
     let paper = ExploreConfig::default();
-    let reduced = ctx.explore.epochs < paper.epochs;
+    let mut notes = Vec::new();
+    if ctx.explore.epochs < paper.epochs {
+        notes.push(format!("{} exploration epochs instead of the paper's {}", ctx.explore.epochs, paper.epochs));
+    }
+    if spec.algo.learner().is_some() && ctx.ugl.images < UglConfig::default().images {
+        notes.push(format!("{} UGL images instead of the paper's {}", ctx.ugl.images, UglConfig::default().images));
+    }
     let manifest = Manifest {
         run_id: spec.run_id(),
         identity: spec.identity(),
         env: spec.env.name().into(),
         algo: spec.algo.name().into(),
-        sampler: spec.sampler().into(),
+        sampler: spec.sampler.name().into(),
+        latents: spec.latents,
+        variant: "none".into(),
+        learner: learner_name,
         seed: spec.seed,
         run_seed: run_seed(ctx.campaign_seed, &spec.identity()),
         campaign: ctx.campaign.into(),
@@ -109,12 +215,9 @@ pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path) -> Result<Summary, 
         config_hash: ctx.config_hash(spec),
         explore: serde_json::to_value(ctx.explore).expect("serialisable"),
         env_config: serde_json::to_value(ctx.env).expect("serialisable"),
-        reduced_budget: reduced,
-        budget_note: if reduced {
-            format!("{} exploration epochs instead of the paper's {}", ctx.explore.epochs, paper.epochs)
-        } else {
-            String::new()
-        },
+        ugl: spec.algo.learner().map(|_| serde_json::to_value(ctx.ugl).expect("serialisable")),
+        reduced_budget: !notes.is_empty(),
+        budget_note: notes.join("; "),
         git_revision: git_revision().into(),
         crate_versions: serde_json::json!({
             "ugl-bench": env!("CARGO_PKG_VERSION"),
@@ -123,6 +226,8 @@ pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path) -> Result<Summary, 
         toolchain: env!("UGL_RUSTC_VERSION").into(),
         threads: ctx.threads,
         wall_s,
+        fit_s,
+        encode_s: explored.encode_s,
         host: host_name().into(),
         summary: summary.clone(),
     };
@@ -163,40 +268,70 @@ pub fn run_campaign(
         profile: opts.profile,
         explore: &cfg.explore,
         env: &cfg.env,
+        ugl: &cfg.ugl,
+        learners: &cfg.learners,
         threads: opts.jobs,
     };
     let all = plan(cfg);
     let todo: Vec<&RunSpec> =
         all.iter().filter(|s| !store::is_complete(out, &s.run_id(), &ctx.config_hash(s))).collect();
     on_progress(Progress::Planned { total: all.len(), skipped: all.len() - todo.len() });
+    // Runs sharing a representation form one group: fitted once, then run one after the other.
+    let mut groups: Vec<(Option<String>, Vec<&RunSpec>)> = Vec::new();
+    let n_todo = todo.len();
+    for spec in todo {
+        let key = spec.representation_identity(cfg.ugl.images);
+        match groups.iter_mut().find(|(k, _)| key.is_some() && *k == key) {
+            Some((_, g)) => g.push(spec),
+            None => groups.push((key, vec![spec])),
+        }
+    }
+    // Expensive groups (learned representations) first, for a better load balance.
+    groups.sort_by_key(|(k, _)| k.is_none());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs.max(1))
         .build()
         .map_err(|e| RunError::Pool(e.to_string()))?;
-    let results: Vec<Option<Result<Summary, RunError>>> = pool.install(|| {
-        todo.par_iter()
-            .map(|spec| {
-                if opts.stop.load(Ordering::SeqCst) {
-                    return None;
+    let results: Vec<Vec<Option<Result<Summary, RunError>>>> = pool.install(|| {
+        groups
+            .par_iter()
+            .map(|(key, specs)| {
+                let mut out_v = Vec::with_capacity(specs.len());
+                let mut repr = None;
+                for spec in specs {
+                    if opts.stop.load(Ordering::SeqCst) {
+                        out_v.push(None);
+                        continue;
+                    }
+                    if key.is_some() && repr.is_none() {
+                        match fit_representation(spec, &ctx) {
+                            Ok(r) => repr = Some(r),
+                            Err(source) => {
+                                out_v.push(Some(Err(RunError::Repr { run: spec.run_id(), source })));
+                                continue;
+                            }
+                        }
+                    }
+                    let r = execute(spec, &ctx, out, repr.as_mut());
+                    if let Ok(s) = &r {
+                        on_progress(Progress::Finished(s.clone()));
+                    }
+                    out_v.push(Some(r));
                 }
-                let r = execute(spec, &ctx, out);
-                if let Ok(s) = &r {
-                    on_progress(Progress::Finished(s.clone()));
-                }
-                Some(r)
+                out_v
             })
             .collect()
     });
     let mut done = Vec::new();
     let mut skipped_now = 0;
-    for r in results {
+    for r in results.into_iter().flatten() {
         match r {
             Some(r) => done.push(r?),
             None => skipped_now += 1,
         }
     }
     if skipped_now > 0 {
-        return Err(RunError::Interrupted { done: all.len() - todo.len() + done.len(), total: all.len() });
+        return Err(RunError::Interrupted { done: all.len() - n_todo + done.len(), total: all.len() });
     }
     Ok(done)
 }

@@ -43,6 +43,15 @@ pub struct Manifest {
     pub env: String,
     pub algo: String,
     pub sampler: String,
+    /// Latent size of a learned goal space (0 for RPE and EFR).
+    #[serde(default)]
+    pub latents: usize,
+    /// `none`, or `faithful` / `corrected` for the neural learners.
+    #[serde(default = "none_string")]
+    pub variant: String,
+    /// Name of the representation learner (the program's name for external learners).
+    #[serde(default)]
+    pub learner: Option<String>,
     pub seed: u64,
     /// The RNG seed derived from (campaign seed, identity).
     pub run_seed: u64,
@@ -54,6 +63,9 @@ pub struct Manifest {
     /// The exploration budget and constants actually used.
     pub explore: serde_json::Value,
     pub env_config: serde_json::Value,
+    /// The UGL-stage settings (learned goal spaces only).
+    #[serde(default)]
+    pub ugl: Option<serde_json::Value>,
     /// Whether the budget is below the paper's, and how.
     pub reduced_budget: bool,
     pub budget_note: String,
@@ -61,9 +73,21 @@ pub struct Manifest {
     pub crate_versions: serde_json::Value,
     pub toolchain: String,
     pub threads: usize,
+    /// Seconds of exploration (excluding the representation's fit).
     pub wall_s: f64,
+    /// Seconds to generate the UGL data set and fit the representation (shared between the
+    /// samplers of a cell in a campaign).
+    #[serde(default)]
+    pub fit_s: Option<f64>,
+    /// Seconds spent rendering and encoding outcomes during exploration.
+    #[serde(default)]
+    pub encode_s: Option<f64>,
     pub host: String,
     pub summary: Summary,
+}
+
+fn none_string() -> String {
+    "none".into()
 }
 
 mod inf_as_string {
@@ -103,8 +127,8 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         "run_id" => vec![spec.run_id(); n],
         "env" => vec![spec.env.name(); n],
         "algo" => vec![spec.algo.name(); n],
-        "sampler" => vec![spec.sampler(); n],
-        "latents" => vec![0i64; n],
+        "sampler" => vec![spec.sampler.name(); n],
+        "latents" => vec![spec.latents as i64; n],
         "variant" => vec!["none"; n],
         "seed" => vec![spec.seed as i64; n],
         "epoch" => c.iter().map(|p| p.epoch as i64).collect::<Vec<_>>(),

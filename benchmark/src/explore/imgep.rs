@@ -12,7 +12,9 @@ use super::history::{ExplorationLog, Recorder};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use super::ExploreConfig;
+use crate::env::render::PIXELS;
 use crate::env::{Environment, PARAMS};
+use crate::repr::{Encoder, ReprError};
 use crate::goals::GoalSampler;
 use crate::metrics::KlCoverage;
 use crate::seed::{stream, Component};
@@ -47,6 +49,48 @@ impl OutcomeSpace for EngineeredSpace {
         for (o, s) in out.iter_mut().zip(state) {
             *o = (s + 1.0) / 2.0;
         }
+    }
+}
+
+/// A learned goal space (RGE-REP, PAPER-NOTES.md section 3): the outcome is encoded as
+/// `encoder(render(final state))`. Measures the time spent encoding.
+pub struct LearnedSpace<'a> {
+    env: &'a dyn Environment,
+    encoder: &'a mut dyn Encoder,
+    image: Vec<f32>,
+    /// Seconds spent rendering and encoding outcomes.
+    pub encode_s: f64,
+    /// The first encoder error, if any (the run is then reported as failed).
+    pub error: Option<ReprError>,
+}
+
+impl<'a> LearnedSpace<'a> {
+    /// Encode outcomes of `env` with `encoder`.
+    pub fn new(env: &'a dyn Environment, encoder: &'a mut dyn Encoder) -> Self {
+        LearnedSpace { env, encoder, image: vec![0.0; PIXELS], encode_s: 0.0, error: None }
+    }
+}
+
+impl OutcomeSpace for LearnedSpace<'_> {
+    fn dim(&self) -> usize {
+        self.encoder.latents()
+    }
+    fn encode(&mut self, state: &[f64], out: &mut [f64]) {
+        let t0 = std::time::Instant::now();
+        self.env.render_into(state, &mut self.image);
+        let r = self.encoder.encode_one(&self.image, out).and_then(|_| {
+            if out.iter().all(|v| v.is_finite()) {
+                Ok(())
+            } else {
+                Err(ReprError::Numerical(format!("encoder returned a non-finite latent for state {state:?}")))
+            }
+        });
+        if let Err(e) = r {
+            // Keep the explorer running on a defined value; the caller reports the error.
+            out.fill(0.0);
+            self.error.get_or_insert(e);
+        }
+        self.encode_s += t0.elapsed().as_secs_f64();
     }
 }
 

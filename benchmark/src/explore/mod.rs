@@ -11,7 +11,7 @@ pub mod rpe;
 use serde::{Deserialize, Serialize};
 
 pub use history::{Checkpoint, ExplorationLog};
-pub use imgep::{run_rge, EngineeredSpace, OutcomeSpace};
+pub use imgep::{run_rge, EngineeredSpace, LearnedSpace, OutcomeSpace};
 pub use rpe::run_rpe;
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
@@ -65,35 +65,84 @@ impl ExploreConfig {
     }
 }
 
+/// The representation learners of IMGEP-UGL (PAPER-NOTES.md section 5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Learner {
+    /// The paper's PCA: non-centred truncated SVD.
+    Pca,
+    /// Ordinary mean-centred PCA.
+    PcaCentred,
+    /// Isomap (5 neighbours).
+    Isomap,
+    /// A program outside this project, through the external-learner protocol.
+    External,
+}
+
+impl Learner {
+    /// All learners of this build.
+    pub const ALL: [Learner; 4] = [Learner::Pca, Learner::PcaCentred, Learner::Isomap, Learner::External];
+
+    /// Name of the learner (`pca`, `pca-centred`, `isomap`, `external`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Learner::Pca => "pca",
+            Learner::PcaCentred => "pca-centred",
+            Learner::Isomap => "isomap",
+            Learner::External => "external",
+        }
+    }
+}
+
 /// Which exploration algorithm.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Algo {
     /// Random parameter exploration.
-    #[serde(rename = "rpe")]
     Rpe,
     /// Random goal exploration with engineered features.
-    #[serde(rename = "rge-efr")]
     RgeEfr,
+    /// Random goal exploration in a goal space learned from images (IMGEP-UGL, RGE-REP).
+    Rge(Learner),
 }
 
 impl Algo {
     /// All algorithms known to this build.
-    pub const ALL: [Algo; 2] = [Algo::Rpe, Algo::RgeEfr];
+    pub fn all() -> Vec<Algo> {
+        let mut v = vec![Algo::Rpe, Algo::RgeEfr];
+        v.extend(Learner::ALL.iter().map(|&l| Algo::Rge(l)));
+        v
+    }
 
-    /// Name on the command line and in results.
+    /// Name on the command line and in results (`rpe`, `rge-efr`, `rge-pca`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Algo::Rpe => "rpe",
             Algo::RgeEfr => "rge-efr",
+            Algo::Rge(Learner::Pca) => "rge-pca",
+            Algo::Rge(Learner::PcaCentred) => "rge-pca-centred",
+            Algo::Rge(Learner::Isomap) => "rge-isomap",
+            Algo::Rge(Learner::External) => "rge-external",
         }
     }
 
-    /// The goal sampler the algorithm uses (`none` for RPE).
-    pub fn sampler(self) -> &'static str {
+    /// The learner, for RGE-REP algorithms.
+    pub fn learner(self) -> Option<Learner> {
         match self {
-            Algo::Rpe => "none",
-            Algo::RgeEfr => "uniform",
+            Algo::Rge(l) => Some(l),
+            _ => None,
         }
+    }
+}
+
+impl Serialize for Algo {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for Algo {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
     }
 }
 
@@ -106,9 +155,54 @@ impl std::fmt::Display for Algo {
 impl std::str::FromStr for Algo {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Algo::ALL.into_iter().find(|a| a.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Algo::ALL.iter().map(|a| a.name()).collect();
+        Algo::all().into_iter().find(|a| a.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Algo::all().iter().map(|a| a.name()).collect();
             format!("unknown algorithm '{s}' (expected one of: {})", names.join(", "))
         })
+    }
+}
+
+/// How goals are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerKind {
+    /// No goals (RPE).
+    None,
+    /// Uniform in the engineered box (RGE-EFR).
+    Uniform,
+    /// Gaussian KDE of the training latents (the paper's default for RGE-REP).
+    Kde,
+    /// Isotropic standard Gaussian, N(0, I) (the paper's "GP" / `--sampling=normal`).
+    Gaussian,
+}
+
+impl SamplerKind {
+    /// Name in results.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::None => "none",
+            SamplerKind::Uniform => "uniform",
+            SamplerKind::Kde => "kde",
+            SamplerKind::Gaussian => "gaussian",
+        }
+    }
+}
+
+impl std::fmt::Display for SamplerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for SamplerKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "kde" => Ok(SamplerKind::Kde),
+            "gaussian" => Ok(SamplerKind::Gaussian),
+            "uniform" => Ok(SamplerKind::Uniform),
+            "none" => Ok(SamplerKind::None),
+            _ => Err(format!("unknown goal sampler '{s}' (expected kde or gaussian)")),
+        }
     }
 }

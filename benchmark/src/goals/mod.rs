@@ -1,8 +1,12 @@
 //! Goal samplers (paper Section 3, "goal policy"; PAPER-NOTES.md section 3): where the explorer
 //! draws its goals in the goal space.
 
+pub mod kde;
+pub mod prior;
 pub mod uniform;
 
+pub use kde::KdeGoals;
+pub use prior::GaussianGoals;
 pub use uniform::UniformGoals;
 
 use crate::seed::Stream;

@@ -6,10 +6,11 @@
 //! 1. The harness creates a work directory, writes `train.npy` (float32, shape `(n, dim)`,
 //!    C order; dim = 4900 = 70 x 70, pixel (x, y) at `x * 70 + y`) and starts the configured
 //!    command with `sh -c` in its own process group, with the caller's working directory and
-//!    environment plus `UGL_PROTOCOL=1`, `UGL_TRAIN`, `UGL_TRAIN_LATENTS`, `UGL_LATENTS`,
-//!    `UGL_SEED` (drawn from the learner stream given to `fit`) and `UGL_WORKDIR`.
+//!    environment plus `UGL_PROTOCOL=1`, `UGL_TRAIN`, `UGL_TRAIN_LATENTS`, `UGL_PRIOR`,
+//!    `UGL_LATENTS`, `UGL_SEED` (drawn from the learner stream given to `fit`), `UGL_WORKDIR`
+//!    and `UGL_HARNESS_PID`.
 //! 2. The program fits, writes `train_latents.npy` (float32 or float64, shape `(n, latents)`),
-//!    optionally `prior.npy` (shape `(2, latents)`: mean row, std row), and prints the line
+//!    optionally `UGL_PRIOR` (shape `(2, latents)`: mean row, std row), and prints the line
 //!    `READY` on stdout. Its stderr is forwarded to `tracing` and its last lines are kept for
 //!    error messages.
 //! 3. Encode requests: the harness writes one npy array (float32, `(m, dim)`, C order,
@@ -131,7 +132,9 @@ impl ExternalLearner {
             .env("UGL_TRAIN_LATENTS", &train_latents)
             .env("UGL_LATENTS", latents.to_string())
             .env("UGL_SEED", seed.to_string())
-            .env("UGL_WORKDIR", &workdir.path);
+            .env("UGL_PRIOR", &prior_path)
+            .env("UGL_WORKDIR", &workdir.path)
+            .env("UGL_HARNESS_PID", std::process::id().to_string());
         tracing::info!(learner = %self.name, command = %self.command, n = images.n, latents, seed,
             workdir = %workdir.path.display(), "starting external learner");
         let mut session = Session::spawn(self, cmd, workdir)?;
@@ -795,7 +798,7 @@ fn write_npy_f32_file(path: &Path, rows: usize, cols: usize, data: &[f32]) -> io
         }
         w.write_all(&chunk)?;
     }
-    w.into_inner().map_err(|e| e.into_error())?.sync_all()
+    w.flush()
 }
 
 struct NpyError {

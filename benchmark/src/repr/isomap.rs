@@ -104,6 +104,7 @@ impl Isomap {
             return Err(ReprError::InvalidInput(format!("isomap: too many training images ({n})")));
         }
 
+        let t0 = std::time::Instant::now();
         // 1. kNN graph (training images against themselves, self excluded).
         let norms: Vec<f64> = images.data.par_chunks(dim).map(sq_norm).collect();
         let use_sparse = match path {
@@ -121,6 +122,7 @@ impl Isomap {
         };
         let graph = Csr::from_knn(n, k, &knn);
         drop(knn);
+        let t_knn = t0.elapsed();
 
         // 2. Geodesic distances.
         let comps = graph.components();
@@ -140,6 +142,7 @@ impl Isomap {
         let mut geo = graph.all_pairs();
         drop(graph);
         symmetrise_min(&mut geo, n);
+        let t_geo = t0.elapsed();
 
         // 3. Classical MDS: double-centred K = -0.5 G^2, top eigenpairs.
         let mut kc: Vec<f64> = vec![0.0; n * n];
@@ -160,8 +163,21 @@ impl Isomap {
                 *v = *v - (ci + cj) + all_mean;
             }
         });
+        let t_kernel = t0.elapsed();
         let (lambdas, mut alphas) = top_eigenpairs(&kc, n, latents, rng)?;
         drop(kc);
+        tracing::debug!(
+            n,
+            sparse = use_sparse,
+            knn_s = t_knn.as_secs_f64(),
+            geodesics_s = (t_geo - t_knn).as_secs_f64(),
+            kernel_s = (t_kernel - t_geo).as_secs_f64(),
+            eigen_s = (t0.elapsed() - t_kernel).as_secs_f64(),
+            "isomap fit phases"
+        );
+        if std::env::var_os("UGL_ISOMAP_TIMING").is_some() {
+            eprintln!("TIMING knn {:?} geo {:?} kernel {:?} eigen {:?}", t_knn, t_geo - t_knn, t_kernel - t_geo, t0.elapsed() - t_kernel);
+        }
         flip_signs(&mut alphas, n, latents);
 
         let mut z = vec![0.0; n * latents];
@@ -1158,6 +1174,30 @@ mod tests {
             // Ties really occur: some query has equal distances among its neighbours.
             assert!(brute.chunks(k).any(|c| c.windows(2).any(|w| w[0].0 == w[1].0)));
         }
+    }
+
+    #[test]
+    fn sparse_and_dense_fits_are_identical_on_exact_data() {
+        // Dyadic pixel values on a 1-D "ball" sliding along a line: exact arithmetic, so both
+        // kNN paths give the same graph and the whole fit the same bits.
+        let (n, dim) = (300, 64);
+        let mut data = vec![0.0f32; n * dim];
+        for i in 0..n {
+            let c = (i * 7) % (dim - 4);
+            data[i * dim + c..i * dim + c + 4].copy_from_slice(&[0.5, 1.0, 1.0, 0.5]);
+            data[i * dim + (i * 13) % dim] += 0.25;
+        }
+        let set = ImageSet::new(n, dim, data).unwrap();
+        let iso = Isomap { n_neighbors: 8 };
+        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse).unwrap();
+        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense).unwrap();
+        assert!(es.uses_sparse_index() && !ed.uses_sparse_index());
+        assert_eq!(zs, zd);
+        assert_eq!(es.encode(&set).unwrap(), ed.encode(&set).unwrap());
+        let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
+        es.encode_one(set.row(3), &mut a).unwrap();
+        ed.encode_one(set.row(3), &mut b).unwrap();
+        assert_eq!(a, b);
     }
 
     #[test]
