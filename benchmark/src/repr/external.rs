@@ -599,8 +599,12 @@ impl Session {
         loop {
             match self.child.try_wait() {
                 Ok(Some(s)) => {
-                    // Exited by itself (and reaped: its group id may be reused, so no group kill).
+                    // Exited by itself. Anything it left behind in its group (background jobs,
+                    // data-loader workers) goes too. The group id is safe to use: Linux does not
+                    // reuse a pid while a process group of that id has members, and an empty
+                    // group's id is only reused after the pid space wraps around.
                     self.status = Some(s);
+                    kill_group(self.child.id());
                     return false;
                 }
                 Ok(None) if Instant::now() < until => thread::sleep(Duration::from_millis(2)),

@@ -22,8 +22,13 @@
 //!    **Disconnected graphs**: sklearn < 1.0 (`utils.graph_shortest_path`, the paper's era)
 //!    silently set the distance between unreachable points to 0 (scikit-learn issue #14010);
 //!    sklearn >= 1.0 joins the components through their closest pair of points (PR #20531).
-//!    We do neither: the fit fails with [`ReprError::Numerical`] naming the number of connected
-//!    components, and suggests more neighbours or more images.
+//!    By default we do neither: the fit fails with [`ReprError::Numerical`] naming the number of
+//!    connected components, and suggests more neighbours or more images. **This happens on the
+//!    paper's own data**: 10,000 ball images at states uniform on [-1,1]^2 fall on only 4900
+//!    pixel positions, so ~90 positions hold 6+ identical images, whose 5 neighbours are each
+//!    other at distance 0; measured, the 5-NN graph of such a set had 5 components (sizes 9935,
+//!    40, 13, 6, 6). [`Isomap::fit_isomap_with`] with [`Disconnected::ConnectClosestPairs`]
+//!    reproduces sklearn >= 1.0 instead.
 //! 3. **Classical MDS** = `KernelPCA(n_components=d, kernel='precomputed')` on
 //!    `K = -0.5 G^2`, centred by `KernelCenterer` (double centring with the column means of K).
 //!    The top-d eigenpairs (largest *algebraic* eigenvalues, as ARPACK `which='LA'`) come from a
@@ -82,13 +87,45 @@ impl RepresentationLearner for Isomap {
     }
 }
 
+/// What a fit does when the kNN graph is disconnected (PAPER-NOTES.md section 5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Disconnected {
+    /// Fail with [`ReprError::Numerical`] naming the number of components (the default, and
+    /// what the [`RepresentationLearner`] implementation does).
+    #[default]
+    Error,
+    /// sklearn >= 1.0 (`utils.graph._fix_connected_components`, PR #20531): for every pair of
+    /// components, add an edge between their closest pair of points (Euclidean; the first pair
+    /// in index order on ties) weighted by its distance, then proceed.
+    ConnectClosestPairs,
+}
+
 impl Isomap {
-    /// Fit and return the concrete encoder (with its eigenvalues) and the training embedding.
+    /// Fit and return the concrete encoder (with its eigenvalues) and the training embedding;
+    /// a disconnected kNN graph is an error (as [`RepresentationLearner::fit`]).
     pub fn fit_isomap(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(IsomapEncoder, Latents), ReprError> {
-        self.fit_with(images, latents, rng, KnnPath::Auto)
+        self.fit_with(images, latents, rng, KnnPath::Auto, Disconnected::Error)
     }
 
-    fn fit_with(&self, images: &ImageSet, latents: usize, rng: &mut Stream, path: KnnPath) -> Result<(IsomapEncoder, Latents), ReprError> {
+    /// As [`Isomap::fit_isomap`], choosing what happens when the kNN graph is disconnected.
+    pub fn fit_isomap_with(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        disconnected: Disconnected,
+    ) -> Result<(IsomapEncoder, Latents), ReprError> {
+        self.fit_with(images, latents, rng, KnnPath::Auto, disconnected)
+    }
+
+    fn fit_with(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        path: KnnPath,
+        disconnected: Disconnected,
+    ) -> Result<(IsomapEncoder, Latents), ReprError> {
         check_fit_input(images, latents)?;
         let (n, dim, k) = (images.n, images.dim, self.n_neighbors);
         if k == 0 {
@@ -120,25 +157,39 @@ impl Isomap {
             let knn = dense_knn(&images.data, n, dim, &norms, &images.data, n, &norms, k, true);
             (TrainIndex::Dense { data: images.data.clone(), norms }, knn)
         };
-        let graph = Csr::from_knn(n, k, &knn);
-        drop(knn);
+        let mut graph = Csr::from_knn(n, k, &knn);
         let t_knn = t0.elapsed();
 
         // 2. Geodesic distances.
-        let comps = graph.components();
-        if comps.len() > 1 {
-            let mut sizes: Vec<usize> = comps.clone();
-            sizes.sort_unstable_by(|a, b| b.cmp(a));
-            let shown: Vec<String> = sizes.iter().take(6).map(|s| s.to_string()).collect();
-            let more = if sizes.len() > 6 { ", ..." } else { "" };
-            return Err(ReprError::Numerical(format!(
-                "isomap: the {k}-nearest-neighbour graph of the {n} training images has {} connected components \
-                 (sizes {}{more}), so geodesic distances between them are infinite; use more neighbours \
-                 (n_neighbors > {k}) or more images",
-                comps.len(),
-                shown.join(", ")
-            )));
+        let (labels, sizes) = graph.components();
+        if sizes.len() > 1 {
+            match disconnected {
+                Disconnected::Error => {
+                    let mut sorted = sizes.clone();
+                    sorted.sort_unstable_by(|a, b| b.cmp(a));
+                    let shown: Vec<String> = sorted.iter().take(6).map(|s| s.to_string()).collect();
+                    let more = if sorted.len() > 6 { ", ..." } else { "" };
+                    return Err(ReprError::Numerical(format!(
+                        "isomap: the {k}-nearest-neighbour graph of the {n} training images has {} connected components \
+                         (sizes {}{more}), so geodesic distances between them are infinite; use more neighbours \
+                         (n_neighbors > {k}) or more images",
+                        sizes.len(),
+                        shown.join(", ")
+                    )));
+                }
+                Disconnected::ConnectClosestPairs => {
+                    let mut edges = graph.edges();
+                    for (a, b, d2) in closest_pairs(&index, images, &labels, sizes.len()) {
+                        let w = d2.sqrt();
+                        edges.push((a, b, w));
+                        edges.push((b, a, w));
+                    }
+                    graph = Csr::from_edges(n, edges);
+                    tracing::debug!(components = sizes.len(), "isomap: joined the components of the kNN graph");
+                }
+            }
         }
+        drop(knn);
         let mut geo = graph.all_pairs();
         drop(graph);
         symmetrise_min(&mut geo, n);
@@ -516,17 +567,10 @@ impl SparseIndex {
         self.knn_sparse_query(vals, x_norm, k, exclude, s, out);
     }
 
-    /// The k nearest training images of a query given by its non-zero pixels in increasing
-    /// pixel order, sorted by (squared distance, index).
-    fn knn_sparse_query(
-        &self,
-        pixels: impl Iterator<Item = (usize, f32)>,
-        x_norm: f64,
-        k: usize,
-        exclude: Option<usize>,
-        s: &mut KnnScratch,
-        out: &mut Vec<(f64, u32)>,
-    ) {
+    /// Dot products of a query (non-zero pixels in increasing pixel order) with every training
+    /// image that shares a pixel with it: afterwards `s.acc[j]` holds the dot product for the
+    /// images with `s.stamp[j] == s.epoch` (listed in `s.touched`), the others are 0.
+    fn dots(&self, pixels: impl Iterator<Item = (usize, f32)>, s: &mut KnnScratch) {
         s.epoch = s.epoch.wrapping_add(1);
         if s.epoch == 0 {
             s.stamp.fill(0);
@@ -547,6 +591,21 @@ impl SparseIndex {
                 s.acc[j] += v * w as f64;
             }
         }
+    }
+
+    /// The k nearest training images of a query given by its non-zero pixels in increasing
+    /// pixel order, sorted by (squared distance, index).
+    fn knn_sparse_query(
+        &self,
+        pixels: impl Iterator<Item = (usize, f32)>,
+        x_norm: f64,
+        k: usize,
+        exclude: Option<usize>,
+        s: &mut KnnScratch,
+        out: &mut Vec<(f64, u32)>,
+    ) {
+        self.dots(pixels, s);
+        let ep = s.epoch;
         let excl = exclude.map_or(u32::MAX, |e| e as u32);
         s.cands.clear();
         for &j in &s.touched {
@@ -666,6 +725,78 @@ fn insert_top(top: &mut [(f64, u32)], cand: (f64, u32)) {
 // Graph and geodesics
 // ---------------------------------------------------------------------------------------------
 
+/// sklearn >= 1.0 `_fix_connected_components`: for every pair of components (ci > cj), the
+/// closest pair (a in ci, b in cj) as (a, b, squared distance); ties go to the first pair in
+/// (a, b) index order, like `argmin` over the row-major distance block. Work: every point of a
+/// component against every point of the components before it.
+fn closest_pairs(index: &TrainIndex, images: &ImageSet, labels: &[u32], ncomp: usize) -> Vec<(u32, u32, f64)> {
+    let n = images.n;
+    // For each point a, the closest point of each earlier component (squared distance, b).
+    let per_point: Vec<Vec<(f64, u32)>> = (0..n)
+        .into_par_iter()
+        .map_init(
+            || (KnnScratch::new(n), vec![0.0f64; n]),
+            |(s, d2), a| {
+                let ca = labels[a] as usize;
+                if ca == 0 {
+                    return Vec::new();
+                }
+                distances_to_all(index, images, a, s, d2);
+                let mut best = vec![(f64::INFINITY, u32::MAX); ca];
+                for (b, &v) in d2.iter().enumerate() {
+                    let cb = labels[b] as usize;
+                    if cb < ca && v < best[cb].0 {
+                        best[cb] = (v, b as u32);
+                    }
+                }
+                best
+            },
+        )
+        .collect();
+    let mut best = vec![(f64::INFINITY, u32::MAX, u32::MAX); ncomp * ncomp];
+    for (a, row) in per_point.iter().enumerate() {
+        let ca = labels[a] as usize;
+        for (cb, &(v, b)) in row.iter().enumerate() {
+            // Points a come in increasing order: strict < keeps the first a on ties.
+            if v < best[ca * ncomp + cb].0 {
+                best[ca * ncomp + cb] = (v, a as u32, b);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for ci in 0..ncomp {
+        for cj in 0..ci {
+            let (v, a, b) = best[ci * ncomp + cj];
+            out.push((a, b, v));
+        }
+    }
+    out
+}
+
+/// Squared distances from training image `a` to every training image.
+fn distances_to_all(index: &TrainIndex, images: &ImageSet, a: usize, s: &mut KnnScratch, d2: &mut [f64]) {
+    match index {
+        TrainIndex::Sparse(idx) => {
+            let x = images.row(a);
+            let xn = idx.norms[a];
+            idx.dots(x.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(p, &v)| (p, v)), s);
+            for (b, o) in d2.iter_mut().enumerate() {
+                let dot = if s.stamp[b] == s.epoch { s.acc[b] } else { 0.0 };
+                *o = clamp0((xn + idx.norms[b]) - 2.0 * dot);
+            }
+        }
+        TrainIndex::Dense { data, norms } => {
+            let dim = images.dim;
+            let x = &data[a * dim..(a + 1) * dim];
+            for (b, o) in d2.iter_mut().enumerate() {
+                let y = &data[b * dim..(b + 1) * dim];
+                let dot: f64 = x.iter().zip(y).map(|(&p, &q)| p as f64 * q as f64).sum();
+                *o = clamp0((norms[a] + norms[b]) - 2.0 * dot);
+            }
+        }
+    }
+}
+
 /// Undirected weighted graph in CSR form.
 struct Csr {
     n: usize,
@@ -707,8 +838,9 @@ impl Csr {
         Csr { n, start, adj, w }
     }
 
-    /// Sizes of the connected components (in order of their smallest node).
-    fn components(&self) -> Vec<usize> {
+    /// Component label of every node (components numbered in order of their smallest node, as
+    /// scipy's `connected_components`) and the component sizes.
+    fn components(&self) -> (Vec<u32>, Vec<usize>) {
         let mut label = vec![u32::MAX; self.n];
         let mut sizes = Vec::new();
         let mut stack = Vec::new();
@@ -731,7 +863,18 @@ impl Csr {
             }
             sizes.push(size);
         }
-        sizes
+        (label, sizes)
+    }
+
+    /// The directed edge triples (each undirected edge twice).
+    fn edges(&self) -> Vec<(u32, u32, f64)> {
+        let mut e = Vec::with_capacity(self.adj.len());
+        for i in 0..self.n {
+            for q in self.start[i]..self.start[i + 1] {
+                e.push((i as u32, self.adj[q], self.w[q]));
+            }
+        }
+        e
     }
 
     /// Geodesic distances from every node (Dijkstra, parallel over sources), n x n row-major,
@@ -1189,8 +1332,8 @@ mod tests {
         }
         let set = ImageSet::new(n, dim, data).unwrap();
         let iso = Isomap { n_neighbors: 8 };
-        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse).unwrap();
-        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense).unwrap();
+        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse, Disconnected::Error).unwrap();
+        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense, Disconnected::Error).unwrap();
         assert!(es.uses_sparse_index() && !ed.uses_sparse_index());
         assert_eq!(zs, zd);
         assert_eq!(es.encode(&set).unwrap(), ed.encode(&set).unwrap());
@@ -1210,7 +1353,7 @@ mod tests {
             e.push((b, a, w));
         }
         let g = Csr::from_edges(6, e);
-        assert_eq!(g.components(), vec![6]);
+        assert_eq!(g.components(), (vec![0; 6], vec![6]));
         let d = g.all_pairs();
         let expect = [
             [0.0, 1.0, 2.0, 2.5, 2.5, 2.5],
@@ -1227,7 +1370,7 @@ mod tests {
         }
         // Disconnected: two components.
         let g2 = Csr::from_edges(4, vec![(0, 1, 1.0), (1, 0, 1.0), (2, 3, 1.0), (3, 2, 1.0)]);
-        assert_eq!(g2.components(), vec![2, 2]);
+        assert_eq!(g2.components(), (vec![0, 0, 1, 1], vec![2, 2]));
     }
 
     #[test]
