@@ -131,12 +131,13 @@ fn out_of_sample_training_points_match_the_embedding() {
         for i in 0..set.n {
             enc.encode_one(set.row(i), &mut one).unwrap();
             // Sparse index (images): the same arithmetic, same bits. Dense fallback (the 3-D
-            // roll): blocked products of another shape, same up to rounding.
+            // roll): blocked products of another shape, same up to rounding (amplified by the
+            // square root near 0: |x|^2 + |x|^2 - 2 x.x is ~1e-15 |x|^2, not 0).
             if set.dim == PIXELS {
                 assert_eq!(&one[..], batch.row(i), "encode_one == encode, image {i}");
             } else {
                 for c in 0..d {
-                    assert!((one[c] - batch.row(i)[c]).abs() <= 1e-9 * scale, "encode_one ~ encode, image {i}");
+                    assert!((one[c] - batch.row(i)[c]).abs() <= 1e-6 * scale, "encode_one ~ encode, image {i}");
                 }
             }
             for c in 0..d {
@@ -144,7 +145,7 @@ fn out_of_sample_training_points_match_the_embedding() {
             }
         }
         println!("out-of-sample on training points (dim {}): max |diff| / max |z| = {:.2e}", set.dim, worst / scale);
-        assert!(worst <= 1e-5 * scale, "worst {worst} scale {scale}");
+        assert!(worst <= 1e-6 * scale, "worst {worst} scale {scale}");
     }
 }
 
