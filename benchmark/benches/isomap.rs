@@ -7,7 +7,7 @@ use rand::RngExt;
 use std::hint::black_box;
 use ugl_bench::env::render::{PIXELS, render_ball_into};
 use ugl_bench::repr::isomap::Isomap;
-use ugl_bench::repr::{Encoder, ImageSet, RepresentationLearner};
+use ugl_bench::repr::{ImageSet, RepresentationLearner};
 use ugl_bench::seed::stream_named;
 
 fn balls(n: usize, seed: u64) -> ImageSet {

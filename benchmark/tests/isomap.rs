@@ -161,7 +161,8 @@ fn fits_are_deterministic() {
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&a.0.data), bits(&b.0.data));
     assert_eq!(bits(&a.1.data), bits(&b.1.data));
-    // Also with the dense kNN fallback, the partial (Krylov) eigen-solver and 10 latents.
+    // Also with the partial (Krylov) eigen-solver (n > 256) and 10 latents, then the dense kNN
+    // fallback (3-D points).
     let (set, _) = balls(400, 5);
     let f = || Isomap::default().fit(&set, 10, &mut stream_named(3, "learner")).unwrap().1;
     assert_eq!(bits(&f().data), bits(&f().data));
@@ -183,7 +184,7 @@ fn disconnected_graph_is_a_clear_error() {
         }
     }
     let set = ImageSet::new(20, 3, data).unwrap();
-    let err = Isomap { n_neighbors: 3 }.fit(&set, 2, &mut stream_named(1, "l")).err().expect("must fail");
+    let err = Isomap { n_neighbors: 3, ..Default::default() }.fit(&set, 2, &mut stream_named(1, "l")).err().expect("must fail");
     match err {
         ReprError::Numerical(msg) => {
             println!("{msg}");
@@ -194,9 +195,8 @@ fn disconnected_graph_is_a_clear_error() {
     }
     // sklearn >= 1.0 behaviour on request: the clusters are joined by their closest pair and
     // the first axis separates them.
-    let (_, z) = Isomap { n_neighbors: 3 }
-        .fit_isomap_with(&set, 2, &mut stream_named(1, "l"), Disconnected::ConnectClosestPairs)
-        .unwrap();
+    let joined = Isomap { n_neighbors: 3, disconnected: Disconnected::ConnectClosestPairs };
+    let (_, z) = joined.fit(&set, 2, &mut stream_named(1, "l")).unwrap();
     let first: Vec<f64> = (0..20).map(|i| z.row(i)[0]).collect();
     let (a, b) = (&first[..10], &first[10..]);
     let sep = a.iter().all(|&v| v > 0.0) && b.iter().all(|&v| v < 0.0) || a.iter().all(|&v| v < 0.0) && b.iter().all(|&v| v > 0.0);
@@ -214,7 +214,7 @@ fn invalid_inputs() {
     // n_neighbors = 5 needs at least 6 images.
     let five = ImageSet::new(5, 3, (0..15).map(|v| v as f32).collect()).unwrap();
     assert!(invalid(Isomap::default().fit(&five, 1, &mut rng).map(|_| ())));
-    assert!(invalid(Isomap { n_neighbors: 0 }.fit(&set, 2, &mut rng).map(|_| ())));
+    assert!(invalid(Isomap { n_neighbors: 0, ..Default::default() }.fit(&set, 2, &mut rng).map(|_| ())));
     // Wrong image size at encode time.
     let (mut enc, _) = Isomap::default().fit(&set, 2, &mut rng).unwrap();
     let mut out = [0.0; 2];
@@ -273,23 +273,15 @@ fn ball_images_recover_positions() {
     // Isomap with 5 neighbours does not give an isometric map of the arena (pixel distances
     // grow like the square root of a small displacement, so geodesics depend on the sampling
     // density; the sklearn output on the same images is equally warped), but it must keep
-    // neighbourhoods and the order of both coordinates. Measured on this data: trustworthiness
-    // 0.93, pairwise Spearman 0.70, per-coordinate best |Spearman| 0.95 (y) and 0.78 (x); a
-    // random embedding gives about 0.5, 0 and 0.
+    // neighbourhoods and the order of both coordinates. Measured on this data (seed 8):
+    // trustworthiness 0.93, pairwise Spearman 0.70, per-coordinate best |Spearman| 0.78 (x) and
+    // 0.95 (y); over seeds 1..9 they ranged over 0.89-0.998, 0.39-0.99 and 0.52-0.98. A random
+    // embedding gives about 0.5, 0 and 0.
     let (trust, rho, best) = ball_stats(500, 8);
     println!("balls: trustworthiness {trust:.4}, pairwise spearman {rho:.4}, best axis |spearman| x {:.3} y {:.3}", best[0], best[1]);
     assert!(trust > 0.85, "{trust}");
     assert!(rho > 0.5, "{rho}");
     assert!(best[0] > 0.6 && best[1] > 0.6, "{best:?}");
-}
-
-#[test]
-#[ignore]
-fn tmp_ball_stats_seeds() {
-    for seed in 1..10 {
-        let (trust, rho, best) = ball_stats(500, seed);
-        println!("seed {seed}: trust {trust:.4} rho {rho:.4} best {:.3} {:.3}", best[0], best[1]);
-    }
 }
 
 /// Measurement (not a check): fit on 10,000 ball images with 10 latents, then encode_one.
@@ -304,15 +296,15 @@ fn measure_fit_10k_balls() {
     // The paper's configuration gives a disconnected 5-NN graph (duplicated pixel positions):
     // the default fit refuses it, so measure the sklearn >= 1.0 behaviour (components joined).
     match Isomap::default().fit_isomap(&set, 10, &mut stream_named(10, "learner")) {
-        Err(ReprError::Numerical(m)) => println!("default fit: {m}"),
+        Err(ReprError::Numerical(m)) => println!("default fit fails after {:.2?}: {m}", t.elapsed()),
         Err(e) => panic!("{e:?}"),
         Ok(_) => println!("default fit: connected"),
     }
     let t = Instant::now();
-    let (mut enc, z) = Isomap::default()
-        .fit_isomap_with(&set, 10, &mut stream_named(10, "learner"), Disconnected::ConnectClosestPairs)
-        .unwrap();
+    let joined = Isomap { disconnected: Disconnected::ConnectClosestPairs, ..Default::default() };
+    let (mut enc, z) = joined.fit_isomap(&set, 10, &mut stream_named(10, "learner")).unwrap();
     println!("fit 10000 x 4900, 10 latents: {:.2?} (sparse index: {})", t.elapsed(), enc.uses_sparse_index());
+    println!("phases: {:?}", enc.fit_timings());
     println!("eigenvalues: {:?}", enc.eigenvalues());
     assert_eq!(z.n, 10_000);
     let (probe, _) = balls(200, 11);
@@ -322,47 +314,4 @@ fn measure_fit_10k_balls() {
         enc.encode_one(probe.row(i), &mut out).unwrap();
     }
     println!("encode_one: {:.1} us per image", t.elapsed().as_secs_f64() * 1e6 / probe.n as f64);
-}
-
-#[test]
-#[ignore]
-fn tmp_dump_for_sklearn() {
-    use std::io::Write;
-    let w = |name: &str, bytes: Vec<u8>| std::fs::File::create(format!("/tmp/iso_{name}.bin")).unwrap().write_all(&bytes).unwrap();
-    let f32b = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-    let f64b = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-    let (set, states) = balls(500, 8);
-    let (mut enc, z) = Isomap::default().fit_isomap(&set, 2, &mut stream_named(8, "learner")).unwrap();
-    w("balls_x", f32b(&set.data));
-    w("balls_s", f64b(&states.iter().flat_map(|s| s.to_vec()).collect::<Vec<_>>()));
-    w("balls_z", f64b(&z.data));
-    let probe = balls(50, 99).0;
-    w("balls_q", f32b(&probe.data));
-    w("balls_zq", f64b(&enc.encode(&probe).unwrap().data));
-    println!("eig {:?}", enc.eigenvalues());
-    let (set, _) = swiss_roll(1000, 1);
-    let (mut enc, z) = Isomap::default().fit_isomap(&set, 2, &mut stream_named(1, "learner")).unwrap();
-    w("roll_x", f32b(&set.data));
-    w("roll_z", f64b(&z.data));
-    let probe = swiss_roll(50, 77).0;
-    w("roll_q", f32b(&probe.data));
-    w("roll_zq", f64b(&enc.encode(&probe).unwrap().data));
-    println!("eig {:?}", enc.eigenvalues());
-}
-
-#[test]
-#[ignore]
-fn tmp_components() {
-    let (set, states) = balls(10_000, 10);
-    // pixel cell of each state and duplicates per cell
-    let cell = |s: &[f64; 2]| (((s[0] + 1.0) / 2.0 * 70.0) as i32, ((s[1] + 1.0) / 2.0 * 70.0) as i32);
-    let mut counts = std::collections::HashMap::new();
-    for s in &states { *counts.entry(cell(s)).or_insert(0) += 1; }
-    let mut hist = std::collections::BTreeMap::new();
-    for c in counts.values() { *hist.entry(*c).or_insert(0) += 1; }
-    println!("cells used {}, copies histogram {:?}", counts.len(), hist);
-    let norms: Vec<f64> = (0..set.n).map(|i| set.row(i).iter().map(|&v| (v as f64).powi(2)).sum()).collect();
-    let mut nh = std::collections::BTreeMap::new();
-    for v in &norms { *nh.entry((v * 1000.0) as i64).or_insert(0) += 1; }
-    println!("distinct norms {}", nh.len());
 }

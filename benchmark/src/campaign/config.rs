@@ -267,14 +267,24 @@ fn validate_env(e: &EnvConfig) -> Result<(), String> {
     Ok(())
 }
 
-/// First line of a (possibly multi-line) message, trimmed.
+/// A (possibly multi-line) TOML error as one line: the reason, the position and the offending
+/// source line (which names the key), e.g.
+/// `invalid value: integer `-5`, expected usize (line 9, column 10: `epochs = -5`)`.
 pub(crate) fn one_line(s: &str) -> String {
-    let mut parts = s.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('|'));
-    let first = parts.next().unwrap_or("").to_string();
-    // toml's messages are "TOML parse error at line L, column C" + a snippet + the reason.
-    match s.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('|') && !l.starts_with("TOML parse error")).last() {
-        Some(reason) if first.starts_with("TOML parse error") => format!("{reason} ({})", first.trim_start_matches("TOML parse error ").trim()),
-        _ => first,
+    let lines: Vec<&str> = s.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    let Some(first) = lines.first() else { return String::new() };
+    let Some(pos) = first.strip_prefix("TOML parse error at ") else { return first.to_string() };
+    // The snippet line looks like "9 | epochs = -5"; the reason is the last line that is not
+    // part of the snippet.
+    let source = lines.iter().find_map(|l| {
+        let (num, text) = l.split_once('|')?;
+        (!num.trim().is_empty() && num.trim().chars().all(|c| c.is_ascii_digit())).then(|| text.trim())
+    });
+    let reason = lines.iter().rev().find(|l| !l.starts_with('|') && !l.contains(" | ") && !l.starts_with("TOML parse error"));
+    match (reason, source) {
+        (Some(r), Some(src)) => format!("{r} ({pos}: `{src}`)"),
+        (Some(r), None) => format!("{r} ({pos})"),
+        _ => first.to_string(),
     }
 }
 

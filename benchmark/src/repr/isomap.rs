@@ -5,47 +5,59 @@
 //!
 //! 1. **kNN graph** = `kneighbors_graph(X, n_neighbors, mode='distance')`: for each training image
 //!    its `n_neighbors` nearest *other* training images (the sample itself is excluded, duplicates
-//!    are not), Euclidean distance. Ties are broken by the lower image index (sklearn's brute
-//!    force uses an unstable `argpartition`, i.e. an unspecified order; ours is deterministic).
-//!    Distances are computed as `sqrt(max(0, |a|^2 + |b|^2 - 2 a.b))` in f64 (sklearn's
-//!    `euclidean_distances` formula). The rendered images are sparse (a ball has 97 lit pixels
-//!    out of 4900), so the dot products go through an inverted index pixel -> images; dense data
-//!    fall back to blocked faer matrix products. Both paths give bit-identical neighbour lists
-//!    whenever the arithmetic is exact (tested), and otherwise differ only in rounding.
+//!    are not), Euclidean distance computed as `sqrt(max(0, |a|^2 + |b|^2 - 2 a.b))` in f64
+//!    (sklearn's `euclidean_distances` formula). Ties are broken by the lower image index
+//!    (sklearn's brute force uses an unstable `argpartition`: an unspecified order). Exact ties
+//!    are common in rendered images (all pairs of non-overlapping balls are at the same
+//!    distance, and identical images at distance 0); distances that are equal mathematically but
+//!    rounded differently are ordered by their computed values, deterministically.
+//!    The rendered images are sparse (a ball lights 97 of 4900 pixels), so the dot products go
+//!    through an inverted index pixel -> images, with a dense fallback (blocked faer products,
+//!    chosen when the sparse work `sum_p c_p^2` is not 80x below `n^2 dim`). Both paths give
+//!    identical neighbour lists whenever the arithmetic is exact (tested).
 //! 2. **Geodesic distances** = `shortest_path(kng, method='D', directed=False)`: the graph is
-//!    made undirected (an edge i-j exists when j is a neighbour of i or i of j; weight = the
-//!    smaller of the two computed distances) and Dijkstra (binary heap with decrease-key, CSR
-//!    adjacency) runs from every node in parallel. Distances are accumulated in f64 and stored
-//!    as **f32** (n x n, 400 MB for n = 10,000), then symmetrised (`min(G_ij, G_ji)`); the kernel
-//!    below is built from the stored f32 values so that fit and out-of-sample transform see the
-//!    same geodesics.
+//!    made undirected (an edge i-j when j is a neighbour of i or i of j; weight the smaller of
+//!    the two computed distances) and Dijkstra (CSR adjacency, radix heap over the bits of the
+//!    f64 keys) runs from every node in parallel. Nodes joined by exact zero-weight edges
+//!    (identical images) are merged first, which changes no distance (adding 0.0 is exact) and
+//!    shrinks the all-pairs problem (10,000 ball images sit on ~4,300 distinct pixel positions).
+//!    Distances are accumulated in f64 and stored as **f32** (n x n, 400 MB for n = 10,000), then
+//!    symmetrised (`min(G_ij, G_ji)`); the kernel is built from the stored f32 values so that fit
+//!    and out-of-sample transform see the same geodesics.
+//!
 //!    **Disconnected graphs**: sklearn < 1.0 (`utils.graph_shortest_path`, the paper's era)
 //!    silently set the distance between unreachable points to 0 (scikit-learn issue #14010);
-//!    sklearn >= 1.0 joins the components through their closest pair of points (PR #20531).
-//!    By default we do neither: the fit fails with [`ReprError::Numerical`] naming the number of
-//!    connected components, and suggests more neighbours or more images. **This happens on the
-//!    paper's own data**: 10,000 ball images at states uniform on [-1,1]^2 fall on only 4900
-//!    pixel positions, so ~90 positions hold 6+ identical images, whose 5 neighbours are each
-//!    other at distance 0; measured, the 5-NN graph of such a set had 5 components (sizes 9935,
-//!    40, 13, 6, 6). [`Isomap::fit_isomap_with`] with [`Disconnected::ConnectClosestPairs`]
+//!    sklearn >= 1.0 joins every pair of components by its closest pair of points (PR #20531).
+//!    By default ([`Disconnected::Error`]) we do neither: the fit fails with
+//!    [`ReprError::Numerical`] naming the number of components and suggesting more neighbours or
+//!    more images. **This happens on the paper's own data**: 10,000 ball images at states uniform
+//!    on [-1,1]^2 fall on only 4900 pixel positions, so ~90 positions hold 6 or more identical
+//!    images whose 5 neighbours are each other at distance 0; measured, the 5-NN graph of such a
+//!    set had 5 components (sizes 9935, 40, 13, 6, 6). [`Disconnected::ConnectClosestPairs`]
 //!    reproduces sklearn >= 1.0 instead.
-//! 3. **Classical MDS** = `KernelPCA(n_components=d, kernel='precomputed')` on
-//!    `K = -0.5 G^2`, centred by `KernelCenterer` (double centring with the column means of K).
-//!    The top-d eigenpairs (largest *algebraic* eigenvalues, as ARPACK `which='LA'`) come from a
-//!    partial solver: block Krylov (block Lanczos with full reorthogonalisation, Rayleigh-Ritz,
-//!    explicit restarts) started from a random block drawn from the learner's stream, iterated
-//!    until every wanted Ritz pair has residual `|K y - theta y| <= 1e-10 |K|` (so each eigenvalue
-//!    is within 1e-10 |K| of the exact one). Small problems (n <= 256) use a full dense
-//!    eigendecomposition. The sign of each eigenvector is fixed as sklearn's `svd_flip`
-//!    (largest-|component| entry positive, the first such on ties). The training embedding is
-//!    `alphas * sqrt(lambdas)` (`fit_transform`). Eigenvalues <= 0 are clamped to 0 as sklearn's
+//! 3. **Classical MDS** = `KernelPCA(n_components=d, kernel='precomputed')` on `K = -0.5 G^2`,
+//!    centred by `KernelCenterer` (double centring with the column means of K). The top-d
+//!    eigenpairs (largest *algebraic* eigenvalues, as ARPACK `which='LA'`) come from a partial
+//!    solver: block Krylov (block Lanczos with full reorthogonalisation, Rayleigh-Ritz after
+//!    every block, explicit restarts) from a random block drawn from the learner's stream, until
+//!    every wanted Ritz pair has residual `|K y - theta y| <= 1e-10 |K|` (each eigenvalue is then
+//!    within 1e-10 |K| of an exact one). Small problems (n <= 256) use a full dense decomposition. The
+//!    sign of each eigenvector is fixed as sklearn's `svd_flip` (largest-|component| entry
+//!    positive, the first such on ties). The training embedding is `alphas * sqrt(lambdas)`
+//!    (`fit_transform`). Eigenvalues <= 0 are clamped to 0 as sklearn's
 //!    `_check_psd_eigenvalues` does: the corresponding latent is then identically 0.
 //! 4. **Out-of-sample** = `Isomap.transform`: the `n_neighbors` nearest training images of the new
 //!    image (itself included if it is a training image), `G_x[j] = min_a (d(x, a) + G[a, j])`,
-//!    `K_x = -0.5 G_x^2`, centred with the training statistics (`KernelCenterer.transform`:
-//!    minus the training column means, minus the row mean of `K_x`, plus the training overall
-//!    mean), projected on `alphas / sqrt(lambdas)`. After the kNN this costs O(n d) and
-//!    allocates nothing (the encoder keeps its scratch buffers).
+//!    `K_x = -0.5 G_x^2`, centred with the training statistics (`KernelCenterer.transform`: minus
+//!    the training column means, minus the row mean of `K_x`, plus the training overall mean),
+//!    projected on `alphas / sqrt(lambdas)`. After the kNN this costs O(n d) and allocates
+//!    nothing (the encoder keeps its scratch buffers).
+//!
+//! Checked against scikit-learn 1.9.1 (`Isomap(n_components=2, n_neighbors=5,
+//! eigen_solver='dense')`, one-off, outside the test suite): swiss roll (1000 points) embedding
+//! and transform within 2e-8 relative; three separated clusters (joined components) within 5e-8;
+//! 500 ball images within 2e-8 once sklearn's kNN ties are broken by index as here (with
+//! sklearn's own tie order the graphs differ and the embeddings by ~5%).
 //!
 //! Determinism: every parallel loop writes disjoint outputs computed sequentially, and every
 //! matrix product is split into fixed-size blocks run with `Par::Seq`, so a fit is a pure
@@ -68,11 +80,13 @@ use crate::seed::Stream;
 pub struct Isomap {
     /// Number of neighbours of the kNN graph (sklearn default 5).
     pub n_neighbors: usize,
+    /// What to do with a disconnected kNN graph (default: error).
+    pub disconnected: Disconnected,
 }
 
 impl Default for Isomap {
     fn default() -> Self {
-        Isomap { n_neighbors: 5 }
+        Isomap { n_neighbors: 5, disconnected: Disconnected::Error }
     }
 }
 
@@ -90,8 +104,7 @@ impl RepresentationLearner for Isomap {
 /// What a fit does when the kNN graph is disconnected (PAPER-NOTES.md section 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Disconnected {
-    /// Fail with [`ReprError::Numerical`] naming the number of components (the default, and
-    /// what the [`RepresentationLearner`] implementation does).
+    /// Fail with [`ReprError::Numerical`] naming the number of components (the default).
     #[default]
     Error,
     /// sklearn >= 1.0 (`utils.graph._fix_connected_components`, PR #20531): for every pair of
@@ -101,41 +114,20 @@ pub enum Disconnected {
 }
 
 impl Isomap {
-    /// Fit and return the concrete encoder (with its eigenvalues) and the training embedding;
-    /// a disconnected kNN graph is an error (as [`RepresentationLearner::fit`]).
+    /// Fit and return the concrete encoder (with its eigenvalues and phase timings) and the
+    /// training embedding.
     pub fn fit_isomap(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(IsomapEncoder, Latents), ReprError> {
-        self.fit_with(images, latents, rng, KnnPath::Auto, Disconnected::Error)
+        self.fit_with(images, latents, rng, KnnPath::Auto)
     }
 
-    /// As [`Isomap::fit_isomap`], choosing what happens when the kNN graph is disconnected.
-    pub fn fit_isomap_with(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-        disconnected: Disconnected,
-    ) -> Result<(IsomapEncoder, Latents), ReprError> {
-        self.fit_with(images, latents, rng, KnnPath::Auto, disconnected)
-    }
-
-    fn fit_with(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-        path: KnnPath,
-        disconnected: Disconnected,
-    ) -> Result<(IsomapEncoder, Latents), ReprError> {
+    fn fit_with(&self, images: &ImageSet, latents: usize, rng: &mut Stream, path: KnnPath) -> Result<(IsomapEncoder, Latents), ReprError> {
         check_fit_input(images, latents)?;
         let (n, dim, k) = (images.n, images.dim, self.n_neighbors);
         if k == 0 {
             return Err(ReprError::InvalidInput("isomap: n_neighbors must be at least 1".into()));
         }
         if k >= n {
-            return Err(ReprError::InvalidInput(format!(
-                "isomap: n_neighbors = {k} needs at least {} training images, got {n}",
-                k + 1
-            )));
+            return Err(ReprError::InvalidInput(format!("isomap: n_neighbors = {k} needs at least {} training images, got {n}", k + 1)));
         }
         if n > u32::MAX as usize - 2 {
             return Err(ReprError::InvalidInput(format!("isomap: too many training images ({n})")));
@@ -163,7 +155,7 @@ impl Isomap {
         // 2. Geodesic distances.
         let (labels, sizes) = graph.components();
         if sizes.len() > 1 {
-            match disconnected {
+            match self.disconnected {
                 Disconnected::Error => {
                     let mut sorted = sizes.clone();
                     sorted.sort_unstable_by(|a, b| b.cmp(a));
@@ -193,17 +185,25 @@ impl Isomap {
         let mut geo = graph.all_pairs();
         drop(graph);
         symmetrise_min(&mut geo, n);
+
         let t_geo = t0.elapsed();
 
         // 3. Classical MDS: double-centred K = -0.5 G^2, top eigenpairs.
         let mut kc: Vec<f64> = vec![0.0; n * n];
-        kc.par_chunks_mut(n).zip(geo.par_chunks(n)).for_each(|(kr, gr)| {
-            for (kv, &g) in kr.iter_mut().zip(gr) {
-                let g = g as f64;
-                *kv = -0.5 * g * g;
-            }
-        });
-        let col_mean: Vec<f64> = kc.par_chunks(n).map(|r| r.iter().sum::<f64>() / n as f64).collect();
+        // Column means of K = row means (K is symmetric), summed in index order.
+        let col_mean: Vec<f64> = kc
+            .par_chunks_mut(n)
+            .zip(geo.par_chunks(n))
+            .map(|(kr, gr)| {
+                let mut sum = 0.0;
+                for (kv, &g) in kr.iter_mut().zip(gr) {
+                    let g = g as f64;
+                    *kv = -0.5 * g * g;
+                    sum += *kv;
+                }
+                sum / n as f64
+            })
+            .collect();
         let all_mean = col_mean.iter().sum::<f64>() / n as f64;
         if !all_mean.is_finite() {
             return Err(ReprError::Numerical("isomap: non-finite geodesic kernel".into()));
@@ -217,18 +217,8 @@ impl Isomap {
         let t_kernel = t0.elapsed();
         let (lambdas, mut alphas) = top_eigenpairs(&kc, n, latents, rng)?;
         drop(kc);
-        tracing::debug!(
-            n,
-            sparse = use_sparse,
-            knn_s = t_knn.as_secs_f64(),
-            geodesics_s = (t_geo - t_knn).as_secs_f64(),
-            kernel_s = (t_kernel - t_geo).as_secs_f64(),
-            eigen_s = (t0.elapsed() - t_kernel).as_secs_f64(),
-            "isomap fit phases"
-        );
-        if std::env::var_os("UGL_ISOMAP_TIMING").is_some() {
-            eprintln!("TIMING knn {:?} geo {:?} kernel {:?} eigen {:?}", t_knn, t_geo - t_knn, t_kernel - t_geo, t0.elapsed() - t_kernel);
-        }
+        let timings = FitTimings { knn: t_knn, geodesics: t_geo - t_knn, kernel: t_kernel - t_geo, eigen: t0.elapsed() - t_kernel };
+        tracing::debug!(n, sparse = use_sparse, ?timings, "isomap fit phases");
         flip_signs(&mut alphas, n, latents);
 
         let mut z = vec![0.0; n * latents];
@@ -255,10 +245,24 @@ impl Isomap {
             all_mean,
             proj,
             eigenvalues: lambdas,
+            timings,
             scratch: Scratch::new(n),
         };
         Ok((enc, z))
     }
+}
+
+/// Wall-clock time of the phases of a fit (for measurements).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FitTimings {
+    /// kNN graph (index, queries, undirected graph).
+    pub knn: std::time::Duration,
+    /// Components check, all-pairs Dijkstra, symmetrisation.
+    pub geodesics: std::time::Duration,
+    /// Kernel `-0.5 G^2` and its double centring.
+    pub kernel: std::time::Duration,
+    /// Top eigenpairs.
+    pub eigen: std::time::Duration,
 }
 
 /// The fitted Isomap: training geodesics, centring statistics and projection (sklearn
@@ -278,6 +282,7 @@ pub struct IsomapEncoder {
     /// `alphas / sqrt(lambdas)`, n x latents row-major (0 where lambda <= 0).
     proj: Vec<f64>,
     eigenvalues: Vec<f64>,
+    timings: FitTimings,
     scratch: Scratch,
 }
 
@@ -286,6 +291,11 @@ impl IsomapEncoder {
     /// (sklearn `kernel_pca_.eigenvalues_`, before clamping negative ones to 0).
     pub fn eigenvalues(&self) -> &[f64] {
         &self.eigenvalues
+    }
+
+    /// Time spent in each phase of the fit.
+    pub fn fit_timings(&self) -> FitTimings {
+        self.timings
     }
 
     /// Number of training images.
@@ -371,10 +381,7 @@ impl Encoder for IsomapEncoder {
             TrainIndex::Dense { data, norms } => {
                 let qn: Vec<f64> = images.data.par_chunks(images.dim).map(sq_norm).collect();
                 let knn = dense_knn(data, n, this.dim, norms, &images.data, m, &qn, k, false);
-                z.par_chunks_mut(l).zip(knn.par_chunks(k)).for_each_init(
-                    || vec![0.0; n],
-                    |g, (out, nb)| this.project(nb, g, out),
-                );
+                z.par_chunks_mut(l).zip(knn.par_chunks(k)).for_each_init(|| vec![0.0; n], |g, (out, nb)| this.project(nb, g, out));
             }
         }
         let z = Latents { n: m, latents: l, data: z };
@@ -423,6 +430,7 @@ impl Scratch {
 // ---------------------------------------------------------------------------------------------
 
 /// Which kNN implementation a fit uses (tests force one or the other).
+#[cfg_attr(not(test), allow(dead_code))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum KnnPath {
     Auto,
@@ -454,9 +462,10 @@ fn nbr_cmp(a: &(f64, u32), b: &(f64, u32)) -> Ordering {
     a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
 }
 
-/// Relative cost of a scattered sparse multiply-add against a dense GEMM flop (calibrated on
-/// the 2-core development machine: see the module tests' timings in the report).
-const SPARSE_COST_RATIO: f64 = 16.0;
+/// Relative cost of a scattered sparse multiply-add against a dense GEMM one. Measured on the
+/// 2-core development machine (3000 random images x 4900 pixels, k = 5): 2.0 ns against
+/// 0.023 ns at 10% density (ratio 87; both paths about 1 s there), 83 at 20%, 114 at 5%.
+const SPARSE_COST_RATIO: f64 = 80.0;
 
 /// Whether the inverted-index kNN costs less than the dense blocked products: the sparse work
 /// of all-pairs dot products is `sum_p c_p^2` (c_p = images lighting pixel p), the dense work
@@ -877,128 +886,161 @@ impl Csr {
         e
     }
 
-    /// Geodesic distances from every node (Dijkstra, parallel over sources), n x n row-major,
-    /// accumulated in f64 and stored as f32.
+    /// Geodesic distances from every node, n x n row-major, accumulated in f64 and stored as
+    /// f32. Nodes joined by exact zero-weight edges (identical images) are first merged: their
+    /// distances to everything are equal (adding 0.0 is exact), so Dijkstra runs once per
+    /// merged node on the merged graph (for 10,000 ball images at 4900 pixel positions, about
+    /// 4,300 nodes: a 5x smaller all-pairs problem), and the rows are then expanded.
     fn all_pairs(&self) -> Vec<f32> {
         let n = self.n;
+        let (class, m) = self.zero_classes();
         let mut out = vec![0.0f32; n * n];
-        out.par_chunks_mut(n).enumerate().for_each_init(
-            || (vec![0.0f64; n], IndexedHeap::new(n)),
-            |(dist, heap), (s, row)| {
-                self.dijkstra(s, dist, heap);
+        if m == n {
+            out.par_chunks_mut(n).enumerate().for_each_init(
+                || (vec![0.0f64; n], vec![false; n], RadixHeap::new()),
+                |(dist, done, heap), (s, row)| {
+                    self.dijkstra(s, dist, done, heap);
+                    for (o, &d) in row.iter_mut().zip(dist.iter()) {
+                        *o = d as f32;
+                    }
+                },
+            );
+            return out;
+        }
+        let mut edges: Vec<(u32, u32, f64)> = Vec::with_capacity(self.adj.len());
+        for i in 0..n {
+            for q in self.start[i]..self.start[i + 1] {
+                let (a, b) = (class[i], class[self.adj[q] as usize]);
+                if a != b {
+                    edges.push((a, b, self.w[q]));
+                }
+            }
+        }
+        let merged = Csr::from_edges(m, edges);
+        let mut small = vec![0.0f32; m * m];
+        small.par_chunks_mut(m).enumerate().for_each_init(
+            || (vec![0.0f64; m], vec![false; m], RadixHeap::new()),
+            |(dist, done, heap), (s, row)| {
+                merged.dijkstra(s, dist, done, heap);
                 for (o, &d) in row.iter_mut().zip(dist.iter()) {
                     *o = d as f32;
                 }
             },
         );
+        out.par_chunks_mut(n).enumerate().for_each(|(i, row)| {
+            let src = &small[class[i] as usize * m..(class[i] as usize + 1) * m];
+            for (o, &c) in row.iter_mut().zip(&class) {
+                *o = src[c as usize];
+            }
+        });
         out
     }
 
-    /// Single-source shortest paths into `dist` (infinite where unreachable).
-    fn dijkstra(&self, s: usize, dist: &mut [f64], heap: &mut IndexedHeap) {
+    /// Classes of nodes joined by exact zero-weight edges: (class of each node, numbered in
+    /// order of first node; number of classes).
+    fn zero_classes(&self) -> (Vec<u32>, usize) {
+        let n = self.n;
+        let mut class = vec![u32::MAX; n];
+        let mut m = 0u32;
+        let mut stack = Vec::new();
+        for s in 0..n {
+            if class[s] != u32::MAX {
+                continue;
+            }
+            class[s] = m;
+            stack.push(s);
+            while let Some(u) = stack.pop() {
+                for q in self.start[u]..self.start[u + 1] {
+                    let v = self.adj[q] as usize;
+                    if self.w[q] == 0.0 && class[v] == u32::MAX {
+                        class[v] = m;
+                        stack.push(v);
+                    }
+                }
+            }
+            m += 1;
+        }
+        (class, m as usize)
+    }
+
+    /// Single-source shortest paths into `dist` (infinite where unreachable), radix heap with
+    /// lazy deletion.
+    fn dijkstra(&self, s: usize, dist: &mut [f64], done: &mut [bool], heap: &mut RadixHeap) {
         dist.fill(f64::INFINITY);
+        done.fill(false);
         heap.reset();
         dist[s] = 0.0;
-        heap.push_or_decrease(s as u32, 0.0);
+        heap.push(0.0, s as u32);
         while let Some((d, u)) = heap.pop() {
+            if done[u as usize] || d > dist[u as usize] {
+                continue;
+            }
+            done[u as usize] = true;
             let (a, b) = (self.start[u as usize], self.start[u as usize + 1]);
             for (&v, &w) in self.adj[a..b].iter().zip(&self.w[a..b]) {
-                if heap.is_done(v) {
-                    continue;
-                }
                 let nd = d + w;
                 if nd < dist[v as usize] {
                     dist[v as usize] = nd;
-                    heap.push_or_decrease(v, nd);
+                    heap.push(nd, v);
                 }
             }
         }
     }
 }
 
-/// Binary min-heap of (key, node) with decrease-key (positions indexed by node).
-struct IndexedHeap {
-    heap: Vec<(f64, u32)>,
-    /// Position in `heap`, or `NOT_SEEN` / `DONE`.
-    pos: Vec<u32>,
+/// Radix heap (monotone priority queue) over the bits of non-negative f64 keys, with lazy
+/// deletion: Dijkstra pops keys in non-decreasing order, which is all a radix heap needs.
+struct RadixHeap {
+    buckets: Vec<Vec<(u64, u32)>>,
+    last: u64,
+    len: usize,
 }
 
-const NOT_SEEN: u32 = u32::MAX;
-const DONE: u32 = u32::MAX - 1;
-
-impl IndexedHeap {
-    fn new(n: usize) -> Self {
-        IndexedHeap { heap: Vec::with_capacity(n), pos: vec![NOT_SEEN; n] }
+impl RadixHeap {
+    fn new() -> Self {
+        RadixHeap { buckets: (0..65).map(|_| Vec::new()).collect(), last: 0, len: 0 }
     }
 
     fn reset(&mut self) {
-        self.heap.clear();
-        self.pos.fill(NOT_SEEN);
-    }
-
-    #[inline]
-    fn is_done(&self, v: u32) -> bool {
-        self.pos[v as usize] == DONE
-    }
-
-    #[inline]
-    fn push_or_decrease(&mut self, v: u32, key: f64) {
-        let p = self.pos[v as usize];
-        let i = if p == NOT_SEEN {
-            self.heap.push((key, v));
-            self.heap.len() - 1
-        } else {
-            self.heap[p as usize].0 = key;
-            p as usize
-        };
-        self.sift_up(i);
-    }
-
-    #[inline]
-    fn sift_up(&mut self, mut i: usize) {
-        let item = self.heap[i];
-        while i > 0 {
-            let parent = (i - 1) / 2;
-            let pv = self.heap[parent];
-            if pv.0 <= item.0 {
-                break;
-            }
-            self.heap[i] = pv;
-            self.pos[pv.1 as usize] = i as u32;
-            i = parent;
+        for b in &mut self.buckets {
+            b.clear();
         }
-        self.heap[i] = item;
-        self.pos[item.1 as usize] = i as u32;
+        self.last = 0;
+        self.len = 0;
+    }
+
+    #[inline]
+    fn bucket(&self, key: u64) -> usize {
+        (64 - (key ^ self.last).leading_zeros()) as usize
+    }
+
+    #[inline]
+    fn push(&mut self, key: f64, v: u32) {
+        let k = key.to_bits();
+        debug_assert!(k >= self.last);
+        let b = self.bucket(k);
+        self.buckets[b].push((k, v));
+        self.len += 1;
     }
 
     #[inline]
     fn pop(&mut self) -> Option<(f64, u32)> {
-        let top = *self.heap.first()?;
-        let last = self.heap.pop().expect("non-empty");
-        self.pos[top.1 as usize] = DONE;
-        let len = self.heap.len();
-        if len > 0 {
-            // Sift `last` down from the root.
-            let mut i = 0;
-            loop {
-                let l = 2 * i + 1;
-                if l >= len {
-                    break;
-                }
-                let r = l + 1;
-                let c = if r < len && self.heap[r].0 < self.heap[l].0 { r } else { l };
-                let cv = self.heap[c];
-                if cv.0 >= last.0 {
-                    break;
-                }
-                self.heap[i] = cv;
-                self.pos[cv.1 as usize] = i as u32;
-                i = c;
-            }
-            self.heap[i] = last;
-            self.pos[last.1 as usize] = i as u32;
+        if self.len == 0 {
+            return None;
         }
-        Some(top)
+        if self.buckets[0].is_empty() {
+            let i = (1..65).find(|&i| !self.buckets[i].is_empty()).expect("non-empty");
+            let mut moved = std::mem::take(&mut self.buckets[i]);
+            self.last = moved.iter().map(|e| e.0).min().expect("non-empty");
+            for &e in &moved {
+                let b = self.bucket(e.0);
+                self.buckets[b].push(e);
+            }
+            moved.clear();
+            self.buckets[i] = moved;
+        }
+        self.len -= 1;
+        self.buckets[0].pop().map(|(k, v)| (f64::from_bits(k), v))
     }
 }
 
@@ -1026,8 +1068,8 @@ fn symmetrise_min(g: &mut [f32], n: usize) {
 const DENSE_EIGEN_MAX: usize = 256;
 /// Residual tolerance of the Ritz pairs, relative to the spectral norm estimate.
 const EIGEN_TOL: f64 = 1e-10;
-/// Krylov blocks per restart cycle.
-const KRYLOV_STEPS: usize = 8;
+/// Most Krylov blocks per restart cycle (convergence is checked after every block).
+const KRYLOV_STEPS: usize = 16;
 /// Maximum restart cycles.
 const MAX_CYCLES: usize = 200;
 /// Rows per block of the parallel symmetric product.
@@ -1046,73 +1088,95 @@ fn top_eigenpairs(a: &[f64], n: usize, d: usize, rng: &mut Stream) -> Result<(Ve
     let mut x: Vec<f64> = (0..n * b).map(|_| rng.random_range(-1.0..1.0)).collect();
     let mut xcols = b;
     for _cycle in 0..MAX_CYCLES {
-        // Build the block Krylov basis Q (orthonormal) and AQ = A Q.
+        // Grow the block Krylov basis Q (orthonormal) and AQ = A Q one block at a time, with a
+        // Rayleigh-Ritz convergence check after every block from the second on.
         let mut m = 0;
-        loop {
+        let mut steps = 0;
+        let rr = loop {
             let kept = orthonormalise_into(&mut q, n, m, &mut x, xcols, cap - m);
-            if kept == 0 {
-                break;
+            if kept > 0 {
+                sym_mul(a, n, &q[m * n..(m + kept) * n], kept, &mut aq[m * n..(m + kept) * n]);
+                x.clear();
+                x.extend_from_slice(&aq[m * n..(m + kept) * n]);
+                xcols = kept;
+                m += kept;
+                steps += 1;
             }
-            sym_mul(a, n, &q[m * n..(m + kept) * n], kept, &mut aq[m * n..(m + kept) * n]);
-            x.clear();
-            x.extend_from_slice(&aq[m * n..(m + kept) * n]);
-            xcols = kept;
-            m += kept;
-            if m >= cap {
-                break;
+            let exhausted = kept == 0 || m >= cap;
+            if m > 0 && (exhausted || steps >= 2) {
+                let rr = rayleigh_ritz(&q[..n * m], &aq[..n * m], n, m, b.min(m), d)?;
+                if rr.converged || exhausted {
+                    break rr;
+                }
             }
-        }
-        // Rayleigh-Ritz.
-        let qm = MatRef::from_column_major_slice(&q[..n * m], n, m);
-        let aqm = MatRef::from_column_major_slice(&aq[..n * m], n, m);
-        let mut t = vec![0.0f64; m * m];
-        matmul(MatMut::from_column_major_slice_mut(&mut t, m, m), Accum::Replace, qm.transpose(), aqm, 1.0, Par::Seq);
-        for i in 0..m {
-            for j in 0..i {
-                let s = 0.5 * (t[i + j * m] + t[j + i * m]);
-                t[i + j * m] = s;
-                t[j + i * m] = s;
+            if m == 0 {
+                return Err(ReprError::Numerical("isomap: the eigen-solver's start block vanished".into()));
             }
-        }
-        let eig = SelfAdjointEigen::new(MatRef::from_column_major_slice(&t, m, m), Side::Lower)
-            .map_err(|e| ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e:?}")))?;
-        let theta: Vec<f64> = eig.S().column_vector().iter().copied().collect();
-        let u = eig.U();
-        let keep = b.min(m);
-        // Top `keep` Ritz vectors, decreasing eigenvalue.
-        let mut s = vec![0.0f64; m * keep];
-        let mut th = vec![0.0f64; keep];
-        for c in 0..keep {
-            let src = m - 1 - c;
-            th[c] = theta[src];
-            for r in 0..m {
-                s[r + c * m] = u[(r, src)];
-            }
-        }
-        let smat = MatRef::from_column_major_slice(&s, m, keep);
-        let mut y = vec![0.0f64; n * keep];
-        let mut ay = vec![0.0f64; n * keep];
-        matmul(MatMut::from_column_major_slice_mut(&mut y, n, keep), Accum::Replace, qm, smat, 1.0, Par::Seq);
-        matmul(MatMut::from_column_major_slice_mut(&mut ay, n, keep), Accum::Replace, aqm, smat, 1.0, Par::Seq);
-        let norm_est = theta.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-        let dd = d.min(keep);
-        let converged = m == n
-            || (0..dd).all(|c| {
-                let r: f64 = (0..n).map(|i| (ay[i + c * n] - th[c] * y[i + c * n]).powi(2)).sum::<f64>().sqrt();
-                r <= EIGEN_TOL * norm_est
-            });
-        if converged && dd == d {
+        };
+        if rr.converged {
+            let (mut th, mut y) = (rr.theta, rr.y);
             y.truncate(n * d);
             th.truncate(d);
             return Ok((th, y));
         }
         // Restart from the top Ritz vectors.
-        x = y;
-        xcols = keep;
+        x = rr.y;
+        xcols = rr.theta.len();
     }
-    Err(ReprError::Numerical(format!(
-        "isomap: the block Krylov eigen-solver did not converge in {MAX_CYCLES} cycles (n = {n}, d = {d})"
-    )))
+    Err(ReprError::Numerical(format!("isomap: the block Krylov eigen-solver did not converge in {MAX_CYCLES} cycles (n = {n}, d = {d})")))
+}
+
+/// Ritz pairs of a Rayleigh-Ritz step.
+struct Ritz {
+    /// Top Ritz values, decreasing.
+    theta: Vec<f64>,
+    /// Their Ritz vectors, n x keep column-major.
+    y: Vec<f64>,
+    /// Whether the top d pairs have residual `<= EIGEN_TOL * |A|` (or the basis is complete).
+    converged: bool,
+}
+
+/// Rayleigh-Ritz on the orthonormal basis `q` (n x m) with `aq = A q`: the top `keep` Ritz
+/// pairs and whether the top `d` have converged.
+fn rayleigh_ritz(q: &[f64], aq: &[f64], n: usize, m: usize, keep: usize, d: usize) -> Result<Ritz, ReprError> {
+    let qm = MatRef::from_column_major_slice(q, n, m);
+    let aqm = MatRef::from_column_major_slice(aq, n, m);
+    let mut t = vec![0.0f64; m * m];
+    matmul(MatMut::from_column_major_slice_mut(&mut t, m, m), Accum::Replace, qm.transpose(), aqm, 1.0, Par::Seq);
+    for i in 0..m {
+        for j in 0..i {
+            let s = 0.5 * (t[i + j * m] + t[j + i * m]);
+            t[i + j * m] = s;
+            t[j + i * m] = s;
+        }
+    }
+    let eig = SelfAdjointEigen::new(MatRef::from_column_major_slice(&t, m, m), Side::Lower)
+        .map_err(|e| ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e:?}")))?;
+    let all: Vec<f64> = eig.S().column_vector().iter().copied().collect();
+    let u = eig.U();
+    // Top `keep` Ritz vectors, decreasing eigenvalue.
+    let mut s = vec![0.0f64; m * keep];
+    let mut theta = vec![0.0f64; keep];
+    for c in 0..keep {
+        let src = m - 1 - c;
+        theta[c] = all[src];
+        for r in 0..m {
+            s[r + c * m] = u[(r, src)];
+        }
+    }
+    let smat = MatRef::from_column_major_slice(&s, m, keep);
+    let mut y = vec![0.0f64; n * keep];
+    let mut ay = vec![0.0f64; n * keep];
+    matmul(MatMut::from_column_major_slice_mut(&mut y, n, keep), Accum::Replace, qm, smat, 1.0, Par::Seq);
+    matmul(MatMut::from_column_major_slice_mut(&mut ay, n, keep), Accum::Replace, aqm, smat, 1.0, Par::Seq);
+    let norm_est = all.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+    let converged = keep >= d
+        && (m == n
+            || (0..d).all(|c| {
+                let r: f64 = (0..n).map(|i| (ay[i + c * n] - theta[c] * y[i + c * n]).powi(2)).sum::<f64>().sqrt();
+                r <= EIGEN_TOL * norm_est
+            }));
+    Ok(Ritz { theta, y, converged })
 }
 
 /// Full dense eigendecomposition (small n).
@@ -1331,9 +1395,9 @@ mod tests {
             data[i * dim + (i * 13) % dim] += 0.25;
         }
         let set = ImageSet::new(n, dim, data).unwrap();
-        let iso = Isomap { n_neighbors: 8 };
-        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse, Disconnected::Error).unwrap();
-        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense, Disconnected::Error).unwrap();
+        let iso = Isomap { n_neighbors: 8, ..Default::default() };
+        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse).unwrap();
+        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense).unwrap();
         assert!(es.uses_sparse_index() && !ed.uses_sparse_index());
         assert_eq!(zs, zd);
         assert_eq!(es.encode(&set).unwrap(), ed.encode(&set).unwrap());
@@ -1397,6 +1461,10 @@ mod tests {
                     add(i, j, rng.random_range(0.0..10.0), &mut e);
                 }
             }
+            // Some zero-weight edges (identical images), merged before Dijkstra.
+            if i % 7 == 3 {
+                add(i, (i * 5) % n, 0.0, &mut e);
+            }
         }
         for kk in 0..n {
             for i in 0..n {
@@ -1409,6 +1477,7 @@ mod tests {
             }
         }
         let g = Csr::from_edges(n, e);
+        assert!(g.zero_classes().1 < n);
         let d = g.all_pairs();
         for i in 0..n * n {
             assert!((d[i] as f64 - fw[i]).abs() <= 1e-5 * fw[i].max(1.0), "{i}: {} vs {}", d[i], fw[i]);
@@ -1468,10 +1537,7 @@ mod tests {
             assert!((vals[c] - sorted[c]).abs() <= 1e-10 * 150.0, "eigenvalue {c}: {} vs {}", vals[c], sorted[c]);
             // Residual of the returned vector.
             let v = &vecs[c * n..(c + 1) * n];
-            let r: f64 = (0..n)
-                .map(|i| ((0..n).map(|j| a[i + j * n] * v[j]).sum::<f64>() - vals[c] * v[i]).powi(2))
-                .sum::<f64>()
-                .sqrt();
+            let r: f64 = (0..n).map(|i| ((0..n).map(|j| a[i + j * n] * v[j]).sum::<f64>() - vals[c] * v[i]).powi(2)).sum::<f64>().sqrt();
             assert!(r <= 1e-9 * 150.0, "residual {c}: {r}");
         }
         // Same as the dense solver on the eigenvalues.
