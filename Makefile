@@ -41,4 +41,4 @@ campaign: check-toolchain
 	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))
 
 bench: check-toolchain
-	$(CARGO) bench -p ugl-bench --profile dev
+	$(CARGO) bench -p ugl-bench --profile dev  # rollout, render, nn_query, klc, isomap

@@ -136,12 +136,12 @@ fn out_of_sample_training_points_match_the_embedding() {
             if set.dim == PIXELS {
                 assert_eq!(&one[..], batch.row(i), "encode_one == encode, image {i}");
             } else {
-                for c in 0..d {
-                    assert!((one[c] - batch.row(i)[c]).abs() <= 1e-6 * scale, "encode_one ~ encode, image {i}");
+                for (a, b) in one.iter().zip(batch.row(i)) {
+                    assert!((a - b).abs() <= 1e-6 * scale, "encode_one ~ encode, image {i}");
                 }
             }
-            for c in 0..d {
-                worst = worst.max((one[c] - z.row(i)[c]).abs());
+            for (a, b) in one.iter().zip(z.row(i)) {
+                worst = worst.max((a - b).abs());
             }
         }
         println!("out-of-sample on training points (dim {}): max |diff| / max |z| = {:.2e}", set.dim, worst / scale);
@@ -219,6 +219,11 @@ fn invalid_inputs() {
     let (mut enc, _) = Isomap::default().fit(&set, 2, &mut rng).unwrap();
     let mut out = [0.0; 2];
     assert!(invalid(enc.encode_one(&[0.0; 4], &mut out)));
+    assert!(invalid(enc.encode_one(&[0.0, f32::NAN, 1.0], &mut out)));
+    // Non-finite training data.
+    let mut bad = set.clone();
+    bad.data[7] = f32::INFINITY;
+    assert!(invalid(Isomap::default().fit(&bad, 2, &mut rng).map(|_| ())));
 }
 
 /// sklearn `manifold.trustworthiness(X, Z, n_neighbors=k)` with X the true states: how much the

@@ -8,6 +8,7 @@ use thiserror::Error;
 
 use crate::env::{EnvConfig, EnvKind};
 use crate::explore::{Algo, ExploreConfig, Learner, SamplerKind};
+use crate::repr::isomap::Disconnected;
 
 /// Errors reading or validating a configuration.
 #[derive(Debug, Error)]
@@ -130,11 +131,17 @@ pub struct LearnersConfig {
 pub struct IsomapConfig {
     /// Neighbours of the kNN graph (sklearn's default, used by the paper: 5).
     pub n_neighbors: usize,
+    /// What to do when the kNN graph is disconnected: `connect-closest-pairs` (sklearn >= 1.0;
+    /// the default) or `error`. With 10,000 ArmBall images it always is: positions are
+    /// truncated to pixels, so groups of 6+ identical images are each other's only neighbours.
+    /// The paper's sklearn (< 1.0) silently set the distances between pieces to 0, a defect we
+    /// do not reproduce.
+    pub disconnected: Disconnected,
 }
 
 impl Default for IsomapConfig {
     fn default() -> Self {
-        IsomapConfig { n_neighbors: 5 }
+        IsomapConfig { n_neighbors: 5, disconnected: Disconnected::ConnectClosestPairs }
     }
 }
 

@@ -102,7 +102,7 @@ pub fn make_learner(learner: Learner, cfg: &LearnersConfig) -> Result<Box<dyn Re
     Ok(match learner {
         Learner::Pca => Box::new(TruncatedSvd::default()),
         Learner::PcaCentred => Box::new(CentredPca),
-        Learner::Isomap => Box::new(Isomap { n_neighbors: cfg.isomap.n_neighbors, ..Default::default() }),
+        Learner::Isomap => Box::new(Isomap { n_neighbors: cfg.isomap.n_neighbors, disconnected: cfg.isomap.disconnected }),
         Learner::External => {
             let e = cfg.external.as_ref().ok_or_else(|| {
                 ReprError::InvalidInput("rge-external needs a [learners.external] section (name, command)".into())

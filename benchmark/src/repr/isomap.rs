@@ -102,7 +102,8 @@ impl RepresentationLearner for Isomap {
 }
 
 /// What a fit does when the kNN graph is disconnected (PAPER-NOTES.md section 5).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Disconnected {
     /// Fail with [`ReprError::Numerical`] naming the number of components (the default).
     #[default]
@@ -313,9 +314,13 @@ impl IsomapEncoder {
         self.geodesic[i * self.n + j]
     }
 
-    fn check_image(&self, len: usize) -> Result<(), ReprError> {
-        if len != self.dim {
-            return Err(ReprError::InvalidInput(format!("isomap: image has {len} pixels, the encoder expects {}", self.dim)));
+    /// Images to encode must have the training size and finite pixels.
+    fn check_images(&self, dim: usize, data: &[f32]) -> Result<(), ReprError> {
+        if dim != self.dim {
+            return Err(ReprError::InvalidInput(format!("isomap: image has {dim} pixels, the encoder expects {}", self.dim)));
+        }
+        if data.iter().any(|v| !v.is_finite()) {
+            return Err(ReprError::InvalidInput("isomap: image to encode contains a non-finite value".into()));
         }
         Ok(())
     }
@@ -360,7 +365,7 @@ impl Encoder for IsomapEncoder {
     }
 
     fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
-        self.check_image(images.dim)?;
+        self.check_images(images.dim, &images.data)?;
         let (m, k, l, n) = (images.n, self.n_neighbors, self.latents, self.n);
         let mut z = vec![0.0; m * l];
         if m == 0 {
@@ -390,7 +395,7 @@ impl Encoder for IsomapEncoder {
     }
 
     fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
-        self.check_image(image.len())?;
+        self.check_images(image.len(), image)?;
         if out.len() != self.latents {
             return Err(ReprError::InvalidInput(format!("isomap: output has {} values, expected {}", out.len(), self.latents)));
         }
@@ -1245,7 +1250,8 @@ fn orthonormalise_into(q: &mut [f64], n: usize, m: usize, x: &mut [f64], xcols: 
             }
         }
         let nv = norm(col);
-        if !(nv > 1e-10 * orig[c]) || nv == 0.0 {
+        // Dependent (or NaN) column: drop it.
+        if nv.is_nan() || nv <= 1e-10 * orig[c] || nv == 0.0 {
             continue;
         }
         for (d, &v) in rest[..n].iter_mut().zip(col.iter()) {
