@@ -170,3 +170,33 @@ fn campaign_plan_and_resume() {
     std::fs::write(&cfg, "[campaign]\nname = \"tiny\"\nreps = 0\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n").unwrap();
     assert_one_line_error(&ugl(&["campaign", "--config", p(&cfg)]), "campaign.reps");
 }
+
+#[test]
+fn run_with_an_external_learner() {
+    let numpy = Command::new("python3").args(["-c", "import numpy"]).output().map(|o| o.status.success()).unwrap_or(false);
+    if !numpy {
+        eprintln!("SKIPPED: rge-external end to end (python3 with numpy not found)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("ext.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"ext\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-external\"]\n\
+         [ugl]\nimages = 200\n[explore]\nepochs = 200\n\
+         [learners.external]\nname = \"random-projection\"\ncommand = \"python3 scripts/external_learners/random_projection.py\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("res");
+    let o = ugl(&["run", "--env", "armball", "--algo", "rge-external", "--latents", "3", "--profile", p(&cfg), "--out", p(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
+    assert_eq!(s["run"], "armball.rge-external.kde.l3.s0");
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("armball.rge-external.kde.l3.s0.json")).unwrap()).unwrap();
+    assert_eq!(m["learner"], "random-projection");
+    assert_eq!(m["reduced_budget"], true);
+    // Without the [learners.external] section: a one-line error.
+    let o = ugl(&["run", "--env", "armball", "--algo", "rge-external", "--out", p(&out)]);
+    assert_one_line_error(&o, "learners.external");
+}
