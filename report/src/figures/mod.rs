@@ -73,6 +73,8 @@ pub fn env_name(env: &str) -> String {
 pub fn algo_name(algo: &str) -> String {
     match algo {
         "rge-isomap" => "RGE-Isomap".into(),
+        "rge-pca-centred" => "RGE-PCA (centred)".into(),
+        "rge-external" => "RGE-external".into(),
         other => other.to_uppercase(),
     }
 }
