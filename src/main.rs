@@ -14,6 +14,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use ugl_bench::campaign::config::{resolve_profile, CampaignConfig};
+use ugl_bench::campaign::plan::parse_shard;
 use ugl_bench::campaign::{plan, run_campaign, CampaignOptions, Progress, RunContext, RunSpec};
 use ugl_bench::env::render::{write_npy, write_png, Image70, PIXELS};
 use ugl_bench::env::{make_env, EnvConfig, EnvKind, PARAMS};
@@ -112,9 +113,43 @@ enum Command {
         /// Runs in parallel (default: the number of cores).
         #[arg(long)]
         jobs: Option<usize>,
-        /// No progress bar.
+        /// No progress bar (also automatic when stderr is not a terminal).
         #[arg(long)]
         quiet: bool,
+        /// Run only the deterministic slice i of n (0-based, `0/4` .. `3/4`); the union of the n
+        /// shards is the whole campaign, and runs sharing a trained representation stay together.
+        #[arg(long)]
+        shard: Option<String>,
+    },
+    /// Write a Slurm array job (one task per shard) and a merge step for a campaign.
+    Slurm {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+        /// Number of array tasks (shards).
+        #[arg(long)]
+        shards: usize,
+        /// Results directory the tasks write to (on a shared file system).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Directory for the generated scripts.
+        #[arg(long, default_value = "slurm")]
+        scripts: PathBuf,
+        /// CPUs per task (each task runs that many runs in parallel).
+        #[arg(long, default_value_t = 2)]
+        cpus: usize,
+        /// Wall-time limit per task (Slurm syntax).
+        #[arg(long, default_value = "04:00:00")]
+        time: String,
+    },
+    /// Merge run files from several results directories (e.g. one per machine) into one store.
+    Merge {
+        /// Destination results directory.
+        #[arg(long)]
+        into: PathBuf,
+        /// Source results directories.
+        #[arg(required = true)]
+        sources: Vec<PathBuf>,
     },
     /// Render the report (markdown + SVG figures) from a results store.
     Report {
@@ -173,7 +208,9 @@ fn dispatch(cmd: Command) -> Result<()> {
             }
             Ok(())
         }
-        Command::Campaign { config, out, jobs, quiet } => campaign(&config, out, jobs, quiet),
+        Command::Campaign { config, out, jobs, quiet, shard } => campaign(&config, out, jobs, quiet, shard.as_deref()),
+        Command::Slurm { config, shards, out, scripts, cpus, time } => slurm(&config, shards, out, &scripts, cpus, &time),
+        Command::Merge { into, sources } => merge(&into, &sources),
         Command::Report { results, out, paper } => {
             let mut opts = ugl_report::ReportOptions::new(results, out);
             opts.paper_dir = paper;
@@ -304,8 +341,9 @@ fn check_out_dir(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
 }
 
-fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<()> {
+fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: bool, shard: Option<&str>) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
+    let shard = shard.map(parse_shard).transpose().map_err(|e| anyhow::anyhow!(e))?;
     let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
     check_out_dir(&out)?;
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
@@ -346,9 +384,117 @@ fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: boo
             bar.set_message(format!("{} klc={:.3}", s.run, s.final_klc));
         }
     };
-    let opts = CampaignOptions { jobs, profile: &profile, stop: &stop };
+    let opts = CampaignOptions { jobs, profile: &profile, stop: &stop, shard };
     let done = run_campaign(&cfg, &out, &opts, &on)?;
     bar.finish_and_clear();
     eprintln!("campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}", cfg.campaign.name, done.len(), t0.elapsed().as_secs_f64(), jobs, out.display());
+    Ok(())
+}
+
+fn slurm(config: &Path, shards: usize, out: Option<PathBuf>, scripts: &Path, cpus: usize, time: &str) -> Result<()> {
+    let cfg = CampaignConfig::load(config)?;
+    if shards == 0 {
+        bail!("--shards must be at least 1");
+    }
+    if cpus == 0 {
+        bail!("--cpus must be at least 1");
+    }
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    check_out_dir(scripts)?;
+    let name = &cfg.campaign.name;
+    let n_runs = plan(&cfg).len();
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    let abs = |p: &Path| if p.is_absolute() { p.to_path_buf() } else { cwd.join(p) };
+    let (config_abs, out_abs) = (abs(config), abs(&out));
+    let array = format!(
+        "#!/usr/bin/env bash\n\
+         # Generated by `ugl slurm` for campaign '{name}' ({n_runs} runs in {shards} shards).\n\
+         # Each task runs one deterministic shard; all write into the same results directory\n\
+         # (files are written atomically and the shards are disjoint). Rerunning a task resumes it.\n\
+         #SBATCH --job-name=ugl-{name}\n#SBATCH --array=0-{last}\n#SBATCH --cpus-per-task={cpus}\n\
+         #SBATCH --time={time}\n#SBATCH --output=ugl-{name}-%A_%a.log\nset -euo pipefail\ncd {cwd}\n\
+         cargo run --quiet --bin ugl -- campaign --config {config} --out {out} --jobs {cpus} --quiet \\\n  \
+         --shard \"${{SLURM_ARRAY_TASK_ID}}/{shards}\"\n",
+        last = shards - 1,
+        cwd = cwd.display(),
+        config = config_abs.display(),
+        out = out_abs.display(),
+    );
+    let merge = format!(
+        "#!/usr/bin/env bash\n# Generated by `ugl slurm`: after every shard, check the campaign is complete and render\n\
+         # the report.\n#SBATCH --job-name=ugl-{name}-report\n#SBATCH --cpus-per-task=1\n#SBATCH --time=00:30:00\n\
+         #SBATCH --output=ugl-{name}-report-%j.log\nset -euo pipefail\ncd {cwd}\n\
+         # A complete campaign has nothing left to run: this executes 0 runs, or the missing ones.\n\
+         cargo run --quiet --bin ugl -- campaign --config {config} --out {out} --jobs 1 --quiet\n\
+         cargo run --quiet --bin ugl -- report --results {results} --out report/out\n",
+        cwd = cwd.display(),
+        config = config_abs.display(),
+        out = out_abs.display(),
+        results = out_abs.parent().unwrap_or(&out_abs).display(),
+    );
+    let submit = format!(
+        "#!/usr/bin/env bash\n# Submit the array job, then the report step once every task succeeded.\nset -euo pipefail\n\
+         cd \"$(dirname \"$0\")\"\n# Build once on the login node so the tasks do not compile concurrently.\n\
+         (cd {cwd} && cargo build --quiet --bin ugl)\njid=$(sbatch --parsable array.sh)\n\
+         sbatch --dependency=afterok:${{jid}} report.sh\necho \"submitted array job ${{jid}} ({shards} tasks) and its report step\"\n",
+        cwd = cwd.display(),
+    );
+    for (file, text) in [("array.sh", array), ("report.sh", merge), ("submit.sh", submit)] {
+        let p = scripts.join(file);
+        std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755))
+                .with_context(|| format!("cannot make {} executable", p.display()))?;
+        }
+    }
+    eprintln!("wrote {}/{{array,report,submit}}.sh: {n_runs} runs in {shards} shards; run {}/submit.sh", scripts.display(), scripts.display());
+    Ok(())
+}
+
+fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
+    check_out_dir(into)?;
+    let (mut copied, mut same) = (0, 0);
+    for src in sources {
+        if !src.is_dir() {
+            bail!("{}: not a directory", src.display());
+        }
+        let mut manifests: Vec<PathBuf> = std::fs::read_dir(src)
+            .with_context(|| format!("cannot read {}", src.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        manifests.sort();
+        for m in manifests {
+            let manifest = ugl_bench::campaign::store::read_manifest(&m)?;
+            let files = ugl_bench::campaign::store::run_paths(src, &manifest.run_id);
+            if !files.iter().all(|f| f.is_file()) {
+                bail!("{}: run {} is incomplete (a data file is missing)", src.display(), manifest.run_id);
+            }
+            let dest = ugl_bench::campaign::store::run_paths(into, &manifest.run_id);
+            if dest[2].exists() {
+                let theirs = ugl_bench::campaign::store::read_manifest(&dest[2])?;
+                let identical_data = files[..2].iter().zip(&dest[..2]).all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
+                if theirs.config_hash != manifest.config_hash || !identical_data {
+                    bail!(
+                        "run {} exists in {} with different {}: refusing to overwrite",
+                        manifest.run_id,
+                        into.display(),
+                        if theirs.config_hash != manifest.config_hash { "config hash" } else { "data" }
+                    );
+                }
+                same += 1;
+                continue;
+            }
+            // Data files first, manifest last (a run is complete when its manifest exists).
+            for (a, b) in files.iter().zip(&dest) {
+                let bytes = std::fs::read(a).with_context(|| format!("cannot read {}", a.display()))?;
+                ugl_bench::campaign::store::write_atomic(b, &bytes)?;
+            }
+            copied += 1;
+        }
+    }
+    eprintln!("merge: {copied} runs copied, {same} already present and identical -> {}", into.display());
     Ok(())
 }

@@ -200,3 +200,66 @@ fn run_with_an_external_learner() {
     let o = ugl(&["run", "--env", "armball", "--algo", "rge-external", "--out", p(&out)]);
     assert_one_line_error(&o, "learners.external");
 }
+
+fn data_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
+        .map(|p| (p.file_name().unwrap().to_str().unwrap().to_string(), std::fs::read(&p).unwrap()))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn shards_merge_into_the_whole_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("sh.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"sh\"\nreps = 2\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\nalgos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\n\
+         samplers = [\"kde\", \"gaussian\"]\nlatents = [3]\n[ugl]\nimages = 100\n[explore]\nepochs = 120\neval_every = 40\n",
+    )
+    .unwrap();
+    let whole = dir.path().join("whole");
+    assert!(ugl(&["campaign", "--config", p(&cfg), "--out", p(&whole), "--quiet"]).status.success());
+    // Three machines, three shards, three stores; merged into one.
+    let mut parts = Vec::new();
+    for i in 0..3 {
+        let d = dir.path().join(format!("part{i}"));
+        let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&d), "--quiet", "--jobs", "1", "--shard", &format!("{i}/3")]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        parts.push(d);
+    }
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge", "--into", p(&merged)];
+    args.extend(parts.iter().map(|d| p(d)));
+    let o = ugl(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(data_files(&whole), data_files(&merged), "the union of the shards equals the whole campaign");
+    // Merging again is a no-op; a conflicting run is refused.
+    assert!(ugl(&args).status.success());
+    let f = parts[0].join(std::fs::read_dir(&parts[0]).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_str().unwrap().ends_with(".outcomes.parquet")).unwrap());
+    std::fs::write(&f, b"corrupt").unwrap();
+    assert_one_line_error(&ugl(&args), "refusing to overwrite");
+    assert_one_line_error(&ugl(&["campaign", "--config", p(&cfg), "--out", p(&whole), "--shard", "3/3"]), "--shard");
+}
+
+#[test]
+fn slurm_scripts() {
+    let dir = tempfile::tempdir().unwrap();
+    let scripts = dir.path().join("slurm");
+    let o = ugl(&["slurm", "--config", "data/campaigns/baselines.toml", "--shards", "4", "--scripts", p(&scripts)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let array = std::fs::read_to_string(scripts.join("array.sh")).unwrap();
+    assert!(array.contains("#SBATCH --array=0-3"), "{array}");
+    assert!(array.contains("--shard \"${SLURM_ARRAY_TASK_ID}/4\""), "{array}");
+    let submit = std::fs::read_to_string(scripts.join("submit.sh")).unwrap();
+    assert!(submit.contains("--dependency=afterok:${jid} report.sh"), "{submit}");
+    for f in ["array.sh", "report.sh", "submit.sh"] {
+        let st = Command::new("bash").args(["-n", p(&scripts.join(f))]).status().unwrap();
+        assert!(st.success(), "{f} is valid bash");
+    }
+    assert_one_line_error(&ugl(&["slurm", "--config", "data/campaigns/baselines.toml", "--shards", "0", "--scripts", p(&scripts)]), "--shards");
+}

@@ -83,6 +83,41 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
     runs
 }
 
+/// A deterministic slice `index` of `count` (0-based) of the plan, for spreading a campaign over
+/// machines (`ugl campaign --shard i/n`). Runs that share a trained representation stay in one
+/// shard, so no representation is fitted twice; groups are dealt round-robin in plan order. The
+/// shards are disjoint and their union is the whole plan.
+pub fn shard(runs: &[RunSpec], images: usize, index: usize, count: usize) -> Vec<RunSpec> {
+    assert!(index < count, "shard index {index} must be below the shard count {count}");
+    let mut keys: Vec<String> = Vec::new();
+    let mut out = Vec::new();
+    for spec in runs {
+        let key = spec.representation_identity(images).unwrap_or_else(|| spec.identity());
+        let g = match keys.iter().position(|k| *k == key) {
+            Some(g) => g,
+            None => {
+                keys.push(key);
+                keys.len() - 1
+            }
+        };
+        if g % count == index {
+            out.push(spec.clone());
+        }
+    }
+    out
+}
+
+/// Parse `i/n` (0 <= i < n).
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let err = || format!("--shard must be i/n with 0 <= i < n (0-based, e.g. 0/4 .. 3/4), got '{s}'");
+    let (i, n) = s.split_once('/').ok_or_else(err)?;
+    let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| err())?, n.trim().parse().map_err(|_| err())?);
+    if n == 0 || i >= n {
+        return Err(err());
+    }
+    Ok((i, n))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,5 +134,32 @@ mod tests {
         assert_eq!(r.run_id(), "armball.rge-pca.kde.l10.s2");
         let g = RunSpec { sampler: SamplerKind::Gaussian, ..r.clone() };
         assert_eq!(r.representation_identity(100), g.representation_identity(100));
+    }
+
+    #[test]
+    fn shards_partition_the_plan_and_keep_groups_together() {
+        let text = "[campaign]\nname = \"t\"\nreps = 3\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
+                    algos = [\"rpe\", \"rge-pca\", \"rge-isomap\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [10, \"true\"]\n";
+        let cfg = CampaignConfig::from_toml(text, std::path::Path::new("t.toml")).unwrap();
+        let all = plan(&cfg);
+        for n in [1, 2, 3, 7, 100] {
+            let mut union: Vec<RunSpec> = (0..n).flat_map(|i| shard(&all, 10, i, n)).collect();
+            assert_eq!(union.len(), all.len(), "n = {n}: shards are disjoint and cover the plan");
+            union.sort();
+            let mut sorted = all.clone();
+            sorted.sort();
+            assert_eq!(union, sorted);
+            for i in 0..n {
+                // The samplers of a cell are in the same shard.
+                for r in shard(&all, 10, i, n) {
+                    let mates = all.iter().filter(|o| o.algo.learner().is_some() && o.representation_identity(10) == r.representation_identity(10));
+                    for m in mates {
+                        assert!(shard(&all, 10, i, n).contains(m));
+                    }
+                }
+            }
+        }
+        assert_eq!(parse_shard("1/4"), Ok((1, 4)));
+        assert!(parse_shard("4/4").is_err() && parse_shard("1").is_err() && parse_shard("a/b").is_err() && parse_shard("0/0").is_err());
     }
 }

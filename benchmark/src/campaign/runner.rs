@@ -252,6 +252,8 @@ pub struct CampaignOptions<'a> {
     pub profile: &'a str,
     /// Set to stop after the runs in flight (Ctrl-C).
     pub stop: &'a AtomicBool,
+    /// Run only this slice `(index, count)` of the plan (`--shard i/n`).
+    pub shard: Option<(usize, usize)>,
 }
 
 /// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
@@ -272,7 +274,10 @@ pub fn run_campaign(
         learners: &cfg.learners,
         threads: opts.jobs,
     };
-    let all = plan(cfg);
+    let all = match opts.shard {
+        None => plan(cfg),
+        Some((i, n)) => super::plan::shard(&plan(cfg), cfg.ugl.images, i, n),
+    };
     let todo: Vec<&RunSpec> =
         all.iter().filter(|s| !store::is_complete(out, &s.run_id(), &ctx.config_hash(s))).collect();
     on_progress(Progress::Planned { total: all.len(), skipped: all.len() - todo.len() });
