@@ -11,13 +11,14 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test campaign bench check-toolchain clean-report
+.PHONY: help report test campaign bench verify verify-update check-toolchain
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
 	@echo "make test                the test suite (what CI runs)"
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
-	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC)"
+	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC, Isomap)"
+	@echo "make verify              rerun the smoke campaign; compare result checksums with data/checksums/smoke.sha256"
 
 check-toolchain:
 	@command -v $(CARGO) >/dev/null 2>&1 || { echo "error: cargo not found. Install Rust $(MIN_RUST) or newer: https://rustup.rs" >&2; exit 1; }
@@ -42,3 +43,18 @@ campaign: check-toolchain
 
 bench: check-toolchain
 	$(CARGO) bench -p ugl-bench --profile dev  # rollout, render, nn_query, klc, isomap
+
+# Reproducibility check: the smoke campaign's result files must hash to the committed checksums.
+# A change that alters results shows up here (and in review, as a change of the checksum file:
+# `make verify-update`).
+VERIFY_DIR ?= target/verify-smoke
+verify: check-toolchain
+	rm -rf $(VERIFY_DIR)
+	$(UGL) campaign --config data/campaigns/smoke.toml --out $(VERIFY_DIR) --quiet
+	cd $(VERIFY_DIR) && sha256sum *.parquet | diff -u $(CURDIR)/data/checksums/smoke.sha256 - \
+	  && echo "verify: $$(wc -l < $(CURDIR)/data/checksums/smoke.sha256) result files identical to data/checksums/smoke.sha256"
+
+verify-update: check-toolchain
+	rm -rf $(VERIFY_DIR)
+	$(UGL) campaign --config data/campaigns/smoke.toml --out $(VERIFY_DIR) --quiet
+	mkdir -p data/checksums && cd $(VERIFY_DIR) && sha256sum *.parquet > $(CURDIR)/data/checksums/smoke.sha256

@@ -1,0 +1,142 @@
+//! The campaign engine: bad configurations, worker-count independence, resume after kill -9.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn ugl() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_ugl"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    ugl().args(args).output().expect("ugl runs")
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// Every file of a results store except manifests (which hold wall times and hosts), by name.
+fn result_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
+        .map(|p| (p.file_name().unwrap().to_str().unwrap().to_string(), std::fs::read(&p).unwrap()))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_bad_config_gives_a_one_line_error_naming_the_key_and_touches_nothing() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_configs");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&corpus).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    assert!(files.len() >= 20, "the corpus has {} configs", files.len());
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("results");
+    std::fs::create_dir(&out).unwrap();
+    let sentinel = out.join("existing.parquet");
+    std::fs::write(&sentinel, b"an existing result").unwrap();
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let expect = text.lines().next().and_then(|l| l.strip_prefix("# expect: ")).unwrap_or_else(|| panic!("{} lacks '# expect:'", f.display()));
+        for cmd in ["plan", "campaign"] {
+            let o = run(&[cmd, "--config", p(&f), "--out", p(&out)][..if cmd == "plan" { 3 } else { 5 }]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{} ({cmd}): {err}", f.display());
+            assert_eq!(err.trim_end().lines().count(), 1, "{}: one line: {err}", f.display());
+            assert!(err.contains(expect), "{}: {err:?} should mention {expect:?}", f.display());
+        }
+    }
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "nothing was written");
+    assert_eq!(std::fs::read(&sentinel).unwrap(), b"an existing result");
+}
+
+#[test]
+fn bad_output_locations() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let o = run(&["campaign", "--config", "data/campaigns/baselines.toml", "--out", p(&file)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a directory"));
+    // A location nobody can create (even root): /proc is read-only.
+    let o = run(&["campaign", "--config", "data/campaigns/baselines.toml", "--out", "/proc/ugl-bench-test/results"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("/proc/ugl-bench-test/results") && err.trim_end().lines().count() == 1, "{err}");
+}
+
+fn write_config(dir: &Path, reps: usize) -> PathBuf {
+    let cfg = dir.join("engine.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "[campaign]\nname = \"engine\"\nreps = {reps}\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
+             algos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [\"true\"]\n\
+             [ugl]\nimages = 300\n[explore]\nepochs = 1500\neval_every = 100\n"
+        ),
+    )
+    .unwrap();
+    cfg
+}
+
+#[test]
+fn results_do_not_depend_on_the_worker_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), 2);
+    let (a, b) = (dir.path().join("one"), dir.path().join("two"));
+    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&a), "--jobs", "1", "--quiet"]).status.success());
+    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&b), "--jobs", "2", "--quiet"]).status.success());
+    let (ra, rb) = (result_bytes(&a), result_bytes(&b));
+    assert_eq!(ra.len(), 2 * 4 * 2 * 2);
+    assert!(ra == rb, "1 and 2 workers give different result files");
+}
+
+#[test]
+fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), 6);
+    let reference = dir.path().join("reference");
+    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&reference), "--quiet"]).status.success());
+    let expected = result_bytes(&reference);
+
+    let out = dir.path().join("killed");
+    let mut child = ugl()
+        .args(["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet", "--jobs", "2"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill -9 as soon as some, but not all, runs are stored (whenever that is: the assertions
+    // below hold for any kill time).
+    let t0 = Instant::now();
+    loop {
+        let done = std::fs::read_dir(&out).map(|d| d.filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "json")).count()).unwrap_or(0);
+        if done >= 3 || child.try_wait().unwrap().is_some() || t0.elapsed() > Duration::from_secs(120) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let partial = result_bytes(&out);
+    // Whatever was stored is complete and correct.
+    for (name, bytes) in &partial {
+        let reference = expected.iter().find(|(n, _)| n == name).expect("a planned run");
+        assert!(&reference.1 == bytes, "{name} differs from the uninterrupted campaign");
+    }
+    let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(result_bytes(&out) == expected, "resumed campaign differs from the uninterrupted one");
+    // A changed configuration reruns the runs whose config hash changed, never reuses them.
+    let text = std::fs::read_to_string(&cfg).unwrap().replace("epochs = 1500", "epochs = 1400");
+    std::fs::write(&cfg, text).unwrap();
+    let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(&format!("{} runs executed", expected.len() / 2)), "{err}");
+}
