@@ -5,22 +5,22 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use ugl_bench::campaign::config::{resolve_profile, CampaignConfig};
+use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::plan::parse_shard;
-use ugl_bench::campaign::{plan, run_campaign, CampaignOptions, Progress, RunContext, RunSpec};
-use ugl_bench::env::render::{write_npy, write_png, Image70, PIXELS};
-use ugl_bench::env::{make_env, EnvConfig, EnvKind, PARAMS};
+use ugl_bench::campaign::{CampaignOptions, Progress, RunContext, RunSpec, plan, run_campaign};
+use ugl_bench::env::render::{Image70, PIXELS, write_npy, write_png};
+use ugl_bench::env::{EnvConfig, EnvKind, PARAMS, make_env};
 use ugl_bench::explore::{Algo, Learner, SamplerKind};
-use ugl_bench::metrics::csv::read_outcomes_csv;
 use ugl_bench::metrics::KlCoverage;
+use ugl_bench::metrics::csv::read_outcomes_csv;
 
 /// ugl-bench: reproduce "Unsupervised Learning of Goal Spaces for Intrinsically Motivated Goal
 /// Exploration" (Péré et al., ICLR 2018) deterministically on a CPU.
@@ -174,12 +174,24 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
                 let _ = e.print();
-                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand { ExitCode::from(2) } else { ExitCode::SUCCESS };
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                    ExitCode::from(2)
+                } else {
+                    ExitCode::SUCCESS
+                };
             }
             let text = e.render().to_string();
-            let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: invalid arguments");
+            let first = text
+                .lines()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("error: invalid arguments");
             eprintln!("{} (see 'ugl --help')", first.trim());
             return ExitCode::from(2);
         }
@@ -198,9 +210,29 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Rollout { env, params } => rollout(env, &params),
         Command::Klc { env, outcomes } => klc(env, &outcomes),
         Command::Render { env, state, out } => render(env, &state, &out),
-        Command::Run { env, algo, sampler, latents, images, seed, epochs, profile, out } => {
-            run(RunArgs { env, algo, sampler, latents, images, seed, epochs }, &profile, &out)
-        }
+        Command::Run {
+            env,
+            algo,
+            sampler,
+            latents,
+            images,
+            seed,
+            epochs,
+            profile,
+            out,
+        } => run(
+            RunArgs {
+                env,
+                algo,
+                sampler,
+                latents,
+                images,
+                seed,
+                epochs,
+            },
+            &profile,
+            &out,
+        ),
         Command::Plan { config } => {
             let cfg = CampaignConfig::load(&config)?;
             for spec in plan(&cfg) {
@@ -208,14 +240,36 @@ fn dispatch(cmd: Command) -> Result<()> {
             }
             Ok(())
         }
-        Command::Campaign { config, out, jobs, quiet, shard } => campaign(&config, out, jobs, quiet, shard.as_deref()),
-        Command::Slurm { config, shards, out, scripts, cpus, time } => slurm(&config, shards, out, &scripts, cpus, &time),
+        Command::Campaign {
+            config,
+            out,
+            jobs,
+            quiet,
+            shard,
+        } => campaign(&config, out, jobs, quiet, shard.as_deref()),
+        Command::Slurm {
+            config,
+            shards,
+            out,
+            scripts,
+            cpus,
+            time,
+        } => slurm(&config, shards, out, &scripts, cpus, &time),
         Command::Merge { into, sources } => merge(&into, &sources),
-        Command::Report { results, out, paper } => {
+        Command::Report {
+            results,
+            out,
+            paper,
+        } => {
             let mut opts = ugl_report::ReportOptions::new(results, out);
             opts.paper_dir = paper;
             let s = ugl_report::render_report(&opts)?;
-            eprintln!("report: {} runs -> {} files in {}", s.n_runs, s.files.len(), opts.out.display());
+            eprintln!(
+                "report: {} runs -> {} files in {}",
+                s.n_runs,
+                s.files.len(),
+                opts.out.display()
+            );
             Ok(())
         }
     }
@@ -229,20 +283,33 @@ struct RolloutOut {
 }
 
 fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
-    let text = std::fs::read_to_string(params).with_context(|| format!("cannot read {}", params.display()))?;
-    let v: Vec<Vec<f64>> = serde_json::from_str(&text)
-        .with_context(|| format!("{}: expected a JSON array of arrays of {PARAMS} numbers", params.display()))?;
+    let text = std::fs::read_to_string(params)
+        .with_context(|| format!("cannot read {}", params.display()))?;
+    let v: Vec<Vec<f64>> = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: expected a JSON array of arrays of {PARAMS} numbers",
+            params.display()
+        )
+    })?;
     let env = make_env(kind, &EnvConfig::default());
     let mut out = Vec::with_capacity(v.len());
     for (i, theta) in v.iter().enumerate() {
         let theta: [f64; PARAMS] = theta.as_slice().try_into().map_err(|_| {
-            anyhow::anyhow!("{}: entry {i} has {} numbers, expected {PARAMS}", params.display(), theta.len())
+            anyhow::anyhow!(
+                "{}: entry {i} has {} numbers, expected {PARAMS}",
+                params.display(),
+                theta.len()
+            )
         })?;
         if theta.iter().any(|x| !x.is_finite()) {
             bail!("{}: entry {i} has a non-finite number", params.display());
         }
         let r = env.rollout(&theta);
-        out.push(RolloutOut { object: r.outcome().to_vec(), moved: r.caught, hand: r.hand });
+        out.push(RolloutOut {
+            object: r.outcome().to_vec(),
+            moved: r.caught,
+            hand: r.hand,
+        });
     }
     println!("{}", serde_json::to_string(&out)?);
     Ok(())
@@ -252,17 +319,29 @@ fn klc(kind: EnvKind, path: &Path) -> Result<()> {
     let pts = read_outcomes_csv(path, kind.state_dim())?;
     let k = KlCoverage::new(kind.state_dim())?;
     let v = k.evaluate(pts.iter().map(|p| &p[..]))?;
-    if v.is_infinite() { println!("inf") } else { println!("{v}") }
+    if v.is_infinite() {
+        println!("inf")
+    } else {
+        println!("{v}")
+    }
     Ok(())
 }
 
 fn render(kind: EnvKind, state: &str, out: &Path) -> Result<()> {
     let vals: Vec<f64> = state
         .split(',')
-        .map(|s| s.trim().parse::<f64>().map_err(|_| anyhow::anyhow!("--state: '{s}' is not a number")))
+        .map(|s| {
+            s.trim()
+                .parse::<f64>()
+                .map_err(|_| anyhow::anyhow!("--state: '{s}' is not a number"))
+        })
         .collect::<Result<_>>()?;
     if vals.len() != kind.state_dim() {
-        bail!("--state for {kind} needs {} comma-separated values, got {}", kind.state_dim(), vals.len());
+        bail!(
+            "--state for {kind} needs {} comma-separated values, got {}",
+            kind.state_dim(),
+            vals.len()
+        );
     }
     if let Some(v) = vals.iter().find(|v| !(-1.0..=1.0).contains(*v)) {
         bail!("--state: {v} is outside [-1,1]");
@@ -274,7 +353,10 @@ fn render(kind: EnvKind, state: &str, out: &Path) -> Result<()> {
     match out.extension().and_then(|e| e.to_str()) {
         Some("npy") => write_npy(&img, out)?,
         Some("png") => write_png(&img, out)?,
-        _ => bail!("--out {}: the extension must be .npy or .png", out.display()),
+        _ => bail!(
+            "--out {}: the extension must be .npy or .png",
+            out.display()
+        ),
     }
     Ok(())
 }
@@ -294,7 +376,9 @@ fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
     let mut cfg = CampaignConfig::load(&path)?;
     if let Some(e) = a.epochs {
         cfg.explore.epochs = e;
-        cfg.explore.validate().map_err(|m| anyhow::anyhow!("--epochs: {m}"))?;
+        cfg.explore
+            .validate()
+            .map_err(|m| anyhow::anyhow!("--epochs: {m}"))?;
     }
     if let Some(n) = a.images {
         if n < 2 {
@@ -309,13 +393,26 @@ fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
                 bail!("--sampler must be kde or gaussian for {}", a.algo);
             }
             if a.latents == 0 || a.latents >= cfg.ugl.images {
-                bail!("--latents must be between 1 and the number of images - 1 ({}), got {}", cfg.ugl.images - 1, a.latents);
+                bail!(
+                    "--latents must be between 1 and the number of images - 1 ({}), got {}",
+                    cfg.ugl.images - 1,
+                    a.latents
+                );
             }
-            RunSpec { env: a.env, algo: a.algo, sampler: a.sampler, latents: a.latents, seed: a.seed }
+            RunSpec {
+                env: a.env,
+                algo: a.algo,
+                sampler: a.sampler,
+                latents: a.latents,
+                seed: a.seed,
+            }
         }
     };
     if a.algo.learner() == Some(Learner::External) && cfg.learners.external.is_none() {
-        bail!("--algo rge-external needs a [learners.external] section (name, command) in the profile {}", path.display());
+        bail!(
+            "--algo rge-external needs a [learners.external] section (name, command) in the profile {}",
+            path.display()
+        );
     }
     check_out_dir(out)?;
     let ctx = RunContext {
@@ -341,12 +438,25 @@ fn check_out_dir(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
 }
 
-fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: bool, shard: Option<&str>) -> Result<()> {
+fn campaign(
+    config: &Path,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    quiet: bool,
+    shard: Option<&str>,
+) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
-    let shard = shard.map(parse_shard).transpose().map_err(|e| anyhow::anyhow!(e))?;
+    let shard = shard
+        .map(parse_shard)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!(e))?;
     let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
     check_out_dir(&out)?;
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    let jobs = jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
     if jobs == 0 {
         bail!("--jobs must be at least 1");
     }
@@ -366,17 +476,26 @@ fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: boo
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} elapsed, ETA {eta}  {msg}")
-            .expect("valid template"),
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs  {elapsed_precise} elapsed, ETA {eta}  {msg}",
+        )
+        .expect("valid template"),
     );
-    let profile = config.file_stem().and_then(|s| s.to_str()).unwrap_or("custom").to_string();
+    let profile = config
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("custom")
+        .to_string();
     let t0 = std::time::Instant::now();
     let on = |p: Progress| match p {
         Progress::Planned { total, skipped } => {
             bar.set_length(total as u64);
             bar.set_position(skipped as u64);
             if skipped > 0 {
-                bar.println(format!("{skipped} of {total} runs already complete in {}; resuming", out.display()));
+                bar.println(format!(
+                    "{skipped} of {total} runs already complete in {}; resuming",
+                    out.display()
+                ));
             }
         }
         Progress::Finished(s) => {
@@ -384,14 +503,33 @@ fn campaign(config: &Path, out: Option<PathBuf>, jobs: Option<usize>, quiet: boo
             bar.set_message(format!("{} klc={:.3}", s.run, s.final_klc));
         }
     };
-    let opts = CampaignOptions { jobs, profile: &profile, stop: &stop, shard };
+    let opts = CampaignOptions {
+        jobs,
+        profile: &profile,
+        stop: &stop,
+        shard,
+    };
     let done = run_campaign(&cfg, &out, &opts, &on)?;
     bar.finish_and_clear();
-    eprintln!("campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}", cfg.campaign.name, done.len(), t0.elapsed().as_secs_f64(), jobs, out.display());
+    eprintln!(
+        "campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}",
+        cfg.campaign.name,
+        done.len(),
+        t0.elapsed().as_secs_f64(),
+        jobs,
+        out.display()
+    );
     Ok(())
 }
 
-fn slurm(config: &Path, shards: usize, out: Option<PathBuf>, scripts: &Path, cpus: usize, time: &str) -> Result<()> {
+fn slurm(
+    config: &Path,
+    shards: usize,
+    out: Option<PathBuf>,
+    scripts: &Path,
+    cpus: usize,
+    time: &str,
+) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
     if shards == 0 {
         bail!("--shards must be at least 1");
@@ -404,7 +542,13 @@ fn slurm(config: &Path, shards: usize, out: Option<PathBuf>, scripts: &Path, cpu
     let name = &cfg.campaign.name;
     let n_runs = plan(&cfg).len();
     let cwd = std::env::current_dir().context("cannot read the current directory")?;
-    let abs = |p: &Path| if p.is_absolute() { p.to_path_buf() } else { cwd.join(p) };
+    let abs = |p: &Path| {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            cwd.join(p)
+        }
+    };
     let (config_abs, out_abs) = (abs(config), abs(&out));
     let array = format!(
         "#!/usr/bin/env bash\n\
@@ -439,7 +583,11 @@ fn slurm(config: &Path, shards: usize, out: Option<PathBuf>, scripts: &Path, cpu
          sbatch --dependency=afterok:${{jid}} report.sh\necho \"submitted array job ${{jid}} ({shards} tasks) and its report step\"\n",
         cwd = cwd.display(),
     );
-    for (file, text) in [("array.sh", array), ("report.sh", merge), ("submit.sh", submit)] {
+    for (file, text) in [
+        ("array.sh", array),
+        ("report.sh", merge),
+        ("submit.sh", submit),
+    ] {
         let p = scripts.join(file);
         std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
         #[cfg(unix)]
@@ -449,7 +597,11 @@ fn slurm(config: &Path, shards: usize, out: Option<PathBuf>, scripts: &Path, cpu
                 .with_context(|| format!("cannot make {} executable", p.display()))?;
         }
     }
-    eprintln!("wrote {}/{{array,report,submit}}.sh: {n_runs} runs in {shards} shards; run {}/submit.sh", scripts.display(), scripts.display());
+    eprintln!(
+        "wrote {}/{{array,report,submit}}.sh: {n_runs} runs in {shards} shards; run {}/submit.sh",
+        scripts.display(),
+        scripts.display()
+    );
     Ok(())
 }
 
@@ -470,18 +622,29 @@ fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
             let manifest = ugl_bench::campaign::store::read_manifest(&m)?;
             let files = ugl_bench::campaign::store::run_paths(src, &manifest.run_id);
             if !files.iter().all(|f| f.is_file()) {
-                bail!("{}: run {} is incomplete (a data file is missing)", src.display(), manifest.run_id);
+                bail!(
+                    "{}: run {} is incomplete (a data file is missing)",
+                    src.display(),
+                    manifest.run_id
+                );
             }
             let dest = ugl_bench::campaign::store::run_paths(into, &manifest.run_id);
             if dest[2].exists() {
                 let theirs = ugl_bench::campaign::store::read_manifest(&dest[2])?;
-                let identical_data = files[..2].iter().zip(&dest[..2]).all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
+                let identical_data = files[..2]
+                    .iter()
+                    .zip(&dest[..2])
+                    .all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
                 if theirs.config_hash != manifest.config_hash || !identical_data {
                     bail!(
                         "run {} exists in {} with different {}: refusing to overwrite",
                         manifest.run_id,
                         into.display(),
-                        if theirs.config_hash != manifest.config_hash { "config hash" } else { "data" }
+                        if theirs.config_hash != manifest.config_hash {
+                            "config hash"
+                        } else {
+                            "data"
+                        }
                     );
                 }
                 same += 1;
@@ -489,12 +652,16 @@ fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
             }
             // Data files first, manifest last (a run is complete when its manifest exists).
             for (a, b) in files.iter().zip(&dest) {
-                let bytes = std::fs::read(a).with_context(|| format!("cannot read {}", a.display()))?;
+                let bytes =
+                    std::fs::read(a).with_context(|| format!("cannot read {}", a.display()))?;
                 ugl_bench::campaign::store::write_atomic(b, &bytes)?;
             }
             copied += 1;
         }
     }
-    eprintln!("merge: {copied} runs copied, {same} already present and identical -> {}", into.display());
+    eprintln!(
+        "merge: {copied} runs copied, {same} already present and identical -> {}",
+        into.display()
+    );
     Ok(())
 }

@@ -24,7 +24,12 @@ fn result_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
-        .map(|p| (p.file_name().unwrap().to_str().unwrap().to_string(), std::fs::read(&p).unwrap()))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_str().unwrap().to_string(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
         .collect();
     v.sort();
     v
@@ -33,7 +38,10 @@ fn result_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
 #[test]
 fn every_bad_config_gives_a_one_line_error_naming_the_key_and_touches_nothing() {
     let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_configs");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&corpus).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&corpus)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     files.sort();
     assert!(files.len() >= 20, "the corpus has {} configs", files.len());
     let dir = tempfile::tempdir().unwrap();
@@ -43,16 +51,35 @@ fn every_bad_config_gives_a_one_line_error_naming_the_key_and_touches_nothing() 
     std::fs::write(&sentinel, b"an existing result").unwrap();
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
-        let expect = text.lines().next().and_then(|l| l.strip_prefix("# expect: ")).unwrap_or_else(|| panic!("{} lacks '# expect:'", f.display()));
+        let expect = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("# expect: "))
+            .unwrap_or_else(|| panic!("{} lacks '# expect:'", f.display()));
         for cmd in ["plan", "campaign"] {
-            let o = run(&[cmd, "--config", p(&f), "--out", p(&out)][..if cmd == "plan" { 3 } else { 5 }]);
+            let o =
+                run(&[cmd, "--config", p(&f), "--out", p(&out)]
+                    [..if cmd == "plan" { 3 } else { 5 }]);
             let err = String::from_utf8_lossy(&o.stderr);
             assert_eq!(o.status.code(), Some(2), "{} ({cmd}): {err}", f.display());
-            assert_eq!(err.trim_end().lines().count(), 1, "{}: one line: {err}", f.display());
-            assert!(err.contains(expect), "{}: {err:?} should mention {expect:?}", f.display());
+            assert_eq!(
+                err.trim_end().lines().count(),
+                1,
+                "{}: one line: {err}",
+                f.display()
+            );
+            assert!(
+                err.contains(expect),
+                "{}: {err:?} should mention {expect:?}",
+                f.display()
+            );
         }
     }
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "nothing was written");
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        1,
+        "nothing was written"
+    );
     assert_eq!(std::fs::read(&sentinel).unwrap(), b"an existing result");
 }
 
@@ -61,14 +88,29 @@ fn bad_output_locations() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
-    let o = run(&["campaign", "--config", "data/campaigns/baselines.toml", "--out", p(&file)]);
+    let o = run(&[
+        "campaign",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--out",
+        p(&file),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("not a directory"));
     // A location nobody can create (even root): /proc is read-only.
-    let o = run(&["campaign", "--config", "data/campaigns/baselines.toml", "--out", "/proc/ugl-bench-test/results"]);
+    let o = run(&[
+        "campaign",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--out",
+        "/proc/ugl-bench-test/results",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("/proc/ugl-bench-test/results") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(
+        err.contains("/proc/ugl-bench-test/results") && err.trim_end().lines().count() == 1,
+        "{err}"
+    );
 }
 
 fn write_config(dir: &Path, reps: usize) -> PathBuf {
@@ -90,8 +132,34 @@ fn results_do_not_depend_on_the_worker_count() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = write_config(dir.path(), 2);
     let (a, b) = (dir.path().join("one"), dir.path().join("two"));
-    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&a), "--jobs", "1", "--quiet"]).status.success());
-    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&b), "--jobs", "2", "--quiet"]).status.success());
+    assert!(
+        run(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&a),
+            "--jobs",
+            "1",
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
+    assert!(
+        run(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&b),
+            "--jobs",
+            "2",
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
     let (ra, rb) = (result_bytes(&a), result_bytes(&b));
     assert_eq!(ra.len(), 2 * 4 * 2 * 2);
     assert!(ra == rb, "1 and 2 workers give different result files");
@@ -102,12 +170,32 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = write_config(dir.path(), 6);
     let reference = dir.path().join("reference");
-    assert!(run(&["campaign", "--config", p(&cfg), "--out", p(&reference), "--quiet"]).status.success());
+    assert!(
+        run(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&reference),
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
     let expected = result_bytes(&reference);
 
     let out = dir.path().join("killed");
     let mut child = ugl()
-        .args(["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet", "--jobs", "2"])
+        .args([
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&out),
+            "--quiet",
+            "--jobs",
+            "2",
+        ])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -116,8 +204,22 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
     // below hold for any kill time).
     let t0 = Instant::now();
     loop {
-        let done = std::fs::read_dir(&out).map(|d| d.filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "json")).count()).unwrap_or(0);
-        if done >= 3 || child.try_wait().unwrap().is_some() || t0.elapsed() > Duration::from_secs(120) {
+        let done = std::fs::read_dir(&out)
+            .map(|d| {
+                d.filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .path()
+                        .extension()
+                        .is_some_and(|x| x == "json")
+                })
+                .count()
+            })
+            .unwrap_or(0);
+        if done >= 3
+            || child.try_wait().unwrap().is_some()
+            || t0.elapsed() > Duration::from_secs(120)
+        {
             break;
         }
         std::thread::sleep(Duration::from_millis(5));
@@ -127,16 +229,30 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
     let partial = result_bytes(&out);
     // Whatever was stored is complete and correct.
     for (name, bytes) in &partial {
-        let reference = expected.iter().find(|(n, _)| n == name).expect("a planned run");
-        assert!(&reference.1 == bytes, "{name} differs from the uninterrupted campaign");
+        let reference = expected
+            .iter()
+            .find(|(n, _)| n == name)
+            .expect("a planned run");
+        assert!(
+            &reference.1 == bytes,
+            "{name} differs from the uninterrupted campaign"
+        );
     }
     let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(result_bytes(&out) == expected, "resumed campaign differs from the uninterrupted one");
+    assert!(
+        result_bytes(&out) == expected,
+        "resumed campaign differs from the uninterrupted one"
+    );
     // A changed configuration reruns the runs whose config hash changed, never reuses them.
-    let text = std::fs::read_to_string(&cfg).unwrap().replace("epochs = 1500", "epochs = 1400");
+    let text = std::fs::read_to_string(&cfg)
+        .unwrap()
+        .replace("epochs = 1500", "epochs = 1400");
     std::fs::write(&cfg, text).unwrap();
     let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains(&format!("{} runs executed", expected.len() / 2)), "{err}");
+    assert!(
+        err.contains(&format!("{} runs executed", expected.len() / 2)),
+        "{err}"
+    );
 }

@@ -35,7 +35,15 @@ fn p(path: &Path) -> &str {
 fn rollout_contract() {
     let dir = tempfile::tempdir().unwrap();
     let f = dir.path().join("params.json");
-    std::fs::write(&f, format!("[{z}, {o}]", z = serde_json::to_string(&[0.0; 21]).unwrap(), o = serde_json::to_string(&[0.3; 21]).unwrap())).unwrap();
+    std::fs::write(
+        &f,
+        format!(
+            "[{z}, {o}]",
+            z = serde_json::to_string(&[0.0; 21]).unwrap(),
+            o = serde_json::to_string(&[0.3; 21]).unwrap()
+        ),
+    )
+    .unwrap();
     for env in ["armball", "armarrow"] {
         let o = ugl(&["rollout", "--env", env, "--params", p(&f)]);
         assert!(o.status.success(), "{}", stderr(&o));
@@ -45,16 +53,38 @@ fn rollout_contract() {
         let hand: Vec<f64> = serde_json::from_value(first["hand"].clone()).unwrap();
         assert!(hand[0].abs() < 1e-12 && (hand[1] - 1.0).abs() < 1e-12);
         let object: Vec<f64> = serde_json::from_value(first["object"].clone()).unwrap();
-        let expected: &[f64] = if env == "armball" { &[0.6, 0.6] } else { &[0.6, 0.6, 0.6] };
+        let expected: &[f64] = if env == "armball" {
+            &[0.6, 0.6]
+        } else {
+            &[0.6, 0.6, 0.6]
+        };
         assert_eq!(object, expected);
         assert_eq!(v.as_array().unwrap().len(), 2);
     }
     std::fs::write(&f, "[[0.1, 0.2]]").unwrap();
-    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", p(&f)]), "21");
+    assert_one_line_error(
+        &ugl(&["rollout", "--env", "armball", "--params", p(&f)]),
+        "21",
+    );
     std::fs::write(&f, "not json").unwrap();
-    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", p(&f)]), "params.json");
-    assert_one_line_error(&ugl(&["rollout", "--env", "armball", "--params", "/nonexistent/x.json"]), "/nonexistent/x.json");
-    assert_one_line_error(&ugl(&["rollout", "--env", "armbal", "--params", p(&f)]), "armbal");
+    assert_one_line_error(
+        &ugl(&["rollout", "--env", "armball", "--params", p(&f)]),
+        "params.json",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "rollout",
+            "--env",
+            "armball",
+            "--params",
+            "/nonexistent/x.json",
+        ]),
+        "/nonexistent/x.json",
+    );
+    assert_one_line_error(
+        &ugl(&["rollout", "--env", "armbal", "--params", p(&f)]),
+        "armbal",
+    );
 }
 
 #[test]
@@ -67,31 +97,83 @@ fn klc_contract() {
     let v: f64 = stdout(&o).trim().parse().unwrap();
     assert!((v - 756f64.ln()).abs() < 1e-12);
     std::fs::write(&f, "x,y\n0.99,0.99\n").unwrap();
-    assert_eq!(stdout(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)])).trim(), "inf");
+    assert_eq!(
+        stdout(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)])).trim(),
+        "inf"
+    );
     std::fs::write(&f, "x,y,angle\n0.1,0.1,0.5\n").unwrap();
     let o = ugl(&["klc", "--env", "armarrow", "--outcomes", p(&f)]);
     assert!((stdout(&o).trim().parse::<f64>().unwrap() - 22680f64.ln()).abs() < 1e-12);
-    assert_one_line_error(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]), "header");
+    assert_one_line_error(
+        &ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]),
+        "header",
+    );
     std::fs::write(&f, "x,y\n0.1,zz\n").unwrap();
-    assert_one_line_error(&ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]), "zz");
+    assert_one_line_error(
+        &ugl(&["klc", "--env", "armball", "--outcomes", p(&f)]),
+        "zz",
+    );
 }
 
 #[test]
 fn render_contract() {
     let dir = tempfile::tempdir().unwrap();
     let npy = dir.path().join("ball.npy");
-    let o = ugl(&["render", "--env", "armball", "--state", "0.2,-0.4", "--out", p(&npy)]);
+    let o = ugl(&[
+        "render",
+        "--env",
+        "armball",
+        "--state",
+        "0.2,-0.4",
+        "--out",
+        p(&npy),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&npy).unwrap();
     assert_eq!(&bytes[..6], b"\x93NUMPY");
     assert!(bytes.len() >= 4900 * 4 + 64);
     let png = dir.path().join("arrow.png");
-    let o = ugl(&["render", "--env", "armarrow", "--state", "-0.3,0.1,0.5", "--out", p(&png)]);
+    let o = ugl(&[
+        "render",
+        "--env",
+        "armarrow",
+        "--state",
+        "-0.3,0.1,0.5",
+        "--out",
+        p(&png),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
-    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "0.2", "--out", p(&npy)]), "2 comma-separated");
-    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "1.2,0", "--out", p(&npy)]), "outside");
-    assert_one_line_error(&ugl(&["render", "--env", "armball", "--state", "0,0", "--out", "x.jpg"]), ".npy or .png");
+    assert_one_line_error(
+        &ugl(&[
+            "render",
+            "--env",
+            "armball",
+            "--state",
+            "0.2",
+            "--out",
+            p(&npy),
+        ]),
+        "2 comma-separated",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "render",
+            "--env",
+            "armball",
+            "--state",
+            "1.2,0",
+            "--out",
+            p(&npy),
+        ]),
+        "outside",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "render", "--env", "armball", "--state", "0,0", "--out", "x.jpg",
+        ]),
+        ".npy or .png",
+    );
 }
 
 #[test]
@@ -99,7 +181,19 @@ fn run_contract_and_determinism() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     let args = |out: &Path, seed: &str| {
-        ugl(&["run", "--env", "armarrow", "--algo", "rge-efr", "--seed", seed, "--epochs", "400", "--out", p(out)])
+        ugl(&[
+            "run",
+            "--env",
+            "armarrow",
+            "--algo",
+            "rge-efr",
+            "--seed",
+            seed,
+            "--epochs",
+            "400",
+            "--out",
+            p(out),
+        ])
     };
     let o = args(&a, "1");
     assert!(o.status.success(), "{}", stderr(&o));
@@ -111,8 +205,15 @@ fn run_contract_and_determinism() {
     }
     // Same inputs -> byte-identical result files.
     assert!(args(&b, "1").status.success());
-    for f in ["armarrow.rge-efr.s1.parquet", "armarrow.rge-efr.s1.outcomes.parquet"] {
-        assert_eq!(std::fs::read(a.join(f)).unwrap(), std::fs::read(b.join(f)).unwrap(), "{f}");
+    for f in [
+        "armarrow.rge-efr.s1.parquet",
+        "armarrow.rge-efr.s1.outcomes.parquet",
+    ] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
     }
     // A different seed gives different results.
     assert!(args(&b, "2").status.success());
@@ -121,7 +222,8 @@ fn run_contract_and_determinism() {
         std::fs::read(b.join("armarrow.rge-efr.s2.outcomes.parquet")).unwrap()
     );
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(a.join("armarrow.rge-efr.s1.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(a.join("armarrow.rge-efr.s1.json")).unwrap())
+            .unwrap();
     assert_eq!(m["reduced_budget"], true);
     assert_eq!(m["explore"]["epochs"], 400);
 }
@@ -132,12 +234,56 @@ fn run_errors() {
     let file = dir.path().join("f");
     std::fs::write(&file, "").unwrap();
     let out = p(dir.path());
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rge-nope", "--out", out]), "rge-nope");
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--epochs", "0", "--out", out]), "epochs");
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--epochs", "-3", "--out", out]), "-3");
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--profile", "nosuch", "--out", out]), "nosuch");
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--out", p(&file)]), "not a directory");
-    assert_one_line_error(&ugl(&["run", "--env", "armball", "--algo", "rpe", "--bogus", "--out", out]), "--bogus");
+    assert_one_line_error(
+        &ugl(&[
+            "run", "--env", "armball", "--algo", "rge-nope", "--out", out,
+        ]),
+        "rge-nope",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "run", "--env", "armball", "--algo", "rpe", "--epochs", "0", "--out", out,
+        ]),
+        "epochs",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "run", "--env", "armball", "--algo", "rpe", "--epochs", "-3", "--out", out,
+        ]),
+        "-3",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--profile",
+            "nosuch",
+            "--out",
+            out,
+        ]),
+        "nosuch",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--out",
+            p(&file),
+        ]),
+        "not a directory",
+    );
+    assert_one_line_error(
+        &ugl(&[
+            "run", "--env", "armball", "--algo", "rpe", "--bogus", "--out", out,
+        ]),
+        "--bogus",
+    );
     assert_one_line_error(&ugl(&["frobnicate"]), "frobnicate");
 }
 
@@ -151,15 +297,48 @@ fn campaign_plan_and_resume() {
     )
     .unwrap();
     let o = ugl(&["plan", "--config", p(&cfg)]);
-    assert_eq!(stdout(&o).lines().collect::<Vec<_>>(), ["armball.rpe.s0", "armball.rpe.s1", "armball.rge-efr.s0", "armball.rge-efr.s1"]);
+    assert_eq!(
+        stdout(&o).lines().collect::<Vec<_>>(),
+        [
+            "armball.rpe.s0",
+            "armball.rpe.s1",
+            "armball.rge-efr.s0",
+            "armball.rge-efr.s1"
+        ]
+    );
     let out = dir.path().join("res");
-    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet", "--jobs", "2"]);
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&out),
+        "--quiet",
+        "--jobs",
+        "2",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 12);
     // The campaign's run equals the single run with the same seed.
     let single = dir.path().join("single");
     let prof = p(&cfg);
-    assert!(ugl(&["run", "--env", "armball", "--algo", "rge-efr", "--seed", "1", "--profile", prof, "--out", p(&single)]).status.success());
+    assert!(
+        ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-efr",
+            "--seed",
+            "1",
+            "--profile",
+            prof,
+            "--out",
+            p(&single)
+        ])
+        .status
+        .success()
+    );
     assert_eq!(
         std::fs::read(out.join("armball.rge-efr.s1.outcomes.parquet")).unwrap(),
         std::fs::read(single.join("armball.rge-efr.s1.outcomes.parquet")).unwrap()
@@ -173,7 +352,11 @@ fn campaign_plan_and_resume() {
 
 #[test]
 fn run_with_an_external_learner() {
-    let numpy = Command::new("python3").args(["-c", "import numpy"]).output().map(|o| o.status.success()).unwrap_or(false);
+    let numpy = Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
     if !numpy {
         eprintln!("SKIPPED: rge-external end to end (python3 with numpy not found)");
         return;
@@ -188,16 +371,38 @@ fn run_with_an_external_learner() {
     )
     .unwrap();
     let out = dir.path().join("res");
-    let o = ugl(&["run", "--env", "armball", "--algo", "rge-external", "--latents", "3", "--profile", p(&cfg), "--out", p(&out)]);
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-external",
+        "--latents",
+        "3",
+        "--profile",
+        p(&cfg),
+        "--out",
+        p(&out),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
     assert_eq!(s["run"], "armball.rge-external.kde.l3.s0");
-    let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("armball.rge-external.kde.l3.s0.json")).unwrap()).unwrap();
+    let m: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("armball.rge-external.kde.l3.s0.json")).unwrap(),
+    )
+    .unwrap();
     assert_eq!(m["learner"], "random-projection");
     assert_eq!(m["reduced_budget"], true);
     // Without the [learners.external] section: a one-line error.
-    let o = ugl(&["run", "--env", "armball", "--algo", "rge-external", "--out", p(&out)]);
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-external",
+        "--out",
+        p(&out),
+    ]);
     assert_one_line_error(&o, "learners.external");
 }
 
@@ -206,7 +411,12 @@ fn data_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
-        .map(|p| (p.file_name().unwrap().to_str().unwrap().to_string(), std::fs::read(&p).unwrap()))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_str().unwrap().to_string(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
         .collect();
     v.sort();
     v
@@ -223,12 +433,34 @@ fn shards_merge_into_the_whole_campaign() {
     )
     .unwrap();
     let whole = dir.path().join("whole");
-    assert!(ugl(&["campaign", "--config", p(&cfg), "--out", p(&whole), "--quiet"]).status.success());
+    assert!(
+        ugl(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&whole),
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
     // Three machines, three shards, three stores; merged into one.
     let mut parts = Vec::new();
     for i in 0..3 {
         let d = dir.path().join(format!("part{i}"));
-        let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&d), "--quiet", "--jobs", "1", "--shard", &format!("{i}/3")]);
+        let o = ugl(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&d),
+            "--quiet",
+            "--jobs",
+            "1",
+            "--shard",
+            &format!("{i}/3"),
+        ]);
         assert!(o.status.success(), "{}", stderr(&o));
         parts.push(d);
     }
@@ -237,29 +469,78 @@ fn shards_merge_into_the_whole_campaign() {
     args.extend(parts.iter().map(|d| p(d)));
     let o = ugl(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(data_files(&whole), data_files(&merged), "the union of the shards equals the whole campaign");
+    assert_eq!(
+        data_files(&whole),
+        data_files(&merged),
+        "the union of the shards equals the whole campaign"
+    );
     // Merging again is a no-op; a conflicting run is refused.
     assert!(ugl(&args).status.success());
-    let f = parts[0].join(std::fs::read_dir(&parts[0]).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_str().unwrap().ends_with(".outcomes.parquet")).unwrap());
+    let f = parts[0].join(
+        std::fs::read_dir(&parts[0])
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.to_str().unwrap().ends_with(".outcomes.parquet"))
+            .unwrap(),
+    );
     std::fs::write(&f, b"corrupt").unwrap();
     assert_one_line_error(&ugl(&args), "refusing to overwrite");
-    assert_one_line_error(&ugl(&["campaign", "--config", p(&cfg), "--out", p(&whole), "--shard", "3/3"]), "--shard");
+    assert_one_line_error(
+        &ugl(&[
+            "campaign",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&whole),
+            "--shard",
+            "3/3",
+        ]),
+        "--shard",
+    );
 }
 
 #[test]
 fn slurm_scripts() {
     let dir = tempfile::tempdir().unwrap();
     let scripts = dir.path().join("slurm");
-    let o = ugl(&["slurm", "--config", "data/campaigns/baselines.toml", "--shards", "4", "--scripts", p(&scripts)]);
+    let o = ugl(&[
+        "slurm",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--shards",
+        "4",
+        "--scripts",
+        p(&scripts),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let array = std::fs::read_to_string(scripts.join("array.sh")).unwrap();
     assert!(array.contains("#SBATCH --array=0-3"), "{array}");
-    assert!(array.contains("--shard \"${SLURM_ARRAY_TASK_ID}/4\""), "{array}");
+    assert!(
+        array.contains("--shard \"${SLURM_ARRAY_TASK_ID}/4\""),
+        "{array}"
+    );
     let submit = std::fs::read_to_string(scripts.join("submit.sh")).unwrap();
-    assert!(submit.contains("--dependency=afterok:${jid} report.sh"), "{submit}");
+    assert!(
+        submit.contains("--dependency=afterok:${jid} report.sh"),
+        "{submit}"
+    );
     for f in ["array.sh", "report.sh", "submit.sh"] {
-        let st = Command::new("bash").args(["-n", p(&scripts.join(f))]).status().unwrap();
+        let st = Command::new("bash")
+            .args(["-n", p(&scripts.join(f))])
+            .status()
+            .unwrap();
         assert!(st.success(), "{f} is valid bash");
     }
-    assert_one_line_error(&ugl(&["slurm", "--config", "data/campaigns/baselines.toml", "--shards", "0", "--scripts", p(&scripts)]), "--shards");
+    assert_one_line_error(
+        &ugl(&[
+            "slurm",
+            "--config",
+            "data/campaigns/baselines.toml",
+            "--shards",
+            "0",
+            "--scripts",
+            p(&scripts),
+        ]),
+        "--shards",
+    );
 }

@@ -29,12 +29,22 @@ fn committed_report_regenerates_byte_identically() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let ours: Vec<_> = files(tmp.path()).iter().map(|p| p.strip_prefix(tmp.path()).unwrap().to_path_buf()).collect();
-    let theirs: Vec<_> = files(&committed).iter().map(|p| p.strip_prefix(&committed).unwrap().to_path_buf()).collect();
-    assert_eq!(ours, theirs, "the set of report files differs: run `make report` and commit report/out");
+    let ours: Vec<_> = files(tmp.path())
+        .iter()
+        .map(|p| p.strip_prefix(tmp.path()).unwrap().to_path_buf())
+        .collect();
+    let theirs: Vec<_> = files(&committed)
+        .iter()
+        .map(|p| p.strip_prefix(&committed).unwrap().to_path_buf())
+        .collect();
+    assert_eq!(
+        ours, theirs,
+        "the set of report files differs: run `make report` and commit report/out"
+    );
     for rel in ours {
         assert!(
-            std::fs::read(tmp.path().join(&rel)).unwrap() == std::fs::read(committed.join(&rel)).unwrap(),
+            std::fs::read(tmp.path().join(&rel)).unwrap()
+                == std::fs::read(committed.join(&rel)).unwrap(),
             "{} differs from a fresh render: run `make report` and commit report/out",
             rel.display()
         );

@@ -26,9 +26,15 @@ fn bench(c: &mut Criterion) {
     let train = balls(2000, 1);
     let learner = Isomap::default();
     g.bench_function("fit_2000_balls_2_latents", |b| {
-        b.iter(|| learner.fit(black_box(&train), 2, &mut stream_named(1, "learner")).unwrap())
+        b.iter(|| {
+            learner
+                .fit(black_box(&train), 2, &mut stream_named(1, "learner"))
+                .unwrap()
+        })
     });
-    let (mut enc, _) = learner.fit(&train, 2, &mut stream_named(1, "learner")).unwrap();
+    let (mut enc, _) = learner
+        .fit(&train, 2, &mut stream_named(1, "learner"))
+        .unwrap();
     let probe = balls(64, 2);
     let mut out = [0.0f64; 2];
     let mut i = 0;

@@ -1,10 +1,10 @@
 //! Rollout throughput: one 50-step DMP episode of the 7-joint arm (target: >= 100,000/s/core).
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use ugl_bench::env::{make_env, EnvConfig, EnvKind};
+use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::meta_policy::random_params;
-use ugl_bench::seed::{stream, Component};
+use ugl_bench::seed::{Component, stream};
 
 fn bench(c: &mut Criterion) {
     let mut rng = stream(0, Component::Params);

@@ -34,10 +34,19 @@ fn swiss_roll(n: usize, seed: u64) -> (ImageSet, Vec<[f64; 2]>) {
 fn procrustes_disparity(x: &[[f64; 2]], y: &[[f64; 2]]) -> f64 {
     let prep = |p: &[[f64; 2]]| {
         let n = p.len() as f64;
-        let m = [p.iter().map(|v| v[0]).sum::<f64>() / n, p.iter().map(|v| v[1]).sum::<f64>() / n];
+        let m = [
+            p.iter().map(|v| v[0]).sum::<f64>() / n,
+            p.iter().map(|v| v[1]).sum::<f64>() / n,
+        ];
         let c: Vec<[f64; 2]> = p.iter().map(|v| [v[0] - m[0], v[1] - m[1]]).collect();
-        let s = c.iter().map(|v| v[0] * v[0] + v[1] * v[1]).sum::<f64>().sqrt();
-        c.into_iter().map(|v| [v[0] / s, v[1] / s]).collect::<Vec<_>>()
+        let s = c
+            .iter()
+            .map(|v| v[0] * v[0] + v[1] * v[1])
+            .sum::<f64>()
+            .sqrt();
+        c.into_iter()
+            .map(|v| [v[0] / s, v[1] / s])
+            .collect::<Vec<_>>()
     };
     let (x, y) = (prep(x), prep(y));
     let mut m = [[0.0; 2]; 2];
@@ -107,7 +116,9 @@ fn swiss_roll_is_unrolled() {
     let (set, sheet) = swiss_roll(1000, 1);
     let learner = Isomap::default();
     assert_eq!(learner.name(), "isomap");
-    let (_enc, z) = learner.fit(&set, 2, &mut stream_named(1, "learner")).unwrap();
+    let (_enc, z) = learner
+        .fit(&set, 2, &mut stream_named(1, "learner"))
+        .unwrap();
     assert_eq!((z.n, z.latents), (1000, 2));
     let emb = rows2(&z);
     let disparity = procrustes_disparity(&emb, &sheet);
@@ -115,7 +126,9 @@ fn swiss_roll_is_unrolled() {
     let s: Vec<f64> = sheet.iter().map(|p| p[0]).collect();
     let e0: Vec<f64> = emb.iter().map(|p| p[0]).collect();
     let rho = spearman(&s, &e0).abs();
-    println!("swiss roll: Procrustes disparity {disparity:.5}, |spearman(arc length, axis 0)| {rho:.5}");
+    println!(
+        "swiss roll: Procrustes disparity {disparity:.5}, |spearman(arc length, axis 0)| {rho:.5}"
+    );
     assert!(disparity < 0.02, "disparity {disparity}");
     assert!(rho > 0.99, "rho {rho}");
 }
@@ -123,7 +136,9 @@ fn swiss_roll_is_unrolled() {
 #[test]
 fn out_of_sample_training_points_match_the_embedding() {
     for (set, d) in [(swiss_roll(600, 2).0, 2usize), (balls(400, 3).0, 3)] {
-        let (mut enc, z) = Isomap::default().fit(&set, d, &mut stream_named(2, "learner")).unwrap();
+        let (mut enc, z) = Isomap::default()
+            .fit(&set, d, &mut stream_named(2, "learner"))
+            .unwrap();
         let scale = z.data.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let batch = enc.encode(&set).unwrap();
         let mut one = vec![0.0; d];
@@ -137,14 +152,21 @@ fn out_of_sample_training_points_match_the_embedding() {
                 assert_eq!(&one[..], batch.row(i), "encode_one == encode, image {i}");
             } else {
                 for (a, b) in one.iter().zip(batch.row(i)) {
-                    assert!((a - b).abs() <= 1e-6 * scale, "encode_one ~ encode, image {i}");
+                    assert!(
+                        (a - b).abs() <= 1e-6 * scale,
+                        "encode_one ~ encode, image {i}"
+                    );
                 }
             }
             for (a, b) in one.iter().zip(z.row(i)) {
                 worst = worst.max((a - b).abs());
             }
         }
-        println!("out-of-sample on training points (dim {}): max |diff| / max |z| = {:.2e}", set.dim, worst / scale);
+        println!(
+            "out-of-sample on training points (dim {}): max |diff| / max |z| = {:.2e}",
+            set.dim,
+            worst / scale
+        );
         assert!(worst <= 1e-6 * scale, "worst {worst} scale {scale}");
     }
 }
@@ -153,7 +175,9 @@ fn out_of_sample_training_points_match_the_embedding() {
 fn fits_are_deterministic() {
     let (set, _) = balls(300, 4);
     let fit = || {
-        let (mut enc, z) = Isomap::default().fit(&set, 2, &mut stream_named(7, "learner")).unwrap();
+        let (mut enc, z) = Isomap::default()
+            .fit(&set, 2, &mut stream_named(7, "learner"))
+            .unwrap();
         let probe = balls(5, 99).0;
         (z, enc.encode(&probe).unwrap())
     };
@@ -164,10 +188,20 @@ fn fits_are_deterministic() {
     // Also with the partial (Krylov) eigen-solver (n > 256) and 10 latents, then the dense kNN
     // fallback (3-D points).
     let (set, _) = balls(400, 5);
-    let f = || Isomap::default().fit(&set, 10, &mut stream_named(3, "learner")).unwrap().1;
+    let f = || {
+        Isomap::default()
+            .fit(&set, 10, &mut stream_named(3, "learner"))
+            .unwrap()
+            .1
+    };
     assert_eq!(bits(&f().data), bits(&f().data));
     let (set, _) = swiss_roll(700, 5);
-    let f = || Isomap::default().fit(&set, 2, &mut stream_named(3, "learner")).unwrap().1;
+    let f = || {
+        Isomap::default()
+            .fit(&set, 2, &mut stream_named(3, "learner"))
+            .unwrap()
+            .1
+    };
     assert_eq!(bits(&f().data), bits(&f().data));
 }
 
@@ -184,22 +218,35 @@ fn disconnected_graph_is_a_clear_error() {
         }
     }
     let set = ImageSet::new(20, 3, data).unwrap();
-    let err = Isomap { n_neighbors: 3, ..Default::default() }.fit(&set, 2, &mut stream_named(1, "l")).err().expect("must fail");
+    let err = Isomap {
+        n_neighbors: 3,
+        ..Default::default()
+    }
+    .fit(&set, 2, &mut stream_named(1, "l"))
+    .err()
+    .expect("must fail");
     match err {
         ReprError::Numerical(msg) => {
             println!("{msg}");
             assert!(msg.contains("2 connected components"), "{msg}");
-            assert!(msg.contains("more neighbours") && msg.contains("more images"), "{msg}");
+            assert!(
+                msg.contains("more neighbours") && msg.contains("more images"),
+                "{msg}"
+            );
         }
         e => panic!("wrong error {e:?}"),
     }
     // sklearn >= 1.0 behaviour on request: the clusters are joined by their closest pair and
     // the first axis separates them.
-    let joined = Isomap { n_neighbors: 3, disconnected: Disconnected::ConnectClosestPairs };
+    let joined = Isomap {
+        n_neighbors: 3,
+        disconnected: Disconnected::ConnectClosestPairs,
+    };
     let (_, z) = joined.fit(&set, 2, &mut stream_named(1, "l")).unwrap();
     let first: Vec<f64> = (0..20).map(|i| z.row(i)[0]).collect();
     let (a, b) = (&first[..10], &first[10..]);
-    let sep = a.iter().all(|&v| v > 0.0) && b.iter().all(|&v| v < 0.0) || a.iter().all(|&v| v < 0.0) && b.iter().all(|&v| v > 0.0);
+    let sep = a.iter().all(|&v| v > 0.0) && b.iter().all(|&v| v < 0.0)
+        || a.iter().all(|&v| v < 0.0) && b.iter().all(|&v| v > 0.0);
     assert!(sep, "{first:?}");
 }
 
@@ -208,13 +255,26 @@ fn invalid_inputs() {
     let (set, _) = swiss_roll(50, 6);
     let mut rng = stream_named(1, "l");
     let invalid = |r: Result<_, ReprError>| matches!(r, Err(ReprError::InvalidInput(_)));
-    assert!(invalid(Isomap::default().fit(&set, 0, &mut rng).map(|_| ())));
+    assert!(invalid(
+        Isomap::default().fit(&set, 0, &mut rng).map(|_| ())
+    ));
     let one = ImageSet::new(1, 3, vec![0.0; 3]).unwrap();
-    assert!(invalid(Isomap::default().fit(&one, 1, &mut rng).map(|_| ())));
+    assert!(invalid(
+        Isomap::default().fit(&one, 1, &mut rng).map(|_| ())
+    ));
     // n_neighbors = 5 needs at least 6 images.
     let five = ImageSet::new(5, 3, (0..15).map(|v| v as f32).collect()).unwrap();
-    assert!(invalid(Isomap::default().fit(&five, 1, &mut rng).map(|_| ())));
-    assert!(invalid(Isomap { n_neighbors: 0, ..Default::default() }.fit(&set, 2, &mut rng).map(|_| ())));
+    assert!(invalid(
+        Isomap::default().fit(&five, 1, &mut rng).map(|_| ())
+    ));
+    assert!(invalid(
+        Isomap {
+            n_neighbors: 0,
+            ..Default::default()
+        }
+        .fit(&set, 2, &mut rng)
+        .map(|_| ())
+    ));
     // Wrong image size at encode time.
     let (mut enc, _) = Isomap::default().fit(&set, 2, &mut rng).unwrap();
     let mut out = [0.0; 2];
@@ -223,7 +283,9 @@ fn invalid_inputs() {
     // Non-finite training data.
     let mut bad = set.clone();
     bad.data[7] = f32::INFINITY;
-    assert!(invalid(Isomap::default().fit(&bad, 2, &mut rng).map(|_| ())));
+    assert!(invalid(
+        Isomap::default().fit(&bad, 2, &mut rng).map(|_| ())
+    ));
 }
 
 /// sklearn `manifold.trustworthiness(X, Z, n_neighbors=k)` with X the true states: how much the
@@ -236,7 +298,11 @@ fn trustworthiness(x: &[[f64; 2]], z: &[[f64; 2]], k: usize) -> f64 {
     for i in 0..n {
         let order = |pts: &[[f64; 2]]| {
             let mut o: Vec<usize> = (0..n).filter(|&j| j != i).collect();
-            o.sort_by(|&a, &b| d(&pts[i], &pts[a]).total_cmp(&d(&pts[i], &pts[b])).then(a.cmp(&b)));
+            o.sort_by(|&a, &b| {
+                d(&pts[i], &pts[a])
+                    .total_cmp(&d(&pts[i], &pts[b]))
+                    .then(a.cmp(&b))
+            });
             o
         };
         let (ox, oz) = (order(x), order(z));
@@ -259,18 +325,31 @@ fn trustworthiness(x: &[[f64; 2]], z: &[[f64; 2]], k: usize) -> f64 {
 /// best |Spearman| with an embedding axis.
 fn ball_stats(n: usize, seed: u64) -> (f64, f64, [f64; 2]) {
     let (set, states) = balls(n, seed);
-    let (_, z) = Isomap::default().fit(&set, 2, &mut stream_named(seed, "learner")).unwrap();
+    let (_, z) = Isomap::default()
+        .fit(&set, 2, &mut stream_named(seed, "learner"))
+        .unwrap();
     let emb = rows2(&z);
     let (mut all_e, mut all_s) = (Vec::new(), Vec::new());
     for i in 0..n {
         for j in i + 1..n {
-            all_s.push(((states[i][0] - states[j][0]).powi(2) + (states[i][1] - states[j][1]).powi(2)).sqrt());
+            all_s.push(
+                ((states[i][0] - states[j][0]).powi(2) + (states[i][1] - states[j][1]).powi(2))
+                    .sqrt(),
+            );
             all_e.push(((emb[i][0] - emb[j][0]).powi(2) + (emb[i][1] - emb[j][1]).powi(2)).sqrt());
         }
     }
     let col = |v: &[[f64; 2]], c: usize| v.iter().map(|p| p[c]).collect::<Vec<f64>>();
-    let best = |c: usize| (0..2).map(|a| spearman(&col(&states, c), &col(&emb, a)).abs()).fold(0.0, f64::max);
-    (trustworthiness(&states, &emb, 10), spearman(&all_s, &all_e), [best(0), best(1)])
+    let best = |c: usize| {
+        (0..2)
+            .map(|a| spearman(&col(&states, c), &col(&emb, a)).abs())
+            .fold(0.0, f64::max)
+    };
+    (
+        trustworthiness(&states, &emb, 10),
+        spearman(&all_s, &all_e),
+        [best(0), best(1)],
+    )
 }
 
 #[test]
@@ -283,7 +362,10 @@ fn ball_images_recover_positions() {
     // 0.95 (y); over seeds 1..9 they ranged over 0.89-0.998, 0.39-0.99 and 0.52-0.98. A random
     // embedding gives about 0.5, 0 and 0.
     let (trust, rho, best) = ball_stats(500, 8);
-    println!("balls: trustworthiness {trust:.4}, pairwise spearman {rho:.4}, best axis |spearman| x {:.3} y {:.3}", best[0], best[1]);
+    println!(
+        "balls: trustworthiness {trust:.4}, pairwise spearman {rho:.4}, best axis |spearman| x {:.3} y {:.3}",
+        best[0], best[1]
+    );
     assert!(trust > 0.85, "{trust}");
     assert!(rho > 0.5, "{rho}");
     assert!(best[0] > 0.6 && best[1] > 0.6, "{best:?}");
@@ -301,14 +383,25 @@ fn measure_fit_10k_balls() {
     // The paper's configuration gives a disconnected 5-NN graph (duplicated pixel positions):
     // the default fit refuses it, so measure the sklearn >= 1.0 behaviour (components joined).
     match Isomap::default().fit_isomap(&set, 10, &mut stream_named(10, "learner")) {
-        Err(ReprError::Numerical(m)) => println!("default fit fails after {:.2?}: {m}", t.elapsed()),
+        Err(ReprError::Numerical(m)) => {
+            println!("default fit fails after {:.2?}: {m}", t.elapsed())
+        }
         Err(e) => panic!("{e:?}"),
         Ok(_) => println!("default fit: connected"),
     }
     let t = Instant::now();
-    let joined = Isomap { disconnected: Disconnected::ConnectClosestPairs, ..Default::default() };
-    let (mut enc, z) = joined.fit_isomap(&set, 10, &mut stream_named(10, "learner")).unwrap();
-    println!("fit 10000 x 4900, 10 latents: {:.2?} (sparse index: {})", t.elapsed(), enc.uses_sparse_index());
+    let joined = Isomap {
+        disconnected: Disconnected::ConnectClosestPairs,
+        ..Default::default()
+    };
+    let (mut enc, z) = joined
+        .fit_isomap(&set, 10, &mut stream_named(10, "learner"))
+        .unwrap();
+    println!(
+        "fit 10000 x 4900, 10 latents: {:.2?} (sparse index: {})",
+        t.elapsed(),
+        enc.uses_sparse_index()
+    );
     println!("phases: {:?}", enc.fit_timings());
     println!("eigenvalues: {:?}", enc.eigenvalues());
     assert_eq!(z.n, 10_000);
@@ -318,5 +411,8 @@ fn measure_fit_10k_balls() {
     for i in 0..probe.n {
         enc.encode_one(probe.row(i), &mut out).unwrap();
     }
-    println!("encode_one: {:.1} us per image", t.elapsed().as_secs_f64() * 1e6 / probe.n as f64);
+    println!(
+        "encode_one: {:.1} us per image",
+        t.elapsed().as_secs_f64() * 1e6 / probe.n as f64
+    );
 }

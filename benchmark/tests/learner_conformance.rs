@@ -7,26 +7,35 @@
 
 use ugl_bench::campaign::config::{ExternalConfig, LearnersConfig};
 use ugl_bench::campaign::runner::make_learner;
-use ugl_bench::env::{make_env, EnvConfig, EnvKind};
+use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::Learner;
-use ugl_bench::repr::dataset::generate;
 use ugl_bench::repr::ImageSet;
-use ugl_bench::seed::{stream, stream_named, Component};
+use ugl_bench::repr::dataset::generate;
+use ugl_bench::seed::{Component, stream, stream_named};
 
 fn images(kind: EnvKind, n: usize) -> ImageSet {
     let env = make_env(kind, &EnvConfig::default());
-    generate(env.as_ref(), n, &mut stream(11, Component::Dataset)).unwrap().images
+    generate(env.as_ref(), n, &mut stream(11, Component::Dataset))
+        .unwrap()
+        .images
 }
 
 fn python_numpy() -> bool {
-    std::process::Command::new("python3").args(["-c", "import numpy"]).output().map(|o| o.status.success()).unwrap_or(false)
+    std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
 }
 
 fn learners_config() -> LearnersConfig {
     LearnersConfig {
         external: Some(ExternalConfig {
             name: "random-projection".into(),
-            command: format!("python3 {}/../scripts/external_learners/random_projection.py", env!("CARGO_MANIFEST_DIR")),
+            command: format!(
+                "python3 {}/../scripts/external_learners/random_projection.py",
+                env!("CARGO_MANIFEST_DIR")
+            ),
         }),
         ..Default::default()
     }
@@ -44,28 +53,56 @@ fn every_registered_learner_conforms() {
             let set = images(kind, 300);
             let l = make_learner(learner, &cfg).unwrap();
             let who = format!("{} on {kind} with {latents} latents", learner.name());
-            let (mut enc, z) = l.fit(&set, latents, &mut stream_named(1, "learner")).unwrap_or_else(|e| panic!("{who}: {e}"));
-            assert_eq!((z.n, z.latents, z.data.len()), (300, latents, 300 * latents), "{who}: shape");
+            let (mut enc, z) = l
+                .fit(&set, latents, &mut stream_named(1, "learner"))
+                .unwrap_or_else(|e| panic!("{who}: {e}"));
+            assert_eq!(
+                (z.n, z.latents, z.data.len()),
+                (300, latents, 300 * latents),
+                "{who}: shape"
+            );
             assert!(z.data.iter().all(|v| v.is_finite()), "{who}: finite");
             assert_eq!(enc.latents(), latents, "{who}");
             // Deterministic for a stream.
-            let (_, z2) = l.fit(&set, latents, &mut stream_named(1, "learner")).unwrap();
-            assert_eq!(z.data, z2.data, "{who}: two fits with the same stream differ");
+            let (_, z2) = l
+                .fit(&set, latents, &mut stream_named(1, "learner"))
+                .unwrap();
+            assert_eq!(
+                z.data, z2.data,
+                "{who}: two fits with the same stream differ"
+            );
             // Encoding the training images reproduces the fitted encodings.
             let again = enc.encode(&set).unwrap();
             let scale = z.data.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-12);
-            let worst = again.data.iter().zip(&z.data).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-            assert!(worst <= 1e-6 * scale, "{who}: batch re-encoding differs by {worst:e} (scale {scale})");
+            let worst = again
+                .data
+                .iter()
+                .zip(&z.data)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= 1e-6 * scale,
+                "{who}: batch re-encoding differs by {worst:e} (scale {scale})"
+            );
             let mut one = vec![0.0; latents];
             for i in [0, 17, 299] {
                 enc.encode_one(set.row(i), &mut one).unwrap();
                 for (a, b) in one.iter().zip(z.row(i)) {
-                    assert!((a - b).abs() <= 1e-6 * scale, "{who}: encode_one of image {i}: {a} vs {b}");
+                    assert!(
+                        (a - b).abs() <= 1e-6 * scale,
+                        "{who}: encode_one of image {i}: {a} vs {b}"
+                    );
                 }
             }
             // Bad input is an error, never a panic.
-            assert!(l.fit(&set, 0, &mut stream_named(1, "learner")).is_err(), "{who}: latents = 0");
-            assert!(enc.encode_one(&[0.0; 10], &mut one).is_err(), "{who}: wrong image size");
+            assert!(
+                l.fit(&set, 0, &mut stream_named(1, "learner")).is_err(),
+                "{who}: latents = 0"
+            );
+            assert!(
+                enc.encode_one(&[0.0; 10], &mut one).is_err(),
+                "{who}: wrong image size"
+            );
         }
     }
 }

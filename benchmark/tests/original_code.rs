@@ -4,16 +4,21 @@
 
 use serde_json::Value;
 use ugl_bench::env::dmp::trajectory;
-use ugl_bench::env::{make_env, DmpConfig, EnvConfig, EnvKind, PARAMS};
+use ugl_bench::env::{DmpConfig, EnvConfig, EnvKind, PARAMS, make_env};
 use ugl_bench::metrics::KlCoverage;
 
 fn load(name: &str) -> Value {
     let path = format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"));
-    serde_json::from_str(&std::fs::read_to_string(&path).expect("fixture present")).expect("fixture parses")
+    serde_json::from_str(&std::fs::read_to_string(&path).expect("fixture present"))
+        .expect("fixture parses")
 }
 
 fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
 }
 
 fn theta(v: &Value) -> [f64; PARAMS] {
@@ -41,7 +46,10 @@ fn rollouts_match_the_original_to_1e12() {
             }
         }
         assert!(worst < 1e-12, "{kind}: largest difference {worst:e}");
-        assert!(caught >= 40, "{kind}: the fixture must exercise catches, got {caught}");
+        assert!(
+            caught >= 40,
+            "{kind}: the fixture must exercise catches, got {caught}"
+        );
     }
 }
 
@@ -84,14 +92,21 @@ fn klc_matches_numpy_scipy() {
                 }
                 v => {
                     let theirs = v.as_f64().unwrap();
-                    assert!((ours - theirs).abs() < 1e-12, "{kind} {label}: {ours} vs {theirs}");
+                    assert!(
+                        (ours - theirs).abs() < 1e-12,
+                        "{kind} {label}: {ours} vs {theirs}"
+                    );
                 }
             }
             let mut h = klc.histogram();
             for p in &pts {
                 h.add(p).unwrap();
             }
-            assert_eq!(h.n_visited() as u64, c["nonempty_bins"].as_u64().unwrap(), "{kind} {label}");
+            assert_eq!(
+                h.n_visited() as u64,
+                c["nonempty_bins"].as_u64().unwrap(),
+                "{kind} {label}"
+            );
         }
     }
 }

@@ -15,7 +15,10 @@ use crate::repr::isomap::Disconnected;
 pub enum ConfigError {
     /// The file could not be read.
     #[error("cannot read config {path}: {source}")]
-    Read { path: PathBuf, source: std::io::Error },
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     /// TOML syntax or schema error (unknown key, wrong type...).
     #[error("invalid config {path}: {message}")]
     Parse { path: PathBuf, message: String },
@@ -96,9 +99,13 @@ impl<'de> Deserialize<'de> for LatentSize {
         }
         match Raw::deserialize(d)? {
             Raw::N(n) if n >= 1 => Ok(LatentSize::N(n as usize)),
-            Raw::N(n) => Err(serde::de::Error::custom(format!("matrix.latents: {n} must be at least 1"))),
+            Raw::N(n) => Err(serde::de::Error::custom(format!(
+                "matrix.latents: {n} must be at least 1"
+            ))),
             Raw::S(s) if s == "true" => Ok(LatentSize::TrueDim),
-            Raw::S(s) => Err(serde::de::Error::custom(format!("matrix.latents: '{s}' is neither a number nor \"true\""))),
+            Raw::S(s) => Err(serde::de::Error::custom(format!(
+                "matrix.latents: '{s}' is neither a number nor \"true\""
+            ))),
         }
     }
 }
@@ -141,7 +148,10 @@ pub struct IsomapConfig {
 
 impl Default for IsomapConfig {
     fn default() -> Self {
-        IsomapConfig { n_neighbors: 5, disconnected: Disconnected::ConnectClosestPairs }
+        IsomapConfig {
+            n_neighbors: 5,
+            disconnected: Disconnected::ConnectClosestPairs,
+        }
     }
 }
 
@@ -178,21 +188,30 @@ impl CampaignConfig {
             path: path.to_path_buf(),
             message: one_line(&e.to_string()),
         })?;
-        cfg.validate().map_err(|message| ConfigError::Invalid { path: path.to_path_buf(), message })?;
+        cfg.validate().map_err(|message| ConfigError::Invalid {
+            path: path.to_path_buf(),
+            message,
+        })?;
         Ok(cfg)
     }
 
     /// Read and validate a file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Read { path: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_toml(&text, path)
     }
 
     /// Check every value; the message names the key.
     pub fn validate(&self) -> Result<(), String> {
         if self.campaign.name.is_empty()
-            || !self.campaign.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            || !self
+                .campaign
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         {
             return Err(format!(
                 "campaign.name must be non-empty and use only letters, digits, '-' and '_', got '{}'",
@@ -208,7 +227,10 @@ impl CampaignConfig {
         if self.matrix.algos.is_empty() {
             return Err("matrix.algos must name at least one algorithm".into());
         }
-        for (k, list) in [("matrix.envs", dup(&self.matrix.envs)), ("matrix.algos", dup(&self.matrix.algos))] {
+        for (k, list) in [
+            ("matrix.envs", dup(&self.matrix.envs)),
+            ("matrix.algos", dup(&self.matrix.algos)),
+        ] {
             if let Some(d) = list {
                 return Err(format!("{k} lists '{d}' twice"));
             }
@@ -216,28 +238,50 @@ impl CampaignConfig {
         if self.matrix.samplers.is_empty() {
             return Err("matrix.samplers must name at least one goal sampler".into());
         }
-        if let Some(s) = self.matrix.samplers.iter().find(|s| !matches!(s, SamplerKind::Kde | SamplerKind::Gaussian)) {
-            return Err(format!("matrix.samplers: '{s}' is not a sampler of learned goal spaces (kde, gaussian)"));
+        if let Some(s) = self
+            .matrix
+            .samplers
+            .iter()
+            .find(|s| !matches!(s, SamplerKind::Kde | SamplerKind::Gaussian))
+        {
+            return Err(format!(
+                "matrix.samplers: '{s}' is not a sampler of learned goal spaces (kde, gaussian)"
+            ));
         }
         if self.matrix.latents.is_empty() {
             return Err("matrix.latents must list at least one latent size".into());
         }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {
-            return Err(format!("ugl.images must be at least 2, got {}", self.ugl.images));
+            return Err(format!(
+                "ugl.images must be at least 2, got {}",
+                self.ugl.images
+            ));
         }
-        if let Some(LatentSize::N(n)) = self.matrix.latents.iter().find(|l| matches!(l, LatentSize::N(n) if *n >= self.ugl.images)) {
-            return Err(format!("matrix.latents: {n} must be below ugl.images ({})", self.ugl.images));
+        if let Some(LatentSize::N(n)) = self
+            .matrix
+            .latents
+            .iter()
+            .find(|l| matches!(l, LatentSize::N(n) if *n >= self.ugl.images))
+        {
+            return Err(format!(
+                "matrix.latents: {n} must be below ugl.images ({})",
+                self.ugl.images
+            ));
         }
         if self.learners.isomap.n_neighbors == 0 {
             return Err("learners.isomap.n_neighbors must be at least 1".into());
         }
-        if self.matrix.algos.contains(&Algo::Rge(Learner::External)) && self.learners.external.is_none() {
+        if self.matrix.algos.contains(&Algo::Rge(Learner::External))
+            && self.learners.external.is_none()
+        {
             return Err("matrix.algos has rge-external but there is no [learners.external] section (name, command)".into());
         }
         if let Some(e) = &self.learners.external {
             if e.command.trim().is_empty() || e.name.trim().is_empty() {
-                return Err("learners.external.name and learners.external.command must not be empty".into());
+                return Err(
+                    "learners.external.name and learners.external.command must not be empty".into(),
+                );
             }
         }
         self.explore.validate()?;
@@ -246,7 +290,10 @@ impl CampaignConfig {
 }
 
 fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
-    v.iter().enumerate().find(|(i, a)| v[..*i].contains(a)).map(|(_, a)| a.to_string())
+    v.iter()
+        .enumerate()
+        .find(|(i, a)| v[..*i].contains(a))
+        .map(|(_, a)| a.to_string())
 }
 
 fn validate_env(e: &EnvConfig) -> Result<(), String> {
@@ -254,7 +301,10 @@ fn validate_env(e: &EnvConfig) -> Result<(), String> {
         return Err("env.arm.lengths must be finite and >= 0".into());
     }
     if !(e.object_size.is_finite() && e.object_size > 0.0) {
-        return Err(format!("env.object_size must be > 0, got {}", e.object_size));
+        return Err(format!(
+            "env.object_size must be > 0, got {}",
+            e.object_size
+        ));
     }
     if e.dmp.timesteps == 0 {
         return Err("env.dmp.timesteps must be at least 1".into());
@@ -262,7 +312,11 @@ fn validate_env(e: &EnvConfig) -> Result<(), String> {
     if !(e.dmp.run_time.is_finite() && e.dmp.run_time > 0.0) {
         return Err("env.dmp.run_time must be > 0".into());
     }
-    for (k, v) in [("env.dmp.ay", e.dmp.ay), ("env.dmp.ax", e.dmp.ax), ("env.dmp.max_params", e.dmp.max_params)] {
+    for (k, v) in [
+        ("env.dmp.ay", e.dmp.ay),
+        ("env.dmp.ax", e.dmp.ax),
+        ("env.dmp.max_params", e.dmp.max_params),
+    ] {
         if !v.is_finite() {
             return Err(format!("{k} must be finite"));
         }
@@ -279,15 +333,23 @@ fn validate_env(e: &EnvConfig) -> Result<(), String> {
 /// `invalid value: integer `-5`, expected usize (line 9, column 10: `epochs = -5`)`.
 pub(crate) fn one_line(s: &str) -> String {
     let lines: Vec<&str> = s.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
-    let Some(first) = lines.first() else { return String::new() };
-    let Some(pos) = first.strip_prefix("TOML parse error at ") else { return first.to_string() };
+    let Some(first) = lines.first() else {
+        return String::new();
+    };
+    let Some(pos) = first.strip_prefix("TOML parse error at ") else {
+        return first.to_string();
+    };
     // The snippet line looks like "9 | epochs = -5"; the reason is the last line that is not
     // part of the snippet.
     let source = lines.iter().find_map(|l| {
         let (num, text) = l.split_once('|')?;
-        (!num.trim().is_empty() && num.trim().chars().all(|c| c.is_ascii_digit())).then(|| text.trim())
+        (!num.trim().is_empty() && num.trim().chars().all(|c| c.is_ascii_digit()))
+            .then(|| text.trim())
     });
-    let reason = lines.iter().rev().find(|l| !l.starts_with('|') && !l.contains(" | ") && !l.starts_with("TOML parse error"));
+    let reason = lines
+        .iter()
+        .rev()
+        .find(|l| !l.starts_with('|') && !l.contains(" | ") && !l.starts_with("TOML parse error"));
     match (reason, source) {
         (Some(r), Some(src)) => format!("{r} ({pos}: `{src}`)"),
         (Some(r), None) => format!("{r} ({pos})"),
@@ -312,7 +374,14 @@ pub fn resolve_profile(name: &str) -> Result<PathBuf, ConfigError> {
         return Ok(p.to_path_buf());
     }
     let path = campaigns_dir().join(format!("{name}.toml"));
-    if path.is_file() { Ok(path) } else { Err(ConfigError::UnknownProfile { name: name.into(), tried: path }) }
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(ConfigError::UnknownProfile {
+            name: name.into(),
+            tried: path,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -343,15 +412,23 @@ epochs = 50
     fn errors_name_the_key() {
         let cases = [
             (GOOD.replace("reps = 2", "reps = 0"), "campaign.reps"),
-            (GOOD.replace("epochs = 50", "epochs = 50\nbogus = 1"), "bogus"),
+            (
+                GOOD.replace("epochs = 50", "epochs = 50\nbogus = 1"),
+                "bogus",
+            ),
             (GOOD.replace("\"rpe\"", "\"rge-foo\""), "rge-foo"),
             (GOOD.replace("epochs = 50", "epochs = -5"), "epochs"),
             (GOOD.replace("epochs = 50", "epochs = \"many\""), "epochs"),
-            (GOOD.replace("epochs = 50", "random_ratio = 1.5"), "explore.random_ratio"),
+            (
+                GOOD.replace("epochs = 50", "random_ratio = 1.5"),
+                "explore.random_ratio",
+            ),
             (GOOD.replace("\"rpe\", ", "\"rge-efr\", "), "matrix.algos"),
         ];
         for (text, key) in cases {
-            let e = CampaignConfig::from_toml(&text, Path::new("t.toml")).unwrap_err().to_string();
+            let e = CampaignConfig::from_toml(&text, Path::new("t.toml"))
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(key), "{e} should name {key}");
             assert!(!e.contains('\n'), "one line: {e}");
         }

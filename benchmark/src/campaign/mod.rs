@@ -7,6 +7,6 @@ pub mod runner;
 pub mod store;
 
 pub use config::{CampaignConfig, ConfigError};
-pub use plan::{plan, RunSpec};
-pub use runner::{execute, explore, run_campaign, CampaignOptions, Progress, RunContext, RunError};
+pub use plan::{RunSpec, plan};
+pub use runner::{CampaignOptions, Progress, RunContext, RunError, execute, explore, run_campaign};
 pub use store::{Manifest, Summary};

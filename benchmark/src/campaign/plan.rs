@@ -22,8 +22,18 @@ pub struct RunSpec {
 impl RunSpec {
     /// A baseline run (RPE or RGE-EFR).
     pub fn baseline(env: EnvKind, algo: Algo, seed: u64) -> Self {
-        let sampler = if algo == Algo::Rpe { SamplerKind::None } else { SamplerKind::Uniform };
-        RunSpec { env, algo, sampler, latents: 0, seed }
+        let sampler = if algo == Algo::Rpe {
+            SamplerKind::None
+        } else {
+            SamplerKind::Uniform
+        };
+        RunSpec {
+            env,
+            algo,
+            sampler,
+            latents: 0,
+            seed,
+        }
     }
 
     /// Canonical identity (DESIGN.md "Seeding"): `env=armball/algo=rge-efr/seed=3`, or for a
@@ -43,7 +53,10 @@ impl RunSpec {
     pub fn run_id(&self) -> String {
         match self.algo.learner() {
             None => format!("{}.{}.s{}", self.env, self.algo, self.seed),
-            Some(_) => format!("{}.{}.{}.l{}.s{}", self.env, self.algo, self.sampler, self.latents, self.seed),
+            Some(_) => format!(
+                "{}.{}.{}.l{}.s{}",
+                self.env, self.algo, self.sampler, self.latents, self.seed
+            ),
         }
     }
 
@@ -51,7 +64,13 @@ impl RunSpec {
     /// the same env, learner, latent size, data-set size and repetition); None for baselines.
     pub fn representation_identity(&self, images: usize) -> Option<String> {
         self.algo.learner().map(|l| {
-            format!("repr/env={}/learner={}/latents={}/images={images}/seed={}", self.env, l.name(), self.latents, self.seed)
+            format!(
+                "repr/env={}/learner={}/latents={}/images={images}/seed={}",
+                self.env,
+                l.name(),
+                self.latents,
+                self.seed
+            )
         })
     }
 }
@@ -74,7 +93,13 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
                         LatentSize::TrueDim => env.state_dim(),
                     };
                     for seed in 0..cfg.campaign.reps as u64 {
-                        runs.push(RunSpec { env, algo, sampler, latents, seed });
+                        runs.push(RunSpec {
+                            env,
+                            algo,
+                            sampler,
+                            latents,
+                            seed,
+                        });
                     }
                 }
             }
@@ -88,11 +113,16 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
 /// shard, so no representation is fitted twice; groups are dealt round-robin in plan order. The
 /// shards are disjoint and their union is the whole plan.
 pub fn shard(runs: &[RunSpec], images: usize, index: usize, count: usize) -> Vec<RunSpec> {
-    assert!(index < count, "shard index {index} must be below the shard count {count}");
+    assert!(
+        index < count,
+        "shard index {index} must be below the shard count {count}"
+    );
     let mut keys: Vec<String> = Vec::new();
     let mut out = Vec::new();
     for spec in runs {
-        let key = spec.representation_identity(images).unwrap_or_else(|| spec.identity());
+        let key = spec
+            .representation_identity(images)
+            .unwrap_or_else(|| spec.identity());
         let g = match keys.iter().position(|k| *k == key) {
             Some(g) => g,
             None => {
@@ -109,9 +139,13 @@ pub fn shard(runs: &[RunSpec], images: usize, index: usize, count: usize) -> Vec
 
 /// Parse `i/n` (0 <= i < n).
 pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let err = || format!("--shard must be i/n with 0 <= i < n (0-based, e.g. 0/4 .. 3/4), got '{s}'");
+    let err =
+        || format!("--shard must be i/n with 0 <= i < n (0-based, e.g. 0/4 .. 3/4), got '{s}'");
     let (i, n) = s.split_once('/').ok_or_else(err)?;
-    let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| err())?, n.trim().parse().map_err(|_| err())?);
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| err())?,
+        n.trim().parse().map_err(|_| err())?,
+    );
     if n == 0 || i >= n {
         return Err(err());
     }
@@ -129,11 +163,26 @@ mod tests {
         assert_eq!(r.identity(), "env=armarrow/algo=rge-efr/seed=3");
         assert_eq!(r.run_id(), "armarrow.rge-efr.s3");
         assert_eq!(r.representation_identity(10), None);
-        let r = RunSpec { env: EnvKind::ArmBall, algo: Algo::Rge(Learner::Pca), sampler: SamplerKind::Kde, latents: 10, seed: 2 };
-        assert_eq!(r.identity(), "env=armball/algo=rge-pca/sampler=kde/latents=10/seed=2");
+        let r = RunSpec {
+            env: EnvKind::ArmBall,
+            algo: Algo::Rge(Learner::Pca),
+            sampler: SamplerKind::Kde,
+            latents: 10,
+            seed: 2,
+        };
+        assert_eq!(
+            r.identity(),
+            "env=armball/algo=rge-pca/sampler=kde/latents=10/seed=2"
+        );
         assert_eq!(r.run_id(), "armball.rge-pca.kde.l10.s2");
-        let g = RunSpec { sampler: SamplerKind::Gaussian, ..r.clone() };
-        assert_eq!(r.representation_identity(100), g.representation_identity(100));
+        let g = RunSpec {
+            sampler: SamplerKind::Gaussian,
+            ..r.clone()
+        };
+        assert_eq!(
+            r.representation_identity(100),
+            g.representation_identity(100)
+        );
     }
 
     #[test]
@@ -144,7 +193,11 @@ mod tests {
         let all = plan(&cfg);
         for n in [1, 2, 3, 7, 100] {
             let mut union: Vec<RunSpec> = (0..n).flat_map(|i| shard(&all, 10, i, n)).collect();
-            assert_eq!(union.len(), all.len(), "n = {n}: shards are disjoint and cover the plan");
+            assert_eq!(
+                union.len(),
+                all.len(),
+                "n = {n}: shards are disjoint and cover the plan"
+            );
             union.sort();
             let mut sorted = all.clone();
             sorted.sort();
@@ -152,7 +205,10 @@ mod tests {
             for i in 0..n {
                 // The samplers of a cell are in the same shard.
                 for r in shard(&all, 10, i, n) {
-                    let mates = all.iter().filter(|o| o.algo.learner().is_some() && o.representation_identity(10) == r.representation_identity(10));
+                    let mates = all.iter().filter(|o| {
+                        o.algo.learner().is_some()
+                            && o.representation_identity(10) == r.representation_identity(10)
+                    });
                     for m in mates {
                         assert!(shard(&all, 10, i, n).contains(m));
                     }
@@ -160,6 +216,11 @@ mod tests {
             }
         }
         assert_eq!(parse_shard("1/4"), Ok((1, 4)));
-        assert!(parse_shard("4/4").is_err() && parse_shard("1").is_err() && parse_shard("a/b").is_err() && parse_shard("0/0").is_err());
+        assert!(
+            parse_shard("4/4").is_err()
+                && parse_shard("1").is_err()
+                && parse_shard("a/b").is_err()
+                && parse_shard("0/0").is_err()
+        );
     }
 }

@@ -1,8 +1,8 @@
 //! Executes runs: environment + explorer, then the results store.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -10,11 +10,12 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::config::{CampaignConfig, LearnersConfig, UglConfig};
-use super::plan::{plan, RunSpec};
+use super::plan::{RunSpec, plan};
 use super::store::{self, Manifest, StoreError, Summary};
-use crate::env::{make_env, EnvConfig, Environment};
+use crate::env::{EnvConfig, Environment, make_env};
 use crate::explore::{
-    run_rge, run_rpe, Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
+    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
+    run_rge, run_rpe,
 };
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::dataset::{dataset_identity, generate};
@@ -22,7 +23,7 @@ use crate::repr::external::ExternalLearner;
 use crate::repr::isomap::Isomap;
 use crate::repr::pca::{CentredPca, TruncatedSvd};
 use crate::repr::{Encoder, Latents, ReprError, RepresentationLearner};
-use crate::seed::{run_seed, stream, Component};
+use crate::seed::{Component, run_seed, stream};
 
 /// Bumped whenever a change alters results for the same configuration.
 pub const RESULTS_VERSION: u32 = 1;
@@ -36,7 +37,9 @@ pub enum RunError {
     Pool(String),
     #[error("run {run}: {source}")]
     Repr { run: String, source: ReprError },
-    #[error("interrupted: {done} of {total} runs finished and stored; rerun the same command to resume")]
+    #[error(
+        "interrupted: {done} of {total} runs finished and stored; rerun the same command to resume"
+    )]
     Interrupted { done: usize, total: usize },
 }
 
@@ -98,14 +101,22 @@ pub struct Representation {
 }
 
 /// Build the learner of an algorithm from the configuration.
-pub fn make_learner(learner: Learner, cfg: &LearnersConfig) -> Result<Box<dyn RepresentationLearner>, ReprError> {
+pub fn make_learner(
+    learner: Learner,
+    cfg: &LearnersConfig,
+) -> Result<Box<dyn RepresentationLearner>, ReprError> {
     Ok(match learner {
         Learner::Pca => Box::new(TruncatedSvd::default()),
         Learner::PcaCentred => Box::new(CentredPca),
-        Learner::Isomap => Box::new(Isomap { n_neighbors: cfg.isomap.n_neighbors, disconnected: cfg.isomap.disconnected }),
+        Learner::Isomap => Box::new(Isomap {
+            n_neighbors: cfg.isomap.n_neighbors,
+            disconnected: cfg.isomap.disconnected,
+        }),
         Learner::External => {
             let e = cfg.external.as_ref().ok_or_else(|| {
-                ReprError::InvalidInput("rge-external needs a [learners.external] section (name, command)".into())
+                ReprError::InvalidInput(
+                    "rge-external needs a [learners.external] section (name, command)".into(),
+                )
             })?;
             Box::new(ExternalLearner::new(e.name.clone(), e.command.clone()))
         }
@@ -114,20 +125,41 @@ pub fn make_learner(learner: Learner, cfg: &LearnersConfig) -> Result<Box<dyn Re
 
 /// Generate the UGL data set of the spec's repetition and fit its learner.
 pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representation, ReprError> {
-    let learner = spec.algo.learner().ok_or_else(|| ReprError::InvalidInput(format!("{} learns no representation", spec.algo)))?;
+    let learner = spec.algo.learner().ok_or_else(|| {
+        ReprError::InvalidInput(format!("{} learns no representation", spec.algo))
+    })?;
     let t0 = Instant::now();
     let env = make_env(spec.env, ctx.env);
-    let ds_seed = run_seed(ctx.campaign_seed, &dataset_identity(spec.env, ctx.ugl.images, spec.seed));
-    let data = generate(env.as_ref(), ctx.ugl.images, &mut stream(ds_seed, Component::Dataset))?;
-    let repr_id = spec.representation_identity(ctx.ugl.images).expect("learned algorithm");
+    let ds_seed = run_seed(
+        ctx.campaign_seed,
+        &dataset_identity(spec.env, ctx.ugl.images, spec.seed),
+    );
+    let data = generate(
+        env.as_ref(),
+        ctx.ugl.images,
+        &mut stream(ds_seed, Component::Dataset),
+    )?;
+    let repr_id = spec
+        .representation_identity(ctx.ugl.images)
+        .expect("learned algorithm");
     let mut rng = stream(run_seed(ctx.campaign_seed, &repr_id), Component::Learner);
     let l = make_learner(learner, ctx.learners)?;
     let (encoder, train) = l.fit(&data.images, spec.latents, &mut rng)?;
     let learner_name = match learner {
-        Learner::External => ctx.learners.external.as_ref().map(|e| e.name.clone()).unwrap_or_default(),
+        Learner::External => ctx
+            .learners
+            .external
+            .as_ref()
+            .map(|e| e.name.clone())
+            .unwrap_or_default(),
         _ => learner.name().to_string(),
     };
-    Ok(Representation { encoder, train, fit_s: t0.elapsed().as_secs_f64(), learner_name })
+    Ok(Representation {
+        encoder,
+        train,
+        fit_s: t0.elapsed().as_secs_f64(),
+        learner_name,
+    })
 }
 
 /// What an exploration produced, with its timings.
@@ -138,48 +170,88 @@ pub struct Explored {
 }
 
 /// Run the exploration of one spec (no I/O). Learned goal spaces need their representation.
-pub fn explore(spec: &RunSpec, ctx: &RunContext, repr: Option<&mut Representation>) -> Result<Explored, RunError> {
+pub fn explore(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    repr: Option<&mut Representation>,
+) -> Result<Explored, RunError> {
     let seed = run_seed(ctx.campaign_seed, &spec.identity());
     let env = make_env(spec.env, ctx.env);
     let env: &dyn Environment = env.as_ref();
     let d = env.state_dim();
     let log = match spec.algo {
         Algo::Rpe => run_rpe(env, ctx.explore, seed),
-        Algo::RgeEfr => run_rge(env, &mut EngineeredSpace::new(d), &mut UniformGoals::unit(d), ctx.explore, seed),
+        Algo::RgeEfr => run_rge(
+            env,
+            &mut EngineeredSpace::new(d),
+            &mut UniformGoals::unit(d),
+            ctx.explore,
+            seed,
+        ),
         Algo::Rge(_) => {
-            let repr_err = |source| RunError::Repr { run: spec.run_id(), source };
-            let repr = repr.ok_or_else(|| repr_err(ReprError::InvalidInput("no representation was fitted".into())))?;
+            let repr_err = |source| RunError::Repr {
+                run: spec.run_id(),
+                source,
+            };
+            let repr = repr.ok_or_else(|| {
+                repr_err(ReprError::InvalidInput(
+                    "no representation was fitted".into(),
+                ))
+            })?;
             let mut sampler: Box<dyn GoalSampler> = match spec.sampler {
                 SamplerKind::Kde => Box::new(KdeGoals::fit(&repr.train).map_err(repr_err)?),
                 SamplerKind::Gaussian => Box::new(GaussianGoals::new(spec.latents)),
-                other => return Err(repr_err(ReprError::InvalidInput(format!("sampler {other} is not for learned goal spaces")))),
+                other => {
+                    return Err(repr_err(ReprError::InvalidInput(format!(
+                        "sampler {other} is not for learned goal spaces"
+                    ))));
+                }
             };
             let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
             let log = run_rge(env, &mut space, sampler.as_mut(), ctx.explore, seed);
             if let Some(e) = space.error.take() {
                 return Err(repr_err(e));
             }
-            return Ok(Explored { log, encode_s: Some(space.encode_s) });
+            return Ok(Explored {
+                log,
+                encode_s: Some(space.encode_s),
+            });
         }
     };
-    Ok(Explored { log, encode_s: None })
+    Ok(Explored {
+        log,
+        encode_s: None,
+    })
 }
 
 /// The summary of a finished log.
 pub fn summarize(spec: &RunSpec, log: &ExplorationLog) -> Summary {
     let last = log.checkpoints.last().expect("at least one checkpoint");
-    Summary { run: spec.run_id(), final_klc: last.klc, n_moved: last.n_moved, coverage: last.coverage }
+    Summary {
+        run: spec.run_id(),
+        final_klc: last.klc,
+        n_moved: last.n_moved,
+        coverage: last.coverage,
+    }
 }
 
 /// Execute one run and store it in `out`; returns its summary. A learned goal space is fitted
 /// first unless `repr` is given (campaigns share one fit between samplers).
-pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path, repr: Option<&mut Representation>) -> Result<Summary, RunError> {
+pub fn execute(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    out: &Path,
+    repr: Option<&mut Representation>,
+) -> Result<Summary, RunError> {
     let mut own: Option<Representation> = None;
     let repr = match (spec.algo.learner(), repr) {
         (None, _) => None,
         (Some(_), Some(r)) => Some(r),
         (Some(_), None) => {
-            let fitted = fit_representation(spec, ctx).map_err(|source| RunError::Repr { run: spec.run_id(), source })?;
+            let fitted = fit_representation(spec, ctx).map_err(|source| RunError::Repr {
+                run: spec.run_id(),
+                source,
+            })?;
             Some(own.insert(fitted))
         }
     };
@@ -193,10 +265,17 @@ pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path, repr: Option<&mut R
     let paper = ExploreConfig::default();
     let mut notes = Vec::new();
     if ctx.explore.epochs < paper.epochs {
-        notes.push(format!("{} exploration epochs instead of the paper's {}", ctx.explore.epochs, paper.epochs));
+        notes.push(format!(
+            "{} exploration epochs instead of the paper's {}",
+            ctx.explore.epochs, paper.epochs
+        ));
     }
     if spec.algo.learner().is_some() && ctx.ugl.images < UglConfig::default().images {
-        notes.push(format!("{} UGL images instead of the paper's {}", ctx.ugl.images, UglConfig::default().images));
+        notes.push(format!(
+            "{} UGL images instead of the paper's {}",
+            ctx.ugl.images,
+            UglConfig::default().images
+        ));
     }
     let manifest = Manifest {
         run_id: spec.run_id(),
@@ -215,7 +294,10 @@ pub fn execute(spec: &RunSpec, ctx: &RunContext, out: &Path, repr: Option<&mut R
         config_hash: ctx.config_hash(spec),
         explore: serde_json::to_value(ctx.explore).expect("serialisable"),
         env_config: serde_json::to_value(ctx.env).expect("serialisable"),
-        ugl: spec.algo.learner().map(|_| serde_json::to_value(ctx.ugl).expect("serialisable")),
+        ugl: spec
+            .algo
+            .learner()
+            .map(|_| serde_json::to_value(ctx.ugl).expect("serialisable")),
         reduced_budget: !notes.is_empty(),
         budget_note: notes.join("; "),
         git_revision: git_revision().into(),
@@ -278,9 +360,14 @@ pub fn run_campaign(
         None => plan(cfg),
         Some((i, n)) => super::plan::shard(&plan(cfg), cfg.ugl.images, i, n),
     };
-    let todo: Vec<&RunSpec> =
-        all.iter().filter(|s| !store::is_complete(out, &s.run_id(), &ctx.config_hash(s))).collect();
-    on_progress(Progress::Planned { total: all.len(), skipped: all.len() - todo.len() });
+    let todo: Vec<&RunSpec> = all
+        .iter()
+        .filter(|s| !store::is_complete(out, &s.run_id(), &ctx.config_hash(s)))
+        .collect();
+    on_progress(Progress::Planned {
+        total: all.len(),
+        skipped: all.len() - todo.len(),
+    });
     // Runs sharing a representation form one group: fitted once, then run one after the other.
     let mut groups: Vec<(Option<String>, Vec<&RunSpec>)> = Vec::new();
     let n_todo = todo.len();
@@ -312,7 +399,10 @@ pub fn run_campaign(
                         match fit_representation(spec, &ctx) {
                             Ok(r) => repr = Some(r),
                             Err(source) => {
-                                out_v.push(Some(Err(RunError::Repr { run: spec.run_id(), source })));
+                                out_v.push(Some(Err(RunError::Repr {
+                                    run: spec.run_id(),
+                                    source,
+                                })));
                                 continue;
                             }
                         }
@@ -336,7 +426,10 @@ pub fn run_campaign(
         }
     }
     if skipped_now > 0 {
-        return Err(RunError::Interrupted { done: all.len() - n_todo + done.len(), total: all.len() });
+        return Err(RunError::Interrupted {
+            done: all.len() - n_todo + done.len(),
+            total: all.len(),
+        });
     }
     Ok(done)
 }
@@ -356,7 +449,8 @@ pub fn git_revision() -> &'static str {
         };
         match run(&["rev-parse", "HEAD"]) {
             Some(rev) => {
-                let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+                let dirty = run(&["status", "--porcelain", "--untracked-files=no"])
+                    .is_some_and(|s| !s.is_empty());
                 if dirty { format!("{rev}-dirty") } else { rev }
             }
             None => "unknown".into(),

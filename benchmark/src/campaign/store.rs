@@ -17,7 +17,10 @@ use crate::explore::ExplorationLog;
 #[derive(Debug, Error)]
 pub enum StoreError {
     #[error("cannot write {path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("cannot encode {path}: {message}")]
     Encode { path: PathBuf, message: String },
     #[error("cannot read {path}: {message}")]
@@ -93,7 +96,11 @@ fn none_string() -> String {
 mod inf_as_string {
     use serde::{Deserialize, Deserializer, Serializer};
     pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        if v.is_infinite() && *v > 0.0 { s.serialize_str("inf") } else { s.serialize_f64(*v) }
+        if v.is_infinite() && *v > 0.0 {
+            s.serialize_str("inf")
+        } else {
+            s.serialize_f64(*v)
+        }
     }
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         #[derive(Deserialize)]
@@ -105,7 +112,9 @@ mod inf_as_string {
         match V::deserialize(d)? {
             V::N(x) => Ok(x),
             V::S(s) if s == "inf" => Ok(f64::INFINITY),
-            V::S(s) => Err(serde::de::Error::custom(format!("expected a number or \"inf\", got {s:?}"))),
+            V::S(s) => Err(serde::de::Error::custom(format!(
+                "expected a number or \"inf\", got {s:?}"
+            ))),
         }
     }
 }
@@ -142,8 +151,11 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
 /// The outcomes table of a run.
 pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
     let n = log.outcomes.len();
-    let angle: Vec<Option<f64>> =
-        log.outcomes.iter().map(|s| if log.dim == 3 { Some(s[2]) } else { None }).collect();
+    let angle: Vec<Option<f64>> = log
+        .outcomes
+        .iter()
+        .map(|s| if log.dim == 3 { Some(s[2]) } else { None })
+        .collect();
     df!(
         "run_id" => vec![spec.run_id(); n],
         "index" => (0..n as i64).collect::<Vec<_>>(),
@@ -158,7 +170,10 @@ pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Data
 /// Write `bytes` to `path` atomically (temporary file in the same directory, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
     let tmp = tmp_path(path);
-    let io = |source| StoreError::Io { path: path.to_path_buf(), source };
+    let io = |source| StoreError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let mut f = File::create(&tmp).map_err(io)?;
     f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -172,7 +187,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
 }
 
 fn tmp_path(path: &Path) -> PathBuf {
-    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
     name.push(format!(".{}.tmp", std::process::id()));
     path.with_file_name(name)
 }
@@ -182,35 +200,60 @@ pub fn parquet_bytes(df: &mut DataFrame, path: &Path) -> Result<Vec<u8>, StoreEr
     let mut buf = Vec::new();
     ParquetWriter::new(&mut buf)
         .finish(df)
-        .map_err(|e| StoreError::Encode { path: path.to_path_buf(), message: e.to_string() })?;
+        .map_err(|e| StoreError::Encode {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     Ok(buf)
 }
 
 /// Write a run's three files; the manifest last.
-pub fn write_run(dir: &Path, spec: &RunSpec, log: &ExplorationLog, manifest: &Manifest) -> Result<(), StoreError> {
-    std::fs::create_dir_all(dir).map_err(|source| StoreError::Io { path: dir.to_path_buf(), source })?;
+pub fn write_run(
+    dir: &Path,
+    spec: &RunSpec,
+    log: &ExplorationLog,
+    manifest: &Manifest,
+) -> Result<(), StoreError> {
+    std::fs::create_dir_all(dir).map_err(|source| StoreError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let [curve_p, outcomes_p, manifest_p] = run_paths(dir, &spec.run_id());
-    let enc = |p: &Path, e: PolarsError| StoreError::Encode { path: p.to_path_buf(), message: e.to_string() };
+    let enc = |p: &Path, e: PolarsError| StoreError::Encode {
+        path: p.to_path_buf(),
+        message: e.to_string(),
+    };
     let mut curve = curve_frame(spec, log).map_err(|e| enc(&curve_p, e))?;
     let mut outcomes = outcomes_frame(spec, log).map_err(|e| enc(&outcomes_p, e))?;
     write_atomic(&curve_p, &parquet_bytes(&mut curve, &curve_p)?)?;
     write_atomic(&outcomes_p, &parquet_bytes(&mut outcomes, &outcomes_p)?)?;
-    let mut json = serde_json::to_vec_pretty(manifest)
-        .map_err(|e| StoreError::Encode { path: manifest_p.clone(), message: e.to_string() })?;
+    let mut json = serde_json::to_vec_pretty(manifest).map_err(|e| StoreError::Encode {
+        path: manifest_p.clone(),
+        message: e.to_string(),
+    })?;
     json.push(b'\n');
     write_atomic(&manifest_p, &json)
 }
 
 /// Read a run's manifest, if it exists and parses.
 pub fn read_manifest(path: &Path) -> Result<Manifest, StoreError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| StoreError::Read { path: path.to_path_buf(), message: e.to_string() })?;
-    serde_json::from_str(&text).map_err(|e| StoreError::Read { path: path.to_path_buf(), message: e.to_string() })
+    let text = std::fs::read_to_string(path).map_err(|e| StoreError::Read {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    serde_json::from_str(&text).map_err(|e| StoreError::Read {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 /// Whether a run is complete in `dir` with the given config hash: manifest present, matching,
 /// and both data files present.
 pub fn is_complete(dir: &Path, run_id: &str, config_hash: &str) -> bool {
     let [c, o, m] = run_paths(dir, run_id);
-    c.is_file() && o.is_file() && read_manifest(&m).map(|m| m.config_hash == config_hash).unwrap_or(false)
+    c.is_file()
+        && o.is_file()
+        && read_manifest(&m)
+            .map(|m| m.config_hash == config_hash)
+            .unwrap_or(false)
 }

@@ -18,7 +18,10 @@ pub struct ArmConfig {
 
 impl Default for ArmConfig {
     fn default() -> Self {
-        ArmConfig { lengths: [0.3, 0.2, 0.2, 0.1, 0.1, 0.05, 0.05], angle_shift: 0.5 }
+        ArmConfig {
+            lengths: [0.3, 0.2, 0.2, 0.1, 0.1, 0.05, 0.05],
+            angle_shift: 0.5,
+        }
     }
 }
 
@@ -51,7 +54,10 @@ impl ArmConfig {
             x += c * self.lengths[k];
             y += s * self.lengths[k];
         }
-        ArmPose { hand: [x, y], last_link: angle_std }
+        ArmPose {
+            hand: [x, y],
+            last_link: angle_std,
+        }
     }
 }
 
@@ -73,7 +79,11 @@ mod tests {
         let mut q = [0.0; JOINTS];
         q[0] = -0.5;
         let p = ArmConfig::default().forward(&q);
-        assert!((p.hand[0] - 1.0).abs() < 1e-12 && p.hand[1].abs() < 1e-12, "{:?}", p);
+        assert!(
+            (p.hand[0] - 1.0).abs() < 1e-12 && p.hand[1].abs() < 1e-12,
+            "{:?}",
+            p
+        );
     }
 
     #[test]
@@ -82,7 +92,11 @@ mod tests {
         let mut q = [0.0; JOINTS];
         q[1] = 1.0;
         let p = ArmConfig::default().forward(&q);
-        assert!(p.hand[0].abs() < 1e-12 && (p.hand[1] + 0.4).abs() < 1e-12, "{:?}", p);
+        assert!(
+            p.hand[0].abs() < 1e-12 && (p.hand[1] + 0.4).abs() < 1e-12,
+            "{:?}",
+            p
+        );
         // Commands beyond [-1,1] are clipped.
         q[1] = 3.7;
         assert_eq!(ArmConfig::default().forward(&q), p);

@@ -3,7 +3,7 @@
 //! [-1, 1). The engineered outcome is (x, y, angle). The angle is a linear coordinate everywhere
 //! (no wrap-around in distances or bins), as in the original code.
 
-use super::{Body, EnvConfig, EnvKind, Environment, Rollout, PARAMS};
+use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
 
 /// The ArmArrow environment.
 #[derive(Clone, Debug)]
@@ -22,7 +22,10 @@ pub fn wrap_angle(a: f64) -> f64 {
 impl ArmArrow {
     /// Build from the environment constants.
     pub fn new(cfg: &EnvConfig) -> Self {
-        ArmArrow { body: Body::new(cfg), initial: cfg.arrow_initial }
+        ArmArrow {
+            body: Body::new(cfg),
+            initial: cfg.arrow_initial,
+        }
     }
 }
 
@@ -42,7 +45,12 @@ impl Environment for ArmArrow {
         } else {
             self.initial
         };
-        Rollout { state: s.map(|v| v.clamp(-1.0, 1.0)), dim: 3, caught, hand: pose.hand }
+        Rollout {
+            state: s.map(|v| v.clamp(-1.0, 1.0)),
+            dim: 3,
+            caught,
+            hand: pose.hand,
+        }
     }
 
     fn render_into(&self, state: &[f64], out: &mut [f32]) {

@@ -1,7 +1,7 @@
 //! ArmBall (paper Section 4.1): the arm can catch a ball of radius 0.1 at (0.6, 0.6) and move it.
 //! The engineered outcome is the ball's final (x, y).
 
-use super::{Body, EnvConfig, EnvKind, Environment, Rollout, PARAMS};
+use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
 
 /// The ArmBall environment.
 #[derive(Clone, Debug)]
@@ -13,7 +13,10 @@ pub struct ArmBall {
 impl ArmBall {
     /// Build from the environment constants.
     pub fn new(cfg: &EnvConfig) -> Self {
-        ArmBall { body: Body::new(cfg), initial: cfg.ball_initial }
+        ArmBall {
+            body: Body::new(cfg),
+            initial: cfg.ball_initial,
+        }
     }
 }
 

@@ -134,7 +134,11 @@ impl DmpState {
         let w = std::array::from_fn(|j| {
             std::array::from_fn(|b| theta[BASIS * j + b].clamp(-1.0, 1.0) * table.max_params)
         });
-        DmpState { w, y: [0.0; JOINTS], dy: [0.0; JOINTS] }
+        DmpState {
+            w,
+            y: [0.0; JOINTS],
+            dy: [0.0; JOINTS],
+        }
     }
 
     /// Advance one step and return the joint command (before the environment's clipping).
@@ -173,7 +177,11 @@ mod tests {
         for (a, b) in w.iter().zip(expected) {
             assert!((a - b).abs() < 1e-6, "{w:?}");
         }
-        let head = DmpConfig { widths: DmpWidths::ExplautoHead, ..Default::default() }.widths();
+        let head = DmpConfig {
+            widths: DmpWidths::ExplautoHead,
+            ..Default::default()
+        }
+        .widths();
         for (a, b) in head.iter().zip([82.08854, 197.20753, 683.05549]) {
             assert!((a - b).abs() < 1e-4, "{head:?}");
         }

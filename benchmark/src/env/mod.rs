@@ -64,7 +64,9 @@ impl FromStr for EnvKind {
         match s {
             "armball" => Ok(EnvKind::ArmBall),
             "armarrow" => Ok(EnvKind::ArmArrow),
-            other => Err(format!("unknown environment '{other}' (expected armball or armarrow)")),
+            other => Err(format!(
+                "unknown environment '{other}' (expected armball or armarrow)"
+            )),
         }
     }
 }
@@ -156,7 +158,11 @@ pub(crate) struct Body {
 
 impl Body {
     pub fn new(cfg: &EnvConfig) -> Self {
-        Body { arm: cfg.arm.clone(), table: cfg.dmp.table(), size_sq: cfg.object_size * cfg.object_size }
+        Body {
+            arm: cfg.arm.clone(),
+            table: cfg.dmp.table(),
+            size_sq: cfg.object_size * cfg.object_size,
+        }
     }
 
     /// Run the movement; the object at `object_xy` is caught the first step the squared
@@ -258,7 +264,11 @@ mod tests {
             let theta: [f64; PARAMS] = std::array::from_fn(|_| scale * rng.random_range(-1.0..1.0));
             for obj in [cfg.ball_initial, [0.0, 0.95], [0.3, -0.2]] {
                 let fast = body.run(&theta, obj);
-                assert_eq!(fast, naive(&body, &theta, obj), "theta {theta:?} object {obj:?}");
+                assert_eq!(
+                    fast,
+                    naive(&body, &theta, obj),
+                    "theta {theta:?} object {obj:?}"
+                );
                 catches += fast.0 as usize;
             }
         }

@@ -1,7 +1,7 @@
 //! What an exploration run records: every outcome in order, and the KL-coverage curve.
 
 use crate::env::Rollout;
-use crate::metrics::{moved, CoverageHistogram, KlCoverage};
+use crate::metrics::{CoverageHistogram, KlCoverage, moved};
 
 /// One point of the exploration curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,7 +70,9 @@ impl<'k> Recorder<'k> {
     pub fn push(&mut self, epoch: usize, r: &Rollout, random: bool) {
         let s = r.outcome();
         // Outcomes are clipped rollouts: finite and of the right dimension by construction.
-        self.hist.add(s).expect("rollout outcome is finite and of the environment's dimension");
+        self.hist
+            .add(s)
+            .expect("rollout outcome is finite and of the environment's dimension");
         let m = moved(s, &self.initial);
         self.n_moved += m as usize;
         self.log.outcomes.push(r.state);
@@ -91,7 +93,10 @@ impl<'k> Recorder<'k> {
             self.log.checkpoints.push(Checkpoint {
                 epoch,
                 n_outcomes: self.log.outcomes.len(),
-                klc: self.hist.klc().expect("at least one outcome at an evaluation epoch"),
+                klc: self
+                    .hist
+                    .klc()
+                    .expect("at least one outcome at an evaluation epoch"),
                 n_moved: self.n_moved,
                 coverage: self.hist.coverage(),
             });

@@ -8,16 +8,16 @@
 //! `or` as in the original); otherwise it samples a goal, takes the parameters of the nearest
 //! stored outcome encoding, and perturbs them.
 
+use super::ExploreConfig;
 use super::history::{ExplorationLog, Recorder};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
-use super::ExploreConfig;
 use crate::env::render::PIXELS;
 use crate::env::{Environment, PARAMS};
-use crate::repr::{Encoder, ReprError};
 use crate::goals::GoalSampler;
 use crate::metrics::KlCoverage;
-use crate::seed::{stream, Component};
+use crate::repr::{Encoder, ReprError};
+use crate::seed::{Component, stream};
 use rand::RngExt;
 
 /// Maps an episode's final object state to its encoding in the goal space.
@@ -67,7 +67,13 @@ pub struct LearnedSpace<'a> {
 impl<'a> LearnedSpace<'a> {
     /// Encode outcomes of `env` with `encoder`.
     pub fn new(env: &'a dyn Environment, encoder: &'a mut dyn Encoder) -> Self {
-        LearnedSpace { env, encoder, image: vec![0.0; PIXELS], encode_s: 0.0, error: None }
+        LearnedSpace {
+            env,
+            encoder,
+            image: vec![0.0; PIXELS],
+            encode_s: 0.0,
+            error: None,
+        }
     }
 }
 
@@ -82,7 +88,9 @@ impl OutcomeSpace for LearnedSpace<'_> {
             if out.iter().all(|v| v.is_finite()) {
                 Ok(())
             } else {
-                Err(ReprError::Numerical(format!("encoder returned a non-finite latent for state {state:?}")))
+                Err(ReprError::Numerical(format!(
+                    "encoder returned a non-finite latent for state {state:?}"
+                )))
             }
         });
         if let Err(e) = r {
@@ -102,7 +110,11 @@ pub fn run_rge(
     cfg: &ExploreConfig,
     run_seed: u64,
 ) -> ExplorationLog {
-    assert_eq!(space.dim(), sampler.dim(), "goal sampler and outcome space dimensions differ");
+    assert_eq!(
+        space.dim(),
+        sampler.dim(),
+        "goal sampler and outcome space dimensions differ"
+    );
     let klc = KlCoverage::new(env.state_dim()).expect("environment dimension is 2 or 3");
     let mut rec = Recorder::new(&klc, env.initial_state(), cfg.eval_epochs(), cfg.epochs + 1);
     let mut params_rng = stream(run_seed, Component::Params);

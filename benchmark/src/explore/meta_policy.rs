@@ -23,7 +23,7 @@ pub fn perturb(theta: &[f64; PARAMS], sigma: f64, rng: &mut Stream) -> [f64; PAR
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::seed::{stream, Component};
+    use crate::seed::{Component, stream};
 
     #[test]
     fn random_params_in_range_and_noise_statistics() {

@@ -11,7 +11,7 @@ pub mod rpe;
 use serde::{Deserialize, Serialize};
 
 pub use history::{Checkpoint, ExplorationLog};
-pub use imgep::{run_rge, EngineeredSpace, LearnedSpace, OutcomeSpace};
+pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, run_rge};
 pub use rpe::run_rpe;
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
@@ -33,7 +33,13 @@ pub struct ExploreConfig {
 
 impl Default for ExploreConfig {
     fn default() -> Self {
-        ExploreConfig { epochs: 5000, bootstrap_epochs: 100, random_ratio: 0.2, noise_sigma: 0.1, eval_every: 100 }
+        ExploreConfig {
+            epochs: 5000,
+            bootstrap_epochs: 100,
+            random_ratio: 0.2,
+            noise_sigma: 0.1,
+            eval_every: 100,
+        }
     }
 }
 
@@ -47,17 +53,25 @@ impl ExploreConfig {
             return Err("explore.eval_every must be at least 1".into());
         }
         if !(0.0..=1.0).contains(&self.random_ratio) {
-            return Err(format!("explore.random_ratio must be in [0, 1], got {}", self.random_ratio));
+            return Err(format!(
+                "explore.random_ratio must be in [0, 1], got {}",
+                self.random_ratio
+            ));
         }
         if !(self.noise_sigma.is_finite() && self.noise_sigma >= 0.0) {
-            return Err(format!("explore.noise_sigma must be finite and >= 0, got {}", self.noise_sigma));
+            return Err(format!(
+                "explore.noise_sigma must be finite and >= 0, got {}",
+                self.noise_sigma
+            ));
         }
         Ok(())
     }
 
     /// The epochs at which the curve is evaluated: every `eval_every`, and the last.
     pub fn eval_epochs(&self) -> Vec<usize> {
-        let mut v: Vec<usize> = (1..=self.epochs / self.eval_every).map(|k| k * self.eval_every).collect();
+        let mut v: Vec<usize> = (1..=self.epochs / self.eval_every)
+            .map(|k| k * self.eval_every)
+            .collect();
         if v.last() != Some(&self.epochs) {
             v.push(self.epochs);
         }
@@ -80,7 +94,12 @@ pub enum Learner {
 
 impl Learner {
     /// All learners of this build.
-    pub const ALL: [Learner; 4] = [Learner::Pca, Learner::PcaCentred, Learner::Isomap, Learner::External];
+    pub const ALL: [Learner; 4] = [
+        Learner::Pca,
+        Learner::PcaCentred,
+        Learner::Isomap,
+        Learner::External,
+    ];
 
     /// Name of the learner (`pca`, `pca-centred`, `isomap`, `external`).
     pub fn name(self) -> &'static str {
@@ -155,10 +174,16 @@ impl std::fmt::Display for Algo {
 impl std::str::FromStr for Algo {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Algo::all().into_iter().find(|a| a.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Algo::all().iter().map(|a| a.name()).collect();
-            format!("unknown algorithm '{s}' (expected one of: {})", names.join(", "))
-        })
+        Algo::all()
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Algo::all().iter().map(|a| a.name()).collect();
+                format!(
+                    "unknown algorithm '{s}' (expected one of: {})",
+                    names.join(", ")
+                )
+            })
     }
 }
 
@@ -202,7 +227,9 @@ impl std::str::FromStr for SamplerKind {
             "gaussian" => Ok(SamplerKind::Gaussian),
             "uniform" => Ok(SamplerKind::Uniform),
             "none" => Ok(SamplerKind::None),
-            _ => Err(format!("unknown goal sampler '{s}' (expected kde or gaussian)")),
+            _ => Err(format!(
+                "unknown goal sampler '{s}' (expected kde or gaussian)"
+            )),
         }
     }
 }

@@ -34,7 +34,14 @@ impl NnIndex {
     /// An empty index for points of dimension `dim` (> 0).
     pub fn new(dim: usize) -> Self {
         assert!(dim > 0, "NnIndex dimension must be positive");
-        NnIndex { dim, coords: Vec::new(), nodes: Vec::new(), first: HashMap::new(), canonical: Vec::new(), owner: Vec::new() }
+        NnIndex {
+            dim,
+            coords: Vec::new(),
+            nodes: Vec::new(),
+            first: HashMap::new(),
+            canonical: Vec::new(),
+            owner: Vec::new(),
+        }
     }
 
     /// Dimension of the points.
@@ -68,7 +75,10 @@ impl NnIndex {
     /// Panics if the point has the wrong dimension or a NaN coordinate (callers check outcomes).
     pub fn insert(&mut self, p: &[f64]) -> usize {
         assert_eq!(p.len(), self.dim, "point dimension");
-        assert!(p.iter().all(|v| !v.is_nan()), "NaN coordinate inserted into NnIndex");
+        assert!(
+            p.iter().all(|v| !v.is_nan()),
+            "NaN coordinate inserted into NnIndex"
+        );
         let idx = self.canonical.len() as u32;
         let key: Box<[u64]> = p.iter().map(|v| (v + 0.0).to_bits()).collect();
         if let Some(&f) = self.first.get(&key) {
@@ -101,7 +111,12 @@ impl NnIndex {
                 cur = next as usize;
             }
         }
-        self.nodes.push(Node { point: slot, axis, left: NONE, right: NONE });
+        self.nodes.push(Node {
+            point: slot,
+            axis,
+            left: NONE,
+            right: NONE,
+        });
         self.owner.push(idx);
         idx as usize
     }
@@ -132,7 +147,11 @@ impl NnIndex {
                 best = (d2, owner);
             }
             let diff = q[n.axis as usize] - p[n.axis as usize];
-            let (near, far) = if diff < 0.0 { (n.left, n.right) } else { (n.right, n.left) };
+            let (near, far) = if diff < 0.0 {
+                (n.left, n.right)
+            } else {
+                (n.right, n.left)
+            };
             // Push the far side first so the near side is explored first.
             if far != NONE {
                 stack.push((far, diff * diff));

@@ -1,12 +1,12 @@
 //! Random parameter exploration (RPE; PAPER-NOTES.md section 3): `epochs` uniformly random
 //! parameter vectors, no warm-up.
 
+use super::ExploreConfig;
 use super::history::{ExplorationLog, Recorder};
 use super::meta_policy::random_params;
-use super::ExploreConfig;
 use crate::env::Environment;
 use crate::metrics::KlCoverage;
-use crate::seed::{stream, Component};
+use crate::seed::{Component, stream};
 
 /// Run RPE. Outcome i is produced at epoch i + 1.
 pub fn run_rpe(env: &dyn Environment, cfg: &ExploreConfig, run_seed: u64) -> ExplorationLog {

@@ -30,10 +30,14 @@ impl KdeGoals {
     pub fn fit(data: &Latents) -> Result<Self, ReprError> {
         let (n, d) = (data.n, data.latents);
         if n < 2 || d == 0 {
-            return Err(ReprError::InvalidInput(format!("KDE needs at least 2 points of dimension >= 1, got {n} x {d}")));
+            return Err(ReprError::InvalidInput(format!(
+                "KDE needs at least 2 points of dimension >= 1, got {n} x {d}"
+            )));
         }
         if data.data.iter().any(|v| !v.is_finite()) {
-            return Err(ReprError::Numerical("KDE: non-finite training latent".into()));
+            return Err(ReprError::Numerical(
+                "KDE: non-finite training latent".into(),
+            ));
         }
         let mut mean = vec![0.0; d];
         for i in 0..n {
@@ -52,7 +56,10 @@ impl KdeGoals {
             }
         }
         let factor = (n as f64).powf(-1.0 / (d as f64 + 4.0));
-        let covariance: Vec<f64> = cov.iter().map(|c| c / (n as f64 - 1.0) * factor * factor).collect();
+        let covariance: Vec<f64> = cov
+            .iter()
+            .map(|c| c / (n as f64 - 1.0) * factor * factor)
+            .collect();
         let (vals, vecs) = jacobi_eigen(&covariance, d);
         let mut sqrt = vec![0.0; d * d];
         for &(l, c) in &vals {
@@ -62,7 +69,12 @@ impl KdeGoals {
                 sqrt[r * d + c] = vecs[r * d + c] * s;
             }
         }
-        Ok(KdeGoals { data: data.clone(), factor, covariance, sqrt })
+        Ok(KdeGoals {
+            data: data.clone(),
+            factor,
+            covariance,
+            sqrt,
+        })
     }
 }
 
@@ -98,7 +110,11 @@ mod tests {
             let b: f64 = StandardNormal.sample(&mut rng);
             data.extend_from_slice(&[2.0 * a + 1.0, 0.5 * a + 0.3 * b - 2.0]);
         }
-        Latents { n, latents: 2, data }
+        Latents {
+            n,
+            latents: 2,
+            data,
+        }
     }
 
     #[test]
@@ -109,10 +125,15 @@ mod tests {
         assert!((k.factor - f).abs() < 1e-15);
         // Unbiased data covariance, computed independently.
         let n = z.n as f64;
-        let m: Vec<f64> = (0..2).map(|a| (0..z.n).map(|i| z.row(i)[a]).sum::<f64>() / n).collect();
+        let m: Vec<f64> = (0..2)
+            .map(|a| (0..z.n).map(|i| z.row(i)[a]).sum::<f64>() / n)
+            .collect();
         for a in 0..2 {
             for b in 0..2 {
-                let c = (0..z.n).map(|i| (z.row(i)[a] - m[a]) * (z.row(i)[b] - m[b])).sum::<f64>() / (n - 1.0);
+                let c = (0..z.n)
+                    .map(|i| (z.row(i)[a] - m[a]) * (z.row(i)[b] - m[b]))
+                    .sum::<f64>()
+                    / (n - 1.0);
                 assert!((k.covariance[a * 2 + b] - c * f * f).abs() < 1e-12);
             }
         }
@@ -136,27 +157,46 @@ mod tests {
             }
         }
         let n = z.n as f64;
-        let mean: Vec<f64> = (0..2).map(|a| (0..z.n).map(|i| z.row(i)[a]).sum::<f64>() / n).collect();
+        let mean: Vec<f64> = (0..2)
+            .map(|a| (0..z.n).map(|i| z.row(i)[a]).sum::<f64>() / n)
+            .collect();
         for a in 0..2 {
             let sm = s[a] / m as f64;
             assert!((sm - mean[a]).abs() < 0.02, "mean {a}: {sm} vs {}", mean[a]);
             for b in 0..2 {
                 // Mixture covariance = biased data covariance + kernel covariance.
-                let data_cov = (0..z.n).map(|i| (z.row(i)[a] - mean[a]) * (z.row(i)[b] - mean[b])).sum::<f64>() / n;
+                let data_cov = (0..z.n)
+                    .map(|i| (z.row(i)[a] - mean[a]) * (z.row(i)[b] - mean[b]))
+                    .sum::<f64>()
+                    / n;
                 let want = data_cov + k.covariance[a * 2 + b];
                 let got = ss[a * 2 + b] / m as f64 - (s[a] / m as f64) * (s[b] / m as f64);
-                assert!((got - want).abs() < 0.03 * want.abs().max(0.3), "cov {a}{b}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 0.03 * want.abs().max(0.3),
+                    "cov {a}{b}: {got} vs {want}"
+                );
             }
         }
     }
 
     #[test]
     fn constant_latent_is_handled() {
-        let z = Latents { n: 3, latents: 2, data: vec![0.0, 1.0, 1.0, 1.0, 2.0, 1.0] };
+        let z = Latents {
+            n: 3,
+            latents: 2,
+            data: vec![0.0, 1.0, 1.0, 1.0, 2.0, 1.0],
+        };
         let mut k = KdeGoals::fit(&z).unwrap();
         let mut out = [0.0; 2];
         k.sample(&mut stream_named(1, "c"), &mut out);
         assert_eq!(out[1], 1.0);
-        assert!(KdeGoals::fit(&Latents { n: 1, latents: 2, data: vec![0.0, 0.0] }).is_err());
+        assert!(
+            KdeGoals::fit(&Latents {
+                n: 1,
+                latents: 2,
+                data: vec![0.0, 0.0]
+            })
+            .is_err()
+        );
     }
 }

@@ -16,7 +16,11 @@ pub struct UniformGoals {
 impl UniformGoals {
     /// Uniform in [0,1)^dim, the engineered goal space of RGE-EFR.
     pub fn unit(dim: usize) -> Self {
-        UniformGoals { dim, lo: 0.0, hi: 1.0 }
+        UniformGoals {
+            dim,
+            lo: 0.0,
+            hi: 1.0,
+        }
     }
 }
 

@@ -9,38 +9,76 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum CsvError {
     #[error("cannot read {path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}: header must be '{expected}', got '{got}'")]
-    Header { path: PathBuf, expected: String, got: String },
+    Header {
+        path: PathBuf,
+        expected: String,
+        got: String,
+    },
     #[error("{path}:{line}: expected {expected} comma-separated numbers, got '{text}'")]
-    Fields { path: PathBuf, line: usize, expected: usize, text: String },
+    Fields {
+        path: PathBuf,
+        line: usize,
+        expected: usize,
+        text: String,
+    },
     #[error("{path}:{line}: '{field}' is not a finite number")]
-    Number { path: PathBuf, line: usize, field: String },
+    Number {
+        path: PathBuf,
+        line: usize,
+        field: String,
+    },
     #[error("{path}: no outcomes after the header")]
     Empty { path: PathBuf },
 }
 
 /// Read outcomes of dimension `dim` (2 or 3) from `path`.
 pub fn read_outcomes_csv(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>, CsvError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io { path: path.into(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io {
+        path: path.into(),
+        source,
+    })?;
     let expected = ["x", "y", "angle"][..dim].join(",");
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
     let header = lines.next().map(|(_, l)| l).unwrap_or("");
-    let got: Vec<&str> = header.split(',').map(|s| s.trim().trim_start_matches('\u{feff}')).collect();
+    let got: Vec<&str> = header
+        .split(',')
+        .map(|s| s.trim().trim_start_matches('\u{feff}'))
+        .collect();
     if got.join(",") != expected {
-        return Err(CsvError::Header { path: path.into(), expected, got: header.trim().into() });
+        return Err(CsvError::Header {
+            path: path.into(),
+            expected,
+            got: header.trim().into(),
+        });
     }
     let mut out = Vec::new();
     for (i, l) in lines {
         let fields: Vec<&str> = l.split(',').map(str::trim).collect();
         if fields.len() != dim {
-            return Err(CsvError::Fields { path: path.into(), line: i + 1, expected: dim, text: l.trim().into() });
+            return Err(CsvError::Fields {
+                path: path.into(),
+                line: i + 1,
+                expected: dim,
+                text: l.trim().into(),
+            });
         }
         let row = fields
             .iter()
             .map(|f| match f.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(CsvError::Number { path: path.into(), line: i + 1, field: (*f).into() }),
+                _ => Err(CsvError::Number {
+                    path: path.into(),
+                    line: i + 1,
+                    field: (*f).into(),
+                }),
             })
             .collect::<Result<Vec<f64>, _>>()?;
         out.push(row);
@@ -60,15 +98,35 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("o.csv");
         std::fs::write(&p, "x,y\n0.1,0.2\n\n-0.5, 0.25\n").unwrap();
-        assert_eq!(read_outcomes_csv(&p, 2).unwrap(), vec![vec![0.1, 0.2], vec![-0.5, 0.25]]);
-        assert!(matches!(read_outcomes_csv(&p, 3), Err(CsvError::Header { .. })));
+        assert_eq!(
+            read_outcomes_csv(&p, 2).unwrap(),
+            vec![vec![0.1, 0.2], vec![-0.5, 0.25]]
+        );
+        assert!(matches!(
+            read_outcomes_csv(&p, 3),
+            Err(CsvError::Header { .. })
+        ));
         std::fs::write(&p, "x,y\n0.1\n").unwrap();
-        assert!(read_outcomes_csv(&p, 2).unwrap_err().to_string().contains(":2:"));
+        assert!(
+            read_outcomes_csv(&p, 2)
+                .unwrap_err()
+                .to_string()
+                .contains(":2:")
+        );
         std::fs::write(&p, "x,y\n0.1,abc\n").unwrap();
-        assert!(matches!(read_outcomes_csv(&p, 2), Err(CsvError::Number { .. })));
+        assert!(matches!(
+            read_outcomes_csv(&p, 2),
+            Err(CsvError::Number { .. })
+        ));
         std::fs::write(&p, "x,y\n0.1,nan\n").unwrap();
-        assert!(matches!(read_outcomes_csv(&p, 2), Err(CsvError::Number { .. })));
+        assert!(matches!(
+            read_outcomes_csv(&p, 2),
+            Err(CsvError::Number { .. })
+        ));
         std::fs::write(&p, "x,y\n").unwrap();
-        assert!(matches!(read_outcomes_csv(&p, 2), Err(CsvError::Empty { .. })));
+        assert!(matches!(
+            read_outcomes_csv(&p, 2),
+            Err(CsvError::Empty { .. })
+        ));
     }
 }

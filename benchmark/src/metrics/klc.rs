@@ -44,7 +44,11 @@ pub fn bin_in_open_disk(ix: usize, iy: usize) -> bool {
     // Bin i spans [i - 15, i - 14] in units of 1/15; distance of the interval to 0:
     let near = |i: usize| -> i64 {
         let (lo, hi) = (i as i64 - 15, i as i64 - 14);
-        if lo <= 0 && 0 <= hi { 0 } else { lo.abs().min(hi.abs()) }
+        if lo <= 0 && 0 <= hi {
+            0
+        } else {
+            lo.abs().min(hi.abs())
+        }
     };
     let (dx, dy) = (near(ix), near(iy));
     dx * dx + dy * dy < 15 * 15
@@ -72,7 +76,12 @@ impl KlCoverage {
             }
         }
         let n_achievable = achievable.iter().filter(|&&a| a).count();
-        Ok(KlCoverage { dim, edges, achievable, n_achievable })
+        Ok(KlCoverage {
+            dim,
+            edges,
+            achievable,
+            n_achievable,
+        })
     }
 
     /// Outcome dimension.
@@ -112,7 +121,10 @@ impl KlCoverage {
     /// Cell index (C order over the dimensions) of a point; None when outside [-1,1]^dim.
     pub fn cell(&self, p: &[f64]) -> Result<Option<usize>, KlcError> {
         if p.len() != self.dim {
-            return Err(KlcError::Dimension { got: p.len(), expected: self.dim });
+            return Err(KlcError::Dimension {
+                got: p.len(),
+                expected: self.dim,
+            });
         }
         let mut idx = 0;
         for &v in p {
@@ -145,7 +157,10 @@ impl KlCoverage {
     }
 
     /// KL-coverage of a set of points (each of length `dim`).
-    pub fn evaluate<'p, I: IntoIterator<Item = &'p [f64]>>(&self, points: I) -> Result<f64, KlcError> {
+    pub fn evaluate<'p, I: IntoIterator<Item = &'p [f64]>>(
+        &self,
+        points: I,
+    ) -> Result<f64, KlcError> {
         let mut h = self.histogram();
         for p in points {
             h.add(p)?;
@@ -283,8 +298,16 @@ mod tests {
                 if bin_in_open_disk(ix, iy) {
                     let lo = |i: usize| (i as f64 - 15.0) / 15.0;
                     // The corner nearest the origin, nudged inside the bin and inside the disk.
-                    let px = if ix < 15 { lo(ix + 1) - 1e-9 } else { lo(ix) + 1e-9 };
-                    let py = if iy < 15 { lo(iy + 1) - 1e-9 } else { lo(iy) + 1e-9 };
+                    let px = if ix < 15 {
+                        lo(ix + 1) - 1e-9
+                    } else {
+                        lo(ix) + 1e-9
+                    };
+                    let py = if iy < 15 {
+                        lo(iy + 1) - 1e-9
+                    } else {
+                        lo(iy) + 1e-9
+                    };
                     h.add(&[px, py]).unwrap();
                 }
             }
@@ -297,12 +320,24 @@ mod tests {
     fn outside_is_infinite_never_a_panic() {
         let b = KlCoverage::new(2).unwrap();
         // Inside [-1,1]^2 but in a corner bin, outside the disk.
-        assert_eq!(b.evaluate([&[0.99, 0.99][..], &[0.0, 0.0][..]]).unwrap(), f64::INFINITY);
+        assert_eq!(
+            b.evaluate([&[0.99, 0.99][..], &[0.0, 0.0][..]]).unwrap(),
+            f64::INFINITY
+        );
         // Outside the histogram range.
         assert_eq!(b.evaluate([&[1.5, 0.0][..]]).unwrap(), f64::INFINITY);
-        assert_eq!(b.evaluate([&[f64::INFINITY, 0.0][..]]).unwrap(), f64::INFINITY);
+        assert_eq!(
+            b.evaluate([&[f64::INFINITY, 0.0][..]]).unwrap(),
+            f64::INFINITY
+        );
         assert_eq!(b.evaluate([&[f64::NAN, 0.0][..]]), Err(KlcError::NaN));
-        assert_eq!(b.evaluate([&[0.0][..]]), Err(KlcError::Dimension { got: 1, expected: 2 }));
+        assert_eq!(
+            b.evaluate([&[0.0][..]]),
+            Err(KlcError::Dimension {
+                got: 1,
+                expected: 2
+            })
+        );
         assert_eq!(b.evaluate(std::iter::empty()), Err(KlcError::Empty));
     }
 

@@ -20,9 +20,15 @@ pub struct UglDataset {
 }
 
 /// Draw `n` states uniformly in [-1,1)^d and render them.
-pub fn generate(env: &dyn Environment, n: usize, rng: &mut Stream) -> Result<UglDataset, ReprError> {
+pub fn generate(
+    env: &dyn Environment,
+    n: usize,
+    rng: &mut Stream,
+) -> Result<UglDataset, ReprError> {
     if n == 0 {
-        return Err(ReprError::InvalidInput("the UGL data set needs at least 1 image".into()));
+        return Err(ReprError::InvalidInput(
+            "the UGL data set needs at least 1 image".into(),
+        ));
     }
     let d = env.state_dim();
     let mut states = Vec::with_capacity(n * d);
@@ -33,7 +39,10 @@ pub fn generate(env: &dyn Environment, n: usize, rng: &mut Stream) -> Result<Ugl
         states.extend_from_slice(&s);
         debug_assert_eq!(states.len(), (i + 1) * d);
     }
-    Ok(UglDataset { states, images: ImageSet::new(n, PIXELS, data)? })
+    Ok(UglDataset {
+        states,
+        images: ImageSet::new(n, PIXELS, data)?,
+    })
 }
 
 /// The identity of a data set, hashed into its seed: shared by every learner of a repetition.
@@ -44,8 +53,8 @@ pub fn dataset_identity(env: EnvKind, n: usize, rep: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::env::{make_env, EnvConfig};
-    use crate::seed::{stream, Component};
+    use crate::env::{EnvConfig, make_env};
+    use crate::seed::{Component, stream};
 
     #[test]
     fn deterministic_and_covers_the_square() {
@@ -55,7 +64,11 @@ mod tests {
         assert_eq!(a.images, b.images);
         assert_eq!(a.images.n, 400);
         // States outside the unit disk are drawn too (the whole square, as the original).
-        let outside = a.states.chunks(2).filter(|s| s[0] * s[0] + s[1] * s[1] > 1.0).count();
+        let outside = a
+            .states
+            .chunks(2)
+            .filter(|s| s[0] * s[0] + s[1] * s[1] > 1.0)
+            .count();
         assert!(outside > 40, "{outside}");
         assert!(a.images.data.iter().all(|v| (0.0..=1.0).contains(v)));
         let c = generate(env.as_ref(), 400, &mut stream(2, Component::Dataset)).unwrap();

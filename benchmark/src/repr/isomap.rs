@@ -72,7 +72,9 @@ use faer::{Accum, MatMut, MatRef, Par, Side};
 use rand::RngExt;
 use rayon::prelude::*;
 
-use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents};
+use super::{
+    Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
+};
 use crate::seed::Stream;
 
 /// Isomap learner (PAPER-NOTES.md section 5): sklearn `Isomap(n_components=latents)` defaults.
@@ -86,7 +88,10 @@ pub struct Isomap {
 
 impl Default for Isomap {
     fn default() -> Self {
-        Isomap { n_neighbors: 5, disconnected: Disconnected::Error }
+        Isomap {
+            n_neighbors: 5,
+            disconnected: Disconnected::Error,
+        }
     }
 }
 
@@ -95,7 +100,12 @@ impl RepresentationLearner for Isomap {
         "isomap"
     }
 
-    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         let (enc, z) = self.fit_isomap(images, latents, rng)?;
         Ok((Box::new(enc), z))
     }
@@ -117,21 +127,39 @@ pub enum Disconnected {
 impl Isomap {
     /// Fit and return the concrete encoder (with its eigenvalues and phase timings) and the
     /// training embedding.
-    pub fn fit_isomap(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(IsomapEncoder, Latents), ReprError> {
+    pub fn fit_isomap(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(IsomapEncoder, Latents), ReprError> {
         self.fit_with(images, latents, rng, KnnPath::Auto)
     }
 
-    fn fit_with(&self, images: &ImageSet, latents: usize, rng: &mut Stream, path: KnnPath) -> Result<(IsomapEncoder, Latents), ReprError> {
+    fn fit_with(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        path: KnnPath,
+    ) -> Result<(IsomapEncoder, Latents), ReprError> {
         check_fit_input(images, latents)?;
         let (n, dim, k) = (images.n, images.dim, self.n_neighbors);
         if k == 0 {
-            return Err(ReprError::InvalidInput("isomap: n_neighbors must be at least 1".into()));
+            return Err(ReprError::InvalidInput(
+                "isomap: n_neighbors must be at least 1".into(),
+            ));
         }
         if k >= n {
-            return Err(ReprError::InvalidInput(format!("isomap: n_neighbors = {k} needs at least {} training images, got {n}", k + 1)));
+            return Err(ReprError::InvalidInput(format!(
+                "isomap: n_neighbors = {k} needs at least {} training images, got {n}",
+                k + 1
+            )));
         }
         if n > u32::MAX as usize - 2 {
-            return Err(ReprError::InvalidInput(format!("isomap: too many training images ({n})")));
+            return Err(ReprError::InvalidInput(format!(
+                "isomap: too many training images ({n})"
+            )));
         }
 
         let t0 = std::time::Instant::now();
@@ -147,8 +175,24 @@ impl Isomap {
             let knn = idx.knn_train(k);
             (TrainIndex::Sparse(idx), knn)
         } else {
-            let knn = dense_knn(&images.data, n, dim, &norms, &images.data, n, &norms, k, true);
-            (TrainIndex::Dense { data: images.data.clone(), norms }, knn)
+            let knn = dense_knn(
+                &images.data,
+                n,
+                dim,
+                &norms,
+                &images.data,
+                n,
+                &norms,
+                k,
+                true,
+            );
+            (
+                TrainIndex::Dense {
+                    data: images.data.clone(),
+                    norms,
+                },
+                knn,
+            )
         };
         let mut graph = Csr::from_knn(n, k, &knn);
         let t_knn = t0.elapsed();
@@ -178,7 +222,10 @@ impl Isomap {
                         edges.push((b, a, w));
                     }
                     graph = Csr::from_edges(n, edges);
-                    tracing::debug!(components = sizes.len(), "isomap: joined the components of the kNN graph");
+                    tracing::debug!(
+                        components = sizes.len(),
+                        "isomap: joined the components of the kNN graph"
+                    );
                 }
             }
         }
@@ -207,7 +254,9 @@ impl Isomap {
             .collect();
         let all_mean = col_mean.iter().sum::<f64>() / n as f64;
         if !all_mean.is_finite() {
-            return Err(ReprError::Numerical("isomap: non-finite geodesic kernel".into()));
+            return Err(ReprError::Numerical(
+                "isomap: non-finite geodesic kernel".into(),
+            ));
         }
         kc.par_chunks_mut(n).enumerate().for_each(|(i, row)| {
             let ci = col_mean[i];
@@ -218,7 +267,12 @@ impl Isomap {
         let t_kernel = t0.elapsed();
         let (lambdas, mut alphas) = top_eigenpairs(&kc, n, latents, rng)?;
         drop(kc);
-        let timings = FitTimings { knn: t_knn, geodesics: t_geo - t_knn, kernel: t_kernel - t_geo, eigen: t0.elapsed() - t_kernel };
+        let timings = FitTimings {
+            knn: t_knn,
+            geodesics: t_geo - t_knn,
+            kernel: t_kernel - t_geo,
+            eigen: t0.elapsed() - t_kernel,
+        };
         tracing::debug!(n, sparse = use_sparse, ?timings, "isomap fit phases");
         flip_signs(&mut alphas, n, latents);
 
@@ -226,14 +280,22 @@ impl Isomap {
         let mut proj = vec![0.0; n * latents];
         for c in 0..latents {
             let lam = lambdas[c].max(0.0);
-            let (s, inv) = if lam > 0.0 { (lam.sqrt(), 1.0 / lam.sqrt()) } else { (0.0, 0.0) };
+            let (s, inv) = if lam > 0.0 {
+                (lam.sqrt(), 1.0 / lam.sqrt())
+            } else {
+                (0.0, 0.0)
+            };
             for i in 0..n {
                 let a = alphas[c * n + i];
                 z[i * latents + c] = a * s;
                 proj[i * latents + c] = a * inv;
             }
         }
-        let z = Latents { n, latents, data: z };
+        let z = Latents {
+            n,
+            latents,
+            data: z,
+        };
         check_latents(&z, "isomap")?;
         let enc = IsomapEncoder {
             n_neighbors: k,
@@ -317,10 +379,15 @@ impl IsomapEncoder {
     /// Images to encode must have the training size and finite pixels.
     fn check_images(&self, dim: usize, data: &[f32]) -> Result<(), ReprError> {
         if dim != self.dim {
-            return Err(ReprError::InvalidInput(format!("isomap: image has {dim} pixels, the encoder expects {}", self.dim)));
+            return Err(ReprError::InvalidInput(format!(
+                "isomap: image has {dim} pixels, the encoder expects {}",
+                self.dim
+            )));
         }
         if data.iter().any(|v| !v.is_finite()) {
-            return Err(ReprError::InvalidInput("isomap: image to encode contains a non-finite value".into()));
+            return Err(ReprError::InvalidInput(
+                "isomap: image to encode contains a non-finite value".into(),
+            ));
         }
         Ok(())
     }
@@ -369,7 +436,11 @@ impl Encoder for IsomapEncoder {
         let (m, k, l, n) = (images.n, self.n_neighbors, self.latents, self.n);
         let mut z = vec![0.0; m * l];
         if m == 0 {
-            return Ok(Latents { n: 0, latents: l, data: z });
+            return Ok(Latents {
+                n: 0,
+                latents: l,
+                data: z,
+            });
         }
         let this = &*self;
         match &this.index {
@@ -386,10 +457,16 @@ impl Encoder for IsomapEncoder {
             TrainIndex::Dense { data, norms } => {
                 let qn: Vec<f64> = images.data.par_chunks(images.dim).map(sq_norm).collect();
                 let knn = dense_knn(data, n, this.dim, norms, &images.data, m, &qn, k, false);
-                z.par_chunks_mut(l).zip(knn.par_chunks(k)).for_each_init(|| vec![0.0; n], |g, (out, nb)| this.project(nb, g, out));
+                z.par_chunks_mut(l)
+                    .zip(knn.par_chunks(k))
+                    .for_each_init(|| vec![0.0; n], |g, (out, nb)| this.project(nb, g, out));
             }
         }
-        let z = Latents { n: m, latents: l, data: z };
+        let z = Latents {
+            n: m,
+            latents: l,
+            data: z,
+        };
         check_latents(&z, "isomap")?;
         Ok(z)
     }
@@ -397,12 +474,18 @@ impl Encoder for IsomapEncoder {
     fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
         self.check_images(image.len(), image)?;
         if out.len() != self.latents {
-            return Err(ReprError::InvalidInput(format!("isomap: output has {} values, expected {}", out.len(), self.latents)));
+            return Err(ReprError::InvalidInput(format!(
+                "isomap: output has {} values, expected {}",
+                out.len(),
+                self.latents
+            )));
         }
         let k = self.n_neighbors;
         let mut s = std::mem::replace(&mut self.scratch, Scratch::new(0));
         match &self.index {
-            TrainIndex::Sparse(idx) => idx.knn_one(image, sq_norm(image), k, None, &mut s.knn, &mut s.nbrs),
+            TrainIndex::Sparse(idx) => {
+                idx.knn_one(image, sq_norm(image), k, None, &mut s.knn, &mut s.nbrs)
+            }
             TrainIndex::Dense { data, norms } => {
                 let q = [sq_norm(image)];
                 s.nbrs = dense_knn(data, self.n, self.dim, norms, image, 1, &q, k, false);
@@ -411,7 +494,9 @@ impl Encoder for IsomapEncoder {
         self.project(&s.nbrs, &mut s.g, out);
         self.scratch = s;
         if let Some(c) = out.iter().position(|v| !v.is_finite()) {
-            return Err(ReprError::Numerical(format!("isomap: non-finite latent (dimension {c})")));
+            return Err(ReprError::Numerical(format!(
+                "isomap: non-finite latent (dimension {c})"
+            )));
         }
         Ok(())
     }
@@ -426,7 +511,11 @@ struct Scratch {
 
 impl Scratch {
     fn new(n: usize) -> Self {
-        Scratch { knn: KnnScratch::new(n), nbrs: Vec::new(), g: vec![0.0; n] }
+        Scratch {
+            knn: KnnScratch::new(n),
+            nbrs: Vec::new(),
+            g: vec![0.0; n],
+        }
     }
 }
 
@@ -515,7 +604,13 @@ struct KnnScratch {
 
 impl KnnScratch {
     fn new(n: usize) -> Self {
-        KnnScratch { acc: vec![0.0; n], stamp: vec![0; n], epoch: 0, touched: Vec::new(), cands: Vec::new() }
+        KnnScratch {
+            acc: vec![0.0; n],
+            stamp: vec![0; n],
+            epoch: 0,
+            touched: Vec::new(),
+            cands: Vec::new(),
+        }
     }
 }
 
@@ -555,8 +650,23 @@ impl SparseIndex {
             }
         }
         let mut by_norm: Vec<u32> = (0..n as u32).collect();
-        by_norm.sort_unstable_by(|&a, &b| norms[a as usize].total_cmp(&norms[b as usize]).then(a.cmp(&b)));
-        SparseIndex { n, dim, norms, by_norm, post_start, post_img, post_val, row_start, row_pix, row_val }
+        by_norm.sort_unstable_by(|&a, &b| {
+            norms[a as usize]
+                .total_cmp(&norms[b as usize])
+                .then(a.cmp(&b))
+        });
+        SparseIndex {
+            n,
+            dim,
+            norms,
+            by_norm,
+            post_start,
+            post_img,
+            post_val,
+            row_start,
+            row_pix,
+            row_val,
+        }
     }
 
     /// All-pairs kNN of the training images (self excluded): n x k (squared distance, index).
@@ -566,7 +676,10 @@ impl SparseIndex {
             || (KnnScratch::new(self.n), Vec::new()),
             |(s, nb), (i, dst)| {
                 let (a, b) = (self.row_start[i], self.row_start[i + 1]);
-                let vals = self.row_pix[a..b].iter().zip(&self.row_val[a..b]).map(|(&p, &v)| (p as usize, v));
+                let vals = self.row_pix[a..b]
+                    .iter()
+                    .zip(&self.row_val[a..b])
+                    .map(|(&p, &v)| (p as usize, v));
                 self.knn_sparse_query(vals, self.norms[i], k, Some(i), s, nb);
                 dst.copy_from_slice(nb);
             },
@@ -575,9 +688,21 @@ impl SparseIndex {
     }
 
     /// kNN of a dense query image `x` (no exclusion unless `exclude`).
-    fn knn_one(&self, x: &[f32], x_norm: f64, k: usize, exclude: Option<usize>, s: &mut KnnScratch, out: &mut Vec<(f64, u32)>) {
+    fn knn_one(
+        &self,
+        x: &[f32],
+        x_norm: f64,
+        k: usize,
+        exclude: Option<usize>,
+        s: &mut KnnScratch,
+        out: &mut Vec<(f64, u32)>,
+    ) {
         debug_assert_eq!(x.len(), self.dim);
-        let vals = x.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(p, &v)| (p, v));
+        let vals = x
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(p, &v)| (p, v));
         self.knn_sparse_query(vals, x_norm, k, exclude, s, out);
     }
 
@@ -685,37 +810,54 @@ fn dense_knn(
     let mut tbuf = vec![0.0f64; dim * DENSE_TRAIN_CHUNK.min(n)];
     for t0 in (0..n).step_by(DENSE_TRAIN_CHUNK) {
         let tn = DENSE_TRAIN_CHUNK.min(n - t0);
-        tbuf[..dim * tn].par_chunks_mut(dim).enumerate().for_each(|(c, col)| {
-            for (d, &s) in col.iter_mut().zip(&train[(t0 + c) * dim..(t0 + c + 1) * dim]) {
-                *d = s as f64;
-            }
-        });
-        let tmat = MatRef::from_column_major_slice(&tbuf[..dim * tn], dim, tn);
-        best.par_chunks_mut(DENSE_QUERY_BLOCK * k).enumerate().for_each_init(
-            || (vec![0.0f64; dim * DENSE_QUERY_BLOCK], vec![0.0f64; DENSE_QUERY_BLOCK * DENSE_TRAIN_CHUNK]),
-            |(qbuf, gbuf), (b, slots)| {
-                let q0 = b * DENSE_QUERY_BLOCK;
-                let qn = slots.len() / k;
-                for (d, &s) in qbuf[..dim * qn].iter_mut().zip(&queries[q0 * dim..(q0 + qn) * dim]) {
+        tbuf[..dim * tn]
+            .par_chunks_mut(dim)
+            .enumerate()
+            .for_each(|(c, col)| {
+                for (d, &s) in col
+                    .iter_mut()
+                    .zip(&train[(t0 + c) * dim..(t0 + c + 1) * dim])
+                {
                     *d = s as f64;
                 }
-                let qmat = MatRef::from_column_major_slice(&qbuf[..dim * qn], dim, qn);
-                let gram = MatMut::from_column_major_slice_mut(&mut gbuf[..qn * tn], qn, tn);
-                matmul(gram, Accum::Replace, qmat.transpose(), tmat, 1.0, Par::Seq);
-                for a in 0..qn {
-                    let qi = q0 + a;
-                    let top = &mut slots[a * k..(a + 1) * k];
-                    for c in 0..tn {
-                        let j = t0 + c;
-                        if exclude_self && j == qi {
-                            continue;
-                        }
-                        let d2 = clamp0((query_norms[qi] + train_norms[j]) - 2.0 * gbuf[a + c * qn]);
-                        insert_top(top, (d2, j as u32));
+            });
+        let tmat = MatRef::from_column_major_slice(&tbuf[..dim * tn], dim, tn);
+        best.par_chunks_mut(DENSE_QUERY_BLOCK * k)
+            .enumerate()
+            .for_each_init(
+                || {
+                    (
+                        vec![0.0f64; dim * DENSE_QUERY_BLOCK],
+                        vec![0.0f64; DENSE_QUERY_BLOCK * DENSE_TRAIN_CHUNK],
+                    )
+                },
+                |(qbuf, gbuf), (b, slots)| {
+                    let q0 = b * DENSE_QUERY_BLOCK;
+                    let qn = slots.len() / k;
+                    for (d, &s) in qbuf[..dim * qn]
+                        .iter_mut()
+                        .zip(&queries[q0 * dim..(q0 + qn) * dim])
+                    {
+                        *d = s as f64;
                     }
-                }
-            },
-        );
+                    let qmat = MatRef::from_column_major_slice(&qbuf[..dim * qn], dim, qn);
+                    let gram = MatMut::from_column_major_slice_mut(&mut gbuf[..qn * tn], qn, tn);
+                    matmul(gram, Accum::Replace, qmat.transpose(), tmat, 1.0, Par::Seq);
+                    for a in 0..qn {
+                        let qi = q0 + a;
+                        let top = &mut slots[a * k..(a + 1) * k];
+                        for c in 0..tn {
+                            let j = t0 + c;
+                            if exclude_self && j == qi {
+                                continue;
+                            }
+                            let d2 =
+                                clamp0((query_norms[qi] + train_norms[j]) - 2.0 * gbuf[a + c * qn]);
+                            insert_top(top, (d2, j as u32));
+                        }
+                    }
+                },
+            );
     }
     best
 }
@@ -743,7 +885,12 @@ fn insert_top(top: &mut [(f64, u32)], cand: (f64, u32)) {
 /// closest pair (a in ci, b in cj) as (a, b, squared distance); ties go to the first pair in
 /// (a, b) index order, like `argmin` over the row-major distance block. Work: every point of a
 /// component against every point of the components before it.
-fn closest_pairs(index: &TrainIndex, images: &ImageSet, labels: &[u32], ncomp: usize) -> Vec<(u32, u32, f64)> {
+fn closest_pairs(
+    index: &TrainIndex,
+    images: &ImageSet,
+    labels: &[u32],
+    ncomp: usize,
+) -> Vec<(u32, u32, f64)> {
     let n = images.n;
     // For each point a, the closest point of each earlier component (squared distance, b).
     let per_point: Vec<Vec<(f64, u32)>> = (0..n)
@@ -788,12 +935,24 @@ fn closest_pairs(index: &TrainIndex, images: &ImageSet, labels: &[u32], ncomp: u
 }
 
 /// Squared distances from training image `a` to every training image.
-fn distances_to_all(index: &TrainIndex, images: &ImageSet, a: usize, s: &mut KnnScratch, d2: &mut [f64]) {
+fn distances_to_all(
+    index: &TrainIndex,
+    images: &ImageSet,
+    a: usize,
+    s: &mut KnnScratch,
+    d2: &mut [f64],
+) {
     match index {
         TrainIndex::Sparse(idx) => {
             let x = images.row(a);
             let xn = idx.norms[a];
-            idx.dots(x.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(p, &v)| (p, v)), s);
+            idx.dots(
+                x.iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v != 0.0)
+                    .map(|(p, &v)| (p, v)),
+                s,
+            );
             for (b, o) in d2.iter_mut().enumerate() {
                 let dot = if s.stamp[b] == s.epoch { s.acc[b] } else { 0.0 };
                 *o = clamp0((xn + idx.norms[b]) - 2.0 * dot);
@@ -1003,7 +1162,11 @@ struct RadixHeap {
 
 impl RadixHeap {
     fn new() -> Self {
-        RadixHeap { buckets: (0..65).map(|_| Vec::new()).collect(), last: 0, len: 0 }
+        RadixHeap {
+            buckets: (0..65).map(|_| Vec::new()).collect(),
+            last: 0,
+            len: 0,
+        }
     }
 
     fn reset(&mut self) {
@@ -1034,7 +1197,9 @@ impl RadixHeap {
             return None;
         }
         if self.buckets[0].is_empty() {
-            let i = (1..65).find(|&i| !self.buckets[i].is_empty()).expect("non-empty");
+            let i = (1..65)
+                .find(|&i| !self.buckets[i].is_empty())
+                .expect("non-empty");
             let mut moved = std::mem::take(&mut self.buckets[i]);
             self.last = moved.iter().map(|e| e.0).min().expect("non-empty");
             for &e in &moved {
@@ -1082,7 +1247,12 @@ const MUL_ROWS: usize = 256;
 
 /// The `d` largest (algebraic) eigenvalues of the symmetric n x n matrix `a` (column-major; by
 /// symmetry also row-major), decreasing, with orthonormal eigenvectors (n x d column-major).
-fn top_eigenpairs(a: &[f64], n: usize, d: usize, rng: &mut Stream) -> Result<(Vec<f64>, Vec<f64>), ReprError> {
+fn top_eigenpairs(
+    a: &[f64],
+    n: usize,
+    d: usize,
+    rng: &mut Stream,
+) -> Result<(Vec<f64>, Vec<f64>), ReprError> {
     if n <= DENSE_EIGEN_MAX {
         return dense_top_eigenpairs(a, n, d);
     }
@@ -1100,7 +1270,13 @@ fn top_eigenpairs(a: &[f64], n: usize, d: usize, rng: &mut Stream) -> Result<(Ve
         let rr = loop {
             let kept = orthonormalise_into(&mut q, n, m, &mut x, xcols, cap - m);
             if kept > 0 {
-                sym_mul(a, n, &q[m * n..(m + kept) * n], kept, &mut aq[m * n..(m + kept) * n]);
+                sym_mul(
+                    a,
+                    n,
+                    &q[m * n..(m + kept) * n],
+                    kept,
+                    &mut aq[m * n..(m + kept) * n],
+                );
                 x.clear();
                 x.extend_from_slice(&aq[m * n..(m + kept) * n]);
                 xcols = kept;
@@ -1115,7 +1291,9 @@ fn top_eigenpairs(a: &[f64], n: usize, d: usize, rng: &mut Stream) -> Result<(Ve
                 }
             }
             if m == 0 {
-                return Err(ReprError::Numerical("isomap: the eigen-solver's start block vanished".into()));
+                return Err(ReprError::Numerical(
+                    "isomap: the eigen-solver's start block vanished".into(),
+                ));
             }
         };
         if rr.converged {
@@ -1128,7 +1306,9 @@ fn top_eigenpairs(a: &[f64], n: usize, d: usize, rng: &mut Stream) -> Result<(Ve
         x = rr.y;
         xcols = rr.theta.len();
     }
-    Err(ReprError::Numerical(format!("isomap: the block Krylov eigen-solver did not converge in {MAX_CYCLES} cycles (n = {n}, d = {d})")))
+    Err(ReprError::Numerical(format!(
+        "isomap: the block Krylov eigen-solver did not converge in {MAX_CYCLES} cycles (n = {n}, d = {d})"
+    )))
 }
 
 /// Ritz pairs of a Rayleigh-Ritz step.
@@ -1143,11 +1323,25 @@ struct Ritz {
 
 /// Rayleigh-Ritz on the orthonormal basis `q` (n x m) with `aq = A q`: the top `keep` Ritz
 /// pairs and whether the top `d` have converged.
-fn rayleigh_ritz(q: &[f64], aq: &[f64], n: usize, m: usize, keep: usize, d: usize) -> Result<Ritz, ReprError> {
+fn rayleigh_ritz(
+    q: &[f64],
+    aq: &[f64],
+    n: usize,
+    m: usize,
+    keep: usize,
+    d: usize,
+) -> Result<Ritz, ReprError> {
     let qm = MatRef::from_column_major_slice(q, n, m);
     let aqm = MatRef::from_column_major_slice(aq, n, m);
     let mut t = vec![0.0f64; m * m];
-    matmul(MatMut::from_column_major_slice_mut(&mut t, m, m), Accum::Replace, qm.transpose(), aqm, 1.0, Par::Seq);
+    matmul(
+        MatMut::from_column_major_slice_mut(&mut t, m, m),
+        Accum::Replace,
+        qm.transpose(),
+        aqm,
+        1.0,
+        Par::Seq,
+    );
     for i in 0..m {
         for j in 0..i {
             let s = 0.5 * (t[i + j * m] + t[j + i * m]);
@@ -1156,7 +1350,9 @@ fn rayleigh_ritz(q: &[f64], aq: &[f64], n: usize, m: usize, keep: usize, d: usiz
         }
     }
     let eig = SelfAdjointEigen::new(MatRef::from_column_major_slice(&t, m, m), Side::Lower)
-        .map_err(|e| ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e:?}")))?;
+        .map_err(|e| {
+            ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e:?}"))
+        })?;
     let all: Vec<f64> = eig.S().column_vector().iter().copied().collect();
     let u = eig.U();
     // Top `keep` Ritz vectors, decreasing eigenvalue.
@@ -1172,16 +1368,37 @@ fn rayleigh_ritz(q: &[f64], aq: &[f64], n: usize, m: usize, keep: usize, d: usiz
     let smat = MatRef::from_column_major_slice(&s, m, keep);
     let mut y = vec![0.0f64; n * keep];
     let mut ay = vec![0.0f64; n * keep];
-    matmul(MatMut::from_column_major_slice_mut(&mut y, n, keep), Accum::Replace, qm, smat, 1.0, Par::Seq);
-    matmul(MatMut::from_column_major_slice_mut(&mut ay, n, keep), Accum::Replace, aqm, smat, 1.0, Par::Seq);
+    matmul(
+        MatMut::from_column_major_slice_mut(&mut y, n, keep),
+        Accum::Replace,
+        qm,
+        smat,
+        1.0,
+        Par::Seq,
+    );
+    matmul(
+        MatMut::from_column_major_slice_mut(&mut ay, n, keep),
+        Accum::Replace,
+        aqm,
+        smat,
+        1.0,
+        Par::Seq,
+    );
     let norm_est = all.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
     let converged = keep >= d
         && (m == n
             || (0..d).all(|c| {
-                let r: f64 = (0..n).map(|i| (ay[i + c * n] - theta[c] * y[i + c * n]).powi(2)).sum::<f64>().sqrt();
+                let r: f64 = (0..n)
+                    .map(|i| (ay[i + c * n] - theta[c] * y[i + c * n]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 r <= EIGEN_TOL * norm_est
             }));
-    Ok(Ritz { theta, y, converged })
+    Ok(Ritz {
+        theta,
+        y,
+        converged,
+    })
 }
 
 /// Full dense eigendecomposition (small n).
@@ -1206,7 +1423,14 @@ fn dense_top_eigenpairs(a: &[f64], n: usize, d: usize) -> Result<(Vec<f64>, Vec<
 /// columns of `q` (two passes of block classical Gram-Schmidt), orthonormalise them among
 /// themselves (modified Gram-Schmidt, twice), dropping numerically dependent columns, and
 /// append at most `room` of them to `q`. Returns the number appended.
-fn orthonormalise_into(q: &mut [f64], n: usize, m: usize, x: &mut [f64], xcols: usize, room: usize) -> usize {
+fn orthonormalise_into(
+    q: &mut [f64],
+    n: usize,
+    m: usize,
+    x: &mut [f64],
+    xcols: usize,
+    room: usize,
+) -> usize {
     let x = &mut x[..n * xcols];
     let orig: Vec<f64> = (0..xcols).map(|c| norm(&x[c * n..(c + 1) * n])).collect();
     if m > 0 {
@@ -1282,7 +1506,14 @@ fn sym_mul(a: &[f64], n: usize, x: &[f64], cols: usize, y: &mut [f64]) {
             let rn = MUL_ROWS.min(n - r0);
             let mut out = vec![0.0f64; rn * cols];
             let ablk = amat.subcols(r0, rn);
-            matmul(MatMut::from_column_major_slice_mut(&mut out, rn, cols), Accum::Replace, ablk.transpose(), xmat, 1.0, Par::Seq);
+            matmul(
+                MatMut::from_column_major_slice_mut(&mut out, rn, cols),
+                Accum::Replace,
+                ablk.transpose(),
+                xmat,
+                1.0,
+                Par::Seq,
+            );
             out
         })
         .collect();
@@ -1338,13 +1569,22 @@ mod tests {
             let lit = rng.random_range(1..5usize);
             for _ in 0..lit {
                 let p = rng.random_range(0..dim);
-                data[i * dim + p] = if rng.random_range(0..2u32) == 0 { 0.5 } else { 1.0 };
+                data[i * dim + p] = if rng.random_range(0..2u32) == 0 {
+                    0.5
+                } else {
+                    1.0
+                };
             }
         }
         ImageSet::new(n, dim, data).unwrap()
     }
 
-    fn brute_knn(train: &ImageSet, queries: &ImageSet, k: usize, exclude_self: bool) -> Vec<(f64, u32)> {
+    fn brute_knn(
+        train: &ImageSet,
+        queries: &ImageSet,
+        k: usize,
+        exclude_self: bool,
+    ) -> Vec<(f64, u32)> {
         let mut out = Vec::new();
         for i in 0..queries.n {
             let x = queries.row(i);
@@ -1365,7 +1605,12 @@ mod tests {
 
     #[test]
     fn knn_sparse_dense_and_brute_force_agree_with_ties() {
-        for (n, dim, k, seed) in [(300, 40, 5, 1u64), (150, 7, 7, 2), (600, 64, 3, 3), (40, 3, 10, 4)] {
+        for (n, dim, k, seed) in [
+            (300, 40, 5, 1u64),
+            (150, 7, 7, 2),
+            (600, 64, 3, 3),
+            (40, 3, 10, 4),
+        ] {
             let set = tie_data(n, dim, seed);
             let norms: Vec<f64> = set.data.chunks(dim).map(sq_norm).collect();
             let brute = brute_knn(&set, &set, k, true);
@@ -1383,9 +1628,16 @@ mod tests {
                 assert_eq!(&nb[..], &brute_q[i * k..(i + 1) * k], "sparse query {i}");
             }
             let qn: Vec<f64> = q.data.chunks(dim).map(sq_norm).collect();
-            assert_eq!(dense_knn(&set.data, n, dim, &norms, &q.data, q.n, &qn, k, false), brute_q);
+            assert_eq!(
+                dense_knn(&set.data, n, dim, &norms, &q.data, q.n, &qn, k, false),
+                brute_q
+            );
             // Ties really occur: some query has equal distances among its neighbours.
-            assert!(brute.chunks(k).any(|c| c.windows(2).any(|w| w[0].0 == w[1].0)));
+            assert!(
+                brute
+                    .chunks(k)
+                    .any(|c| c.windows(2).any(|w| w[0].0 == w[1].0))
+            );
         }
     }
 
@@ -1401,9 +1653,16 @@ mod tests {
             data[i * dim + (i * 13) % dim] += 0.25;
         }
         let set = ImageSet::new(n, dim, data).unwrap();
-        let iso = Isomap { n_neighbors: 8, ..Default::default() };
-        let (mut es, zs) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse).unwrap();
-        let (mut ed, zd) = iso.fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense).unwrap();
+        let iso = Isomap {
+            n_neighbors: 8,
+            ..Default::default()
+        };
+        let (mut es, zs) = iso
+            .fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Sparse)
+            .unwrap();
+        let (mut ed, zd) = iso
+            .fit_with(&set, 2, &mut stream_named(1, "l"), KnnPath::Dense)
+            .unwrap();
         assert!(es.uses_sparse_index() && !ed.uses_sparse_index());
         assert_eq!(zs, zd);
         assert_eq!(es.encode(&set).unwrap(), ed.encode(&set).unwrap());
@@ -1416,7 +1675,15 @@ mod tests {
     #[test]
     fn dijkstra_on_a_known_graph() {
         // 0 -1- 1 -1- 2 -1- 3, shortcut 0 -2.5- 3, pendant 4 -0.5- 2, zero edge 5 -0- 4.
-        let und = [(0u32, 1u32, 1.0), (1, 2, 1.0), (2, 3, 1.0), (0, 3, 2.5), (4, 2, 0.5), (5, 4, 0.0), (0, 1, 3.0)];
+        let und = [
+            (0u32, 1u32, 1.0),
+            (1, 2, 1.0),
+            (2, 3, 1.0),
+            (0, 3, 2.5),
+            (4, 2, 0.5),
+            (5, 4, 0.0),
+            (0, 1, 3.0),
+        ];
         let mut e = Vec::new();
         for &(a, b, w) in &und {
             e.push((a, b, w));
@@ -1486,7 +1753,12 @@ mod tests {
         assert!(g.zero_classes().1 < n);
         let d = g.all_pairs();
         for i in 0..n * n {
-            assert!((d[i] as f64 - fw[i]).abs() <= 1e-5 * fw[i].max(1.0), "{i}: {} vs {}", d[i], fw[i]);
+            assert!(
+                (d[i] as f64 - fw[i]).abs() <= 1e-5 * fw[i].max(1.0),
+                "{i}: {} vs {}",
+                d[i],
+                fw[i]
+            );
         }
     }
 
@@ -1540,10 +1812,20 @@ mod tests {
         let mut sorted = spec.clone();
         sorted.sort_by(|a, b| b.total_cmp(a));
         for c in 0..d {
-            assert!((vals[c] - sorted[c]).abs() <= 1e-10 * 150.0, "eigenvalue {c}: {} vs {}", vals[c], sorted[c]);
+            assert!(
+                (vals[c] - sorted[c]).abs() <= 1e-10 * 150.0,
+                "eigenvalue {c}: {} vs {}",
+                vals[c],
+                sorted[c]
+            );
             // Residual of the returned vector.
             let v = &vecs[c * n..(c + 1) * n];
-            let r: f64 = (0..n).map(|i| ((0..n).map(|j| a[i + j * n] * v[j]).sum::<f64>() - vals[c] * v[i]).powi(2)).sum::<f64>().sqrt();
+            let r: f64 = (0..n)
+                .map(|i| {
+                    ((0..n).map(|j| a[i + j * n] * v[j]).sum::<f64>() - vals[c] * v[i]).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
             assert!(r <= 1e-9 * 150.0, "residual {c}: {r}");
         }
         // Same as the dense solver on the eigenvalues.

@@ -12,7 +12,9 @@
 use rand_distr::{Distribution, StandardNormal};
 
 use super::sparse::SparseRows;
-use super::{check_fit_input, check_latents, Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use super::{
+    Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
+};
 use crate::seed::Stream;
 
 /// Non-centred truncated SVD with the randomized range finder (Halko et al. 2011), as
@@ -29,7 +31,11 @@ pub struct TruncatedSvd {
 
 impl Default for TruncatedSvd {
     fn default() -> Self {
-        TruncatedSvd { n_oversamples: 10, n_iter: 5, centre: false }
+        TruncatedSvd {
+            n_oversamples: 10,
+            n_iter: 5,
+            centre: false,
+        }
     }
 }
 
@@ -52,7 +58,10 @@ impl Encoder for ProjectionEncoder {
     }
     fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
         if images.dim != self.dim {
-            return Err(ReprError::InvalidInput(format!("images have {} pixels, the model {}", images.dim, self.dim)));
+            return Err(ReprError::InvalidInput(format!(
+                "images have {} pixels, the model {}",
+                images.dim, self.dim
+            )));
         }
         let mut z = SparseRows::from_images(images).mul_dense(&self.components, self.latents);
         for row in z.chunks_exact_mut(self.latents) {
@@ -60,13 +69,19 @@ impl Encoder for ProjectionEncoder {
                 *v -= o;
             }
         }
-        let z = Latents { n: images.n, latents: self.latents, data: z };
+        let z = Latents {
+            n: images.n,
+            latents: self.latents,
+            data: z,
+        };
         check_latents(&z, "pca")?;
         Ok(z)
     }
     fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
         if image.len() != self.dim || out.len() != self.latents {
-            return Err(ReprError::InvalidInput("encode_one: wrong image or output size".into()));
+            return Err(ReprError::InvalidInput(
+                "encode_one: wrong image or output size".into(),
+            ));
         }
         for (o, off) in out.iter_mut().zip(&self.offset) {
             *o = -off;
@@ -88,7 +103,12 @@ impl RepresentationLearner for TruncatedSvd {
         if self.centre { "pca-centred" } else { "pca" }
     }
 
-    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         check_fit_input(images, latents)?;
         let x = SparseRows::from_images(images);
         let (n, p) = (images.n, images.dim);
@@ -103,7 +123,9 @@ impl RepresentationLearner for TruncatedSvd {
         let mul = |b: &[f64]| {
             let mut out = x.mul_dense(b, k);
             if self.centre {
-                let mb: Vec<f64> = (0..k).map(|t| (0..p).map(|j| mean[j] * b[j * k + t]).sum()).collect();
+                let mb: Vec<f64> = (0..k)
+                    .map(|t| (0..p).map(|j| mean[j] * b[j * k + t]).sum())
+                    .collect();
                 for row in out.chunks_exact_mut(k) {
                     row.iter_mut().zip(&mb).for_each(|(v, m)| *v -= m);
                 }
@@ -164,8 +186,16 @@ impl RepresentationLearner for TruncatedSvd {
                 components[r * latents + t] = best.1 * v / sigma;
             }
         }
-        let offset: Vec<f64> = (0..latents).map(|t| (0..p).map(|j| mean[j] * components[j * latents + t]).sum()).collect();
-        let mut enc = ProjectionEncoder { components, dim: p, latents, singular_values, offset };
+        let offset: Vec<f64> = (0..latents)
+            .map(|t| (0..p).map(|j| mean[j] * components[j * latents + t]).sum())
+            .collect();
+        let mut enc = ProjectionEncoder {
+            components,
+            dim: p,
+            latents,
+            singular_values,
+            offset,
+        };
         let z = enc.encode(images)?;
         Ok((Box::new(enc), z))
     }
@@ -176,7 +206,10 @@ impl RepresentationLearner for TruncatedSvd {
 fn orthonormalize(a: &mut [f64], m: usize, k: usize) {
     let mut before = vec![0.0; k];
     for (j, b) in before.iter_mut().enumerate() {
-        *b = (0..m).map(|i| a[i * k + j] * a[i * k + j]).sum::<f64>().sqrt();
+        *b = (0..m)
+            .map(|i| a[i * k + j] * a[i * k + j])
+            .sum::<f64>()
+            .sqrt();
     }
     for pass in 0..2 {
         for j in 0..k {
@@ -186,7 +219,10 @@ fn orthonormalize(a: &mut [f64], m: usize, k: usize) {
                     a[i * k + j] -= dot * a[i * k + q];
                 }
             }
-            let norm = (0..m).map(|i| a[i * k + j] * a[i * k + j]).sum::<f64>().sqrt();
+            let norm = (0..m)
+                .map(|i| a[i * k + j] * a[i * k + j])
+                .sum::<f64>()
+                .sqrt();
             let dead = norm <= 1e-300 || (pass == 0 && norm <= 1e-10 * before[j]);
             let inv = if dead { 0.0 } else { 1.0 / norm };
             for i in 0..m {
@@ -206,7 +242,10 @@ pub fn jacobi_eigen(a: &[f64], k: usize) -> (Vec<(f64, usize)>, Vec<f64>) {
         v[i * k + i] = 1.0;
     }
     for _sweep in 0..100 {
-        let off: f64 = (0..k).flat_map(|i| (0..k).filter(move |&j| j != i).map(move |j| (i, j))).map(|(i, j)| m[i * k + j].powi(2)).sum();
+        let off: f64 = (0..k)
+            .flat_map(|i| (0..k).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| m[i * k + j].powi(2))
+            .sum();
         let total: f64 = m.iter().map(|x| x * x).sum();
         if off <= 1e-30 * total.max(1e-300) {
             break;
@@ -253,8 +292,17 @@ impl RepresentationLearner for CentredPca {
     fn name(&self) -> &str {
         "pca-centred"
     }
-    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
-        TruncatedSvd { centre: true, ..Default::default() }.fit(images, latents, rng)
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        TruncatedSvd {
+            centre: true,
+            ..Default::default()
+        }
+        .fit(images, latents, rng)
     }
 }
 
@@ -266,12 +314,19 @@ mod tests {
     /// A hand-computable case: rows (3,0), (0,1), (3,0), (0,1) (plus a zero pixel). X^T X =
     /// diag(18, 2): singular values sqrt(18), sqrt(2), right singular vectors e1, e2.
     fn toy() -> ImageSet {
-        ImageSet::new(4, 3, vec![3.0, 0.0, 0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 1.0, 0.0]).unwrap()
+        ImageSet::new(
+            4,
+            3,
+            vec![3.0, 0.0, 0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        )
+        .unwrap()
     }
 
     #[test]
     fn truncated_svd_hand_case_is_not_centred() {
-        let (mut enc, z) = TruncatedSvd::default().fit(&toy(), 2, &mut stream_named(0, "t")).unwrap();
+        let (mut enc, z) = TruncatedSvd::default()
+            .fit(&toy(), 2, &mut stream_named(0, "t"))
+            .unwrap();
         // Non-centred: the first latent of row 0 is its projection on e1 = 3 (sign fixed positive).
         let expected = [3.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0];
         for (a, b) in z.data.iter().zip(expected) {
@@ -279,13 +334,18 @@ mod tests {
         }
         let mut out = [0.0; 2];
         enc.encode_one(&[0.0, 2.0, 0.0], &mut out).unwrap();
-        assert!((out[0]).abs() < 1e-9 && (out[1] - 2.0).abs() < 1e-9, "{out:?}");
+        assert!(
+            (out[0]).abs() < 1e-9 && (out[1] - 2.0).abs() < 1e-9,
+            "{out:?}"
+        );
     }
 
     #[test]
     fn centred_pca_hand_case() {
         // Centred data: rows (1.5,-0.5), (-1.5,0.5) ... all variance along (3,-1)/sqrt(10).
-        let (_, z) = CentredPca.fit(&toy(), 1, &mut stream_named(0, "t")).unwrap();
+        let (_, z) = CentredPca
+            .fit(&toy(), 1, &mut stream_named(0, "t"))
+            .unwrap();
         let s = 1.5f64.hypot(0.5);
         for (i, v) in z.data.iter().enumerate() {
             assert!((v.abs() - s).abs() < 1e-9, "{:?}", z.data);
@@ -309,15 +369,24 @@ mod tests {
         let set = ImageSet::new(80, 30, data).unwrap();
         let (_, ours) = CentredPca.fit(&set, 3, &mut stream_named(5, "t")).unwrap();
         let arr = ndarray::Array2::from_shape_fn((80, 30), |(i, j)| set.data[i * 30 + j] as f64);
-        let model = linfa_reduction::Pca::params(3).fit(&linfa::DatasetBase::from(arr.clone())).unwrap();
+        let model = linfa_reduction::Pca::params(3)
+            .fit(&linfa::DatasetBase::from(arr.clone()))
+            .unwrap();
         let theirs: ndarray::Array2<f64> = model.predict(&arr);
         for t in 0..3 {
             // Same component up to sign.
             let dot: f64 = (0..80).map(|i| ours.row(i)[t] * theirs[[i, t]]).sum();
             let n1: f64 = (0..80).map(|i| ours.row(i)[t].powi(2)).sum::<f64>().sqrt();
             let n2: f64 = (0..80).map(|i| theirs[[i, t]].powi(2)).sum::<f64>().sqrt();
-            assert!((dot.abs() / (n1 * n2) - 1.0).abs() < 1e-6, "component {t}: cos {}", dot / (n1 * n2));
-            assert!((n1 - n2).abs() < 1e-6 * n2, "component {t}: norms {n1} {n2}");
+            assert!(
+                (dot.abs() / (n1 * n2) - 1.0).abs() < 1e-6,
+                "component {t}: cos {}",
+                dot / (n1 * n2)
+            );
+            assert!(
+                (n1 - n2).abs() < 1e-6 * n2,
+                "component {t}: norms {n1} {n2}"
+            );
         }
     }
 
@@ -338,7 +407,13 @@ mod tests {
     fn randomized_matches_exact_on_low_rank_data() {
         // 60 images that are mixtures of 3 fixed patterns: the top-3 subspace is exact.
         let mut rng = stream_named(3, "t");
-        let pats: Vec<Vec<f32>> = (0..3).map(|k| (0..50).map(|j| if j % (k + 2) == 0 { 1.0 } else { 0.0 }).collect()).collect();
+        let pats: Vec<Vec<f32>> = (0..3)
+            .map(|k| {
+                (0..50)
+                    .map(|j| if j % (k + 2) == 0 { 1.0 } else { 0.0 })
+                    .collect()
+            })
+            .collect();
         let mut data = Vec::new();
         for _ in 0..60 {
             let w: Vec<f64> = (0..3).map(|_| StandardNormal.sample(&mut rng)).collect();
@@ -347,14 +422,18 @@ mod tests {
             }
         }
         let set = ImageSet::new(60, 50, data).unwrap();
-        let (enc, z) = TruncatedSvd::default().fit(&set, 3, &mut stream_named(1, "t")).unwrap();
+        let (enc, z) = TruncatedSvd::default()
+            .fit(&set, 3, &mut stream_named(1, "t"))
+            .unwrap();
         let _ = enc;
         // Energy is preserved: ||X||_F^2 == ||Z||_F^2 for rank-3 data.
         let ex: f64 = set.data.iter().map(|v| (*v as f64).powi(2)).sum();
         let ez: f64 = z.data.iter().map(|v| v * v).sum();
         assert!((ex - ez).abs() < 1e-6 * ex, "{ex} {ez}");
         // Deterministic for a stream.
-        let (_, z2) = TruncatedSvd::default().fit(&set, 3, &mut stream_named(1, "t")).unwrap();
+        let (_, z2) = TruncatedSvd::default()
+            .fit(&set, 3, &mut stream_named(1, "t"))
+            .unwrap();
         assert_eq!(z, z2);
     }
 }

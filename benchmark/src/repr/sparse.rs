@@ -28,13 +28,22 @@ impl SparseRows {
             }
             indptr.push(indices.len());
         }
-        SparseRows { n_rows: images.n, n_cols: images.dim, indptr, indices, values }
+        SparseRows {
+            n_rows: images.n,
+            n_cols: images.dim,
+            indptr,
+            indices,
+            values,
+        }
     }
 
     /// Row `i` as (column, value) pairs.
     pub fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let r = self.indptr[i]..self.indptr[i + 1];
-        self.indices[r.clone()].iter().map(|&c| c as usize).zip(self.values[r].iter().copied())
+        self.indices[r.clone()]
+            .iter()
+            .map(|&c| c as usize)
+            .zip(self.values[r].iter().copied())
     }
 
     /// `self (n x p) * b (p x k, row-major)` -> n x k row-major.
@@ -74,7 +83,9 @@ mod tests {
 
     #[test]
     fn products_match_dense() {
-        let data: Vec<f32> = (0..12).map(|i| if i % 3 == 0 { 0.0 } else { i as f32 * 0.1 }).collect();
+        let data: Vec<f32> = (0..12)
+            .map(|i| if i % 3 == 0 { 0.0 } else { i as f32 * 0.1 })
+            .collect();
         let set = ImageSet::new(3, 4, data.clone()).unwrap();
         let s = SparseRows::from_images(&set);
         let b: Vec<f64> = (0..8).map(|i| i as f64 - 3.0).collect(); // 4 x 2
