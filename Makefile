@@ -44,15 +44,13 @@ campaign: check-toolchain
 bench: check-toolchain
 	$(CARGO) bench -p ugl-bench --profile dev  # rollout, render, nn_query, klc, isomap
 
-# Reproducibility check: the smoke campaign's result files must hash to the committed checksums.
-# A change that alters results shows up here (and in review, as a change of the checksum file:
-# `make verify-update`).
+# Reproducibility check: the smoke campaign's result files must hash to the committed checksums
+# (`tests/verify_smoke.rs`, also part of `make test`, so CI builds the binary once). A change that
+# alters results shows up here, and in review as a change of data/checksums/smoke.sha256
+# (`make verify-update`).
 VERIFY_DIR ?= target/verify-smoke
 verify: check-toolchain
-	rm -rf $(VERIFY_DIR)
-	$(UGL) campaign --config data/campaigns/smoke.toml --out $(VERIFY_DIR) --quiet
-	cd $(VERIFY_DIR) && sha256sum *.parquet | diff -u $(CURDIR)/data/checksums/smoke.sha256 - \
-	  && echo "verify: $$(wc -l < $(CURDIR)/data/checksums/smoke.sha256) result files identical to data/checksums/smoke.sha256"
+	$(CARGO) test --test verify_smoke
 
 verify-update: check-toolchain
 	rm -rf $(VERIFY_DIR)
