@@ -6,11 +6,16 @@
 //! [`registry`]. The conformance suite (`benchmark/tests/learner_conformance.rs`) runs against
 //! every registered learner.
 
+pub mod ae;
 pub mod dataset;
 pub mod external;
 pub mod isomap;
+pub mod nets;
+pub mod neural;
 pub mod pca;
+pub mod rfvae;
 pub mod sparse;
+pub mod vae;
 
 use thiserror::Error;
 
@@ -29,7 +34,10 @@ impl ImageSet {
     /// Wrap row-major data; `data.len()` must be `n * dim`.
     pub fn new(n: usize, dim: usize, data: Vec<f32>) -> Result<Self, ReprError> {
         if data.len() != n * dim {
-            return Err(ReprError::InvalidInput(format!("image data has {} values, expected {n} x {dim}", data.len())));
+            return Err(ReprError::InvalidInput(format!(
+                "image data has {} values, expected {n} x {dim}",
+                data.len()
+            )));
         }
         Ok(ImageSet { n, dim, data })
     }
@@ -106,7 +114,12 @@ pub trait RepresentationLearner: Send + Sync {
     /// Fit on `images` with `latents` output dimensions. `rng` is the learner's own stream
     /// (initialisation, mini-batches, randomized solvers): same stream, same encoder.
     /// Returns the encoder and the encodings of the training images.
-    fn fit(&self, images: &ImageSet, latents: usize, rng: &mut Stream) -> Result<(Box<dyn Encoder>, Latents), ReprError>;
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError>;
 }
 
 /// Check the common preconditions of a fit.
@@ -115,7 +128,10 @@ pub fn check_fit_input(images: &ImageSet, latents: usize) -> Result<(), ReprErro
         return Err(ReprError::InvalidInput("latents must be at least 1".into()));
     }
     if images.n < 2 {
-        return Err(ReprError::InvalidInput(format!("need at least 2 training images, got {}", images.n)));
+        return Err(ReprError::InvalidInput(format!(
+            "need at least 2 training images, got {}",
+            images.n
+        )));
     }
     if latents > images.dim || latents >= images.n {
         return Err(ReprError::InvalidInput(format!(
@@ -124,7 +140,9 @@ pub fn check_fit_input(images: &ImageSet, latents: usize) -> Result<(), ReprErro
         )));
     }
     if images.data.iter().any(|v| !v.is_finite()) {
-        return Err(ReprError::InvalidInput("training images contain a non-finite value".into()));
+        return Err(ReprError::InvalidInput(
+            "training images contain a non-finite value".into(),
+        ));
     }
     Ok(())
 }
@@ -132,10 +150,19 @@ pub fn check_fit_input(images: &ImageSet, latents: usize) -> Result<(), ReprErro
 /// Check an encoder's output: right shape, finite.
 pub fn check_latents(z: &Latents, who: &str) -> Result<(), ReprError> {
     if z.data.len() != z.n * z.latents {
-        return Err(ReprError::Numerical(format!("{who}: latents have {} values, expected {} x {}", z.data.len(), z.n, z.latents)));
+        return Err(ReprError::Numerical(format!(
+            "{who}: latents have {} values, expected {} x {}",
+            z.data.len(),
+            z.n,
+            z.latents
+        )));
     }
     if let Some(i) = z.data.iter().position(|v| !v.is_finite()) {
-        return Err(ReprError::Numerical(format!("{who}: non-finite latent (image {}, dimension {})", i / z.latents.max(1), i % z.latents.max(1))));
+        return Err(ReprError::Numerical(format!(
+            "{who}: non-finite latent (image {}, dimension {})",
+            i / z.latents.max(1),
+            i % z.latents.max(1)
+        )));
     }
     Ok(())
 }

@@ -1,0 +1,574 @@
+//! The neural representation learners of the paper (AE, VAE, RFVAE; PAPER-NOTES.md section 5):
+//! configuration, the training loop and the fitted encoder. The model-specific parts (loss,
+//! encoding) live in `ae.rs`, `vae.rs` and `rfvae.rs`; the layers and optimisers in `nets.rs`.
+//!
+//! Training (all three models), as the original's `BaseNetwork.train`:
+//! - weights drawn on the host from the learner stream ([`HostNet::init`]), loaded into a burn
+//!   module on `Device::flex().autodiff()`;
+//! - each iteration: the first `batch` indices of a fresh uniform permutation of the training
+//!   set (a partial Fisher-Yates shuffle: `batch` draws `random_range(i..n)` from the learner
+//!   stream), then the model's noise (VAE/RFVAE: standard normals from the same stream), a
+//!   forward pass, the loss, backward, and one optimiser step with element-wise gradient
+//!   clipping to [-1, 1];
+//! - the loss of every iteration is checked (NaN/inf -> [`ReprError::Numerical`]) and recorded
+//!   every `log_every` iterations.
+//!
+//! Nothing draws from burn's RNG, so the result is a function of the stream alone. Encoding
+//! runs on the host ([`HostNet::encode_head`]), image by image, so a batch encode and
+//! `encode_one` agree bit for bit and neither depends on the thread count.
+
+use std::sync::Arc;
+
+use burn::module::Module as _;
+use burn::optim::{GradientsParams, ModuleOptimizer};
+use burn::tensor::{Device, Tensor, TensorData};
+use rand::{Rng, RngExt, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::nets::{DenseNet, HostNet, Scratch, TfAdagrad, TfAdam};
+use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_input, check_latents};
+use crate::repr::{ae, rfvae, vae};
+use crate::seed::Stream;
+
+/// Which network.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Model {
+    /// Dense auto-encoder, sigmoid latents, Adagrad.
+    Ae,
+    /// Dense VAE, Adam.
+    Vae,
+    /// Dense VAE with 10 amortised radial flows, KL warm-up, Adam.
+    Rfvae,
+}
+
+impl Model {
+    /// All three.
+    pub const ALL: [Model; 3] = [Model::Ae, Model::Vae, Model::Rfvae];
+
+    /// `ae`, `vae`, `rfvae`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Ae => "ae",
+            Model::Vae => "vae",
+            Model::Rfvae => "rfvae",
+        }
+    }
+
+    /// The widths of the encoder's head blocks for `latents` dimensions.
+    pub fn head_blocks(self, latents: usize) -> Vec<usize> {
+        match self {
+            Model::Ae => vec![latents],
+            Model::Vae => vec![latents, latents],
+            Model::Rfvae => rfvae::head_blocks(latents),
+        }
+    }
+
+    /// The paper's training length (the original's `fit`: AE 2e5, VAE 1e5, RFVAE 5e4).
+    pub fn paper_iterations(self) -> usize {
+        match self {
+            Model::Ae => 200_000,
+            Model::Vae => 100_000,
+            Model::Rfvae => 50_000,
+        }
+    }
+}
+
+/// Paper-faithful or corrected behaviour where the original code has a defect.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Variant {
+    /// What the original code did, defects included (see `vae.rs`, `rfvae.rs`).
+    #[default]
+    Faithful,
+    /// The defects fixed. The AE has none: both variants are identical.
+    Corrected,
+}
+
+impl Variant {
+    /// `faithful` / `corrected`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Faithful => "faithful",
+            Variant::Corrected => "corrected",
+        }
+    }
+}
+
+/// Training configuration of a neural learner. Every field is required in serde form (it is the
+/// complete, hashable description of a training run); [`NeuralSection`] is the partial form for
+/// configuration files, with the paper's values per model as defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeuralConfig {
+    /// Optimiser steps.
+    pub iterations: usize,
+    /// Hidden sizes `[H1, H2]` (paper: 1200, 1200).
+    pub hidden: [usize; 2],
+    /// Mini-batch size (paper: 100; capped at the training set size).
+    pub batch: usize,
+    /// Learning rate (paper: 1e-3).
+    pub lr: f64,
+    /// Faithful or corrected.
+    pub variant: Variant,
+    /// Record the loss every this many iterations (the original logged every 100).
+    pub log_every: usize,
+}
+
+impl NeuralConfig {
+    /// The paper's configuration of `model`, faithful variant.
+    pub fn paper(model: Model) -> NeuralConfig {
+        NeuralConfig {
+            iterations: model.paper_iterations(),
+            hidden: [1200, 1200],
+            batch: 100,
+            lr: 1e-3,
+            variant: Variant::Faithful,
+            log_every: 100,
+        }
+    }
+
+    /// Check every value; the message names the key.
+    pub fn validate(&self, who: &str) -> Result<(), ReprError> {
+        let bad = |msg: String| Err(ReprError::InvalidInput(format!("{who}: {msg}")));
+        if self.iterations == 0 {
+            return bad("iterations must be at least 1".into());
+        }
+        if self.batch == 0 {
+            return bad("batch must be at least 1".into());
+        }
+        if self.hidden.contains(&0) {
+            return bad(format!(
+                "hidden sizes must be at least 1, got {:?}",
+                self.hidden
+            ));
+        }
+        if !(self.lr.is_finite() && self.lr > 0.0) {
+            return bad(format!("lr must be positive and finite, got {}", self.lr));
+        }
+        if self.log_every == 0 {
+            return bad("log_every must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// The partial form of [`NeuralConfig`] for configuration files: missing keys take the paper's
+/// value for the model ([`NeuralSection::resolve`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NeuralSection {
+    pub iterations: Option<usize>,
+    pub hidden: Option<[usize; 2]>,
+    pub batch: Option<usize>,
+    pub lr: Option<f64>,
+    pub variant: Option<Variant>,
+    pub log_every: Option<usize>,
+}
+
+impl NeuralSection {
+    /// The complete configuration for `model`.
+    pub fn resolve(&self, model: Model) -> NeuralConfig {
+        let p = NeuralConfig::paper(model);
+        NeuralConfig {
+            iterations: self.iterations.unwrap_or(p.iterations),
+            hidden: self.hidden.unwrap_or(p.hidden),
+            batch: self.batch.unwrap_or(p.batch),
+            lr: self.lr.unwrap_or(p.lr),
+            variant: self.variant.unwrap_or(p.variant),
+            log_every: self.log_every.unwrap_or(p.log_every),
+        }
+    }
+}
+
+/// Progress of a training run, reported after every iteration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrainProgress {
+    /// Iterations done (1-based).
+    pub iteration: usize,
+    /// Iterations in all.
+    pub total: usize,
+    /// The loss of this iteration's mini-batch.
+    pub loss: f64,
+}
+
+/// A progress callback (e.g. driving an indicatif bar).
+pub type ProgressFn = Arc<dyn Fn(TrainProgress) + Send + Sync>;
+
+/// A fitted neural encoder. `losses` is the recorded loss curve: `(iteration, loss)` pairs,
+/// iteration 0-based, every `log_every` iterations plus the last.
+pub struct NeuralEncoder {
+    pub model: Model,
+    pub variant: Variant,
+    pub net: HostNet,
+    pub losses: Vec<(usize, f64)>,
+    /// The stream of the faithful RFVAE's stochastic encoding (unused by the others).
+    rng: Stream,
+    scratch: Scratch,
+}
+
+impl std::fmt::Debug for NeuralEncoder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NeuralEncoder")
+            .field("model", &self.model)
+            .field("variant", &self.variant)
+            .field("dim", &self.net.dim)
+            .field("hidden", &self.net.hidden)
+            .field("latents", &self.net.latents)
+            .field("losses", &self.losses.len())
+            .finish()
+    }
+}
+
+impl NeuralEncoder {
+    /// An encoder from trained weights; `encode_seed` seeds the stream of the stochastic
+    /// (faithful RFVAE) encoding.
+    pub fn new(
+        model: Model,
+        variant: Variant,
+        net: HostNet,
+        losses: Vec<(usize, f64)>,
+        encode_seed: [u8; 32],
+    ) -> Self {
+        NeuralEncoder {
+            model,
+            variant,
+            net,
+            losses,
+            rng: Stream::from_seed(encode_seed),
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// Whether encoding draws random numbers (the faithful RFVAE).
+    pub fn is_stochastic(&self) -> bool {
+        self.model == Model::Rfvae && self.variant == Variant::Faithful
+    }
+
+    fn encode_row(&mut self, image: &[f32], out: &mut [f64]) {
+        let head = self.net.encode_head(image, &mut self.scratch);
+        let d = self.net.latents;
+        match self.model {
+            Model::Ae => ae::encoding(&head, d, out),
+            Model::Vae => vae::encoding(&head, d, out),
+            Model::Rfvae => rfvae::encoding(&head, d, self.variant, &mut self.rng, out),
+        }
+    }
+
+    fn check_dim(&self, dim: usize) -> Result<(), ReprError> {
+        if dim != self.net.dim {
+            return Err(ReprError::InvalidInput(format!(
+                "images have {dim} pixels, the model {}",
+                self.net.dim
+            )));
+        }
+        Ok(())
+    }
+
+    /// The training latents (what the KDE is fitted on). Faithful RFVAE: z0 samples
+    /// `mu + eps sigma` (the original's `transform(X, sampling=True)`); otherwise the encoding.
+    pub fn training_latents(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        if !self.is_stochastic() {
+            return self.encode(images);
+        }
+        self.check_dim(images.dim)?;
+        let d = self.net.latents;
+        let mut data = vec![0.0; images.n * d];
+        for (i, out) in data.chunks_exact_mut(d).enumerate() {
+            let head = self.net.encode_head(images.row(i), &mut self.scratch);
+            rfvae::z0_sample(&head, d, &mut self.rng, out);
+        }
+        let z = Latents {
+            n: images.n,
+            latents: d,
+            data,
+        };
+        check_latents(&z, self.model.name())?;
+        Ok(z)
+    }
+}
+
+impl Encoder for NeuralEncoder {
+    fn latents(&self) -> usize {
+        self.net.latents
+    }
+
+    fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        self.check_dim(images.dim)?;
+        let d = self.net.latents;
+        let mut data = vec![0.0; images.n * d];
+        if self.is_stochastic() {
+            // Sequential: the noise is drawn image by image from the encoder's stream.
+            for (i, out) in data.chunks_exact_mut(d).enumerate() {
+                self.encode_row(images.row(i), out);
+            }
+        } else {
+            let (net, model) = (&self.net, self.model);
+            let variant = self.variant;
+            data.par_chunks_mut(d).enumerate().for_each_init(
+                Scratch::default,
+                |scratch, (i, out)| {
+                    let head = net.encode_head(images.row(i), scratch);
+                    match model {
+                        Model::Ae => ae::encoding(&head, d, out),
+                        Model::Vae => vae::encoding(&head, d, out),
+                        Model::Rfvae => rfvae::encoding_deterministic(&head, d, variant, out),
+                    }
+                },
+            );
+        }
+        let z = Latents {
+            n: images.n,
+            latents: d,
+            data,
+        };
+        check_latents(&z, self.model.name())?;
+        Ok(z)
+    }
+
+    fn encode_one(&mut self, image: &[f32], out: &mut [f64]) -> Result<(), ReprError> {
+        if image.len() != self.net.dim || out.len() != self.net.latents {
+            return Err(ReprError::InvalidInput(format!(
+                "encode_one: image of {} pixels / output of {} values, the model takes {} / {}",
+                image.len(),
+                out.len(),
+                self.net.dim,
+                self.net.latents
+            )));
+        }
+        self.encode_row(image, out);
+        if let Some(j) = out.iter().position(|v| !v.is_finite()) {
+            return Err(ReprError::Numerical(format!(
+                "{}: non-finite latent (dimension {j})",
+                self.model.name()
+            )));
+        }
+        Ok(())
+    }
+
+    fn prior(&self) -> Option<GaussianPrior> {
+        match self.model {
+            Model::Ae => None,
+            Model::Vae | Model::Rfvae => Some(GaussianPrior {
+                mean: vec![0.0; self.net.latents],
+                std: vec![1.0; self.net.latents],
+            }),
+        }
+    }
+}
+
+/// What one training iteration's loss needs besides the network and the batch.
+pub struct StepInput<'a> {
+    pub x: Tensor<2>,
+    pub batch: usize,
+    pub latents: usize,
+    /// 0-based iteration.
+    pub step: usize,
+    pub variant: Variant,
+    pub device: &'a Device,
+}
+
+/// The initial weights of `model` (a function of the stream only; the variant plays no part).
+pub fn init_net(
+    model: Model,
+    cfg: &NeuralConfig,
+    dim: usize,
+    latents: usize,
+    rng: &mut Stream,
+) -> HostNet {
+    HostNet::init(rng, dim, cfg.hidden, latents, &model.head_blocks(latents))
+}
+
+/// Draw the mini-batch: the first `k` entries of a fresh uniform permutation of `perm`'s
+/// contents (partial Fisher-Yates; `perm` keeps the shuffled order between calls, which does not
+/// bias the next draw).
+pub fn draw_batch(perm: &mut [usize], k: usize, rng: &mut Stream) {
+    let n = perm.len();
+    for i in 0..k.min(n) {
+        let j = rng.random_range(i..n);
+        perm.swap(i, j);
+    }
+}
+
+/// `n` standard normals from `rng`.
+pub fn normals(rng: &mut Stream, n: usize) -> Vec<f32> {
+    (0..n)
+        .map(|_| StandardNormal.sample(rng))
+        .map(|v: f64| v as f32)
+        .collect()
+}
+
+/// A training run in progress: the module, its optimiser and the batch sampler. [`train`]
+/// drives it; the `train_step` bench times [`Trainer::step`].
+pub struct Trainer<'a> {
+    pub model: Model,
+    pub cfg: NeuralConfig,
+    images: &'a ImageSet,
+    latents: usize,
+    device: Device,
+    net: Option<DenseNet>,
+    opt: ModuleOptimizer,
+    perm: Vec<usize>,
+    xbuf: Vec<f32>,
+    /// Iterations done.
+    pub step: usize,
+}
+
+impl<'a> Trainer<'a> {
+    /// Validate, draw the initial weights from `rng` and set up the module and optimiser.
+    pub fn new(
+        model: Model,
+        cfg: &NeuralConfig,
+        images: &'a ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<Self, ReprError> {
+        cfg.validate(model.name())?;
+        check_fit_input(images, latents)?;
+        let host = init_net(model, cfg, images.dim, latents, rng);
+        let device = Device::flex().autodiff();
+        let net = host.to_module(&device);
+        let opt: ModuleOptimizer = match model {
+            Model::Ae => TfAdagrad::default().into(),
+            Model::Vae | Model::Rfvae => TfAdam::default().into(),
+        };
+        let k = cfg.batch.min(images.n);
+        Ok(Trainer {
+            model,
+            cfg: cfg.clone(),
+            images,
+            latents,
+            device,
+            net: Some(net),
+            opt,
+            perm: (0..images.n).collect(),
+            xbuf: vec![0.0; k * images.dim],
+            step: 0,
+        })
+    }
+
+    /// One iteration: batch, noise, forward, loss, backward, optimiser step. Returns the
+    /// mini-batch loss (checked finite).
+    pub fn step(&mut self, rng: &mut Stream) -> Result<f64, ReprError> {
+        let dim = self.images.dim;
+        let k = self.xbuf.len() / dim;
+        draw_batch(&mut self.perm, k, rng);
+        for (row, &i) in self.xbuf.chunks_exact_mut(dim).zip(&self.perm[..k]) {
+            row.copy_from_slice(self.images.row(i));
+        }
+        let x = tensor2(self.xbuf.clone(), k, dim, &self.device);
+        let net = self
+            .net
+            .take()
+            .expect("the module is present between steps");
+        let input = StepInput {
+            x,
+            batch: k,
+            latents: self.latents,
+            step: self.step,
+            variant: self.cfg.variant,
+            device: &self.device,
+        };
+        let loss = match self.model {
+            Model::Ae => ae::loss(&net, input),
+            Model::Vae => vae::loss(&net, input, rng),
+            Model::Rfvae => rfvae::loss(&net, input, rng),
+        };
+        let value = f64::from(loss.clone().into_scalar::<f32>());
+        if !value.is_finite() {
+            return Err(ReprError::Numerical(format!(
+                "{} training diverged at iteration {}: loss = {value}",
+                self.model.name(),
+                self.step
+            )));
+        }
+        let grads = GradientsParams::from_grads(loss.backward(), &net);
+        self.net = Some(self.opt.step(self.cfg.lr, net, grads));
+        self.step += 1;
+        Ok(value)
+    }
+
+    /// The current weights on the host.
+    pub fn host_net(&self) -> Result<HostNet, ReprError> {
+        let net = self
+            .net
+            .as_ref()
+            .expect("the module is present between steps")
+            .valid();
+        HostNet::from_module(&net, self.images.dim, self.cfg.hidden, self.latents)
+    }
+}
+
+/// Train `model` on `images` and return the encoder. The stream is used for: the initial
+/// weights, then per iteration the batch indices and the model's noise, then (after training)
+/// the 32-byte seed of the encoder's own stream.
+pub fn train(
+    model: Model,
+    cfg: &NeuralConfig,
+    images: &ImageSet,
+    latents: usize,
+    rng: &mut Stream,
+    progress: Option<&ProgressFn>,
+) -> Result<NeuralEncoder, ReprError> {
+    let mut trainer = Trainer::new(model, cfg, images, latents, rng)?;
+    let mut losses = Vec::new();
+    for step in 0..cfg.iterations {
+        let value = trainer.step(rng)?;
+        if step % cfg.log_every == 0 || step + 1 == cfg.iterations {
+            losses.push((step, value));
+        }
+        if let Some(p) = progress {
+            p(TrainProgress {
+                iteration: step + 1,
+                total: cfg.iterations,
+                loss: value,
+            });
+        }
+    }
+    let trained = trainer.host_net()?;
+    let mut seed = [0u8; 32];
+    rng.fill_bytes(&mut seed);
+    Ok(NeuralEncoder::new(
+        model,
+        cfg.variant,
+        trained,
+        losses,
+        seed,
+    ))
+}
+
+/// Floating-point operations of one training iteration, counted as `3 x` the forward pass's
+/// `2 m n k` per dense layer (`m` = batch).
+pub fn flops_per_iteration(
+    model: Model,
+    dim: usize,
+    hidden: [usize; 2],
+    latents: usize,
+    batch: usize,
+) -> f64 {
+    let [h1, h2] = hidden;
+    let p: usize = model.head_blocks(latents).iter().sum();
+    let macs = dim * h1 + h1 * h2 + h2 * p + latents * h2 + h2 * h1 + h1 * dim;
+    3.0 * 2.0 * (batch * macs) as f64
+}
+
+/// `train` plus the training latents, as [`super::RepresentationLearner::fit`] returns them.
+pub fn fit(
+    model: Model,
+    cfg: &NeuralConfig,
+    images: &ImageSet,
+    latents: usize,
+    rng: &mut Stream,
+    progress: Option<&ProgressFn>,
+) -> Result<(NeuralEncoder, Latents), ReprError> {
+    let mut enc = train(model, cfg, images, latents, rng, progress)?;
+    let z = enc.training_latents(images)?;
+    Ok((enc, z))
+}
+
+/// Helper for the model files: a `[rows, cols]` tensor from host values.
+pub fn tensor2(values: Vec<f32>, rows: usize, cols: usize, device: &Device) -> Tensor<2> {
+    Tensor::from_data(TensorData::new(values, [rows, cols]), device)
+}

@@ -1,0 +1,124 @@
+//! The paper's dense VAE (`DenseVAE`; PAPER-NOTES.md section 5, "VAE"): the AE's trunk with
+//! linear heads mu and logvar, `z = mu + eps * exp(logvar / 2)`, loss = batch mean of
+//! (pixel-summed Bernoulli cross-entropy + analytic KL(N(mu, sigma^2) || N(0, I))), beta = 1,
+//! no warm-up, TF Adam (lr 1e-3), 100,000 iterations. Encoding = mu; prior = N(0, I).
+//!
+//! Variants (the only difference; initial weights, batches and everything else are the same
+//! for the same stream):
+//! - **faithful**: `eps` has shape `[d]` and is **shared by the whole batch**, as the
+//!   original's `tf.random_normal([emb_size])`: one draw of `d` normals per iteration.
+//! - **corrected**: one `eps` per sample, `[batch, d]`: `batch * d` normals per iteration
+//!   (row-major), the standard reparameterisation.
+
+use std::sync::Arc;
+
+use burn::tensor::Tensor;
+
+use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
+use super::neural::{
+    self, Model, NeuralConfig, NeuralEncoder, ProgressFn, StepInput, TrainProgress, Variant,
+    normals, tensor2,
+};
+use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use crate::seed::Stream;
+
+/// The VAE learner (`vae`).
+#[derive(Clone)]
+pub struct Vae {
+    pub config: NeuralConfig,
+    progress: Option<ProgressFn>,
+}
+
+impl Vae {
+    /// With a configuration.
+    pub fn new(config: NeuralConfig) -> Self {
+        Vae {
+            config,
+            progress: None,
+        }
+    }
+
+    /// The paper's configuration.
+    pub fn paper() -> Self {
+        Vae::new(NeuralConfig::paper(Model::Vae))
+    }
+
+    /// Report every training iteration to `f`.
+    pub fn with_progress(mut self, f: Arc<dyn Fn(TrainProgress) + Send + Sync>) -> Self {
+        self.progress = Some(f);
+        self
+    }
+
+    /// Fit and return the concrete encoder (with its loss curve) and the training latents.
+    pub fn fit_neural(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(NeuralEncoder, Latents), ReprError> {
+        neural::fit(
+            Model::Vae,
+            &self.config,
+            images,
+            latents,
+            rng,
+            self.progress.as_ref(),
+        )
+    }
+}
+
+impl std::fmt::Debug for Vae {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Vae").field("config", &self.config).finish()
+    }
+}
+
+impl RepresentationLearner for Vae {
+    fn name(&self) -> &str {
+        "vae"
+    }
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let (enc, z) = self.fit_neural(images, latents, rng)?;
+        Ok((Box::new(enc), z))
+    }
+}
+
+/// The reparameterisation noise of one iteration: `[1, d]` (faithful: shared by the batch,
+/// broadcast) or `[batch, d]` (corrected).
+pub fn eps(
+    variant: Variant,
+    batch: usize,
+    d: usize,
+    rng: &mut Stream,
+    device: &burn::tensor::Device,
+) -> Tensor<2> {
+    let rows = match variant {
+        Variant::Faithful => 1,
+        Variant::Corrected => batch,
+    };
+    tensor2(normals(rng, rows * d), rows, d, device)
+}
+
+/// The training loss of one mini-batch: `mean_b (sum_pixels BCE + KL)`.
+pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
+    let d = input.latents;
+    let heads = net.heads(input.x.clone());
+    let mu = heads.clone().narrow(1, 0, d);
+    let logvar = heads.narrow(1, d, d);
+    let e = eps(input.variant, input.batch, d, rng, input.device);
+    let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
+    let rec = bce_with_logits_sum(net.decode(z), input.x);
+    (rec + kl_std_normal(mu, logvar)).mean()
+}
+
+/// Encoding from the head outputs: mu.
+pub fn encoding(head: &[f32], d: usize, out: &mut [f64]) {
+    for (o, &h) in out.iter_mut().zip(&head[..d]) {
+        *o = f64::from(h);
+    }
+}
