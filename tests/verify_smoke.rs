@@ -9,10 +9,19 @@ use std::process::Command;
 #[test]
 fn smoke_campaign_matches_the_committed_checksums() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let expected = std::fs::read_to_string(root.join("data/checksums/smoke.sha256")).expect("committed checksums");
+    let expected = std::fs::read_to_string(root.join("data/checksums/smoke.sha256"))
+        .expect("committed checksums");
     let dir = tempfile::tempdir().unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_ugl"))
-        .args(["campaign", "--config", "data/campaigns/smoke.toml", "--quiet", "--jobs", "2", "--out"])
+        .args([
+            "campaign",
+            "--config",
+            "data/campaigns/smoke.toml",
+            "--quiet",
+            "--jobs",
+            "2",
+            "--out",
+        ])
         .arg(dir.path())
         .current_dir(root)
         .output()
@@ -24,11 +33,20 @@ fn smoke_campaign_matches_the_committed_checksums() {
         .filter(|n| n.ends_with(".parquet"))
         .collect();
     files.sort();
-    let sums = Command::new("sha256sum").args(&files).current_dir(dir.path()).output().expect("sha256sum (coreutils) is installed");
+    let sums = Command::new("sha256sum")
+        .args(&files)
+        .current_dir(dir.path())
+        .output()
+        .expect("sha256sum (coreutils) is installed");
     assert!(sums.status.success());
     let got = String::from_utf8(sums.stdout).unwrap();
     let (exp, got): (Vec<&str>, Vec<&str>) = (expected.lines().collect(), got.lines().collect());
     let differing: Vec<&&str> = got.iter().filter(|l| !exp.contains(l)).collect();
     assert_eq!(exp.len(), got.len(), "number of result files changed");
-    assert!(differing.is_empty(), "results changed for {} files, e.g. {:?}; if intended, run `make verify-update` and commit", differing.len(), differing.first());
+    assert!(
+        differing.is_empty(),
+        "results changed for {} files, e.g. {:?}; if intended, run `make verify-update` and commit",
+        differing.len(),
+        differing.first()
+    );
 }

@@ -12,7 +12,9 @@ use std::time::Duration;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
 use ugl_bench::env::render::{PIXELS, render_ball_into};
-use ugl_bench::repr::neural::{Model, NeuralConfig, NeuralEncoder, Trainer, Variant, flops_per_iteration, init_net};
+use ugl_bench::repr::neural::{
+    Model, NeuralConfig, NeuralEncoder, Trainer, Variant, flops_per_iteration, init_net,
+};
 use ugl_bench::repr::{Encoder, ImageSet};
 use ugl_bench::seed::stream_named;
 
@@ -29,17 +31,27 @@ fn balls(n: usize, seed: u64) -> ImageSet {
 fn bench(c: &mut Criterion) {
     let train = balls(1000, 1);
     let latents = 10;
-    for (arch, hidden) in [("paper-1200-1200", [1200, 1200]), ("reduced-512-256", [512, 256])] {
+    for (arch, hidden) in [
+        ("paper-1200-1200", [1200, 1200]),
+        ("reduced-512-256", [512, 256]),
+    ] {
         let mut g = c.benchmark_group(format!("train_step/{arch}"));
         g.sample_size(10);
         g.warm_up_time(Duration::from_secs(2));
         g.measurement_time(Duration::from_secs(8));
         for model in Model::ALL {
-            let cfg = NeuralConfig { hidden, ..NeuralConfig::paper(model) };
+            let cfg = NeuralConfig {
+                hidden,
+                ..NeuralConfig::paper(model)
+            };
             let mut rng = stream_named(1, "learner");
             let mut trainer = Trainer::new(model, &cfg, &train, latents, &mut rng).unwrap();
-            g.throughput(Throughput::Elements(flops_per_iteration(model, PIXELS, hidden, latents, 100) as u64));
-            g.bench_function(model.name(), |b| b.iter(|| black_box(trainer.step(&mut rng).unwrap())));
+            g.throughput(Throughput::Elements(flops_per_iteration(
+                model, PIXELS, hidden, latents, 100,
+            ) as u64));
+            g.bench_function(model.name(), |b| {
+                b.iter(|| black_box(trainer.step(&mut rng).unwrap()))
+            });
         }
         g.finish();
 
@@ -47,9 +59,21 @@ fn bench(c: &mut Criterion) {
         // weights' values, only on the image's and the hidden layers' zeros).
         let mut g = c.benchmark_group(format!("encode_one/{arch}"));
         let probe = balls(64, 2);
-        for (model, variant) in [(Model::Ae, Variant::Faithful), (Model::Rfvae, Variant::Corrected)] {
-            let cfg = NeuralConfig { hidden, ..NeuralConfig::paper(model) };
-            let net = init_net(model, &cfg, PIXELS, latents, &mut stream_named(1, "learner"));
+        for (model, variant) in [
+            (Model::Ae, Variant::Faithful),
+            (Model::Rfvae, Variant::Corrected),
+        ] {
+            let cfg = NeuralConfig {
+                hidden,
+                ..NeuralConfig::paper(model)
+            };
+            let net = init_net(
+                model,
+                &cfg,
+                PIXELS,
+                latents,
+                &mut stream_named(1, "learner"),
+            );
             let mut enc = NeuralEncoder::new(model, variant, net, vec![], [0; 32]);
             let mut out = vec![0.0f64; latents];
             let mut i = 0;

@@ -1,26 +1,38 @@
 //! The neural learners (AE, VAE, RFVAE; `repr::neural`), on tiny networks (hidden [32, 16])
 //! and ~200 rendered images, so the whole file runs in seconds on 2 cores.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::RngExt;
-use ugl_bench::env::{make_env, EnvConfig, EnvKind};
+use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::repr::ae::Ae;
 use ugl_bench::repr::dataset::generate;
-use ugl_bench::repr::neural::{init_net, Model, NeuralConfig, NeuralEncoder, NeuralSection, Variant};
-use ugl_bench::repr::rfvae::{flow_logdet_tensor, flow_step_host, Rfvae};
+use ugl_bench::repr::neural::{
+    Model, NeuralConfig, NeuralEncoder, NeuralSection, Variant, init_net,
+};
+use ugl_bench::repr::rfvae::{Rfvae, flow_logdet_tensor, flow_step_host};
 use ugl_bench::repr::vae::Vae;
 use ugl_bench::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
-use ugl_bench::seed::{stream, stream_named, Component};
+use ugl_bench::seed::{Component, stream, stream_named};
 
 fn images(kind: EnvKind, n: usize) -> ImageSet {
     let env = make_env(kind, &EnvConfig::default());
-    generate(env.as_ref(), n, &mut stream(11, Component::Dataset)).unwrap().images
+    generate(env.as_ref(), n, &mut stream(11, Component::Dataset))
+        .unwrap()
+        .images
 }
 
 fn tiny(model: Model, variant: Variant, iterations: usize) -> NeuralConfig {
-    NeuralConfig { iterations, hidden: [32, 16], batch: 100, lr: 1e-3, variant, log_every: 1, ..NeuralConfig::paper(model) }
+    NeuralConfig {
+        iterations,
+        hidden: [32, 16],
+        batch: 100,
+        lr: 1e-3,
+        variant,
+        log_every: 1,
+        ..NeuralConfig::paper(model)
+    }
 }
 
 fn learner(model: Model, cfg: NeuralConfig) -> Box<dyn RepresentationLearner> {
@@ -31,7 +43,13 @@ fn learner(model: Model, cfg: NeuralConfig) -> Box<dyn RepresentationLearner> {
     }
 }
 
-fn fit_neural(model: Model, cfg: NeuralConfig, set: &ImageSet, latents: usize, seed: u64) -> (NeuralEncoder, Latents) {
+fn fit_neural(
+    model: Model,
+    cfg: NeuralConfig,
+    set: &ImageSet,
+    latents: usize,
+    seed: u64,
+) -> (NeuralEncoder, Latents) {
     let mut rng = stream_named(seed, "learner");
     match model {
         Model::Ae => Ae::new(cfg).fit_neural(set, latents, &mut rng),
@@ -50,12 +68,24 @@ fn loss_decreases_for_every_model_and_variant() {
     let set = images(EnvKind::ArmBall, 200);
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
-            let cfg = NeuralConfig { lr: 5e-3, ..tiny(model, variant, 150) };
+            let cfg = NeuralConfig {
+                lr: 5e-3,
+                ..tiny(model, variant, 150)
+            };
             let (enc, _) = fit_neural(model, cfg, &set, 2, 1);
             assert_eq!(enc.losses.len(), 150);
             let (first, last) = (mean(&enc.losses[..20]), mean(&enc.losses[130..]));
-            eprintln!("{} {}: mean loss of the first 20 iterations {first:.2}, last 20 {last:.2}", model.name(), variant.name());
-            assert!(last < first, "{} {}: loss did not decrease: {first} -> {last}", model.name(), variant.name());
+            eprintln!(
+                "{} {}: mean loss of the first 20 iterations {first:.2}, last 20 {last:.2}",
+                model.name(),
+                variant.name()
+            );
+            assert!(
+                last < first,
+                "{} {}: loss did not decrease: {first} -> {last}",
+                model.name(),
+                variant.name()
+            );
         }
     }
 }
@@ -79,7 +109,10 @@ fn encoders_have_the_right_shapes_and_priors() {
             assert!(one.iter().all(|v| v.is_finite()));
             if model == Model::Ae {
                 assert!(enc.prior().is_none());
-                assert!(z.data.iter().all(|&v| v > 0.0 && v < 1.0), "AE latents are sigmoids");
+                assert!(
+                    z.data.iter().all(|&v| v > 0.0 && v < 1.0),
+                    "AE latents are sigmoids"
+                );
             } else {
                 let p = enc.prior().expect("VAE-type models have a prior");
                 assert_eq!((p.mean, p.std), (vec![0.0; 3], vec![1.0; 3]));
@@ -97,11 +130,26 @@ fn training_is_deterministic_for_a_stream() {
             let (mut a, za) = fit_neural(model, cfg.clone(), &set, 2, 3);
             let (mut b, zb) = fit_neural(model, cfg.clone(), &set, 2, 3);
             let bits = |z: &Latents| z.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&za), bits(&zb), "{} {}: training latents differ", model.name(), variant.name());
-            assert_eq!(a.net, b.net, "{} {}: weights differ", model.name(), variant.name());
+            assert_eq!(
+                bits(&za),
+                bits(&zb),
+                "{} {}: training latents differ",
+                model.name(),
+                variant.name()
+            );
+            assert_eq!(
+                a.net,
+                b.net,
+                "{} {}: weights differ",
+                model.name(),
+                variant.name()
+            );
             assert_eq!(a.losses, b.losses);
             // Later encodings too (the faithful RFVAE's stochastic ones included).
-            assert_eq!(bits(&a.encode(&set).unwrap()), bits(&b.encode(&set).unwrap()));
+            assert_eq!(
+                bits(&a.encode(&set).unwrap()),
+                bits(&b.encode(&set).unwrap())
+            );
             // A different stream gives a different model.
             let (c, _) = fit_neural(model, cfg, &set, 2, 4);
             assert_ne!(a.net, c.net);
@@ -125,7 +173,8 @@ fn fd_logdet(z: &[f64], c: &[f64], a: f64, b: f64) -> f64 {
         }
     }
     assert_eq!(d, 3);
-    let det = jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1]) - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
+    let det = jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1])
+        - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
         + jac[0][2] * (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]);
     det.abs().ln()
 }
@@ -135,7 +184,11 @@ fn radial_flow_logdet_matches_the_jacobian() {
     let d = 3;
     let n = 6;
     let mut rng = stream_named(5, "flow-points");
-    let mut draw = |lo: f64, hi: f64, k: usize| (0..k).map(|_| rng.random_range(lo..hi)).collect::<Vec<f64>>();
+    let mut draw = |lo: f64, hi: f64, k: usize| {
+        (0..k)
+            .map(|_| rng.random_range(lo..hi))
+            .collect::<Vec<f64>>()
+    };
     let z = draw(-2.0, 2.0, n * d);
     let c = draw(-1.0, 1.0, n * d);
     let a = draw(-1.5, 1.5, n);
@@ -147,10 +200,20 @@ fn radial_flow_logdet_matches_the_jacobian() {
         let fd = fd_logdet(zi, ci, a[i], b[i]);
         let mut host = zi.to_vec();
         let analytic = flow_step_host(&mut host, ci, a[i], b[i]);
-        assert!((analytic - fd).abs() < 1e-6, "point {i}: host log-det {analytic} vs finite differences {fd}");
-        assert!((ld[i] - fd).abs() < 1e-4, "point {i}: tensor log-det {} vs finite differences {fd}", ld[i]);
+        assert!(
+            (analytic - fd).abs() < 1e-6,
+            "point {i}: host log-det {analytic} vs finite differences {fd}"
+        );
+        assert!(
+            (ld[i] - fd).abs() < 1e-4,
+            "point {i}: tensor log-det {} vs finite differences {fd}",
+            ld[i]
+        );
         for j in 0..d {
-            assert!((zn[i * d + j] - host[j]).abs() < 1e-5, "point {i}: tensor flow output differs from the host's");
+            assert!(
+                (zn[i * d + j] - host[j]).abs() < 1e-5,
+                "point {i}: tensor flow output differs from the host's"
+            );
         }
     }
     // The faithful broadcast: [i, j] = sample j's geometry with sample i's beta; the diagonal is
@@ -165,11 +228,20 @@ fn radial_flow_logdet_matches_the_jacobian() {
             let (zj, cj) = (&z[j * d..(j + 1) * d], &c[j * d..(j + 1) * d]);
             let aj = a[j].abs();
             let beta_j = softplus(b[j]) - aj;
-            let r = zj.iter().zip(cj).map(|(p, q)| (p - q) * (p - q)).sum::<f64>().sqrt();
+            let r = zj
+                .iter()
+                .zip(cj)
+                .map(|(p, q)| (p - q) * (p - q))
+                .sum::<f64>()
+                .sqrt();
             let bh = beta_j / (aj + r);
             let t = (1.0 + bh).powi(d as i32 - 1) * (1.0 + bh - beta_i * r / ((aj + r) * (aj + r)));
             let expected = t.clamp(1e-4, 1e6).ln();
-            assert!((ldf[i * n + j] - expected).abs() < 1e-4, "[{i}, {j}]: {} vs {expected}", ldf[i * n + j]);
+            assert!(
+                (ldf[i * n + j] - expected).abs() < 1e-4,
+                "[{i}, {j}]: {} vs {expected}",
+                ldf[i * n + j]
+            );
         }
     }
 }
@@ -180,13 +252,42 @@ fn variants_differ_exactly_where_documented() {
     let d = 2;
     // Initial weights are a function of the stream only.
     for model in Model::ALL {
-        let f = init_net(model, &tiny(model, Variant::Faithful, 1), set.dim, d, &mut stream_named(6, "learner"));
-        let c = init_net(model, &tiny(model, Variant::Corrected, 1), set.dim, d, &mut stream_named(6, "learner"));
-        assert_eq!(f, c, "{}: initial weights depend on the variant", model.name());
+        let f = init_net(
+            model,
+            &tiny(model, Variant::Faithful, 1),
+            set.dim,
+            d,
+            &mut stream_named(6, "learner"),
+        );
+        let c = init_net(
+            model,
+            &tiny(model, Variant::Corrected, 1),
+            set.dim,
+            d,
+            &mut stream_named(6, "learner"),
+        );
+        assert_eq!(
+            f,
+            c,
+            "{}: initial weights depend on the variant",
+            model.name()
+        );
     }
     // AE: no defect, the variants are identical.
-    let (mut af, zf) = fit_neural(Model::Ae, tiny(Model::Ae, Variant::Faithful, 10), &set, d, 6);
-    let (mut ac, zc) = fit_neural(Model::Ae, tiny(Model::Ae, Variant::Corrected, 10), &set, d, 6);
+    let (mut af, zf) = fit_neural(
+        Model::Ae,
+        tiny(Model::Ae, Variant::Faithful, 10),
+        &set,
+        d,
+        6,
+    );
+    let (mut ac, zc) = fit_neural(
+        Model::Ae,
+        tiny(Model::Ae, Variant::Corrected, 10),
+        &set,
+        d,
+        6,
+    );
     assert_eq!(af.losses, ac.losses);
     assert_eq!(zf, zc);
     assert_eq!(af.encode(&set).unwrap(), ac.encode(&set).unwrap());
@@ -197,8 +298,18 @@ fn variants_differ_exactly_where_documented() {
         let (mut c, zc) = fit_neural(model, tiny(model, Variant::Corrected, 3), &set, d, 6);
         // (At the 0.001-std start the decoder barely sees z, so the very first f32 losses can
         // coincide; the curves and the weights cannot.)
-        assert_ne!(f.losses, c.losses, "{}: the losses should differ", model.name());
-        assert_ne!(f.net, c.net, "{}: the trained weights should differ", model.name());
+        assert_ne!(
+            f.losses,
+            c.losses,
+            "{}: the losses should differ",
+            model.name()
+        );
+        assert_ne!(
+            f.net,
+            c.net,
+            "{}: the trained weights should differ",
+            model.name()
+        );
         // Corrected encodings are deterministic and reproduce the training latents.
         assert_eq!(c.encode(&set).unwrap(), zc);
         assert_eq!(c.encode(&set).unwrap(), zc);
@@ -212,10 +323,21 @@ fn variants_differ_exactly_where_documented() {
         }
         c.encode_one(set.row(3), &mut one).unwrap();
         c.encode_one(set.row(3), &mut two).unwrap();
-        assert_eq!(one, two, "{} corrected encoding is deterministic", model.name());
+        assert_eq!(
+            one,
+            two,
+            "{} corrected encoding is deterministic",
+            model.name()
+        );
     }
     // RFVAE faithful: training latents (z0 samples) are not the encodings (z_K of fresh samples).
-    let (mut f, zf) = fit_neural(Model::Rfvae, tiny(Model::Rfvae, Variant::Faithful, 3), &set, d, 6);
+    let (mut f, zf) = fit_neural(
+        Model::Rfvae,
+        tiny(Model::Rfvae, Variant::Faithful, 3),
+        &set,
+        d,
+        6,
+    );
     assert!(f.is_stochastic());
     assert_ne!(f.encode(&set).unwrap(), zf);
 }
@@ -225,35 +347,99 @@ fn invalid_configurations_are_rejected() {
     let set = images(EnvKind::ArmBall, 30);
     let base = tiny(Model::Vae, Variant::Faithful, 2);
     let cases: Vec<(&str, NeuralConfig)> = vec![
-        ("iterations", NeuralConfig { iterations: 0, ..base.clone() }),
-        ("batch", NeuralConfig { batch: 0, ..base.clone() }),
-        ("hidden", NeuralConfig { hidden: [0, 4], ..base.clone() }),
-        ("hidden", NeuralConfig { hidden: [4, 0], ..base.clone() }),
-        ("lr", NeuralConfig { lr: 0.0, ..base.clone() }),
-        ("lr", NeuralConfig { lr: f64::NAN, ..base.clone() }),
-        ("lr", NeuralConfig { lr: f64::INFINITY, ..base.clone() }),
-        ("log_every", NeuralConfig { log_every: 0, ..base.clone() }),
+        (
+            "iterations",
+            NeuralConfig {
+                iterations: 0,
+                ..base.clone()
+            },
+        ),
+        (
+            "batch",
+            NeuralConfig {
+                batch: 0,
+                ..base.clone()
+            },
+        ),
+        (
+            "hidden",
+            NeuralConfig {
+                hidden: [0, 4],
+                ..base.clone()
+            },
+        ),
+        (
+            "hidden",
+            NeuralConfig {
+                hidden: [4, 0],
+                ..base.clone()
+            },
+        ),
+        (
+            "lr",
+            NeuralConfig {
+                lr: 0.0,
+                ..base.clone()
+            },
+        ),
+        (
+            "lr",
+            NeuralConfig {
+                lr: f64::NAN,
+                ..base.clone()
+            },
+        ),
+        (
+            "lr",
+            NeuralConfig {
+                lr: f64::INFINITY,
+                ..base.clone()
+            },
+        ),
+        (
+            "log_every",
+            NeuralConfig {
+                log_every: 0,
+                ..base.clone()
+            },
+        ),
     ];
     for model in Model::ALL {
         for (key, cfg) in &cases {
             match learner(model, cfg.clone()).fit(&set, 2, &mut stream_named(1, "learner")) {
-                Err(ReprError::InvalidInput(msg)) => assert!(msg.contains(key), "{}: '{msg}' should name {key}", model.name()),
+                Err(ReprError::InvalidInput(msg)) => assert!(
+                    msg.contains(key),
+                    "{}: '{msg}' should name {key}",
+                    model.name()
+                ),
                 Err(e) => panic!("{}: {key}: wrong error {e}", model.name()),
                 Ok(_) => panic!("{}: {key}: accepted", model.name()),
             }
         }
         let l = learner(model, base.clone());
-        assert!(matches!(l.fit(&set, 0, &mut stream_named(1, "learner")), Err(ReprError::InvalidInput(_))));
-        assert!(matches!(l.fit(&set, 30, &mut stream_named(1, "learner")), Err(ReprError::InvalidInput(_))));
+        assert!(matches!(
+            l.fit(&set, 0, &mut stream_named(1, "learner")),
+            Err(ReprError::InvalidInput(_))
+        ));
+        assert!(matches!(
+            l.fit(&set, 30, &mut stream_named(1, "learner")),
+            Err(ReprError::InvalidInput(_))
+        ));
     }
 }
 
 #[test]
 fn divergence_is_reported() {
     let set = images(EnvKind::ArmBall, 50);
-    let cfg = NeuralConfig { lr: 1e30, ..tiny(Model::Vae, Variant::Corrected, 50) };
+    let cfg = NeuralConfig {
+        lr: 1e30,
+        ..tiny(Model::Vae, Variant::Corrected, 50)
+    };
     match Vae::new(cfg).fit(&set, 2, &mut stream_named(1, "learner")) {
-        Err(ReprError::Numerical(msg)) => assert!(msg.starts_with("vae training diverged at iteration"), "{msg}"),
+        Err(ReprError::Numerical(msg)) => assert!(
+            msg.starts_with("vae training diverged at iteration"),
+            "{msg}"
+        ),
         Err(e) => panic!("wrong error: {e}"),
         Ok(_) => panic!("a learning rate of 1e30 should diverge"),
     }
@@ -264,12 +450,18 @@ fn progress_is_reported_every_iteration() {
     let set = images(EnvKind::ArmBall, 50);
     let calls = Arc::new(AtomicUsize::new(0));
     let seen = calls.clone();
-    let l = Ae::new(NeuralConfig { log_every: 4, ..tiny(Model::Ae, Variant::Faithful, 10) }).with_progress(Arc::new(move |p| {
+    let l = Ae::new(NeuralConfig {
+        log_every: 4,
+        ..tiny(Model::Ae, Variant::Faithful, 10)
+    })
+    .with_progress(Arc::new(move |p| {
         assert_eq!(p.total, 10);
         assert!(p.loss.is_finite());
         assert_eq!(seen.fetch_add(1, Ordering::SeqCst) + 1, p.iteration);
     }));
-    let (enc, _) = l.fit_neural(&set, 2, &mut stream_named(1, "learner")).unwrap();
+    let (enc, _) = l
+        .fit_neural(&set, 2, &mut stream_named(1, "learner"))
+        .unwrap();
     assert_eq!(calls.load(Ordering::SeqCst), 10);
     let steps: Vec<usize> = enc.losses.iter().map(|p| p.0).collect();
     assert_eq!(steps, vec![0, 4, 8, 9]);
@@ -288,11 +480,21 @@ fn configuration_serde() {
     assert_eq!(NeuralConfig::paper(Model::Ae).iterations, 200_000);
     assert_eq!(NeuralConfig::paper(Model::Vae).iterations, 100_000);
     assert_eq!(NeuralConfig::paper(Model::Rfvae).iterations, 50_000);
-    let s: NeuralSection = toml::from_str("iterations = 500\nvariant = \"corrected\"\nhidden = [512, 256]").unwrap();
+    let s: NeuralSection =
+        toml::from_str("iterations = 500\nvariant = \"corrected\"\nhidden = [512, 256]").unwrap();
     let c = s.resolve(Model::Rfvae);
-    assert_eq!((c.iterations, c.variant, c.hidden, c.batch), (500, Variant::Corrected, [512, 256], 100));
-    assert!(toml::from_str::<NeuralSection>("iteration = 5").is_err(), "unknown keys are rejected");
-    assert!(toml::from_str::<NeuralConfig>("iterations = 5").is_err(), "the complete form needs every key");
+    assert_eq!(
+        (c.iterations, c.variant, c.hidden, c.batch),
+        (500, Variant::Corrected, [512, 256], 100)
+    );
+    assert!(
+        toml::from_str::<NeuralSection>("iteration = 5").is_err(),
+        "unknown keys are rejected"
+    );
+    assert!(
+        toml::from_str::<NeuralConfig>("iterations = 5").is_err(),
+        "the complete form needs every key"
+    );
 }
 
 /// The repository's plug-in conformance checks (`learner_conformance.rs`) on the three neural
@@ -306,13 +508,28 @@ fn neural_learners_conform() {
         for model in Model::ALL {
             for variant in [Variant::Faithful, Variant::Corrected] {
                 let l = learner(model, tiny(model, variant, 8));
-                let who = format!("{} {} on {kind} with {latents} latents", model.name(), variant.name());
-                let (mut enc, z) = l.fit(&set, latents, &mut stream_named(1, "learner")).unwrap_or_else(|e| panic!("{who}: {e}"));
-                assert_eq!((z.n, z.latents, z.data.len()), (150, latents, 150 * latents), "{who}: shape");
+                let who = format!(
+                    "{} {} on {kind} with {latents} latents",
+                    model.name(),
+                    variant.name()
+                );
+                let (mut enc, z) = l
+                    .fit(&set, latents, &mut stream_named(1, "learner"))
+                    .unwrap_or_else(|e| panic!("{who}: {e}"));
+                assert_eq!(
+                    (z.n, z.latents, z.data.len()),
+                    (150, latents, 150 * latents),
+                    "{who}: shape"
+                );
                 assert!(z.data.iter().all(|v| v.is_finite()), "{who}: finite");
                 assert_eq!(enc.latents(), latents, "{who}");
-                let (_, z2) = l.fit(&set, latents, &mut stream_named(1, "learner")).unwrap();
-                assert_eq!(z.data, z2.data, "{who}: two fits with the same stream differ");
+                let (_, z2) = l
+                    .fit(&set, latents, &mut stream_named(1, "learner"))
+                    .unwrap();
+                assert_eq!(
+                    z.data, z2.data,
+                    "{who}: two fits with the same stream differ"
+                );
                 let stochastic = model == Model::Rfvae && variant == Variant::Faithful;
                 if !stochastic {
                     let again = enc.encode(&set).unwrap();
@@ -324,9 +541,18 @@ fn neural_learners_conform() {
                     }
                 }
                 let mut one = vec![0.0; latents];
-                assert!(l.fit(&set, 0, &mut stream_named(1, "learner")).is_err(), "{who}: latents = 0");
-                assert!(enc.encode_one(&[0.0; 10], &mut one).is_err(), "{who}: wrong image size");
-                assert!(enc.encode_one(set.row(0), &mut one[..1]).is_err() || latents == 1, "{who}: wrong output size");
+                assert!(
+                    l.fit(&set, 0, &mut stream_named(1, "learner")).is_err(),
+                    "{who}: latents = 0"
+                );
+                assert!(
+                    enc.encode_one(&[0.0; 10], &mut one).is_err(),
+                    "{who}: wrong image size"
+                );
+                assert!(
+                    enc.encode_one(set.row(0), &mut one[..1]).is_err() || latents == 1,
+                    "{who}: wrong output size"
+                );
                 let bad = ImageSet::new(1, 10, vec![0.0; 10]).unwrap();
                 assert!(enc.encode(&bad).is_err(), "{who}: wrong image size (batch)");
             }
@@ -343,14 +569,28 @@ fn fingerprint_for_thread_count_comparison() {
     let arch: Vec<usize> = std::env::var("UGL_FINGERPRINT_ARCH")
         .unwrap_or_else(|_| "64,48,20".into())
         .split(',')
-        .map(|v| v.trim().parse().expect("UGL_FINGERPRINT_ARCH=H1,H2,iterations"))
+        .map(|v| {
+            v.trim()
+                .parse()
+                .expect("UGL_FINGERPRINT_ARCH=H1,H2,iterations")
+        })
         .collect();
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
-            let cfg = NeuralConfig { hidden: [arch[0], arch[1]], ..tiny(model, variant, arch[2]) };
+            let cfg = NeuralConfig {
+                hidden: [arch[0], arch[1]],
+                ..tiny(model, variant, arch[2])
+            };
             let (enc, z) = fit_neural(model, cfg, &set, 3, 9);
             let mut h = blake3::Hasher::new();
-            for l in [&enc.net.enc1, &enc.net.enc2, &enc.net.head, &enc.net.dec1, &enc.net.dec2, &enc.net.dec_out] {
+            for l in [
+                &enc.net.enc1,
+                &enc.net.enc2,
+                &enc.net.head,
+                &enc.net.dec1,
+                &enc.net.dec2,
+                &enc.net.dec_out,
+            ] {
                 l.w.iter().chain(&l.b).for_each(|v| {
                     h.update(&v.to_le_bytes());
                 });
@@ -358,7 +598,12 @@ fn fingerprint_for_thread_count_comparison() {
             z.data.iter().for_each(|v| {
                 h.update(&v.to_le_bytes());
             });
-            eprintln!("fingerprint {} {}: {}", model.name(), variant.name(), h.finalize().to_hex());
+            eprintln!(
+                "fingerprint {} {}: {}",
+                model.name(),
+                variant.name(),
+                h.finalize().to_hex()
+            );
         }
     }
 }

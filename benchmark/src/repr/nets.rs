@@ -335,7 +335,12 @@ pub struct TfAdam {
 
 impl Default for TfAdam {
     fn default() -> Self {
-        TfAdam { beta1: 0.9, beta2: 0.999, epsilon: 1e-8, clip: Some(1.0) }
+        TfAdam {
+            beta1: 0.9,
+            beta2: 0.999,
+            epsilon: 1e-8,
+            clip: Some(1.0),
+        }
     }
 }
 
@@ -358,7 +363,12 @@ impl<const D: usize> RecordState for TfAdamState<D> {
         let (time, _) = state_values(src.take_tensor(prefix, "time")?)?;
         let (m, shape) = state_values(src.take_tensor(prefix, "m")?)?;
         let (v, _) = state_values(src.take_tensor(prefix, "v")?)?;
-        Some(TfAdamState { time: *time.first()? as usize, m, v, shape })
+        Some(TfAdamState {
+            time: *time.first()? as usize,
+            m,
+            v,
+            shape,
+        })
     }
 }
 
@@ -377,10 +387,16 @@ impl Optimizer for TfAdam {
         let mut p = host_values(tensor);
         let g = host_values(grad);
         let n = f32_slice(&g).len();
-        let mut st = state.unwrap_or_else(|| TfAdamState { time: 0, m: vec![0.0; n], v: vec![0.0; n], shape });
+        let mut st = state.unwrap_or_else(|| TfAdamState {
+            time: 0,
+            m: vec![0.0; n],
+            v: vec![0.0; n],
+            shape,
+        });
         st.time += 1;
         let (b1, b2) = (self.beta1, self.beta2);
-        let lr_t = (lr * (1.0 - b2.powi(st.time as i32)).sqrt() / (1.0 - b1.powi(st.time as i32))) as f32;
+        let lr_t =
+            (lr * (1.0 - b2.powi(st.time as i32)).sqrt() / (1.0 - b1.powi(st.time as i32))) as f32;
         let (b1, b2, eps, c) = (b1 as f32, b2 as f32, self.epsilon as f32, self.clip);
         f32_slice_mut(&mut p)
             .par_chunks_mut(OPT_CHUNK)
@@ -417,7 +433,10 @@ pub struct TfAdagrad {
 
 impl Default for TfAdagrad {
     fn default() -> Self {
-        TfAdagrad { initial_accumulator: 0.1, clip: Some(1.0) }
+        TfAdagrad {
+            initial_accumulator: 0.1,
+            clip: Some(1.0),
+        }
     }
 }
 
@@ -453,7 +472,10 @@ impl Optimizer for TfAdagrad {
         let mut p = host_values(tensor);
         let g = host_values(grad);
         let n = f32_slice(&g).len();
-        let mut st = state.unwrap_or_else(|| TfAdagradState { acc: vec![self.initial_accumulator as f32; n], shape });
+        let mut st = state.unwrap_or_else(|| TfAdagradState {
+            acc: vec![self.initial_accumulator as f32; n],
+            shape,
+        });
         let (lr, c) = (lr as f32, self.clip);
         f32_slice_mut(&mut p)
             .par_chunks_mut(OPT_CHUNK)
