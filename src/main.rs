@@ -10,17 +10,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::plan::parse_shard;
+use ugl_bench::campaign::runner::TrainSink;
 use ugl_bench::campaign::{CampaignOptions, Progress, RunContext, RunSpec, plan, run_campaign};
 use ugl_bench::env::render::{Image70, PIXELS, write_npy, write_png};
 use ugl_bench::env::{EnvConfig, EnvKind, PARAMS, make_env};
 use ugl_bench::explore::{Algo, Learner, SamplerKind};
 use ugl_bench::metrics::KlCoverage;
 use ugl_bench::metrics::csv::read_outcomes_csv;
+use ugl_bench::repr::cache::ModelCache;
+use ugl_bench::repr::neural::Variant;
 
 /// ugl-bench: reproduce "Unsupervised Learning of Goal Spaces for Intrinsically Motivated Goal
 /// Exploration" (Péré et al., ICLR 2018) deterministically on a CPU.
@@ -71,12 +74,17 @@ enum Command {
         #[arg(long)]
         env: EnvKind,
         /// rpe, rge-efr, or a learned goal space: rge-pca (the paper's non-centred PCA),
-        /// rge-pca-centred, rge-isomap, rge-external (needs [learners.external] in the profile).
+        /// rge-pca-centred, rge-isomap, rge-ae, rge-vae, rge-rfvae (neural; budgets in the
+        /// profile's [learners.ae|vae|rfvae]), rge-external (needs [learners.external]).
         #[arg(long)]
         algo: Algo,
-        /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (N(0, I)).
+        /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (the
+        /// prior N(0, I); VAE, RFVAE, or an external learner that writes a prior).
         #[arg(long, default_value = "kde")]
         sampler: SamplerKind,
+        /// rge-vae / rge-rfvae: `faithful` (the original code, defects included) or `corrected`.
+        #[arg(long)]
+        variant: Option<Variant>,
         /// Latent size of a learned goal space.
         #[arg(long, default_value_t = 10)]
         latents: usize,
@@ -95,6 +103,8 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        cache: CacheArgs,
     },
     /// List the run ids of a campaign, one per line.
     Plan {
@@ -120,6 +130,8 @@ enum Command {
         /// shards is the whole campaign, and runs sharing a trained representation stay together.
         #[arg(long)]
         shard: Option<String>,
+        #[command(flatten)]
+        cache: CacheArgs,
     },
     /// Write a Slurm array job (one task per shard) and a merge step for a campaign.
     Slurm {
@@ -163,6 +175,62 @@ enum Command {
         #[arg(long, default_value = "data/paper")]
         paper: PathBuf,
     },
+}
+
+/// Where trained neural models are kept.
+#[derive(clap::Args, Debug)]
+struct CacheArgs {
+    /// Model cache directory for trained neural representations (default: OUT/models). A
+    /// model is keyed by the hash of everything it depends on; an invalid file is retrained.
+    #[arg(long)]
+    cache: Option<PathBuf>,
+    /// Do not read or write the model cache (always train).
+    #[arg(long, conflicts_with = "cache")]
+    no_cache: bool,
+}
+
+impl CacheArgs {
+    fn resolve(&self, out: &Path) -> Option<ModelCache> {
+        if self.no_cache {
+            return None;
+        }
+        Some(ModelCache::new(
+            self.cache.clone().unwrap_or_else(|| out.join("models")),
+        ))
+    }
+}
+
+/// Progress bars for neural trainings, one per representation, above `main` (if any).
+fn training_bars(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<TrainSink> {
+    let bars: std::sync::Mutex<std::collections::HashMap<String, ProgressBar>> =
+        Default::default();
+    let mp = mp.clone();
+    let main = main.cloned();
+    Arc::new(move |label: &str, p| {
+        let mut bars = bars.lock().expect("progress bars");
+        let bar = bars.entry(label.to_string()).or_insert_with(|| {
+            let b = ProgressBar::new(p.total as u64);
+            let b = match &main {
+                Some(m) => mp.insert_before(m, b),
+                None => mp.add(b),
+            };
+            b.set_style(
+                ProgressStyle::with_template(
+                    "  train {prefix:32} {bar:25} {pos}/{len} it  {per_sec}  ETA {eta}  loss {msg}",
+                )
+                .expect("valid template"),
+            );
+            b.set_prefix(label.to_string());
+            b
+        });
+        bar.set_position(p.iteration as u64);
+        bar.set_message(format!("{:.2}", p.loss));
+        if p.iteration >= p.total {
+            bar.finish_and_clear();
+            mp.remove(bar);
+            bars.remove(label);
+        }
+    })
 }
 
 fn main() -> ExitCode {
@@ -214,17 +282,20 @@ fn dispatch(cmd: Command) -> Result<()> {
             env,
             algo,
             sampler,
+            variant,
             latents,
             images,
             seed,
             epochs,
             profile,
             out,
+            cache,
         } => run(
             RunArgs {
                 env,
                 algo,
                 sampler,
+                variant,
                 latents,
                 images,
                 seed,
@@ -232,6 +303,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             },
             &profile,
             &out,
+            &cache,
         ),
         Command::Plan { config } => {
             let cfg = CampaignConfig::load(&config)?;
@@ -246,7 +318,8 @@ fn dispatch(cmd: Command) -> Result<()> {
             jobs,
             quiet,
             shard,
-        } => campaign(&config, out, jobs, quiet, shard.as_deref()),
+            cache,
+        } => campaign(&config, out, jobs, quiet, shard.as_deref(), &cache),
         Command::Slurm {
             config,
             shards,
@@ -365,13 +438,14 @@ struct RunArgs {
     env: EnvKind,
     algo: Algo,
     sampler: SamplerKind,
+    variant: Option<Variant>,
     latents: usize,
     images: Option<usize>,
     seed: u64,
     epochs: Option<usize>,
 }
 
-fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
+fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
     let path = resolve_profile(profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
     if let Some(e) = a.epochs {
@@ -399,15 +473,29 @@ fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
                     a.latents
                 );
             }
-            RunSpec {
-                env: a.env,
-                algo: a.algo,
-                sampler: a.sampler,
-                latents: a.latents,
-                seed: a.seed,
-            }
+            RunSpec::learned(
+                a.env,
+                a.algo,
+                a.sampler,
+                a.latents,
+                a.variant.unwrap_or_default(),
+                a.seed,
+            )
         }
     };
+    if a.variant.is_some() && !a.algo.learner().is_some_and(|l| l.has_variants()) {
+        bail!(
+            "--variant applies to rge-vae and rge-rfvae only (the other algorithms have one behaviour), not {}",
+            a.algo
+        );
+    }
+    if a.sampler == SamplerKind::Gaussian && !a.algo.learner().is_some_and(|l| l.may_have_prior())
+    {
+        bail!(
+            "--sampler gaussian needs a goal-space prior: rge-vae, rge-rfvae or rge-external, not {} (use kde)",
+            a.algo
+        );
+    }
     if a.algo.learner() == Some(Learner::External) && cfg.learners.external.is_none() {
         bail!(
             "--algo rge-external needs a [learners.external] section (name, command) in the profile {}",
@@ -415,6 +503,11 @@ fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
         );
     }
     check_out_dir(out)?;
+    let cache = cache.resolve(out);
+    let mp = MultiProgress::new();
+    if !std::io::stderr().is_terminal() {
+        mp.set_draw_target(ProgressDrawTarget::hidden());
+    }
     let ctx = RunContext {
         campaign: &cfg.campaign.name,
         campaign_seed: cfg.campaign.seed,
@@ -423,7 +516,10 @@ fn run(a: RunArgs, profile: &str, out: &Path) -> Result<()> {
         env: &cfg.env,
         ugl: &cfg.ugl,
         learners: &cfg.learners,
-        threads: 1,
+        threads: rayon::current_num_threads(),
+        cache: cache.as_ref(),
+        train_progress: Some(training_bars(&mp, None)),
+        train_threads: 0,
     };
     let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
     println!("{}", serde_json::to_string(&summary)?);
@@ -444,6 +540,7 @@ fn campaign(
     jobs: Option<usize>,
     quiet: bool,
     shard: Option<&str>,
+    cache: &CacheArgs,
 ) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
     let shard = shard
@@ -471,10 +568,12 @@ fn campaign(
         })
         .context("cannot install the Ctrl-C handler")?;
     }
-    let bar = ProgressBar::new(0);
+    let mp = MultiProgress::new();
     if quiet || !std::io::stderr().is_terminal() {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
+        mp.set_draw_target(ProgressDrawTarget::hidden());
     }
+    let bar = mp.add(ProgressBar::new(0));
+    let cache = cache.resolve(&out);
     bar.set_style(
         ProgressStyle::with_template(
             "{bar:40} {pos}/{len} runs  {elapsed_precise} elapsed, ETA {eta}  {msg}",
@@ -508,6 +607,8 @@ fn campaign(
         profile: &profile,
         stop: &stop,
         shard,
+        cache: cache.as_ref(),
+        train_progress: Some(training_bars(&mp, Some(&bar))),
     };
     let done = run_campaign(&cfg, &out, &opts, &on)?;
     bar.finish_and_clear();

@@ -3,7 +3,10 @@
 //! images stably (batch and single-image paths agree with the fitted encodings).
 //!
 //! A new learner is covered by adding it to `Learner::ALL` (and `make_learner`); the external
-//! learner runs with the example program when python3 + numpy are present.
+//! learner runs with the example program when python3 + numpy are present. The neural learners
+//! run with tiny networks and budgets, in their corrected variant: the faithful RFVAE encodes
+//! outcomes stochastically in another space than its training latents (the original code's
+//! defect, which it reproduces on purpose; `neural.rs` tests it).
 
 use ugl_bench::campaign::config::{ExternalConfig, LearnersConfig};
 use ugl_bench::campaign::runner::make_learner;
@@ -11,6 +14,7 @@ use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::Learner;
 use ugl_bench::repr::ImageSet;
 use ugl_bench::repr::dataset::generate;
+use ugl_bench::repr::neural::{NeuralSection, Variant};
 use ugl_bench::seed::{Component, stream, stream_named};
 
 fn images(kind: EnvKind, n: usize) -> ImageSet {
@@ -37,6 +41,20 @@ fn learners_config() -> LearnersConfig {
                 env!("CARGO_MANIFEST_DIR")
             ),
         }),
+        ae: tiny(),
+        vae: tiny(),
+        rfvae: NeuralSection {
+            warmup: Some(10),
+            ..tiny()
+        },
+        ..Default::default()
+    }
+}
+
+fn tiny() -> NeuralSection {
+    NeuralSection {
+        iterations: Some(20),
+        hidden: Some([32, 16]),
         ..Default::default()
     }
 }
@@ -51,7 +69,7 @@ fn every_registered_learner_conforms() {
         }
         for (kind, latents) in [(EnvKind::ArmBall, 2), (EnvKind::ArmArrow, 10)] {
             let set = images(kind, 300);
-            let l = make_learner(learner, &cfg).unwrap();
+            let l = make_learner(learner, &cfg, Some(Variant::Corrected)).unwrap();
             let who = format!("{} on {kind} with {latents} latents", learner.name());
             let (mut enc, z) = l
                 .fit(&set, latents, &mut stream_named(1, "learner"))

@@ -6,13 +6,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::RngExt;
 use ugl_bench::env::{EnvConfig, EnvKind, make_env};
-use ugl_bench::repr::ae::Ae;
 use ugl_bench::repr::dataset::generate;
 use ugl_bench::repr::neural::{
-    Model, NeuralConfig, NeuralEncoder, NeuralSection, Variant, init_net,
+    Model, NeuralConfig, NeuralEncoder, NeuralLearner, NeuralSection, Variant, init_net,
 };
-use ugl_bench::repr::rfvae::{Rfvae, flow_logdet_tensor, flow_step_host};
-use ugl_bench::repr::vae::Vae;
+use ugl_bench::repr::rfvae::{flow_logdet_tensor, flow_step_host};
 use ugl_bench::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use ugl_bench::seed::{Component, stream, stream_named};
 
@@ -36,11 +34,7 @@ fn tiny(model: Model, variant: Variant, iterations: usize) -> NeuralConfig {
 }
 
 fn learner(model: Model, cfg: NeuralConfig) -> Box<dyn RepresentationLearner> {
-    match model {
-        Model::Ae => Box::new(Ae::new(cfg)),
-        Model::Vae => Box::new(Vae::new(cfg)),
-        Model::Rfvae => Box::new(Rfvae::new(cfg)),
-    }
+    Box::new(NeuralLearner::new(model, cfg))
 }
 
 fn fit_neural(
@@ -51,12 +45,9 @@ fn fit_neural(
     seed: u64,
 ) -> (NeuralEncoder, Latents) {
     let mut rng = stream_named(seed, "learner");
-    match model {
-        Model::Ae => Ae::new(cfg).fit_neural(set, latents, &mut rng),
-        Model::Vae => Vae::new(cfg).fit_neural(set, latents, &mut rng),
-        Model::Rfvae => Rfvae::new(cfg).fit_neural(set, latents, &mut rng),
-    }
-    .unwrap_or_else(|e| panic!("{}: {e}", model.name()))
+    NeuralLearner::new(model, cfg)
+        .fit_neural(set, latents, &mut rng)
+        .unwrap_or_else(|e| panic!("{}: {e}", model.name()))
 }
 
 fn mean(v: &[(usize, f64)]) -> f64 {
@@ -435,7 +426,7 @@ fn divergence_is_reported() {
         lr: 1e30,
         ..tiny(Model::Vae, Variant::Corrected, 50)
     };
-    match Vae::new(cfg).fit(&set, 2, &mut stream_named(1, "learner")) {
+    match NeuralLearner::new(Model::Vae, cfg).fit(&set, 2, &mut stream_named(1, "learner")) {
         Err(ReprError::Numerical(msg)) => assert!(
             msg.starts_with("vae training diverged at iteration"),
             "{msg}"
@@ -450,10 +441,13 @@ fn progress_is_reported_every_iteration() {
     let set = images(EnvKind::ArmBall, 50);
     let calls = Arc::new(AtomicUsize::new(0));
     let seen = calls.clone();
-    let l = Ae::new(NeuralConfig {
-        log_every: 4,
-        ..tiny(Model::Ae, Variant::Faithful, 10)
-    })
+    let l = NeuralLearner::new(
+        Model::Ae,
+        NeuralConfig {
+            log_every: 4,
+            ..tiny(Model::Ae, Variant::Faithful, 10)
+        },
+    )
     .with_progress(Arc::new(move |p| {
         assert_eq!(p.total, 10);
         assert!(p.loss.is_finite());
@@ -475,14 +469,14 @@ fn configuration_serde() {
         assert_eq!((p.batch, p.lr, p.variant), (100, 1e-3, Variant::Faithful));
         let text = toml::to_string(&p).unwrap();
         assert_eq!(toml::from_str::<NeuralConfig>(&text).unwrap(), p);
-        assert_eq!(NeuralSection::default().resolve(model), p);
+        assert_eq!(NeuralSection::default().resolve(model, Variant::Faithful), p);
     }
     assert_eq!(NeuralConfig::paper(Model::Ae).iterations, 200_000);
     assert_eq!(NeuralConfig::paper(Model::Vae).iterations, 100_000);
     assert_eq!(NeuralConfig::paper(Model::Rfvae).iterations, 50_000);
     let s: NeuralSection =
-        toml::from_str("iterations = 500\nvariant = \"corrected\"\nhidden = [512, 256]").unwrap();
-    let c = s.resolve(Model::Rfvae);
+        toml::from_str("iterations = 500\nhidden = [512, 256]").unwrap();
+    let c = s.resolve(Model::Rfvae, Variant::Corrected);
     assert_eq!(
         (c.iterations, c.variant, c.hidden, c.batch),
         (500, Variant::Corrected, [512, 256], 100)
@@ -490,6 +484,10 @@ fn configuration_serde() {
     assert!(
         toml::from_str::<NeuralSection>("iteration = 5").is_err(),
         "unknown keys are rejected"
+    );
+    assert!(
+        toml::from_str::<NeuralSection>("variant = \"corrected\"").is_err(),
+        "the variant is a matrix dimension, not a learner setting"
     );
     assert!(
         toml::from_str::<NeuralConfig>("iterations = 5").is_err(),

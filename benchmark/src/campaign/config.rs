@@ -9,6 +9,7 @@ use thiserror::Error;
 use crate::env::{EnvConfig, EnvKind};
 use crate::explore::{Algo, ExploreConfig, Learner, SamplerKind};
 use crate::repr::isomap::Disconnected;
+use crate::repr::neural::{Model, NeuralConfig, NeuralSection, Variant};
 
 /// Errors reading or validating a configuration.
 #[derive(Debug, Error)]
@@ -61,6 +62,14 @@ pub struct Matrix {
     /// Latent sizes: numbers, or `"true"` for the environment's true dimension (2 / 3).
     #[serde(default = "default_latents")]
     pub latents: Vec<LatentSize>,
+    /// Variants of the VAE and RFVAE (`faithful`, `corrected`; PAPER-NOTES.md section 5).
+    /// The other learners have one behaviour and ignore this list.
+    #[serde(default = "default_variants")]
+    pub variants: Vec<Variant>,
+}
+
+fn default_variants() -> Vec<Variant> {
+    vec![Variant::Faithful]
 }
 
 fn default_samplers() -> Vec<SamplerKind> {
@@ -130,6 +139,46 @@ impl Default for UglConfig {
 pub struct LearnersConfig {
     pub isomap: IsomapConfig,
     pub external: Option<ExternalConfig>,
+    /// `[learners.ae]`: training budget and architecture; missing keys take the paper's values.
+    pub ae: NeuralSection,
+    /// `[learners.vae]`.
+    pub vae: NeuralSection,
+    /// `[learners.rfvae]`.
+    pub rfvae: NeuralSection,
+}
+
+impl LearnersConfig {
+    /// The configuration section of a neural model.
+    pub fn neural(&self, model: Model) -> &NeuralSection {
+        match model {
+            Model::Ae => &self.ae,
+            Model::Vae => &self.vae,
+            Model::Rfvae => &self.rfvae,
+        }
+    }
+
+    /// The complete training configuration of a neural model and variant.
+    pub fn neural_config(&self, model: Model, variant: Variant) -> NeuralConfig {
+        self.neural(model).resolve(model, variant)
+    }
+
+    /// The part of the configuration a learner depends on (hashed into its runs' config hash,
+    /// so changing the VAE budget reruns only the VAE's runs).
+    pub fn hash_value(&self, learner: Learner, variant: Option<Variant>) -> serde_json::Value {
+        let v = match learner {
+            Learner::Pca | Learner::PcaCentred => serde_json::Value::Null,
+            Learner::Isomap => serde_json::to_value(&self.isomap).expect("serialisable"),
+            Learner::External => serde_json::to_value(&self.external).expect("serialisable"),
+            Learner::Ae | Learner::Vae | Learner::Rfvae => {
+                let model = learner.model().expect("neural");
+                serde_json::to_value(
+                    self.neural_config(model, variant.unwrap_or_default()),
+                )
+                .expect("serialisable")
+            }
+        };
+        serde_json::json!({ learner.name(): v })
+    }
 }
 
 /// `[learners.isomap]`.
@@ -230,6 +279,8 @@ impl CampaignConfig {
         for (k, list) in [
             ("matrix.envs", dup(&self.matrix.envs)),
             ("matrix.algos", dup(&self.matrix.algos)),
+            ("matrix.samplers", dup(&self.matrix.samplers)),
+            ("matrix.variants", dup(&self.matrix.variants)),
         ] {
             if let Some(d) = list {
                 return Err(format!("{k} lists '{d}' twice"));
@@ -250,6 +301,24 @@ impl CampaignConfig {
         }
         if self.matrix.latents.is_empty() {
             return Err("matrix.latents must list at least one latent size".into());
+        }
+        if self.matrix.variants.is_empty() {
+            return Err("matrix.variants must list at least one variant (faithful, corrected)".into());
+        }
+        for model in Model::ALL {
+            if model != Model::Rfvae && self.learners.neural(model).warmup.is_some() {
+                return Err(format!(
+                    "learners.{}.warmup: only the rfvae has a KL warm-up",
+                    model.name()
+                ));
+            }
+            self.learners
+                .neural_config(model, Variant::Faithful)
+                .validate(model, &format!("learners.{}", model.name()))
+                .map_err(|e| match e {
+                    crate::repr::ReprError::InvalidInput(m) => m,
+                    other => other.to_string(),
+                })?;
         }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {

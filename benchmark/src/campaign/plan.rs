@@ -5,6 +5,7 @@ use serde::Serialize;
 use super::config::{CampaignConfig, LatentSize};
 use crate::env::EnvKind;
 use crate::explore::{Algo, SamplerKind};
+use crate::repr::neural::Variant;
 
 /// One run of the matrix.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -15,6 +16,8 @@ pub struct RunSpec {
     pub sampler: SamplerKind,
     /// Latent size of a learned goal space; 0 for RPE and EFR.
     pub latents: usize,
+    /// Faithful or corrected, for the learners that have both (VAE, RFVAE); None otherwise.
+    pub variant: Option<Variant>,
     /// Repetition index (`--seed` of `ugl run`).
     pub seed: u64,
 }
@@ -32,37 +35,92 @@ impl RunSpec {
             algo,
             sampler,
             latents: 0,
+            variant: None,
             seed,
         }
     }
 
-    /// Canonical identity (DESIGN.md "Seeding"): `env=armball/algo=rge-efr/seed=3`, or for a
-    /// learned goal space `env=armball/algo=rge-pca/sampler=kde/latents=10/seed=3`. It enters
-    /// the run-seed hash, so it is part of the results' specification.
+    /// A run in a learned goal space; `variant` is kept only for the learners that have
+    /// variants ([`crate::explore::Learner::has_variants`]).
+    pub fn learned(
+        env: EnvKind,
+        algo: Algo,
+        sampler: SamplerKind,
+        latents: usize,
+        variant: Variant,
+        seed: u64,
+    ) -> Self {
+        let variant = algo
+            .learner()
+            .filter(|l| l.has_variants())
+            .map(|_| variant);
+        RunSpec {
+            env,
+            algo,
+            sampler,
+            latents,
+            variant,
+            seed,
+        }
+    }
+
+    /// `/variant=NAME` or nothing.
+    fn variant_part(&self, sep: &str, key: &str) -> String {
+        self.variant
+            .map(|v| format!("{sep}{key}{v}"))
+            .unwrap_or_default()
+    }
+
+    /// Canonical identity (DESIGN.md "Seeding"): `env=armball/algo=rge-efr/seed=3`, for a
+    /// learned goal space `env=armball/algo=rge-pca/sampler=kde/latents=10/seed=3`, and with a
+    /// variant `env=armball/algo=rge-vae/variant=corrected/sampler=kde/latents=10/seed=3`. It
+    /// enters the run-seed hash, so it is part of the results' specification.
     pub fn identity(&self) -> String {
         match self.algo.learner() {
             None => format!("env={}/algo={}/seed={}", self.env, self.algo, self.seed),
             Some(_) => format!(
-                "env={}/algo={}/sampler={}/latents={}/seed={}",
-                self.env, self.algo, self.sampler, self.latents, self.seed
+                "env={}/algo={}{}/sampler={}/latents={}/seed={}",
+                self.env,
+                self.algo,
+                self.variant_part("/", "variant="),
+                self.sampler,
+                self.latents,
+                self.seed
             ),
         }
     }
 
-    /// File-name-safe identity: `armball.rge-efr.s3`, `armball.rge-pca.kde.l10.s3`.
+    /// File-name-safe identity: `armball.rge-efr.s3`, `armball.rge-pca.kde.l10.s3`,
+    /// `armball.rge-vae.corrected.kde.l10.s3`.
     pub fn run_id(&self) -> String {
         match self.algo.learner() {
             None => format!("{}.{}.s{}", self.env, self.algo, self.seed),
             Some(_) => format!(
-                "{}.{}.{}.l{}.s{}",
-                self.env, self.algo, self.sampler, self.latents, self.seed
+                "{}.{}{}.{}.l{}.s{}",
+                self.env,
+                self.algo,
+                self.variant_part(".", ""),
+                self.sampler,
+                self.latents,
+                self.seed
             ),
         }
     }
 
     /// The identity of the trained representation this run uses (shared by every sampler of
-    /// the same env, learner, latent size, data-set size and repetition); None for baselines.
+    /// the same env, learner, variant, latent size, data-set size and repetition); None for
+    /// baselines. It groups runs, shards and names the model cache entry.
     pub fn representation_identity(&self, images: usize) -> Option<String> {
+        self.learner_seed_identity(images).map(|id| match self.variant {
+            Some(v) => format!("{id}/variant={v}"),
+            None => id,
+        })
+    }
+
+    /// The identity the learner's random stream derives from: the representation identity
+    /// without the variant, so the faithful and corrected variants of a cell start from the
+    /// same weights and draw the same batches (a paired comparison).
+    pub fn learner_seed_identity(&self, images: usize) -> Option<String> {
         self.algo.learner().map(|l| {
             format!(
                 "repr/env={}/learner={}/latents={}/images={images}/seed={}",
@@ -75,31 +133,40 @@ impl RunSpec {
     }
 }
 
-/// All runs of a campaign, in a fixed order (env, algo, sampler, latents, seed).
+/// All runs of a campaign, in a fixed order (env, algo, variant, sampler, latents, seed).
+/// Learned goal spaces are crossed with `matrix.samplers` and `matrix.latents`; the VAE and
+/// RFVAE also with `matrix.variants`. `gaussian` goals need a prior, so they are planned only
+/// for the learners that may have one (VAE, RFVAE, external), as in the paper.
 pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
     let mut runs = Vec::new();
     for &env in &cfg.matrix.envs {
         for &algo in &cfg.matrix.algos {
-            if algo.learner().is_none() {
+            let Some(learner) = algo.learner() else {
                 for seed in 0..cfg.campaign.reps as u64 {
                     runs.push(RunSpec::baseline(env, algo, seed));
                 }
                 continue;
-            }
-            for &sampler in &cfg.matrix.samplers {
-                for l in &cfg.matrix.latents {
-                    let latents = match l {
-                        LatentSize::N(n) => *n,
-                        LatentSize::TrueDim => env.state_dim(),
-                    };
-                    for seed in 0..cfg.campaign.reps as u64 {
-                        runs.push(RunSpec {
-                            env,
-                            algo,
-                            sampler,
-                            latents,
-                            seed,
-                        });
+            };
+            let variants: &[Variant] = if learner.has_variants() {
+                &cfg.matrix.variants
+            } else {
+                &[Variant::Faithful]
+            };
+            for &variant in variants {
+                for &sampler in &cfg.matrix.samplers {
+                    if sampler == SamplerKind::Gaussian && !learner.may_have_prior() {
+                        continue;
+                    }
+                    for l in &cfg.matrix.latents {
+                        let latents = match l {
+                            LatentSize::N(n) => *n,
+                            LatentSize::TrueDim => env.state_dim(),
+                        };
+                        for seed in 0..cfg.campaign.reps as u64 {
+                            runs.push(RunSpec::learned(
+                                env, algo, sampler, latents, variant, seed,
+                            ));
+                        }
                     }
                 }
             }
@@ -163,13 +230,15 @@ mod tests {
         assert_eq!(r.identity(), "env=armarrow/algo=rge-efr/seed=3");
         assert_eq!(r.run_id(), "armarrow.rge-efr.s3");
         assert_eq!(r.representation_identity(10), None);
-        let r = RunSpec {
-            env: EnvKind::ArmBall,
-            algo: Algo::Rge(Learner::Pca),
-            sampler: SamplerKind::Kde,
-            latents: 10,
-            seed: 2,
-        };
+        let r = RunSpec::learned(
+            EnvKind::ArmBall,
+            Algo::Rge(Learner::Pca),
+            SamplerKind::Kde,
+            10,
+            Variant::Corrected,
+            2,
+        );
+        assert_eq!(r.variant, None, "PCA has no variants");
         assert_eq!(
             r.identity(),
             "env=armball/algo=rge-pca/sampler=kde/latents=10/seed=2"
@@ -182,6 +251,64 @@ mod tests {
         assert_eq!(
             r.representation_identity(100),
             g.representation_identity(100)
+        );
+        let v = RunSpec::learned(
+            EnvKind::ArmBall,
+            Algo::Rge(Learner::Vae),
+            SamplerKind::Gaussian,
+            2,
+            Variant::Corrected,
+            0,
+        );
+        assert_eq!(
+            v.identity(),
+            "env=armball/algo=rge-vae/variant=corrected/sampler=gaussian/latents=2/seed=0"
+        );
+        assert_eq!(v.run_id(), "armball.rge-vae.corrected.gaussian.l2.s0");
+        let f = RunSpec {
+            variant: Some(Variant::Faithful),
+            ..v.clone()
+        };
+        assert_ne!(
+            v.representation_identity(10),
+            f.representation_identity(10)
+        );
+        assert_eq!(
+            v.learner_seed_identity(10),
+            f.learner_seed_identity(10),
+            "the variants of a cell are paired"
+        );
+        assert_eq!(
+            RunSpec::learned(
+                EnvKind::ArmBall,
+                Algo::Rge(Learner::Ae),
+                SamplerKind::Kde,
+                2,
+                Variant::Corrected,
+                0
+            )
+            .run_id(),
+            "armball.rge-ae.kde.l2.s0"
+        );
+    }
+
+    #[test]
+    fn gaussian_goals_and_variants_only_where_they_apply() {
+        let text = "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+                    algos = [\"rge-pca\", \"rge-ae\", \"rge-vae\"]\nsamplers = [\"kde\", \"gaussian\"]\n\
+                    latents = [10]\nvariants = [\"faithful\", \"corrected\"]\n";
+        let cfg = CampaignConfig::from_toml(text, std::path::Path::new("t.toml")).unwrap();
+        let ids: Vec<String> = plan(&cfg).iter().map(|r| r.run_id()).collect();
+        assert_eq!(
+            ids,
+            [
+                "armball.rge-pca.kde.l10.s0",
+                "armball.rge-ae.kde.l10.s0",
+                "armball.rge-vae.faithful.kde.l10.s0",
+                "armball.rge-vae.faithful.gaussian.l10.s0",
+                "armball.rge-vae.corrected.kde.l10.s0",
+                "armball.rge-vae.corrected.gaussian.l10.s0",
+            ]
         );
     }
 

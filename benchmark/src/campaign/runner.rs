@@ -1,7 +1,7 @@
 //! Executes runs: environment + explorer, then the results store.
 
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -18,11 +18,13 @@ use crate::explore::{
     run_rge, run_rpe,
 };
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
+use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::repr::external::ExternalLearner;
 use crate::repr::isomap::Isomap;
+use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
 use crate::repr::pca::{CentredPca, TruncatedSvd};
-use crate::repr::{Encoder, Latents, ReprError, RepresentationLearner};
+use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 /// Bumped whenever a change alters results for the same configuration.
@@ -54,11 +56,15 @@ struct HashInput<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     ugl: Option<&'a UglConfig>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    learners: Option<&'a LearnersConfig>,
+    learner: Option<serde_json::Value>,
 }
 
+/// Receives the training progress of neural representations: the representation's label
+/// (`armball.rge-vae.faithful.l10.s0`) and the progress.
+pub type TrainSink = dyn Fn(&str, TrainProgress) + Send + Sync;
+
 /// Everything needed to execute one run.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct RunContext<'a> {
     pub campaign: &'a str,
     pub campaign_seed: u64,
@@ -68,6 +74,14 @@ pub struct RunContext<'a> {
     pub ugl: &'a UglConfig,
     pub learners: &'a LearnersConfig,
     pub threads: usize,
+    /// Where trained neural models are kept (None: always train).
+    pub cache: Option<&'a ModelCache>,
+    /// Training progress of neural representations.
+    pub train_progress: Option<Arc<TrainSink>>,
+    /// Threads of a neural training: 0 = the calling pool's; campaigns with several workers
+    /// train each model on its own 1-thread pool (two 1-thread trainings side by side beat one
+    /// 2-thread training on 2 cores; STACK-NOTES.md).
+    pub train_threads: usize,
 }
 
 impl RunContext<'_> {
@@ -82,7 +96,10 @@ impl RunContext<'_> {
             env: self.env,
             // Learned goal spaces also depend on the UGL stage; baseline hashes do not.
             ugl: spec.algo.learner().map(|_| self.ugl),
-            learners: spec.algo.learner().map(|_| self.learners),
+            learner: spec
+                .algo
+                .learner()
+                .map(|l| self.learners.hash_value(l, spec.variant)),
         };
         let json = serde_json::to_vec(&input).expect("config serialises");
         blake3::hash(&json).to_hex().to_string()
@@ -98,13 +115,37 @@ pub struct Representation {
     pub fit_s: f64,
     /// Name of the learner (the external program's configured name for `external`).
     pub learner_name: String,
+    /// Training details of a neural representation.
+    pub training: Option<TrainInfo>,
 }
 
-/// Build the learner of an algorithm from the configuration.
+/// How a neural representation was obtained, recorded in the manifests of its runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrainInfo {
+    /// The complete training configuration.
+    pub config: NeuralConfig,
+    /// The recorded loss curve, `(iteration, mini-batch loss)`.
+    pub losses: Vec<(usize, f64)>,
+    /// `hit` (loaded from the model cache), `miss` (trained and stored), `rebuilt` (a cache
+    /// file was invalid: trained again and overwritten) or `off` (no cache).
+    pub cache: &'static str,
+    /// The cache key (BLAKE3 of everything the model depends on).
+    pub key: String,
+}
+
+/// Build the learner of an algorithm from the configuration; `variant` is used by the
+/// learners that have variants.
 pub fn make_learner(
     learner: Learner,
     cfg: &LearnersConfig,
+    variant: Option<Variant>,
 ) -> Result<Box<dyn RepresentationLearner>, ReprError> {
+    if let Some(model) = learner.model() {
+        return Ok(Box::new(NeuralLearner::new(
+            model,
+            cfg.neural_config(model, variant.unwrap_or_default()),
+        )));
+    }
     Ok(match learner {
         Learner::Pca => Box::new(TruncatedSvd::default()),
         Learner::PcaCentred => Box::new(CentredPca),
@@ -120,7 +161,108 @@ pub fn make_learner(
             })?;
             Box::new(ExternalLearner::new(e.name.clone(), e.command.clone()))
         }
+        Learner::Ae | Learner::Vae | Learner::Rfvae => unreachable!("handled above"),
     })
+}
+
+/// The model-cache key of a neural representation: BLAKE3 of everything it depends on (the
+/// environment and its constants, learner, variant, latents, data-set size and seed, learner
+/// seed, training configuration, backend, and the cache and results versions).
+pub fn model_key(spec: &RunSpec, ctx: &RunContext, cfg: &NeuralConfig) -> String {
+    let images = ctx.ugl.images;
+    let input = serde_json::json!({
+        "cache_format": crate::repr::cache::FORMAT_VERSION,
+        "results_version": RESULTS_VERSION,
+        "env": spec.env.name(),
+        "env_config": ctx.env,
+        "learner": spec.algo.learner().map(|l| l.name()),
+        "variant": spec.variant.map(|v| v.name()),
+        "latents": spec.latents,
+        "images": images,
+        "dataset_seed": run_seed(ctx.campaign_seed, &dataset_identity(spec.env, images, spec.seed)),
+        "learner_seed": spec.learner_seed_identity(images).map(|id| run_seed(ctx.campaign_seed, &id)),
+        "config": cfg,
+        "backend": neural::BACKEND,
+    });
+    let json = serde_json::to_vec(&input).expect("key serialises");
+    blake3::hash(&json).to_hex().to_string()
+}
+
+/// Train (or load from the cache) the neural representation of `spec` on `images`.
+fn fit_neural(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    images: &ImageSet,
+    rng: &mut crate::seed::Stream,
+) -> Result<(Box<dyn Encoder>, Latents, TrainInfo), ReprError> {
+    let learner = spec.algo.learner().expect("learned algorithm");
+    let model = learner.model().expect("neural learner");
+    let cfg = ctx
+        .learners
+        .neural_config(model, spec.variant.unwrap_or_default());
+    let key = model_key(spec, ctx, &cfg);
+    let mut status = "off";
+    let cached = match ctx.cache.map(|c| c.load(&key)) {
+        Some(CacheEntry::Hit(enc)) => {
+            status = "hit";
+            Some(*enc)
+        }
+        Some(CacheEntry::Invalid(why)) => {
+            tracing::warn!("model cache: ignoring an invalid file ({why}); training again");
+            status = "rebuilt";
+            None
+        }
+        Some(CacheEntry::Miss) => {
+            status = "miss";
+            None
+        }
+        None => None,
+    };
+    let mut enc = match cached {
+        Some(enc) => enc,
+        None => {
+            let mut l = NeuralLearner::new(model, cfg.clone());
+            if let Some(sink) = &ctx.train_progress {
+                let sink = sink.clone();
+                let label = representation_label(spec);
+                l = l.with_progress(Arc::new(move |p| sink(&label, p)));
+            }
+            let mut train = || {
+                neural::train(model, &l.config, images, spec.latents, rng, l.progress())
+            };
+            let enc = if ctx.train_threads > 0 {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(ctx.train_threads)
+                    .build()
+                    .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
+                    .install(train)?
+            } else {
+                train()?
+            };
+            if let Some(c) = ctx.cache {
+                c.store(&key, &enc)?;
+            }
+            enc
+        }
+    };
+    let z = enc.training_latents(images)?;
+    let info = TrainInfo {
+        config: cfg,
+        losses: enc.losses.clone(),
+        cache: status,
+        key,
+    };
+    Ok((Box::new(enc), z, info))
+}
+
+/// A short label of a run's representation, for progress bars and messages:
+/// `armball.rge-vae.faithful.l10.s0`.
+pub fn representation_label(spec: &RunSpec) -> String {
+    let v = spec.variant.map(|v| format!(".{v}")).unwrap_or_default();
+    format!(
+        "{}.{}{v}.l{}.s{}",
+        spec.env, spec.algo, spec.latents, spec.seed
+    )
 }
 
 /// Generate the UGL data set of the spec's repetition and fit its learner.
@@ -139,12 +281,18 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
         ctx.ugl.images,
         &mut stream(ds_seed, Component::Dataset),
     )?;
-    let repr_id = spec
-        .representation_identity(ctx.ugl.images)
+    let seed_id = spec
+        .learner_seed_identity(ctx.ugl.images)
         .expect("learned algorithm");
-    let mut rng = stream(run_seed(ctx.campaign_seed, &repr_id), Component::Learner);
-    let l = make_learner(learner, ctx.learners)?;
-    let (encoder, train) = l.fit(&data.images, spec.latents, &mut rng)?;
+    let mut rng = stream(run_seed(ctx.campaign_seed, &seed_id), Component::Learner);
+    let (encoder, train, info) = if learner.model().is_some() {
+        let (e, z, info) = fit_neural(spec, ctx, &data.images, &mut rng)?;
+        (e, z, Some(info))
+    } else {
+        let l = make_learner(learner, ctx.learners, spec.variant)?;
+        let (e, z) = l.fit(&data.images, spec.latents, &mut rng)?;
+        (e, z, None)
+    };
     let learner_name = match learner {
         Learner::External => ctx
             .learners
@@ -159,6 +307,7 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
         train,
         fit_s: t0.elapsed().as_secs_f64(),
         learner_name,
+        training: info,
     })
 }
 
@@ -200,7 +349,16 @@ pub fn explore(
             })?;
             let mut sampler: Box<dyn GoalSampler> = match spec.sampler {
                 SamplerKind::Kde => Box::new(KdeGoals::fit(&repr.train).map_err(repr_err)?),
-                SamplerKind::Gaussian => Box::new(GaussianGoals::new(spec.latents)),
+                SamplerKind::Gaussian => match repr.encoder.prior() {
+                    Some(prior) => Box::new(GaussianGoals::from_prior(&prior)),
+                    None => {
+                        return Err(repr_err(ReprError::InvalidInput(format!(
+                            "the gaussian sampler needs a goal-space prior, and {} has none \
+                             (use kde)",
+                            spec.algo
+                        ))));
+                    }
+                },
                 other => {
                     return Err(repr_err(ReprError::InvalidInput(format!(
                         "sampler {other} is not for learned goal spaces"
@@ -257,6 +415,7 @@ pub fn execute(
     };
     let fit_s = repr.as_ref().map(|r| r.fit_s);
     let learner_name = repr.as_ref().map(|r| r.learner_name.clone());
+    let train = repr.as_ref().and_then(|r| r.training.clone());
     let t0 = Instant::now();
     let explored = explore(spec, ctx, repr)?;
     let wall_s = t0.elapsed().as_secs_f64();
@@ -277,6 +436,27 @@ pub fn execute(
             UglConfig::default().images
         ));
     }
+    if let (Some(t), Some(model)) = (&train, spec.algo.learner().and_then(|l| l.model())) {
+        let p = NeuralConfig::paper(model);
+        if t.config.iterations < p.iterations {
+            notes.push(format!(
+                "{} training iterations instead of the paper's {}",
+                t.config.iterations, p.iterations
+            ));
+        }
+        if t.config.hidden != p.hidden {
+            notes.push(format!(
+                "hidden layers {:?} instead of the paper's {:?}",
+                t.config.hidden, p.hidden
+            ));
+        }
+        if t.config.batch != p.batch || t.config.lr != p.lr {
+            notes.push(format!(
+                "batch {} / lr {} instead of the paper's {} / {}",
+                t.config.batch, t.config.lr, p.batch, p.lr
+            ));
+        }
+    }
     let manifest = Manifest {
         run_id: spec.run_id(),
         identity: spec.identity(),
@@ -284,7 +464,11 @@ pub fn execute(
         algo: spec.algo.name().into(),
         sampler: spec.sampler.name().into(),
         latents: spec.latents,
-        variant: "none".into(),
+        variant: spec
+            .variant
+            .map(|v| v.name())
+            .unwrap_or("none")
+            .into(),
         learner: learner_name,
         seed: spec.seed,
         run_seed: run_seed(ctx.campaign_seed, &spec.identity()),
@@ -310,6 +494,7 @@ pub fn execute(
         wall_s,
         fit_s,
         encode_s: explored.encode_s,
+        train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
         host: host_name().into(),
         summary: summary.clone(),
     };
@@ -336,6 +521,10 @@ pub struct CampaignOptions<'a> {
     pub stop: &'a AtomicBool,
     /// Run only this slice `(index, count)` of the plan (`--shard i/n`).
     pub shard: Option<(usize, usize)>,
+    /// The model cache of neural representations.
+    pub cache: Option<&'a ModelCache>,
+    /// Training progress of neural representations.
+    pub train_progress: Option<Arc<TrainSink>>,
 }
 
 /// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
@@ -355,6 +544,9 @@ pub fn run_campaign(
         ugl: &cfg.ugl,
         learners: &cfg.learners,
         threads: opts.jobs,
+        cache: opts.cache,
+        train_progress: opts.train_progress.clone(),
+        train_threads: if opts.jobs > 1 { 1 } else { 0 },
     };
     let all = match opts.shard {
         None => plan(cfg),

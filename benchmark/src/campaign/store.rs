@@ -85,6 +85,9 @@ pub struct Manifest {
     /// Seconds spent rendering and encoding outcomes during exploration.
     #[serde(default)]
     pub encode_s: Option<f64>,
+    /// Training of a neural representation: configuration, loss curve, model-cache status.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub train: Option<serde_json::Value>,
     pub host: String,
     pub summary: Summary,
 }

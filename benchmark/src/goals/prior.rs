@@ -6,16 +6,32 @@ use rand_distr::{Distribution, StandardNormal};
 use super::GoalSampler;
 use crate::seed::Stream;
 
-/// N(0, I) goals in dimension `dim`.
+/// Goals `mean + std * N(0, I)`; N(0, I) in dimension `dim` by default.
 #[derive(Clone, Debug)]
 pub struct GaussianGoals {
     dim: usize,
+    mean: Vec<f64>,
+    std: Vec<f64>,
 }
 
 impl GaussianGoals {
     /// Standard normal goals.
     pub fn new(dim: usize) -> Self {
-        GaussianGoals { dim }
+        GaussianGoals {
+            dim,
+            mean: vec![0.0; dim],
+            std: vec![1.0; dim],
+        }
+    }
+
+    /// Goals from an encoder's diagonal Gaussian prior (N(0, I) for the VAE and RFVAE, what an
+    /// external program's `prior.npy` says otherwise).
+    pub fn from_prior(prior: &crate::repr::GaussianPrior) -> Self {
+        GaussianGoals {
+            dim: prior.mean.len(),
+            mean: prior.mean.clone(),
+            std: prior.std.clone(),
+        }
     }
 }
 
@@ -24,8 +40,9 @@ impl GoalSampler for GaussianGoals {
         self.dim
     }
     fn sample(&mut self, rng: &mut Stream, out: &mut [f64]) {
-        for v in out.iter_mut() {
-            *v = StandardNormal.sample(rng);
+        for ((v, m), s) in out.iter_mut().zip(&self.mean).zip(&self.std) {
+            let z: f64 = StandardNormal.sample(rng);
+            *v = m + s * z;
         }
     }
     fn name(&self) -> &'static str {

@@ -7,83 +7,11 @@
 //! The original AE has no documented defect: [`Variant::Faithful`](super::neural::Variant) and
 //! `Corrected` train and encode identically (same stream, same weights, same latents).
 
-use std::sync::Arc;
-
 use burn::tensor::Tensor;
 use burn::tensor::activation::sigmoid;
 
 use super::nets::{DenseNet, bce_with_logits_sum};
-use super::neural::{
-    self, Model, NeuralConfig, NeuralEncoder, ProgressFn, StepInput, TrainProgress,
-};
-use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
-use crate::seed::Stream;
-
-/// The AE learner (`ae`).
-#[derive(Clone)]
-pub struct Ae {
-    pub config: NeuralConfig,
-    progress: Option<ProgressFn>,
-}
-
-impl Ae {
-    /// With a configuration.
-    pub fn new(config: NeuralConfig) -> Self {
-        Ae {
-            config,
-            progress: None,
-        }
-    }
-
-    /// The paper's configuration.
-    pub fn paper() -> Self {
-        Ae::new(NeuralConfig::paper(Model::Ae))
-    }
-
-    /// Report every training iteration to `f`.
-    pub fn with_progress(mut self, f: Arc<dyn Fn(TrainProgress) + Send + Sync>) -> Self {
-        self.progress = Some(f);
-        self
-    }
-
-    /// Fit and return the concrete encoder (with its loss curve) and the training latents.
-    pub fn fit_neural(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(NeuralEncoder, Latents), ReprError> {
-        neural::fit(
-            Model::Ae,
-            &self.config,
-            images,
-            latents,
-            rng,
-            self.progress.as_ref(),
-        )
-    }
-}
-
-impl std::fmt::Debug for Ae {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Ae").field("config", &self.config).finish()
-    }
-}
-
-impl RepresentationLearner for Ae {
-    fn name(&self) -> &str {
-        "ae"
-    }
-    fn fit(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
-        let (enc, z) = self.fit_neural(images, latents, rng)?;
-        Ok((Box::new(enc), z))
-    }
-}
+use super::neural::StepInput;
 
 /// The training loss of one mini-batch: `mean_b sum_pixels BCE(decode(sigmoid(head(x))), x)`.
 pub fn loss(net: &DenseNet, input: StepInput<'_>) -> Tensor<1> {

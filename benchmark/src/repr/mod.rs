@@ -7,6 +7,7 @@
 //! every registered learner.
 
 pub mod ae;
+pub mod cache;
 pub mod dataset;
 pub mod external;
 pub mod isomap;
@@ -72,6 +73,9 @@ pub enum ReprError {
     /// The fit failed numerically (disconnected graph, NaN, no convergence...).
     #[error("{0}")]
     Numerical(String),
+    /// The model cache could not be written.
+    #[error("model cache: {0}")]
+    Cache(String),
     /// An external learner program failed or broke the protocol.
     #[error("external learner: {0}")]
     External(String),

@@ -32,6 +32,9 @@ use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_inpu
 use crate::repr::{ae, rfvae, vae};
 use crate::seed::Stream;
 
+/// The backend neural training runs on (part of the model-cache key).
+pub const BACKEND: &str = "burn-0.22.1/flex/f32";
+
 /// Which network.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -77,7 +80,9 @@ impl Model {
 }
 
 /// Paper-faithful or corrected behaviour where the original code has a defect.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Variant {
     /// What the original code did, defects included (see `vae.rs`, `rfvae.rs`).
@@ -88,6 +93,9 @@ pub enum Variant {
 }
 
 impl Variant {
+    /// Both.
+    pub const ALL: [Variant; 2] = [Variant::Faithful, Variant::Corrected];
+
     /// `faithful` / `corrected`.
     pub fn name(self) -> &'static str {
         match self {
@@ -115,6 +123,9 @@ pub struct NeuralConfig {
     pub variant: Variant,
     /// Record the loss every this many iterations (the original logged every 100).
     pub log_every: usize,
+    /// RFVAE only: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000
+    /// of 50,000); ignored by the AE and VAE.
+    pub warmup: usize,
 }
 
 impl NeuralConfig {
@@ -127,11 +138,15 @@ impl NeuralConfig {
             lr: 1e-3,
             variant: Variant::Faithful,
             log_every: 100,
+            warmup: match model {
+                Model::Rfvae => rfvae::ANNEAL_STEPS,
+                Model::Ae | Model::Vae => 0,
+            },
         }
     }
 
-    /// Check every value; the message names the key.
-    pub fn validate(&self, who: &str) -> Result<(), ReprError> {
+    /// Check every value for `model`; the message names the key.
+    pub fn validate(&self, model: Model, who: &str) -> Result<(), ReprError> {
         let bad = |msg: String| Err(ReprError::InvalidInput(format!("{who}: {msg}")));
         if self.iterations == 0 {
             return bad("iterations must be at least 1".into());
@@ -151,12 +166,32 @@ impl NeuralConfig {
         if self.log_every == 0 {
             return bad("log_every must be at least 1".into());
         }
+        if model == Model::Rfvae && self.warmup == 0 {
+            return bad("warmup must be at least 1".into());
+        }
         Ok(())
     }
 }
 
-/// The partial form of [`NeuralConfig`] for configuration files: missing keys take the paper's
-/// value for the model ([`NeuralSection::resolve`]).
+impl std::fmt::Display for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Variant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Variant::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| format!("unknown variant '{s}' (expected faithful or corrected)"))
+    }
+}
+
+/// The partial form of [`NeuralConfig`] for configuration files (`[learners.vae]` etc.):
+/// missing keys take the paper's value for the model ([`NeuralSection::resolve`]). The variant
+/// is not here: it is a dimension of the run matrix (`matrix.variants`, `ugl run --variant`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NeuralSection {
@@ -164,22 +199,101 @@ pub struct NeuralSection {
     pub hidden: Option<[usize; 2]>,
     pub batch: Option<usize>,
     pub lr: Option<f64>,
-    pub variant: Option<Variant>,
     pub log_every: Option<usize>,
+    /// RFVAE warm-up iterations (only valid in `[learners.rfvae]`).
+    pub warmup: Option<usize>,
 }
 
 impl NeuralSection {
-    /// The complete configuration for `model`.
-    pub fn resolve(&self, model: Model) -> NeuralConfig {
+    /// The complete configuration for `model` and `variant`.
+    pub fn resolve(&self, model: Model, variant: Variant) -> NeuralConfig {
         let p = NeuralConfig::paper(model);
         NeuralConfig {
             iterations: self.iterations.unwrap_or(p.iterations),
             hidden: self.hidden.unwrap_or(p.hidden),
             batch: self.batch.unwrap_or(p.batch),
             lr: self.lr.unwrap_or(p.lr),
-            variant: self.variant.unwrap_or(p.variant),
+            variant,
             log_every: self.log_every.unwrap_or(p.log_every),
+            warmup: self.warmup.unwrap_or(p.warmup),
         }
+    }
+}
+
+/// A neural representation learner (`ae`, `vae`, `rfvae`): the model, its training
+/// configuration and an optional progress callback.
+#[derive(Clone)]
+pub struct NeuralLearner {
+    pub model: Model,
+    pub config: NeuralConfig,
+    progress: Option<ProgressFn>,
+}
+
+impl NeuralLearner {
+    /// `model` trained with `config`.
+    pub fn new(model: Model, config: NeuralConfig) -> Self {
+        NeuralLearner {
+            model,
+            config,
+            progress: None,
+        }
+    }
+
+    /// `model` at the paper's configuration (faithful).
+    pub fn paper(model: Model) -> Self {
+        NeuralLearner::new(model, NeuralConfig::paper(model))
+    }
+
+    /// Report every training iteration to `f`.
+    pub fn with_progress(mut self, f: ProgressFn) -> Self {
+        self.progress = Some(f);
+        self
+    }
+
+    /// The progress callback, if any.
+    pub fn progress(&self) -> Option<&ProgressFn> {
+        self.progress.as_ref()
+    }
+
+    /// Fit and return the concrete encoder (with its loss curve) and the training latents.
+    pub fn fit_neural(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(NeuralEncoder, Latents), ReprError> {
+        fit(
+            self.model,
+            &self.config,
+            images,
+            latents,
+            rng,
+            self.progress.as_ref(),
+        )
+    }
+}
+
+impl std::fmt::Debug for NeuralLearner {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NeuralLearner")
+            .field("model", &self.model)
+            .field("config", &self.config)
+            .finish()
+    }
+}
+
+impl super::RepresentationLearner for NeuralLearner {
+    fn name(&self) -> &str {
+        self.model.name()
+    }
+    fn fit(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let (enc, z) = self.fit_neural(images, latents, rng)?;
+        Ok((Box::new(enc), z))
     }
 }
 
@@ -204,6 +318,8 @@ pub struct NeuralEncoder {
     pub variant: Variant,
     pub net: HostNet,
     pub losses: Vec<(usize, f64)>,
+    /// The seed of the encoder's own stream (drawn from the learner stream after training).
+    pub encode_seed: [u8; 32],
     /// The stream of the faithful RFVAE's stochastic encoding (unused by the others).
     rng: Stream,
     scratch: Scratch,
@@ -237,6 +353,7 @@ impl NeuralEncoder {
             variant,
             net,
             losses,
+            encode_seed,
             rng: Stream::from_seed(encode_seed),
             scratch: Scratch::default(),
         }
@@ -366,6 +483,8 @@ pub struct StepInput<'a> {
     pub latents: usize,
     /// 0-based iteration.
     pub step: usize,
+    /// RFVAE warm-up length.
+    pub warmup: usize,
     pub variant: Variant,
     pub device: &'a Device,
 }
@@ -425,7 +544,7 @@ impl<'a> Trainer<'a> {
         latents: usize,
         rng: &mut Stream,
     ) -> Result<Self, ReprError> {
-        cfg.validate(model.name())?;
+        cfg.validate(model, model.name())?;
         check_fit_input(images, latents)?;
         let host = init_net(model, cfg, images.dim, latents, rng);
         let device = Device::flex().autodiff();
@@ -468,6 +587,7 @@ impl<'a> Trainer<'a> {
             batch: k,
             latents: self.latents,
             step: self.step,
+            warmup: self.cfg.warmup,
             variant: self.cfg.variant,
             device: &self.device,
         };

@@ -6,7 +6,7 @@
 //! `r = ||z - c||`, `h = 1 / (a + r)`, `z_k = z + beta h (z - c)`, and the log-determinant term
 //! `log(clip((1 + beta h)^(d-1) (1 + beta h - beta r / (a + r)^2), 1e-4, 1e6))`.
 //! Loss = `mean(ann * (KL(q0 || N(0, I)) + sum BCE) - sum_k logdet_k)` with the warm-up
-//! `ann = min(1, 0.01 + step / 1e4)` (step 0-based) on both the KL and the reconstruction, not
+//! `ann = min(1, 0.01 + step / warmup)` (step 0-based; the paper's warm-up is 1e4 iterations) on both the KL and the reconstruction, not
 //! on the log-det; the KL is the analytic Gaussian KL of z0. TF Adam, lr 1e-3, 50,000
 //! iterations. Prior = N(0, I).
 //!
@@ -35,103 +35,32 @@
 //!   encoding and training latents are both the deterministic `z_K` of `z0 = mu` (the flows
 //!   applied to the mean).
 
-use std::sync::Arc;
-
 use burn::tensor::activation::softplus;
 use burn::tensor::{Device, Tensor};
 use rand_distr::{Distribution, StandardNormal};
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{
-    self, Model, NeuralConfig, NeuralEncoder, ProgressFn, StepInput, TrainProgress, Variant,
-};
+use super::neural::{self, StepInput, Variant};
 use super::vae::eps;
-use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::Stream;
 
 /// Number of radial flows (the original's `nb_trans`).
 pub const FLOWS: usize = 10;
 /// The log-det clip range.
 pub const LOGDET_CLIP: (f64, f64) = (1e-4, 1e6);
-/// Warm-up length (the original's `ann_duration`).
-pub const ANNEAL_STEPS: f64 = 1e4;
-
-/// The RFVAE learner (`rfvae`).
-#[derive(Clone)]
-pub struct Rfvae {
-    pub config: NeuralConfig,
-    progress: Option<ProgressFn>,
-}
-
-impl Rfvae {
-    /// With a configuration.
-    pub fn new(config: NeuralConfig) -> Self {
-        Rfvae {
-            config,
-            progress: None,
-        }
-    }
-
-    /// The paper's configuration.
-    pub fn paper() -> Self {
-        Rfvae::new(NeuralConfig::paper(Model::Rfvae))
-    }
-
-    /// Report every training iteration to `f`.
-    pub fn with_progress(mut self, f: Arc<dyn Fn(TrainProgress) + Send + Sync>) -> Self {
-        self.progress = Some(f);
-        self
-    }
-
-    /// Fit and return the concrete encoder (with its loss curve) and the training latents.
-    pub fn fit_neural(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(NeuralEncoder, Latents), ReprError> {
-        neural::fit(
-            Model::Rfvae,
-            &self.config,
-            images,
-            latents,
-            rng,
-            self.progress.as_ref(),
-        )
-    }
-}
-
-impl std::fmt::Debug for Rfvae {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Rfvae")
-            .field("config", &self.config)
-            .finish()
-    }
-}
-
-impl RepresentationLearner for Rfvae {
-    fn name(&self) -> &str {
-        "rfvae"
-    }
-    fn fit(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
-        let (enc, z) = self.fit_neural(images, latents, rng)?;
-        Ok((Box::new(enc), z))
-    }
-}
+/// Warm-up length of the paper (the original's `ann_duration`); configurable as
+/// `[learners.rfvae] warmup` (reduced budgets scale it down with the iterations).
+pub const ANNEAL_STEPS: usize = 10_000;
 
 /// Head block widths: mu, logvar, c, b, a.
 pub fn head_blocks(d: usize) -> Vec<usize> {
     vec![d, d, FLOWS * d, FLOWS, FLOWS]
 }
 
-/// The KL warm-up factor at 0-based iteration `step`.
-pub fn annealing(step: usize) -> f64 {
-    (0.01 + step as f64 / ANNEAL_STEPS).min(1.0)
+/// The KL warm-up factor at 0-based iteration `step` of a `warmup`-iteration warm-up:
+/// `min(1, 0.01 + step / warmup)`.
+pub fn annealing(step: usize, warmup: usize) -> f64 {
+    (0.01 + step as f64 / warmup.max(1) as f64).min(1.0)
 }
 
 /// The flow parameters of a batch, sliced from the head outputs `[B, P]`.
@@ -211,7 +140,7 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
     let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
     let (zk, logdet) = flows(z0, &p, d, input.variant);
     let rec = bce_with_logits_sum(net.decode(zk), input.x) + kl_std_normal(mu, logvar);
-    let ann = annealing(input.step);
+    let ann = annealing(input.step, input.warmup);
     match input.variant {
         Variant::Corrected => (rec.mul_scalar(ann) - logdet).mean(),
         Variant::Faithful => rec.mul_scalar(ann).mean() - logdet.mean(),

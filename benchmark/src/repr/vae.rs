@@ -10,83 +10,11 @@
 //! - **corrected**: one `eps` per sample, `[batch, d]`: `batch * d` normals per iteration
 //!   (row-major), the standard reparameterisation.
 
-use std::sync::Arc;
-
 use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{
-    self, Model, NeuralConfig, NeuralEncoder, ProgressFn, StepInput, TrainProgress, Variant,
-    normals, tensor2,
-};
-use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use super::neural::{StepInput, Variant, normals, tensor2};
 use crate::seed::Stream;
-
-/// The VAE learner (`vae`).
-#[derive(Clone)]
-pub struct Vae {
-    pub config: NeuralConfig,
-    progress: Option<ProgressFn>,
-}
-
-impl Vae {
-    /// With a configuration.
-    pub fn new(config: NeuralConfig) -> Self {
-        Vae {
-            config,
-            progress: None,
-        }
-    }
-
-    /// The paper's configuration.
-    pub fn paper() -> Self {
-        Vae::new(NeuralConfig::paper(Model::Vae))
-    }
-
-    /// Report every training iteration to `f`.
-    pub fn with_progress(mut self, f: Arc<dyn Fn(TrainProgress) + Send + Sync>) -> Self {
-        self.progress = Some(f);
-        self
-    }
-
-    /// Fit and return the concrete encoder (with its loss curve) and the training latents.
-    pub fn fit_neural(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(NeuralEncoder, Latents), ReprError> {
-        neural::fit(
-            Model::Vae,
-            &self.config,
-            images,
-            latents,
-            rng,
-            self.progress.as_ref(),
-        )
-    }
-}
-
-impl std::fmt::Debug for Vae {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Vae").field("config", &self.config).finish()
-    }
-}
-
-impl RepresentationLearner for Vae {
-    fn name(&self) -> &str {
-        "vae"
-    }
-    fn fit(
-        &self,
-        images: &ImageSet,
-        latents: usize,
-        rng: &mut Stream,
-    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
-        let (enc, z) = self.fit_neural(images, latents, rng)?;
-        Ok((Box::new(enc), z))
-    }
-}
 
 /// The reparameterisation noise of one iteration: `[1, d]` (faithful: shared by the batch,
 /// broadcast) or `[batch, d]` (corrected).

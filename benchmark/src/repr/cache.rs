@@ -1,0 +1,221 @@
+//! The model cache: trained neural representations on disk, keyed by the hash of everything
+//! they depend on (see [`crate::campaign::runner::model_key`]), so the samplers of a cell and a
+//! rerun of a campaign do not retrain.
+//!
+//! File format (`<dir>/<key>.model`, little-endian), written atomically (temp + rename):
+//! `b"UGL-MODEL\0"`, format version `u32`, header length `u64`, the header (JSON: key, model,
+//! variant, shapes, loss curve, encoder seed), then every layer's weights and biases as `f32`
+//! in the header's order, then the BLAKE3 hash (32 bytes) of everything before it.
+//!
+//! A file is trusted only if its magic, version, length, checksum, key and shapes all match;
+//! anything else (truncated, corrupted, written by another version, a key collision) is
+//! reported as [`CacheEntry::Invalid`] and the caller retrains and overwrites it.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::ReprError;
+use super::nets::{HostLayer, HostNet};
+use super::neural::{Model, NeuralEncoder, Variant};
+
+const MAGIC: &[u8; 10] = b"UGL-MODEL\0";
+/// Bumped when the file layout changes.
+pub const FORMAT_VERSION: u32 = 1;
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    key: String,
+    model: Model,
+    variant: Variant,
+    dim: usize,
+    hidden: [usize; 2],
+    latents: usize,
+    /// `(inp, out)` of enc1, enc2, head, dec1, dec2, dec_out.
+    layers: Vec<(usize, usize)>,
+    losses: Vec<(usize, f64)>,
+    encode_seed: String,
+}
+
+/// What [`ModelCache::load`] found.
+pub enum CacheEntry {
+    /// A valid model.
+    Hit(Box<NeuralEncoder>),
+    /// No file.
+    Miss,
+    /// A file that cannot be trusted; the reason.
+    Invalid(String),
+}
+
+/// A directory of trained models.
+#[derive(Clone, Debug)]
+pub struct ModelCache {
+    pub dir: PathBuf,
+}
+
+fn layers(net: &HostNet) -> [&HostLayer; 6] {
+    [
+        &net.enc1,
+        &net.enc2,
+        &net.head,
+        &net.dec1,
+        &net.dec2,
+        &net.dec_out,
+    ]
+}
+
+/// Serialise an encoder under `key`.
+pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
+    let net = &enc.net;
+    let header = Header {
+        key: key.into(),
+        model: enc.model,
+        variant: enc.variant,
+        dim: net.dim,
+        hidden: net.hidden,
+        latents: net.latents,
+        layers: layers(net).iter().map(|l| (l.inp, l.out)).collect(),
+        losses: enc.losses.clone(),
+        encode_seed: hex(&enc.encode_seed),
+    };
+    let header = serde_json::to_vec(&header).expect("header serialises");
+    let mut out = Vec::with_capacity(64 + header.len() + 4 * net.num_params());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(header.len() as u64).to_le_bytes());
+    out.extend_from_slice(&header);
+    for l in layers(net) {
+        for v in l.w.iter().chain(&l.b) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let sum = blake3::hash(&out);
+    out.extend_from_slice(sum.as_bytes());
+    out
+}
+
+/// Parse and check a file's bytes; `Err` says why it cannot be trusted.
+pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
+    let n = bytes.len();
+    if n < MAGIC.len() + 12 + 32 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err("not a model file (bad magic or too short)".into());
+    }
+    let (body, sum) = bytes.split_at(n - 32);
+    if blake3::hash(body).as_bytes() != sum {
+        return Err("checksum mismatch (truncated or corrupted)".into());
+    }
+    let mut at = MAGIC.len();
+    let version = u32::from_le_bytes(body[at..at + 4].try_into().expect("4 bytes"));
+    at += 4;
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "format version {version}, this build reads {FORMAT_VERSION}"
+        ));
+    }
+    let hlen = u64::from_le_bytes(body[at..at + 8].try_into().expect("8 bytes")) as usize;
+    at += 8;
+    let hend = at
+        .checked_add(hlen)
+        .filter(|&e| e <= body.len())
+        .ok_or("header length out of range")?;
+    let h: Header =
+        serde_json::from_slice(&body[at..hend]).map_err(|e| format!("bad header: {e}"))?;
+    if h.key != key {
+        return Err(format!("key mismatch (file holds {})", h.key));
+    }
+    let [h1, h2] = h.hidden;
+    let p: usize = h.model.head_blocks(h.latents).iter().sum();
+    let expect = vec![
+        (h.dim, h1),
+        (h1, h2),
+        (h2, p),
+        (h.latents, h2),
+        (h2, h1),
+        (h1, h.dim),
+    ];
+    if h.layers != expect {
+        return Err("layer shapes do not match the model".into());
+    }
+    let values: usize = expect.iter().map(|(i, o)| i * o + o).sum();
+    if body.len() - hend != 4 * values {
+        return Err(format!(
+            "weights have {} bytes, the shapes need {}",
+            body.len() - hend,
+            4 * values
+        ));
+    }
+    let mut floats = body[hend..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")));
+    let mut take = |k: usize| -> Vec<f32> { floats.by_ref().take(k).collect() };
+    let mut layer = |(inp, out): (usize, usize)| HostLayer {
+        inp,
+        out,
+        w: take(inp * out),
+        b: take(out),
+    };
+    let net = HostNet {
+        dim: h.dim,
+        hidden: h.hidden,
+        latents: h.latents,
+        enc1: layer(expect[0]),
+        enc2: layer(expect[1]),
+        head: layer(expect[2]),
+        dec1: layer(expect[3]),
+        dec2: layer(expect[4]),
+        dec_out: layer(expect[5]),
+    };
+    let seed = unhex(&h.encode_seed).ok_or("bad encoder seed")?;
+    Ok(NeuralEncoder::new(h.model, h.variant, net, h.losses, seed))
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect()
+}
+
+fn unhex(s: &str) -> Option<[u8; 32]> {
+    if s.len() != 64 {
+        return None;
+    }
+    let mut out = [0u8; 32];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = u8::from_str_radix(s.get(2 * i..2 * i + 2)?, 16).ok()?;
+    }
+    Some(out)
+}
+
+impl ModelCache {
+    /// A cache in `dir` (created on the first store).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        ModelCache { dir: dir.into() }
+    }
+
+    /// The file of `key`.
+    pub fn path(&self, key: &str) -> PathBuf {
+        self.dir.join(format!("{key}.model"))
+    }
+
+    /// Look `key` up.
+    pub fn load(&self, key: &str) -> CacheEntry {
+        let path = self.path(key);
+        match std::fs::read(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => CacheEntry::Miss,
+            Err(e) => CacheEntry::Invalid(format!("cannot read {}: {e}", path.display())),
+            Ok(bytes) => match from_bytes(key, &bytes) {
+                Ok(enc) => CacheEntry::Hit(Box::new(enc)),
+                Err(why) => CacheEntry::Invalid(format!("{}: {why}", path.display())),
+            },
+        }
+    }
+
+    /// Store `enc` under `key` (atomically: temp file + rename).
+    pub fn store(&self, key: &str, enc: &NeuralEncoder) -> Result<(), ReprError> {
+        let io = |what: &str, p: &Path, e: std::io::Error| {
+            ReprError::Cache(format!("cannot {what} {}: {e}", p.display()))
+        };
+        std::fs::create_dir_all(&self.dir).map_err(|e| io("create", &self.dir, e))?;
+        let path = self.path(key);
+        crate::campaign::store::write_atomic(&path, &to_bytes(key, enc))
+            .map_err(|e| ReprError::Cache(e.to_string()))
+    }
+}
