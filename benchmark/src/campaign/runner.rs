@@ -2,10 +2,10 @@
 
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -78,9 +78,9 @@ pub struct RunContext<'a> {
     pub cache: Option<&'a ModelCache>,
     /// Training progress of neural representations.
     pub train_progress: Option<Arc<TrainSink>>,
-    /// Threads of a neural training: 0 = the calling pool's; campaigns with several workers
-    /// train each model on its own 1-thread pool (two 1-thread trainings side by side beat one
-    /// 2-thread training on 2 cores; STACK-NOTES.md).
+    /// Threads of a neural training: 0 = the calling pool's (a campaign's workers each have a
+    /// pool of `cores / jobs` threads: two 1-thread trainings side by side beat one 2-thread
+    /// training on 2 cores; STACK-NOTES.md).
     pub train_threads: usize,
 }
 
@@ -511,6 +511,9 @@ pub enum Progress {
     Finished(Summary),
 }
 
+/// The outcome of each run of a group (None: skipped after a stop request).
+type GroupResult = Vec<Option<Result<Summary, RunError>>>;
+
 /// Options of a campaign execution.
 pub struct CampaignOptions<'a> {
     /// Worker threads (runs in parallel; each run is single-threaded).
@@ -546,7 +549,8 @@ pub fn run_campaign(
         threads: opts.jobs,
         cache: opts.cache,
         train_progress: opts.train_progress.clone(),
-        train_threads: if opts.jobs > 1 { 1 } else { 0 },
+        // Each worker's own pool is the training's (see below).
+        train_threads: 0,
     };
     let all = match opts.shard {
         None => plan(cfg),
@@ -572,43 +576,79 @@ pub fn run_campaign(
     }
     // Expensive groups (learned representations) first, for a better load balance.
     groups.sort_by_key(|(k, _)| k.is_none());
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.jobs.max(1))
-        .build()
-        .map_err(|e| RunError::Pool(e.to_string()))?;
-    let results: Vec<Vec<Option<Result<Summary, RunError>>>> = pool.install(|| {
-        groups
-            .par_iter()
-            .map(|(key, specs)| {
-                let mut out_v = Vec::with_capacity(specs.len());
-                let mut repr = None;
-                for spec in specs {
-                    if opts.stop.load(Ordering::SeqCst) {
-                        out_v.push(None);
+    // `jobs` plain worker threads pull groups from a shared counter. Each worker owns a rayon
+    // pool of `cores / jobs` threads for the parallel parts of a fit (Isomap's searches, burn's
+    // kernels). Not a rayon `par_iter` over groups: a rayon worker waiting inside a fit steals
+    // other groups and starts their fits too, so dozens of fits (and their memory) pile up.
+    let jobs = opts.jobs.max(1);
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let inner = (cores / jobs).max(1);
+    let next = AtomicUsize::new(0);
+    let slots: Vec<Mutex<GroupResult>> = groups.iter().map(|_| Mutex::new(Vec::new())).collect();
+    let run_group = |key: &Option<String>, specs: &[&RunSpec]| -> GroupResult {
+        let mut out_v = Vec::with_capacity(specs.len());
+        let mut repr = None;
+        for spec in specs {
+            if opts.stop.load(Ordering::SeqCst) {
+                out_v.push(None);
+                continue;
+            }
+            if key.is_some() && repr.is_none() {
+                match fit_representation(spec, &ctx) {
+                    Ok(r) => repr = Some(r),
+                    Err(source) => {
+                        out_v.push(Some(Err(RunError::Repr {
+                            run: spec.run_id(),
+                            source,
+                        })));
                         continue;
                     }
-                    if key.is_some() && repr.is_none() {
-                        match fit_representation(spec, &ctx) {
-                            Ok(r) => repr = Some(r),
-                            Err(source) => {
-                                out_v.push(Some(Err(RunError::Repr {
-                                    run: spec.run_id(),
-                                    source,
-                                })));
-                                continue;
-                            }
-                        }
-                    }
-                    let r = execute(spec, &ctx, out, repr.as_mut());
-                    if let Ok(s) = &r {
-                        on_progress(Progress::Finished(s.clone()));
-                    }
-                    out_v.push(Some(r));
                 }
-                out_v
+            }
+            let r = execute(spec, &ctx, out, repr.as_mut());
+            if let Ok(s) = &r {
+                on_progress(Progress::Finished(s.clone()));
+            }
+            out_v.push(Some(r));
+        }
+        out_v
+    };
+    let pools = (0..jobs.min(groups.len()))
+        .map(|_| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(inner)
+                .build()
+                .map_err(|e| RunError::Pool(e.to_string()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = pools
+            .iter()
+            .map(|pool| {
+                scope.spawn(|| {
+                    loop {
+                        let g = next.fetch_add(1, Ordering::SeqCst);
+                        let Some((key, specs)) = groups.get(g) else {
+                            break;
+                        };
+                        let r = pool.install(|| run_group(key, specs));
+                        *slots[g].lock().expect("result slot") = r;
+                    }
+                })
             })
-            .collect()
+            .collect();
+        for h in handles {
+            if let Err(panic) = h.join() {
+                std::panic::resume_unwind(panic);
+            }
+        }
     });
+    let results: Vec<GroupResult> = slots
+        .into_iter()
+        .map(|m| m.into_inner().expect("result slot"))
+        .collect();
     let mut done = Vec::new();
     let mut skipped_now = 0;
     for r in results.into_iter().flatten() {
