@@ -119,8 +119,10 @@ fn write_config(dir: &Path, reps: usize) -> PathBuf {
         &cfg,
         format!(
             "[campaign]\nname = \"engine\"\nreps = {reps}\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
-             algos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [\"true\"]\n\
-             [ugl]\nimages = 300\n[explore]\nepochs = 1500\neval_every = 100\n"
+             algos = [\"rpe\", \"rge-efr\", \"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\", \"gaussian\"]\n\
+             latents = [\"true\"]\nvariants = [\"faithful\", \"corrected\"]\n\
+             [ugl]\nimages = 300\n[explore]\nepochs = 1500\neval_every = 100\n\
+             [learners.vae]\niterations = 20\nhidden = [16, 8]\n"
         ),
     )
     .unwrap();
@@ -161,7 +163,10 @@ fn results_do_not_depend_on_the_worker_count() {
         .success()
     );
     let (ra, rb) = (result_bytes(&a), result_bytes(&b));
-    assert_eq!(ra.len(), 2 * 4 * 2 * 2);
+    // Per env: rpe, rge-efr, rge-pca (kde; no prior for gaussian goals), rge-vae x 2 variants
+    // x 2 samplers; 2 reps; 2 files per run. With 1 worker the VAE trains on 2 threads, with 2
+    // workers on 1 thread each: the bytes must not differ.
+    assert_eq!(ra.len(), 2 * 7 * 2 * 2);
     assert!(ra == rb, "1 and 2 workers give different result files");
 }
 

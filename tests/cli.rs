@@ -544,3 +544,163 @@ fn slurm_scripts() {
         "--shards",
     );
 }
+
+/// A tiny profile with the neural learners.
+fn neural_profile(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("tiny-neural.toml");
+    std::fs::write(
+        &path,
+        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
+         [ugl]\nimages = 200\n[explore]\nepochs = 300\neval_every = 100\n\
+         [learners.ae]\niterations = 15\nhidden = [16, 8]\n\
+         [learners.vae]\niterations = 15\nhidden = [16, 8]\n\
+         [learners.rfvae]\niterations = 15\nhidden = [16, 8]\nwarmup = 5\n",
+    )
+    .unwrap();
+    path
+}
+
+fn manifest(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn neural_runs_share_the_model_cache_and_rebuild_a_corrupted_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = neural_profile(dir.path());
+    let cache = dir.path().join("cache");
+    let run = |out: &Path, sampler: &str, variant: &str| {
+        ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-rfvae",
+            "--variant",
+            variant,
+            "--sampler",
+            sampler,
+            "--latents",
+            "2",
+            "--profile",
+            p(&profile),
+            "--cache",
+            p(&cache),
+            "--out",
+            p(out),
+        ])
+    };
+    let (a, b, c) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("c"),
+    );
+    let id = "armball.rge-rfvae.faithful.kde.l2.s0";
+    let o = run(&a, "kde", "faithful");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = manifest(&a.join(format!("{id}.json")));
+    assert_eq!(m["train"]["cache"], "miss");
+    assert_eq!(m["variant"], "faithful");
+    assert_eq!(m["train"]["config"]["iterations"], 15);
+    assert_eq!(m["reduced_budget"], true);
+    let models: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
+    assert_eq!(models.len(), 1, "one model stored");
+    // The Gaussian sampler uses the same model: no training.
+    let o = run(&a, "gaussian", "faithful");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let g = manifest(&a.join("armball.rge-rfvae.faithful.gaussian.l2.s0.json"));
+    assert_eq!(g["train"]["cache"], "hit");
+    assert_eq!(g["train"]["key"], m["train"]["key"]);
+    // A second run loads the model and gives the same bytes.
+    assert!(run(&b, "kde", "faithful").status.success());
+    assert_eq!(
+        manifest(&b.join(format!("{id}.json")))["train"]["cache"],
+        "hit"
+    );
+    let same = |x: &Path, y: &Path| {
+        for suffix in [".parquet", ".outcomes.parquet"] {
+            assert_eq!(
+                std::fs::read(x.join(format!("{id}{suffix}"))).unwrap(),
+                std::fs::read(y.join(format!("{id}{suffix}"))).unwrap(),
+                "{id}{suffix}"
+            );
+        }
+    };
+    same(&a, &b);
+    // Corrupt the model (flip one byte of the weights): detected, retrained, same results.
+    let model = std::fs::read_dir(&cache)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let mut bytes = std::fs::read(&model).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    std::fs::write(&model, &bytes).unwrap();
+    assert!(run(&c, "kde", "faithful").status.success());
+    assert_eq!(
+        manifest(&c.join(format!("{id}.json")))["train"]["cache"],
+        "rebuilt"
+    );
+    same(&a, &c);
+    // Truncated (a partial write): also rebuilt.
+    let bytes = std::fs::read(&model).unwrap();
+    std::fs::write(&model, &bytes[..bytes.len() / 3]).unwrap();
+    std::fs::remove_dir_all(&c).unwrap();
+    assert!(run(&c, "kde", "faithful").status.success());
+    assert_eq!(
+        manifest(&c.join(format!("{id}.json")))["train"]["cache"],
+        "rebuilt"
+    );
+    same(&a, &c);
+    // The corrected variant is another model.
+    assert!(run(&c, "kde", "corrected").status.success());
+    let k = manifest(&c.join("armball.rge-rfvae.corrected.kde.l2.s0.json"));
+    assert_eq!(k["train"]["cache"], "miss");
+    assert_ne!(k["train"]["key"], m["train"]["key"]);
+}
+
+#[test]
+fn neural_run_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = neural_profile(dir.path());
+    let out = p(dir.path());
+    let args = |extra: &[&str]| {
+        let mut v = vec![
+            "run",
+            "--env",
+            "armball",
+            "--profile",
+            p(&profile),
+            "--out",
+            out,
+        ];
+        v.extend_from_slice(extra);
+        ugl(&v)
+    };
+    assert_one_line_error(
+        &args(&["--algo", "rge-pca", "--variant", "corrected"]),
+        "--variant applies to rge-vae and rge-rfvae",
+    );
+    assert_one_line_error(
+        &args(&["--algo", "rge-ae", "--variant", "faithful"]),
+        "--variant",
+    );
+    assert_one_line_error(
+        &args(&["--algo", "rge-vae", "--variant", "fixed"]),
+        "fixed",
+    );
+    assert_one_line_error(
+        &args(&["--algo", "rge-isomap", "--sampler", "gaussian"]),
+        "prior",
+    );
+    assert_one_line_error(
+        &args(&["--algo", "rge-ae", "--sampler", "gaussian"]),
+        "prior",
+    );
+    assert_one_line_error(
+        &args(&["--algo", "rge-vae", "--no-cache", "--cache", out]),
+        "--cache",
+    );
+}

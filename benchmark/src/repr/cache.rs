@@ -219,3 +219,56 @@ impl ModelCache {
             .map_err(|e| ReprError::Cache(e.to_string()))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::repr::neural::{Model, NeuralConfig, init_net};
+    use crate::seed::stream_named;
+
+    fn encoder(model: Model) -> NeuralEncoder {
+        let cfg = NeuralConfig {
+            hidden: [6, 5],
+            ..NeuralConfig::paper(model)
+        };
+        let net = init_net(model, &cfg, 12, 3, &mut stream_named(1, "cache-test"));
+        NeuralEncoder::new(model, Variant::Corrected, net, vec![(0, 1.5), (9, 0.25)], [7; 32])
+    }
+
+    #[test]
+    fn round_trip_and_every_defect_is_detected() {
+        for model in Model::ALL {
+            let enc = encoder(model);
+            let bytes = to_bytes("k1", &enc);
+            let back = from_bytes("k1", &bytes).unwrap();
+            assert_eq!(back.net, enc.net);
+            assert_eq!(back.losses, enc.losses);
+            assert_eq!(back.encode_seed, enc.encode_seed);
+            assert_eq!((back.model, back.variant), (enc.model, enc.variant));
+            assert!(from_bytes("k2", &bytes).unwrap_err().contains("key mismatch"));
+            for cut in [0, 5, 40, bytes.len() / 2, bytes.len() - 1] {
+                assert!(from_bytes("k1", &bytes[..cut]).is_err(), "cut at {cut}");
+            }
+            for at in [3, 12, 30, bytes.len() / 2, bytes.len() - 1] {
+                let mut bad = bytes.clone();
+                bad[at] ^= 1;
+                assert!(from_bytes("k1", &bad).is_err(), "flip at {at}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_cache_directory() {
+        let dir = tempfile::tempdir().unwrap();
+        let cache = ModelCache::new(dir.path().join("models"));
+        assert!(matches!(cache.load("abc"), CacheEntry::Miss));
+        cache.store("abc", &encoder(Model::Vae)).unwrap();
+        assert!(matches!(cache.load("abc"), CacheEntry::Hit(_)));
+        std::fs::write(cache.path("abc"), b"junk").unwrap();
+        assert!(matches!(cache.load("abc"), CacheEntry::Invalid(_)));
+        // A directory where the cache should be is an error, not a panic.
+        let blocked = ModelCache::new(dir.path().join("file"));
+        std::fs::write(&blocked.dir, b"").unwrap();
+        assert!(blocked.store("abc", &encoder(Model::Ae)).is_err());
+    }
+}
