@@ -261,3 +261,60 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
         "{err}"
     );
 }
+
+/// A full disk: a 64 KiB tmpfs (mounted in a private user + mount namespace with `unshare`, so
+/// no root is needed) fills up after a few runs. The campaign must stop with a one-line error
+/// naming the path, leave no temporary files behind, and not touch the existing result.
+#[test]
+fn a_full_disk_gives_a_clear_error_and_touches_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("disk.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"disk\"\nreps = 20\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 2000\n",
+    )
+    .unwrap();
+    let mnt = dir.path().join("tiny");
+    std::fs::create_dir(&mnt).unwrap();
+    let script = format!(
+        "mount -t tmpfs -o size=64k tmpfs {m} || exit 77; mkdir {m}/results && \
+         printf 'an existing result' > {m}/results/existing.parquet && \
+         {ugl} campaign --config {cfg} --out {m}/results --jobs 2 --quiet; code=$?; \
+         ls -a {m}/results > {d}/listing; cat {m}/results/existing.parquet > {d}/existing; exit $code",
+        m = p(&mnt),
+        d = p(dir.path()),
+        ugl = env!("CARGO_BIN_EXE_ugl"),
+        cfg = p(&cfg),
+    );
+    let skip = || eprintln!("SKIPPED: cannot mount a tmpfs in a user namespace here (unshare -rm)");
+    let o = match Command::new("unshare")
+        .args(["-rm", "sh", "-c", &script])
+        .output()
+    {
+        Err(_) => return skip(),
+        Ok(o)
+            if o.status.code() == Some(77)
+                || String::from_utf8_lossy(&o.stderr).contains("unshare:") =>
+        {
+            return skip();
+        }
+        Ok(o) => o,
+    };
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err:?}");
+    assert!(
+        err.contains("No space left on device") && err.contains("/results/"),
+        "{err}"
+    );
+    let listing = std::fs::read_to_string(dir.path().join("listing")).unwrap();
+    assert!(
+        !listing.contains(".tmp"),
+        "temporary files left behind: {listing}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("existing")).unwrap(),
+        "an existing result"
+    );
+}

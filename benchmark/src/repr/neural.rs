@@ -32,8 +32,27 @@ use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_inpu
 use crate::repr::{ae, rfvae, vae};
 use crate::seed::Stream;
 
-/// The backend neural training runs on (part of the model-cache key).
+/// The backend neural training runs on (part of the model-cache key, so models trained on
+/// another backend are never mixed up).
+#[cfg(not(feature = "cuda"))]
 pub const BACKEND: &str = "burn-0.22.1/flex/f32";
+/// The backend neural training runs on (part of the model-cache key).
+#[cfg(feature = "cuda")]
+pub const BACKEND: &str = "burn-0.22.1/cuda/f32";
+
+/// The device of training: burn's `flex` CPU backend (bit-for-bit deterministic for a seed and
+/// any thread count), or with the `cuda` cargo feature the first CUDA GPU (for the paper's
+/// budgets; not deterministic across GPU models, not built or tested by CI).
+pub fn training_device() -> Device {
+    #[cfg(feature = "cuda")]
+    {
+        Device::cuda(0).autodiff()
+    }
+    #[cfg(not(feature = "cuda"))]
+    {
+        Device::flex().autodiff()
+    }
+}
 
 /// Which network.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -547,7 +566,7 @@ impl<'a> Trainer<'a> {
         cfg.validate(model, model.name())?;
         check_fit_input(images, latents)?;
         let host = init_net(model, cfg, images.dim, latents, rng);
-        let device = Device::flex().autodiff();
+        let device = training_device();
         let net = host.to_module(&device);
         let opt: ModuleOptimizer = match model {
             Model::Ae => TfAdagrad::default().into(),
