@@ -133,6 +133,10 @@ enum Command {
         #[command(flatten)]
         cache: CacheArgs,
     },
+    /// Run one more representation learner on the cells and seeds of a campaign (default: the
+    /// paper's), into data/results/compare-NAME; the report ranks it against the paper's
+    /// algorithms with the same statistics.
+    Compare(CompareArgs),
     /// Write a Slurm array job (one task per shard) and a merge step for a campaign.
     Slurm {
         /// Campaign file (data/campaigns/NAME.toml).
@@ -175,6 +179,35 @@ enum Command {
         #[arg(long, default_value = "data/paper")]
         paper: PathBuf,
     },
+}
+
+#[derive(clap::Args, Debug)]
+struct CompareArgs {
+    /// A registered learner (pca, pca-centred, isomap, ae, vae, rfvae), or with --command the
+    /// name of an external program.
+    #[arg(long)]
+    learner: String,
+    /// Command line of a program speaking the external-learner protocol
+    /// (docs/external-learners.md), run with `sh -c`.
+    #[arg(long)]
+    command: Option<String>,
+    /// External learners: also run Gaussian-prior goals (the program must write prior.npy).
+    #[arg(long)]
+    gaussian: bool,
+    /// The campaign whose cells, seeds and budgets to use.
+    #[arg(long, default_value = "data/campaigns/paper.toml")]
+    config: PathBuf,
+    /// Results directory (default: data/results/compare-NAME).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Runs in parallel (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// No progress bars.
+    #[arg(long)]
+    quiet: bool,
+    #[command(flatten)]
+    cache: CacheArgs,
 }
 
 /// Where trained neural models are kept.
@@ -329,6 +362,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             time,
         } => slurm(&config, shards, out, &scripts, cpus, &time),
         Command::Merge { into, sources } => merge(&into, &sources),
+        Command::Compare(a) => compare(a),
         Command::Report {
             results,
             out,
@@ -543,6 +577,80 @@ fn campaign(
     cache: &CacheArgs,
 ) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
+    let profile = config
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("custom")
+        .to_string();
+    run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
+}
+
+/// `ugl compare`: the paper's matrix cells and seeds for one more learner.
+fn compare(a: CompareArgs) -> Result<()> {
+    let mut cfg = CampaignConfig::load(&a.config)?;
+    let name = a.learner.trim().to_string();
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
+    {
+        bail!("--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'");
+    }
+    let registered: Vec<Learner> = Learner::ALL
+        .into_iter()
+        .filter(|l| *l != Learner::External)
+        .collect();
+    let algo = match (registered.iter().find(|l| l.name() == name), &a.command) {
+        (Some(l), None) => Algo::Rge(*l),
+        (Some(_), Some(_)) => bail!(
+            "--learner {name} is a registered learner: drop --command, or give the external program another name"
+        ),
+        (None, Some(cmd)) => {
+            if cmd.trim().is_empty() {
+                bail!("--command must not be empty");
+            }
+            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
+                name: name.clone(),
+                command: cmd.clone(),
+            });
+            Algo::Rge(Learner::External)
+        }
+        (None, None) => {
+            let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
+            bail!(
+                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
+                names.join(", ")
+            )
+        }
+    };
+    // Same campaign seed, matrix cells, reps and budgets as the base campaign: the same run
+    // seeds and UGL data sets, so the new learner is compared on paired runs.
+    let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
+    cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
+    cfg.matrix.algos = vec![algo];
+    if algo == Algo::Rge(Learner::External) && !a.gaussian {
+        cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);
+        if cfg.matrix.samplers.is_empty() {
+            cfg.matrix.samplers = vec![SamplerKind::Kde];
+        }
+    }
+    cfg.validate()
+        .map_err(|m| anyhow::anyhow!("{}: {m}", a.config.display()))?;
+    let out = a
+        .out
+        .unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    run_config(&cfg, &cfg.campaign.name.clone(), Some(out), a.jobs, a.quiet, None, &a.cache)
+}
+
+fn run_config(
+    cfg: &CampaignConfig,
+    profile: &str,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    quiet: bool,
+    shard: Option<&str>,
+    cache: &CacheArgs,
+) -> Result<()> {
     let shard = shard
         .map(parse_shard)
         .transpose()
@@ -580,11 +688,6 @@ fn campaign(
         )
         .expect("valid template"),
     );
-    let profile = config
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("custom")
-        .to_string();
     let t0 = std::time::Instant::now();
     let on = |p: Progress| match p {
         Progress::Planned { total, skipped } => {
@@ -604,13 +707,13 @@ fn campaign(
     };
     let opts = CampaignOptions {
         jobs,
-        profile: &profile,
+        profile,
         stop: &stop,
         shard,
         cache: cache.as_ref(),
         train_progress: Some(training_bars(&mp, Some(&bar))),
     };
-    let done = run_campaign(&cfg, &out, &opts, &on)?;
+    let done = run_campaign(cfg, &out, &opts, &on)?;
     bar.finish_and_clear();
     eprintln!(
         "campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}",

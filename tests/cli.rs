@@ -704,3 +704,79 @@ fn neural_run_errors() {
         "--cache",
     );
 }
+
+#[test]
+fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base.toml");
+    std::fs::write(
+        &base,
+        "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [\"true\"]\n\
+         [ugl]\nimages = 200\n[explore]\nepochs = 200\n",
+    )
+    .unwrap();
+    let out = dir.path().join("cmp");
+    let o = ugl(&[
+        "compare",
+        "--learner",
+        "pca-centred",
+        "--config",
+        p(&base),
+        "--out",
+        p(&out),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".json"))
+        .collect();
+    names.sort();
+    // The base campaign's cells (armball, true latents, kde; no prior for gaussian) and seeds.
+    assert_eq!(
+        names,
+        [
+            "armball.rge-pca-centred.kde.l2.s0.json",
+            "armball.rge-pca-centred.kde.l2.s1.json"
+        ]
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join(&names[0])).unwrap()).unwrap();
+    assert_eq!(m["campaign"], "compare-pca-centred");
+    // The same run as `ugl run` with the base campaign's seed.
+    let single = dir.path().join("single");
+    assert!(
+        ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-pca-centred",
+            "--latents",
+            "2",
+            "--profile",
+            p(&base),
+            "--out",
+            p(&single),
+        ])
+        .status
+        .success()
+    );
+    assert_eq!(
+        std::fs::read(out.join("armball.rge-pca-centred.kde.l2.s0.parquet")).unwrap(),
+        std::fs::read(single.join("armball.rge-pca-centred.kde.l2.s0.parquet")).unwrap()
+    );
+    let args = |extra: &[&str]| {
+        let mut v = vec!["compare", "--config", p(&base), "--out", p(&out)];
+        v.extend_from_slice(extra);
+        ugl(&v)
+    };
+    assert_one_line_error(&args(&["--learner", "nosuch"]), "not a registered learner");
+    assert_one_line_error(
+        &args(&["--learner", "pca", "--command", "true"]),
+        "registered learner",
+    );
+    assert_one_line_error(&args(&["--learner", "Bad Name"]), "--learner");
+}
