@@ -13,6 +13,9 @@ pub struct CurveStat {
     pub epoch: i64,
     pub n: usize,
     pub mean: f64,
+    /// Sample standard deviation over the runs (`None` with one run or an infinite value).
+    pub std: Option<f64>,
+    /// 90% percentile-bootstrap CI of the mean.
     pub lo: f64,
     pub hi: f64,
 }
@@ -32,6 +35,8 @@ pub struct ConditionSummary {
     pub final_epochs: Vec<i64>,
     /// KL-coverage at each run's last epoch.
     pub final_klc: Summary,
+    /// (seed, KL-coverage at the run's last epoch), in seed order: the values of `final_klc`.
+    pub final_by_seed: Vec<(i64, f64)>,
     pub final_moved_mean: f64,
     pub final_outcomes_mean: f64,
     pub final_coverage_mean: f64,
@@ -88,6 +93,7 @@ fn summarize_condition(
                 epoch,
                 n: s.n,
                 mean: s.mean,
+                std: s.std,
                 lo: s.ci_lo,
                 hi: s.ci_hi,
             }
@@ -95,6 +101,11 @@ fn summarize_condition(
         .collect();
 
     let finals: Vec<_> = rs.iter().map(|r| r.final_point()).collect();
+    let final_by_seed = rs
+        .iter()
+        .zip(&finals)
+        .map(|(r, p)| (r.seed, p.klc))
+        .collect();
     let mut final_epochs: Vec<i64> = finals.iter().map(|p| p.epoch).collect();
     final_epochs.sort_unstable();
     final_epochs.dedup();
@@ -124,6 +135,7 @@ fn summarize_condition(
         curve,
         final_epochs,
         final_klc,
+        final_by_seed,
         final_moved_mean,
         final_outcomes_mean,
         final_coverage_mean,

@@ -46,7 +46,19 @@ pub enum ReportError {
         source: serde_json::Error,
     },
 
-    #[error("run `{run_id}` appears twice in the results: {first} and {second}")]
+    #[error(
+        "main campaign `{main}` not found in {dir}: campaigns found: {}; choose one with \
+         ReportOptions::main_campaign (`ugl report --main NAME`)",
+        if found.is_empty() { "none".to_string() } else { found.join(", ") }
+    )]
+    MissingMainCampaign {
+        dir: PathBuf,
+        main: String,
+        /// Campaigns holding run files, sorted (`(top level)` for runs directly in `dir`).
+        found: Vec<String>,
+    },
+
+    #[error("run `{run_id}` appears twice in one campaign: {first} and {second}")]
     DuplicateRun {
         run_id: String,
         first: PathBuf,

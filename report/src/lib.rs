@@ -7,10 +7,12 @@
 //! the bootstrap is seeded, and nothing depends on the clock or the host.
 
 pub mod aggregate;
+pub mod campaigns;
 pub mod error;
 pub mod figures;
 pub mod load;
 pub mod markdown;
+pub mod neural;
 pub mod paper;
 pub mod stats;
 
@@ -21,8 +23,13 @@ pub use error::ReportError;
 /// What to render, from where, to where.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReportOptions {
-    /// The results store: run files at the top level and/or one sub-directory down (one per campaign).
+    /// The results store: one sub-directory per campaign (run files directly in it form the
+    /// campaign `""`).
     pub results: PathBuf,
+    /// The campaign that reproduces the paper (curves, scatters, Figure 4, variants, the table
+    /// against the paper). Campaigns named `budget-*` feed the training-budget section; others
+    /// are listed as unused. `""` selects the runs at the store's top level.
+    pub main_campaign: String,
     /// Where `REPORT.md` and `figures/*.svg` are written (created if missing).
     pub out: PathBuf,
     /// The paper's reference values (`klc_final.csv`); a missing directory is reported, not fatal.
@@ -34,10 +41,15 @@ pub struct ReportOptions {
 }
 
 impl ReportOptions {
-    /// Defaults: `paper_dir` = `data/paper`, bootstrap seed 0, 10,000 resamples.
+    /// The default main campaign.
+    pub const DEFAULT_MAIN_CAMPAIGN: &'static str = "paper";
+
+    /// Defaults: main campaign `paper`, `paper_dir` = `data/paper`, bootstrap seed 0, 10,000
+    /// resamples.
     pub fn new(results: PathBuf, out: PathBuf) -> Self {
         ReportOptions {
             results,
+            main_campaign: Self::DEFAULT_MAIN_CAMPAIGN.to_string(),
             out,
             paper_dir: PathBuf::from("data/paper"),
             bootstrap_seed: 0,
@@ -49,8 +61,14 @@ impl ReportOptions {
 /// What `render_report` did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReportSummary {
-    /// Complete runs read from the store.
+    /// Complete runs the report used (main and budget campaigns).
     pub n_runs: usize,
+    /// Complete runs of the main campaign.
+    pub n_main_runs: usize,
+    /// The budget campaigns used, sorted.
+    pub budget_campaigns: Vec<String>,
+    /// Campaigns present in the store but not used, sorted.
+    pub unused_campaigns: Vec<String>,
     /// Files written (`REPORT.md` first, then the figures), sorted, under `opts.out`.
     pub files: Vec<PathBuf>,
 }
@@ -60,28 +78,60 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     if opts.n_boot == 0 {
         return Err(ReportError::Options("n_boot must be at least 1".into()));
     }
-    let store = load::load_store(&opts.results)?;
+    let camps = campaigns::load_campaigns(&opts.results, &opts.main_campaign)?;
+    let store = &camps.main.store;
     let paper = paper::load_paper(&opts.paper_dir)?;
-    let conditions = aggregate::aggregate(&store, &paper, opts.bootstrap_seed, opts.n_boot);
+    let conditions = aggregate::aggregate(store, &paper, opts.bootstrap_seed, opts.n_boot);
+    let pairs = neural::variant_pairs(&conditions, opts.bootstrap_seed, opts.n_boot);
+    let budget = neural::budget_analysis(
+        &camps.budget,
+        store,
+        &conditions,
+        opts.bootstrap_seed,
+        opts.n_boot,
+    );
+    let losses = neural::loss_curves(store);
 
     let fig_dir = opts.out.join("figures");
     create_dir(&fig_dir)?;
 
-    let mut figure_files = Vec::new();
     let klc_figs = figures::klc_curves::draw_all(&conditions, &fig_dir)?;
-    let outcome_figs = figures::outcomes::draw_all(&store, &conditions, &fig_dir)?;
-    for f in klc_figs.iter().chain(outcome_figs.iter()) {
-        figure_files.push(f.path.clone());
+    let outcome_figs = figures::outcomes::draw_all(store, &conditions, &fig_dir)?;
+    let mut sampler_figs = Vec::new();
+    for (algo, name) in SAMPLER_FIGURES {
+        if let Some(f) = figures::sampler_compare::draw(&conditions, algo, name, &fig_dir)? {
+            sampler_figs.push(f);
+        }
     }
+    let variants_fig = figures::variants::draw(&pairs, &fig_dir)?;
+    let budget_figs = figures::budget::draw_all(&budget.series, &opts.main_campaign, &fig_dir)?;
+    let loss_fig = figures::training_loss::draw(&losses, &fig_dir)?;
+
+    let mut figure_files: Vec<PathBuf> = klc_figs
+        .iter()
+        .chain(&outcome_figs)
+        .chain(&sampler_figs)
+        .chain(&variants_fig)
+        .chain(&budget_figs)
+        .chain(&loss_fig)
+        .map(|f| f.path.clone())
+        .collect();
     remove_stale_figures(&fig_dir, &figure_files)?;
 
     let md = markdown::render(&markdown::Inputs {
         opts,
-        store: &store,
+        campaigns: &camps,
+        store,
         paper: &paper,
         conditions: &conditions,
         klc_figures: &klc_figs,
         outcome_figures: &outcome_figs,
+        sampler_figures: &sampler_figs,
+        variant_pairs: &pairs,
+        variants_figure: variants_fig.as_ref(),
+        budget: &budget,
+        budget_figures: &budget_figs,
+        loss_figure: loss_fig.as_ref(),
     });
     let report_path = opts.out.join("REPORT.md");
     write_file(&report_path, md.as_bytes())?;
@@ -90,10 +140,29 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     let mut files = vec![report_path];
     files.extend(figure_files);
     Ok(ReportSummary {
-        n_runs: store.runs.len(),
+        n_runs: camps.n_used_runs(),
+        n_main_runs: store.runs.len(),
+        budget_campaigns: camps.budget.iter().map(|c| c.name.clone()).collect(),
+        unused_campaigns: camps.unused.iter().map(|c| c.name.clone()).collect(),
         files,
     })
 }
+
+/// The KDE-vs-Gaussian figures: the paper's Figure 4 (RGE-VAE), and the same for RGE-RFVAE,
+/// which the paper did not plot (drawn when its Gaussian-goal runs exist).
+pub const SAMPLER_FIGURES: [(&str, &str); 2] = [
+    ("rge-vae", "fig4_vae_kde_vs_gaussian.svg"),
+    ("rge-rfvae", "rfvae_kde_vs_gaussian.svg"),
+];
+
+/// File names of figures this crate writes besides the per-condition ones: a stale copy of any
+/// of them is removed when a render no longer writes it.
+const OWN_FIGURES: [&str; 4] = [
+    figures::variants::FILE,
+    figures::training_loss::FILE,
+    "fig4_vae_kde_vs_gaussian.svg",
+    "rfvae_kde_vs_gaussian.svg",
+];
 
 fn create_dir(dir: &Path) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
@@ -110,7 +179,8 @@ pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
 }
 
 /// Figures of an earlier render whose condition is gone would otherwise linger (and be committed):
-/// remove our own figure files (`klc_*.svg`, `outcomes_*.svg`) that this render did not write.
+/// remove our own figure files (`klc_*.svg`, `outcomes_*.svg`, `budget_*.svg` and the fixed
+/// names of [`OWN_FIGURES`]) that this render did not write.
 fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), ReportError> {
     let entries = std::fs::read_dir(fig_dir).map_err(|source| ReportError::Io {
         path: fig_dir.to_path_buf(),
@@ -122,8 +192,11 @@ fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), Repor
         let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
             continue;
         };
-        let ours =
-            name.ends_with(".svg") && (name.starts_with("klc_") || name.starts_with("outcomes_"));
+        let ours = name.ends_with(".svg")
+            && (name.starts_with("klc_")
+                || name.starts_with("outcomes_")
+                || name.starts_with("budget_")
+                || OWN_FIGURES.contains(&name));
         if ours && !written.contains(&path) {
             stale.push(path);
         }

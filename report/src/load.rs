@@ -198,7 +198,7 @@ impl Run {
     }
 }
 
-/// The whole store.
+/// The whole store, or one campaign of it.
 #[derive(Debug, Clone)]
 pub struct Store {
     /// Sorted by condition order, then seed, then campaign.
@@ -207,8 +207,97 @@ pub struct Store {
     pub incomplete: Vec<(PathBuf, Vec<String>)>,
 }
 
-/// Reads every run under `dir` (top level and one sub-directory down).
-pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
+/// Display name of a campaign: its directory name, `(top level)` for runs directly in the store.
+pub fn campaign_display(name: &str) -> String {
+    if name.is_empty() {
+        "(top level)".into()
+    } else {
+        name.to_string()
+    }
+}
+
+/// One campaign of the store: a directory holding run files (the store itself, campaign `""`,
+/// or one of its sub-directories), with the file stems found in it.
+#[derive(Debug, Clone)]
+pub struct CampaignDir {
+    /// Sub-directory name; `""` for the store's top level.
+    pub name: String,
+    pub path: PathBuf,
+    /// stem path -> which of the three files (curve, outcomes, manifest) exist.
+    stems: BTreeMap<PathBuf, [bool; 3]>,
+}
+
+impl CampaignDir {
+    /// Runs whose three files are all present.
+    pub fn n_complete(&self) -> usize {
+        self.stems.values().filter(|p| p.iter().all(|&b| b)).count()
+    }
+
+    /// Runs missing one of their three files.
+    pub fn n_incomplete(&self) -> usize {
+        self.stems.len() - self.n_complete()
+    }
+
+    /// Reads every complete run; lists the incomplete ones. A run id twice within the campaign is
+    /// an error (the same run in two campaigns is not: campaigns are separate experiments).
+    pub fn load(&self) -> Result<Store, ReportError> {
+        let mut runs = Vec::new();
+        let mut incomplete = Vec::new();
+        for (stem, present) in &self.stems {
+            let [curve, outcomes, manifest] = *present;
+            if !(curve && outcomes && manifest) {
+                let missing: Vec<String> = [
+                    (curve, CURVE_SUFFIX),
+                    (outcomes, OUTCOMES_SUFFIX),
+                    (manifest, MANIFEST_SUFFIX),
+                ]
+                .iter()
+                .filter(|(p, _)| !p)
+                .map(|(_, s)| format!("{}{s}", stem_name(stem)))
+                .collect();
+                tracing::warn!(run = %stem.display(), ?missing, "incomplete run skipped");
+                incomplete.push((stem.clone(), missing));
+                continue;
+            }
+            runs.push(load_run(stem, self.name.clone())?);
+        }
+        check_unique_run_ids(
+            runs.iter()
+                .map(|r| (r.run_id.as_str(), r.curve_path.as_path())),
+        )?;
+        sort_runs(&mut runs);
+        Ok(Store { runs, incomplete })
+    }
+}
+
+/// Within one campaign every run id is unique: the first repeated one is a
+/// [`ReportError::DuplicateRun`] naming both files.
+pub fn check_unique_run_ids<'a>(
+    runs: impl IntoIterator<Item = (&'a str, &'a Path)>,
+) -> Result<(), ReportError> {
+    let mut seen: BTreeMap<&str, &Path> = BTreeMap::new();
+    for (id, path) in runs {
+        if let Some(first) = seen.get(id) {
+            return Err(ReportError::DuplicateRun {
+                run_id: id.to_string(),
+                first: first.to_path_buf(),
+                second: path.to_path_buf(),
+            });
+        }
+        seen.insert(id, path);
+    }
+    Ok(())
+}
+
+fn sort_runs(runs: &mut [Run]) {
+    runs.sort_by(|a, b| {
+        (a.key.order_key(), a.seed, &a.campaign).cmp(&(b.key.order_key(), b.seed, &b.campaign))
+    });
+}
+
+/// The campaigns of the store `dir` (its top level and its sub-directories), sorted by name,
+/// keeping only those that hold at least one run file (a directory of cached models is none).
+pub fn scan_store(dir: &Path) -> Result<Vec<CampaignDir>, ReportError> {
     if !dir.is_dir() {
         return Err(ReportError::NoResultsDir(dir.to_path_buf()));
     }
@@ -224,25 +313,24 @@ pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
             }
         }
     }
-
-    // stem path -> which of the three files exist
-    let mut stems: BTreeMap<PathBuf, (String, [bool; 3])> = BTreeMap::new();
-    for (campaign, d) in &dirs {
-        for path in sorted_entries(d)? {
+    let mut out = Vec::new();
+    for (name, d) in dirs {
+        let mut stems: BTreeMap<PathBuf, [bool; 3]> = BTreeMap::new();
+        for path in sorted_entries(&d)? {
             if !path.is_file() {
                 continue;
             }
-            let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+            let Some(file) = path.file_name().and_then(|n| n.to_str()) else {
                 continue;
             };
-            if name.starts_with('.') {
+            if file.starts_with('.') {
                 continue; // temporary files of the atomic writer, editor files
             }
-            let (stem, slot) = if let Some(s) = name.strip_suffix(OUTCOMES_SUFFIX) {
+            let (stem, slot) = if let Some(s) = file.strip_suffix(OUTCOMES_SUFFIX) {
                 (s, 1)
-            } else if let Some(s) = name.strip_suffix(CURVE_SUFFIX) {
+            } else if let Some(s) = file.strip_suffix(CURVE_SUFFIX) {
                 (s, 0)
-            } else if let Some(s) = name.strip_suffix(MANIFEST_SUFFIX) {
+            } else if let Some(s) = file.strip_suffix(MANIFEST_SUFFIX) {
                 (s, 2)
             } else {
                 continue;
@@ -250,42 +338,30 @@ pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
             if stem.is_empty() {
                 continue;
             }
-            let entry = stems
-                .entry(d.join(stem))
-                .or_insert_with(|| (campaign.clone(), [false; 3]));
-            entry.1[slot] = true;
+            stems.entry(d.join(stem)).or_insert([false; 3])[slot] = true;
         }
-    }
-
-    let mut runs = Vec::new();
-    let mut incomplete = Vec::new();
-    let mut seen: BTreeMap<String, PathBuf> = BTreeMap::new();
-    for (stem, (campaign, present)) in stems {
-        let [curve, outcomes, manifest] = present;
-        if !(curve && outcomes && manifest) {
-            let missing: Vec<String> = [
-                (curve, CURVE_SUFFIX),
-                (outcomes, OUTCOMES_SUFFIX),
-                (manifest, MANIFEST_SUFFIX),
-            ]
-            .iter()
-            .filter(|(p, _)| !p)
-            .map(|(_, s)| format!("{}{s}", stem_name(&stem)))
-            .collect();
-            tracing::warn!(run = %stem.display(), ?missing, "incomplete run skipped");
-            incomplete.push((stem, missing));
-            continue;
-        }
-        let run = load_run(&stem, campaign)?;
-        if let Some(first) = seen.get(&run.run_id) {
-            return Err(ReportError::DuplicateRun {
-                run_id: run.run_id.clone(),
-                first: first.clone(),
-                second: run.curve_path.clone(),
+        if !stems.is_empty() {
+            out.push(CampaignDir {
+                name,
+                path: d,
+                stems,
             });
         }
-        seen.insert(run.run_id.clone(), run.curve_path.clone());
-        runs.push(run);
+    }
+    out.sort_by(|a, b| a.name.cmp(&b.name));
+    Ok(out)
+}
+
+/// Reads every run under `dir` (top level and one sub-directory down), all campaigns together.
+/// Run ids are unique within each campaign; the report itself reads campaigns separately
+/// ([`crate::campaigns::load_campaigns`]).
+pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
+    let mut runs = Vec::new();
+    let mut incomplete = Vec::new();
+    for c in scan_store(dir)? {
+        let s = c.load()?;
+        runs.extend(s.runs);
+        incomplete.extend(s.incomplete);
     }
     if runs.is_empty() {
         if !incomplete.is_empty() {
@@ -296,9 +372,8 @@ pub fn load_store(dir: &Path) -> Result<Store, ReportError> {
         }
         return Err(ReportError::EmptyResults(dir.to_path_buf()));
     }
-    runs.sort_by(|a, b| {
-        (a.key.order_key(), a.seed, &a.campaign).cmp(&(b.key.order_key(), b.seed, &b.campaign))
-    });
+    sort_runs(&mut runs);
+    incomplete.sort();
     Ok(Store { runs, incomplete })
 }
 
@@ -430,6 +505,9 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         });
     }
 
+    let mut key = key;
+    reconcile_identity(&mut key, seed, &raw, &manifest_path)?;
+
     Ok(Run {
         run_id,
         campaign,
@@ -442,6 +520,53 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         outcomes_path,
         manifest_path,
     })
+}
+
+/// Checks the curve file's identity columns against the manifest's fields of the same name
+/// (those present): a disagreement is an error naming the manifest and the field.
+///
+/// One exception, a known defect of the writer: ugl-bench's curve files wrote `variant = none` for
+/// every run, also for the faithful and corrected variants of the VAE and RFVAE, whose manifests
+/// (and run ids) carry the variant. A curve file's `none` therefore gives way to the manifest's
+/// variant; without this the two variants would be merged into one condition.
+pub fn reconcile_identity(
+    key: &mut ConditionKey,
+    seed: i64,
+    manifest: &Value,
+    manifest_path: &Path,
+) -> Result<(), ReportError> {
+    let mismatch = |field: &str, curve: String, man: String| ReportError::Invalid {
+        path: manifest_path.to_path_buf(),
+        problem: format!("field `{field}` is `{man}` but the curve file's column holds `{curve}`"),
+    };
+    for (field, value) in [
+        ("env", &key.env),
+        ("algo", &key.algo),
+        ("sampler", &key.sampler),
+    ] {
+        if let Some(m) = manifest.get(field).and_then(Value::as_str)
+            && m != value.as_str()
+        {
+            return Err(mismatch(field, value.clone(), m.to_string()));
+        }
+    }
+    for (field, value) in [("latents", key.latents), ("seed", seed)] {
+        if let Some(m) = manifest.get(field).and_then(Value::as_i64)
+            && m != value
+        {
+            return Err(mismatch(field, value.to_string(), m.to_string()));
+        }
+    }
+    if let Some(m) = manifest.get("variant").and_then(Value::as_str)
+        && m != key.variant
+    {
+        if key.variant == "none" {
+            key.variant = m.to_string();
+        } else {
+            return Err(mismatch("variant", key.variant.clone(), m.to_string()));
+        }
+    }
+    Ok(())
 }
 
 /// Reads a parquet file into a DataFrame. Errors (and panics inside the reader, which a corrupt
@@ -596,5 +721,73 @@ impl Cols<'_> {
             ));
         }
         Ok(first)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_id_twice_in_one_campaign_is_an_error_naming_both_files() {
+        let (a, b, c) = (
+            Path::new("p/x.parquet"),
+            Path::new("q/x.parquet"),
+            Path::new("p/y.parquet"),
+        );
+        assert!(check_unique_run_ids([("x", a), ("y", c)]).is_ok());
+        let err = check_unique_run_ids([("x", a), ("y", c), ("x", b)]).unwrap_err();
+        match &err {
+            ReportError::DuplicateRun {
+                run_id,
+                first,
+                second,
+            } => {
+                assert_eq!(run_id, "x");
+                assert_eq!((first.as_path(), second.as_path()), (a, b));
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        assert!(err.to_string().contains("twice in one campaign"), "{err}");
+    }
+
+    fn key(variant: &str) -> ConditionKey {
+        ConditionKey {
+            env: "armball".into(),
+            algo: "rge-vae".into(),
+            sampler: "kde".into(),
+            latents: 10,
+            variant: variant.into(),
+        }
+    }
+
+    #[test]
+    fn the_manifest_variant_replaces_a_curve_file_none() {
+        let p = Path::new("m.json");
+        let m = serde_json::json!({"env": "armball", "algo": "rge-vae", "sampler": "kde",
+            "latents": 10, "seed": 3, "variant": "corrected"});
+        let mut k = key("none");
+        reconcile_identity(&mut k, 3, &m, p).unwrap();
+        assert_eq!(k.variant, "corrected");
+        // Agreement, or no field, changes nothing.
+        let mut k = key("corrected");
+        reconcile_identity(&mut k, 3, &m, p).unwrap();
+        reconcile_identity(&mut k, 3, &serde_json::json!({}), p).unwrap();
+        assert_eq!(k, key("corrected"));
+        // A real disagreement is an error naming the field.
+        let mut k = key("faithful");
+        let e = reconcile_identity(&mut k, 3, &m, p).unwrap_err();
+        assert!(e.to_string().contains("`variant`"), "{e}");
+        let e = reconcile_identity(&mut key("corrected"), 4, &m, p).unwrap_err();
+        assert!(
+            e.to_string().contains("`seed`") && e.to_string().contains("m.json"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn campaign_display_names_the_top_level() {
+        assert_eq!(campaign_display(""), "(top level)");
+        assert_eq!(campaign_display("paper"), "paper");
     }
 }

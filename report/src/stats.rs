@@ -180,6 +180,35 @@ pub fn summarize(xs: &[f64], n_boot: usize, seed: u64) -> Summary {
     }
 }
 
+/// Pairs two samples by key (the seed: runs with the same seed share their initial weights and
+/// batches) and returns `(key, b − a)` for every key present in both, sorted by key. Keys present
+/// in only one sample are left out; each key must appear at most once per sample.
+pub fn paired_differences(a: &[(i64, f64)], b: &[(i64, f64)]) -> Vec<(i64, f64)> {
+    let a: std::collections::BTreeMap<i64, f64> = a.iter().copied().collect();
+    let mut out: Vec<(i64, f64)> = b
+        .iter()
+        .filter_map(|&(k, vb)| a.get(&k).map(|&va| (k, vb - va)))
+        .collect();
+    out.sort_by_key(|&(k, _)| k);
+    out
+}
+
+/// Summary of the paired differences `b − a` (see [`paired_differences`]): their mean, sd and
+/// 90% percentile-bootstrap CI of the mean difference (the pairs are resampled), seeded by `seed`.
+/// `None` when no key is in both samples.
+pub fn paired_summary(
+    a: &[(i64, f64)],
+    b: &[(i64, f64)],
+    n_boot: usize,
+    seed: u64,
+) -> Option<Summary> {
+    let d: Vec<f64> = paired_differences(a, b)
+        .into_iter()
+        .map(|(_, d)| d)
+        .collect();
+    (!d.is_empty()).then(|| summarize(&d, n_boot, seed))
+}
+
 /// A stable 64-bit seed for one bootstrap stream, from the report's seed and a label (condition
 /// and epoch). FNV-1a over the bytes, then the splitmix64 finaliser: fixed by this code, not by
 /// `std`'s hasher, so it never changes between Rust versions; adding a condition never shifts
@@ -327,6 +356,40 @@ mod tests {
         assert_eq!(IndexSampler::new(5).k, 4);
         assert_eq!(IndexSampler::new(2).k, 1);
         assert_eq!(IndexSampler::new(1).k, 1);
+    }
+
+    #[test]
+    fn paired_differences_match_by_seed() {
+        let a = [(0, 4.0), (1, 5.0), (2, 6.0), (4, 1.0)];
+        let b = [(2, 6.5), (0, 3.0), (1, 5.25), (3, 9.0)];
+        assert_eq!(
+            paired_differences(&a, &b),
+            vec![(0, -1.0), (1, 0.25), (2, 0.5)]
+        );
+        assert_eq!(paired_summary(&a, &[(7, 1.0)], 100, 0), None);
+    }
+
+    #[test]
+    fn constant_paired_differences_give_a_zero_width_ci_on_the_difference() {
+        // Every corrected run is 0.5 below its faithful pair, whatever the spread of the runs.
+        let faithful = [(0, 4.75), (1, 5.5), (2, 3.25), (3, 6.0), (4, 4.0)];
+        let corrected: Vec<(i64, f64)> = faithful.iter().map(|&(s, v)| (s, v - 0.5)).collect();
+        let d = paired_summary(&faithful, &corrected, 10_000, 3).unwrap();
+        assert_eq!((d.n, d.mean, d.ci_lo, d.ci_hi), (5, -0.5, -0.5, -0.5));
+        assert_eq!(d.std, Some(0.0));
+        // The unpaired CIs of the two means are wide; the paired one is not.
+        let fa: Vec<f64> = faithful.iter().map(|p| p.1).collect();
+        let s = summarize(&fa, 10_000, 3);
+        assert!(s.ci_hi - s.ci_lo > 0.5);
+    }
+
+    #[test]
+    fn paired_ci_on_a_two_value_case_is_exact() {
+        // Differences {0, 1}: as `two_point_case_is_exact`, the 90% CI is [0, 1], mean 0.5.
+        let a = [(0, 2.0), (1, 3.0)];
+        let b = [(0, 2.0), (1, 4.0)];
+        let d = paired_summary(&a, &b, 10_000, 9).unwrap();
+        assert_eq!((d.mean, d.ci_lo, d.ci_hi), (0.5, 0.0, 1.0));
     }
 
     #[test]

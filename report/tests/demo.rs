@@ -1,5 +1,6 @@
-//! A paper-sized synthetic store (every condition of the paper's matrix, 5 seeds, 5000 epochs),
-//! rendered with the default options: checks that a full report renders in reasonable time and
+//! A paper-sized synthetic store (every condition of the `paper` campaign's matrix: 48 conditions
+//! with the VAE / RFVAE variants and Gaussian goals, 5 seeds, 5000 epochs; and four `budget-vae-*`
+//! campaigns), rendered with the default options: checks that a full report renders in reasonable time and
 //! gives something to look at. Ignored by default (a few seconds in an optimised build):
 //!
 //! `UGL_REPORT_DEMO_OUT=/tmp/demo cargo test -p ugl-report --test demo -- --ignored`
@@ -49,39 +50,34 @@ fn conditions() -> Vec<Cond> {
                 .into_iter()
                 .enumerate()
             {
-                let variant = if matches!(algo, "rge-ae" | "rge-vae" | "rge-rfvae") {
-                    "faithful"
+                let variants: &[&'static str] = if matches!(algo, "rge-vae" | "rge-rfvae") {
+                    &["faithful", "corrected"]
                 } else {
-                    "none"
+                    &["none"]
                 };
-                let f = efr - 0.3 + 0.15 * j as f64 + 0.2 * k as f64;
-                v.push(Cond {
-                    env,
-                    algo,
-                    sampler: "kde",
-                    latents: l,
-                    variant,
-                    final_klc: f,
-                });
+                let samplers: &[&'static str] = if matches!(algo, "rge-vae" | "rge-rfvae") {
+                    &["kde", "gaussian"]
+                } else {
+                    &["kde"]
+                };
+                for (iv, &variant) in variants.iter().enumerate() {
+                    for (is, &sampler) in samplers.iter().enumerate() {
+                        let f = efr - 0.3 + 0.15 * j as f64 + 0.2 * k as f64
+                            - 0.2 * iv as f64
+                            - 0.1 * is as f64;
+                        v.push(Cond {
+                            env,
+                            algo,
+                            sampler,
+                            latents: l,
+                            variant,
+                            final_klc: f,
+                        });
+                    }
+                }
             }
         }
     }
-    v.push(Cond {
-        env: "armball",
-        algo: "rge-vae",
-        sampler: "gaussian",
-        latents: 10,
-        variant: "faithful",
-        final_klc: 3.9,
-    });
-    v.push(Cond {
-        env: "armball",
-        algo: "rge-vae",
-        sampler: "kde",
-        latents: 10,
-        variant: "corrected",
-        final_klc: 4.1,
-    });
     v
 }
 
@@ -90,16 +86,41 @@ fn write(path: &Path, df: &mut DataFrame) {
     ParquetWriter::new(&mut f).finish(df).unwrap();
 }
 
+fn iterations(algo: &str) -> Option<i64> {
+    match algo {
+        "rge-ae" => Some(2000),
+        "rge-vae" => Some(1000),
+        "rge-rfvae" => Some(500),
+        _ => None,
+    }
+}
+
 fn write_store(root: &Path) {
-    let dir = root.join("paper-like");
-    std::fs::create_dir_all(&dir).unwrap();
-    for c in conditions() {
+    write_campaign(&root.join("paper"), &conditions(), 5, None);
+    // The budget campaigns: RGE-VAE faithful, KDE, 10 latents on ArmBall, 3 seeds, better with
+    // more iterations.
+    for (it, d) in [(300, 0.4), (1000, 0.0), (3000, -0.2), (10000, -0.3)] {
+        let c = Cond {
+            env: "armball",
+            algo: "rge-vae",
+            sampler: "kde",
+            latents: 10,
+            variant: "faithful",
+            final_klc: 4.73 + d,
+        };
+        write_campaign(&root.join(format!("budget-vae-{it}")), &[c], 3, Some(it));
+    }
+}
+
+fn write_campaign(dir: &Path, conds: &[Cond], reps: i64, budget: Option<i64>) {
+    std::fs::create_dir_all(dir).unwrap();
+    for c in conds {
         let kmax = if c.env == "armball" {
             756f64.ln()
         } else {
             22680f64.ln()
         };
-        for seed in 0..5i64 {
+        for seed in 0..reps {
             let id = format!(
                 "{}.{}.{}.{}.{}.s{seed}",
                 c.env, c.algo, c.sampler, c.latents, c.variant
@@ -172,11 +193,34 @@ fn write_store(root: &Path) {
             )
             .unwrap();
             write(&dir.join(format!("{id}.outcomes.parquet")), &mut odf);
-            let manifest = serde_json::json!({
+            let mut manifest = serde_json::json!({
                 "run_id": id, "profile": "demo", "git_revision": "0000000", "toolchain": "rustc 1.95.0",
                 "threads": 2, "host": "demo", "wall_time_s": 600.0 + 10.0 * seed as f64,
-                "reduced_budget": false,
+                "reduced_budget": false, "variant": c.variant,
             });
+            if let Some(it) = budget.or_else(|| iterations(c.algo)) {
+                let l = c.algo.trim_start_matches("rge-");
+                let losses: Vec<(i64, f64)> = (0..=it / 100)
+                    .map(|i| (i * 100, 400.0 + 3000.0 * (-(i as f64) / 3.0).exp()))
+                    .collect();
+                manifest.as_object_mut().unwrap().insert(
+                    "train".into(),
+                    serde_json::json!({
+                        "config": {"iterations": it, "hidden": [512, 256], "batch": 100,
+                                   "lr": 0.001, "log_every": 100, "warmup": 100},
+                        "losses": losses,
+                        "key": format!("{}-{l}-{}-{}-{seed}", c.env, c.latents, c.variant),
+                    }),
+                );
+                manifest
+                    .as_object_mut()
+                    .unwrap()
+                    .insert("learner".into(), l.into());
+                manifest
+                    .as_object_mut()
+                    .unwrap()
+                    .insert("reduced_budget".into(), true.into());
+            }
             std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
         }
     }
@@ -201,5 +245,6 @@ fn paper_sized_demo_renders() {
         s.files.len(),
         t.elapsed()
     );
-    assert_eq!(s.n_runs, 26 * 5);
+    assert_eq!(s.n_main_runs, 48 * 5);
+    assert_eq!(s.n_runs, 48 * 5 + 4 * 3);
 }

@@ -1,5 +1,6 @@
 //! End-to-end tests of `render_report` on a synthetic results store written with polars, following
-//! `data/results/README.md` exactly: 2 envs x 2 algos x 3 seeds, epochs 0, 100, ..., 500.
+//! `data/results/README.md` exactly: 2 envs x 2 algos x 3 seeds, epochs 0, 100, ..., 500, in the
+//! main campaign `paper` (`tests/campaigns.rs` covers the other campaigns and the neural sections).
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -34,13 +35,9 @@ fn sampler(algo: &str) -> &'static str {
     if algo == "rpe" { "none" } else { "uniform" }
 }
 
-fn dir_of(root: &Path, env: &str) -> PathBuf {
-    // ArmBall runs in a campaign sub-directory, ArmArrow ones at the top level.
-    if env == "armball" {
-        root.join("camp-a")
-    } else {
-        root.to_path_buf()
-    }
+/// Every run in the main campaign's directory.
+fn dir_of(root: &Path, _env: &str) -> PathBuf {
+    root.join("paper")
 }
 
 fn run_id(env: &str, algo: &str, seed: i64) -> String {
@@ -247,7 +244,13 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("| 50.0 % |"));
     // What was run, links, notes, the reduced budget.
     assert!(md.contains("Reduced budget"));
-    assert!(md.contains("500 epochs instead of 5000 (camp-a)"));
+    assert!(md.contains("500 epochs instead of 5000 (paper)"));
+    assert!(
+        md.contains("- **Campaigns:** main `paper` (12 runs"),
+        "{md}"
+    );
+    assert!(md.contains("No `budget-*` campaign in the store"));
+    assert!(!out.join("figures/budget_vae.svg").exists());
     assert!(md.contains("(figures/klc_armball.svg)"));
     assert!(md.contains("(figures/outcomes_armarrow_rge-efr_uniform_0_none.svg)"));
     assert!(md.contains(ugl_report::markdown::EPOCH_NOTE));
@@ -298,7 +301,7 @@ fn missing_column_names_the_file_and_column() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    let path = results.join("armarrow.rpe.s1.parquet");
+    let path = results.join("paper/armarrow.rpe.s1.parquet");
     let mut df = curve_frame("armarrow", "rpe", 1).drop("coverage").unwrap();
     write_parquet(&path, &mut df);
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
@@ -323,7 +326,7 @@ fn wrong_column_type_names_the_file_and_column() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    let path = results.join("camp-a/armball.rge-efr.s2.outcomes.parquet");
+    let path = results.join("paper/armball.rge-efr.s2.outcomes.parquet");
     let mut df = outcomes_frame("armball", "rge-efr", 2);
     let moved_as_int = df.column("moved").unwrap().cast(&DataType::Int64).unwrap();
     df.with_column(moved_as_int).unwrap();
@@ -343,7 +346,7 @@ fn corrupt_parquet_is_an_error_naming_the_file() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    let path = results.join("camp-a/armball.rpe.s0.outcomes.parquet");
+    let path = results.join("paper/armball.rpe.s0.outcomes.parquet");
     std::fs::write(&path, b"PAR1 this is not parquet at all PAR1").unwrap();
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
     assert!(matches!(err, ReportError::Parquet { .. }), "{err:?}");
@@ -359,7 +362,7 @@ fn corrupt_manifest_is_an_error_naming_the_file() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    std::fs::write(results.join("armarrow.rge-efr.s0.json"), "{ not json").unwrap();
+    std::fs::write(results.join("paper/armarrow.rge-efr.s0.json"), "{ not json").unwrap();
     let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
     assert!(
         err.to_string().contains("armarrow.rge-efr.s0.json"),
@@ -381,9 +384,9 @@ fn empty_or_missing_results_dir_is_a_clear_error() {
 
     // Only an incomplete run: a campaign that has not finished its first run.
     let partial = tmp.path().join("partial");
-    std::fs::create_dir_all(&partial).unwrap();
+    std::fs::create_dir_all(partial.join("paper")).unwrap();
     write_parquet(
-        &partial.join("armball.rpe.s0.parquet"),
+        &partial.join("paper/armball.rpe.s0.parquet"),
         &mut curve_frame("armball", "rpe", 0),
     );
     let err = render_report(&opts(&partial, &tmp.path().join("out"))).unwrap_err();
@@ -398,32 +401,46 @@ fn incomplete_runs_are_skipped_and_listed() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    std::fs::remove_file(results.join("camp-a/armball.rpe.s2.json")).unwrap();
+    std::fs::remove_file(results.join("paper/armball.rpe.s2.json")).unwrap();
     let out = tmp.path().join("out");
     let s = render_report(&opts(&results, &out)).unwrap();
     assert_eq!(s.n_runs, 11);
     let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
     assert!(md.contains("Incomplete runs skipped"), "{md}");
     assert!(
-        md.contains("`camp-a/armball.rpe.s2`: missing armball.rpe.s2.json"),
+        md.contains("`paper/armball.rpe.s2`: missing armball.rpe.s2.json"),
         "{md}"
     );
 }
 
 #[test]
-fn duplicate_run_ids_are_an_error() {
+fn the_same_run_in_another_campaign_is_no_duplicate_and_is_not_used() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    // The same ArmArrow run copied into a second campaign directory.
+    // The same ArmArrow run copied into a second campaign directory, and one at the top level.
     let other = results.join("camp-b");
     std::fs::create_dir_all(&other).unwrap();
     for suffix in [".parquet", ".outcomes.parquet", ".json"] {
         let name = format!("armarrow.rpe.s0{suffix}");
-        std::fs::copy(results.join(&name), other.join(&name)).unwrap();
+        std::fs::copy(results.join("paper").join(&name), other.join(&name)).unwrap();
+        std::fs::copy(results.join("paper").join(&name), results.join(&name)).unwrap();
     }
-    let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
-    assert!(matches!(err, ReportError::DuplicateRun { .. }), "{err:?}");
+    let out = tmp.path().join("out");
+    let s = render_report(&opts(&results, &out)).unwrap();
+    assert_eq!((s.n_runs, s.n_main_runs), (12, 12));
+    assert_eq!(
+        s.unused_campaigns,
+        vec!["".to_string(), "camp-b".to_string()]
+    );
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("present but not used: `(top level)` (1 run), `camp-b` (1 run)"),
+        "{md}"
+    );
+    // Seeds stay 0-2: the copies are not merged into the main campaign's conditions.
+    assert!(md.contains("| 3 (0–2) |"));
+    assert!(!md.contains("| 4 ("));
 }
 
 #[test]
@@ -438,7 +455,7 @@ fn infinite_klc_is_reported_as_inf_not_nan() {
         .collect();
     *k.last_mut().unwrap() = f64::INFINITY;
     df.with_column(Column::new("klc".into(), k)).unwrap();
-    write_parquet(&results.join("armarrow.rge-efr.s1.parquet"), &mut df);
+    write_parquet(&results.join("paper/armarrow.rge-efr.s1.parquet"), &mut df);
     let out = tmp.path().join("out");
     render_report(&opts(&results, &out)).unwrap();
     let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
@@ -465,7 +482,7 @@ fn damaged_parquet_pages_are_an_error_not_a_panic() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     synthetic_store(&results);
-    let path = results.join("armarrow.rge-efr.s2.outcomes.parquet");
+    let path = results.join("paper/armarrow.rge-efr.s2.outcomes.parquet");
     let mut bytes = std::fs::read(&path).unwrap();
     // Overwrite the data pages but keep the magic bytes and the footer.
     let n = bytes.len();

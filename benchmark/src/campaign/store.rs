@@ -141,7 +141,7 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         "algo" => vec![spec.algo.name(); n],
         "sampler" => vec![spec.sampler.name(); n],
         "latents" => vec![spec.latents as i64; n],
-        "variant" => vec!["none"; n],
+        "variant" => vec![spec.variant.map(|v| v.name()).unwrap_or("none"); n],
         "seed" => vec![spec.seed as i64; n],
         "epoch" => c.iter().map(|p| p.epoch as i64).collect::<Vec<_>>(),
         "n_outcomes" => c.iter().map(|p| p.n_outcomes as i64).collect::<Vec<_>>(),

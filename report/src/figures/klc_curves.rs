@@ -1,8 +1,13 @@
-//! KL-coverage against exploration epochs, like the paper's Figure 4: one figure per environment,
+//! KL-coverage against exploration epochs, like the paper's Figure 2: one figure per environment,
 //! one panel per latent size of the learned goal spaces (the baselines RPE and RGE-EFR, which have
 //! no latent size, appear in every panel, as in the paper), one curve per condition: the mean over
 //! seeds with its shaded 90% bootstrap band. The paper's final value is a hollow star at the
 //! condition's last epoch.
+//!
+//! As the paper's figure (its notebook filtered `sampling != 'normal'`), the Gaussian-goal runs are
+//! left out: they have their own figure ([`super::sampler_compare`], the paper's Figure 4).
+//! Colour and marker shape identify the algorithm; the corrected variant is dashed with hollow
+//! markers, the faithful one solid with filled markers.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -11,17 +16,20 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, algo_name, algo_slot, colour, dash_pattern, env_name, file_safe, fmt_epoch,
-    icon_parts, klc_max, marker, marker_points, star_points, write_svg,
+    FONT, FigureFile, SOLID, algo_slot, colour, condition_name, dash_pattern, env_name, file_safe,
+    fmt_epoch, icon_parts, klc_max, marker, marker_points, sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
 
 const PANEL_W: u32 = 620;
-const PANEL_H: u32 = 470;
+const PANEL_H: u32 = 520;
 const TITLE_H: u32 = 36;
-/// A dash this long never ends within a panel: a solid line drawn by the dashed-path element.
-const SOLID: i32 = 1_000_000;
+
+/// Whether a condition belongs in this figure: every goal sampler but the Gaussian prior.
+pub fn in_figure(c: &ConditionSummary) -> bool {
+    c.key.sampler != "gaussian"
+}
 
 /// One panel: a title and the conditions drawn in it.
 struct Panel<'a> {
@@ -42,8 +50,13 @@ pub fn draw_all(
     }
     let mut out = Vec::new();
     for env in envs {
-        let of_env: Vec<&ConditionSummary> =
-            conditions.iter().filter(|c| c.key.env == env).collect();
+        let of_env: Vec<&ConditionSummary> = conditions
+            .iter()
+            .filter(|c| c.key.env == env && in_figure(c))
+            .collect();
+        if of_env.is_empty() {
+            continue;
+        }
         let panels = panels_of(env, &of_env);
         let name = format!("klc_{}.svg", file_safe(env));
         let path = fig_dir.join(&name);
@@ -106,8 +119,13 @@ fn panels_of<'a>(env: &str, conds: &[&'a ConditionSummary]) -> Vec<Panel<'a>> {
         .collect()
 }
 
-/// Style of each member: (colour/marker slot, dash pattern), stable within the panel.
-fn styles(members: &[&ConditionSummary]) -> Vec<(usize, Option<(i32, i32)>)> {
+/// (colour/marker slot, dash pattern, filled marker).
+type Style = (usize, Option<(i32, i32)>, bool);
+
+/// Style of each member: (colour/marker slot, dash pattern, filled marker), stable within the
+/// panel. The dash pattern follows the variant and sampler (faithful/none solid, corrected dashed,
+/// Gaussian goals dotted), else the next one free for the algorithm.
+fn styles(members: &[&ConditionSummary]) -> Vec<Style> {
     let mut unknown: Vec<&str> = members
         .iter()
         .map(|c| c.key.algo.as_str())
@@ -115,33 +133,34 @@ fn styles(members: &[&ConditionSummary]) -> Vec<(usize, Option<(i32, i32)>)> {
         .collect();
     unknown.sort_unstable();
     unknown.dedup();
-    let mut per_algo: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut used: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     members
         .iter()
         .map(|c| {
             let ui = unknown.iter().position(|a| *a == c.key.algo).unwrap_or(0);
             let slot = algo_slot(&c.key.algo, ui);
-            let k = per_algo.entry(c.key.algo.as_str()).or_insert(0);
-            let dash = dash_pattern(*k);
-            *k += 1;
-            (slot, dash)
+            let corrected = c.key.variant == "corrected";
+            let wanted = usize::from(corrected) + if c.key.sampler == "gaussian" { 2 } else { 0 };
+            let taken = used.entry(c.key.algo.as_str()).or_default();
+            let k = (0..)
+                .map(|i| wanted + i)
+                .find(|k| !taken.contains(k))
+                .expect("a free pattern");
+            taken.push(k);
+            let (_, filled) = marker_points(slot, 1.0);
+            (slot, dash_pattern(k), filled && !corrected)
         })
         .collect()
 }
 
-/// The legend label of a condition within a panel.
+/// The legend label of a condition within a panel: `RGE-VAE (corrected), n=5`. KDE goals are
+/// the default of the learned spaces and not named; other samplers are.
 fn label(c: &ConditionSummary) -> String {
-    let mut s = algo_name(&c.key.algo);
-    let default_sampler = matches!(c.key.sampler.as_str(), "none" | "uniform" | "kde");
-    if !default_sampler {
-        s.push_str(&format!(", {} goals", c.key.sampler));
-    } else if c.key.sampler == "kde" {
-        s.push_str(", kde");
+    let mut s = condition_name(&c.key.algo, &c.key.variant);
+    if !matches!(c.key.sampler.as_str(), "none" | "uniform" | "kde") {
+        s.push_str(&format!(", {} goals", sampler_name(&c.key.sampler)));
     }
-    if c.key.variant != "none" {
-        s.push_str(&format!(", {}", c.key.variant));
-    }
-    s.push_str(&format!(" (n={})", c.seeds.len()));
+    s.push_str(&format!(", n={}", c.seeds.len()));
     s
 }
 
@@ -200,7 +219,7 @@ fn draw_panel(
     let styles = styles(&panel.members);
 
     // Bands first, so that every line is drawn over every band.
-    for (c, &(slot, _)) in panel.members.iter().zip(&styles) {
+    for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
         let pts: Vec<_> = c
             .curve
             .iter()
@@ -217,9 +236,9 @@ fn draw_panel(
         )))?;
     }
 
-    for (i, (c, &(slot, dash))) in panel.members.iter().zip(&styles).enumerate() {
+    for (i, (c, &(slot, dash, filled))) in panel.members.iter().zip(&styles).enumerate() {
         let col = colour(slot);
-        let (mpts, filled) = marker_points(slot, 4.0);
+        let (mpts, _) = marker_points(slot, 4.0);
         let (dash_len, gap) = dash.unwrap_or((SOLID, 0));
         let line_style = col.stroke_width(2);
 
@@ -275,7 +294,7 @@ fn draw_panel(
     // The paper's single-run values, at the last epoch of each condition.
     let star = star_points(8.0, 3.5);
     let mut any_paper = false;
-    for (c, &(slot, _)) in panel.members.iter().zip(&styles) {
+    for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
         if let Some(p) = &c.paper {
             any_paper = true;
             let at = (c.last_epoch() as f64, clamp(p.klc));

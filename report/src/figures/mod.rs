@@ -3,8 +3,12 @@
 //! Every condition gets a colour (Okabe–Ito, colour-blind safe), a marker shape and a dash
 //! pattern, so the curves stay apart on a greyscale print as well.
 
+pub mod budget;
 pub mod klc_curves;
 pub mod outcomes;
+pub mod sampler_compare;
+pub mod training_loss;
+pub mod variants;
 
 use std::path::{Path, PathBuf};
 
@@ -72,11 +76,174 @@ pub fn env_name(env: &str) -> String {
 /// Display name of an algorithm (`rge-vae` → `RGE-VAE`).
 pub fn algo_name(algo: &str) -> String {
     match algo {
+        "rpe" => "RPE".into(),
+        "rge-efr" => "RGE-EFR".into(),
+        "rge-pca" => "RGE-PCA".into(),
         "rge-isomap" => "RGE-Isomap".into(),
         "rge-pca-centred" => "RGE-PCA (centred)".into(),
+        "rge-ae" => "RGE-AE".into(),
+        "rge-vae" => "RGE-VAE".into(),
+        "rge-rfvae" => "RGE-RFVAE".into(),
         "rge-external" => "RGE-external".into(),
         other => other.to_uppercase(),
     }
+}
+
+/// An algorithm with its variant: `RGE-VAE (corrected)`; `RGE-AE` for variant `none`.
+/// *faithful* is the original code's behaviour, defects included (PAPER-NOTES section 5);
+/// *corrected* has those defects fixed.
+pub fn condition_name(algo: &str, variant: &str) -> String {
+    let a = algo_name(algo);
+    match variant {
+        "" | "none" => a,
+        v => format!("{a} ({v})"),
+    }
+}
+
+/// Display name of a goal sampler: `KDE`, `Gaussian` (the VAE's isotropic prior), `uniform`
+/// (EFR), `none` (RPE).
+pub fn sampler_name(sampler: &str) -> String {
+    match sampler {
+        "kde" => "KDE".into(),
+        "gaussian" => "Gaussian".into(),
+        other => other.to_string(),
+    }
+}
+
+/// Display name of a neural learner (`vae` → `VAE`).
+pub fn learner_name(learner: &str) -> String {
+    learner.to_uppercase()
+}
+
+/// The environment's true latent dimension (the paper's "complete" representation): 2 for
+/// ArmBall (ball x, y), 3 for ArmArrow (x, y, angle).
+pub fn true_latents(env: &str) -> Option<i64> {
+    match env {
+        "armball" => Some(2),
+        "armarrow" => Some(3),
+        _ => None,
+    }
+}
+
+/// The paper's panel order for one algorithm's conditions: environments in the report's order,
+/// then the over-complete 10 latents before the true dimension (larger latents first).
+pub fn panel_order(env: &str, latents: i64) -> impl Ord + use<> {
+    (
+        rank(env, &["armball", "armarrow"]),
+        env.to_string(),
+        std::cmp::Reverse(latents),
+    )
+}
+
+/// Colours of the goal samplers where they are what a figure compares: KDE blue, Gaussian
+/// vermillion (Okabe–Ito; 30% and 45% luminance, apart in greyscale too).
+pub fn sampler_colour(sampler: &str) -> RGBColor {
+    match sampler {
+        "kde" => RGBColor(0x00, 0x72, 0xB2),
+        "gaussian" => RGBColor(0xD5, 0x5E, 0x00),
+        _ => RGBColor(0x77, 0x77, 0x77),
+    }
+}
+
+/// Marker slot of a goal sampler where samplers are compared: KDE circle, Gaussian triangle.
+pub fn sampler_marker_slot(sampler: &str) -> usize {
+    match sampler {
+        "kde" => 0,
+        "gaussian" => 2,
+        _ => 3,
+    }
+}
+
+/// Line style of a variant where variants are compared: faithful (and `none`) solid, corrected
+/// dashed.
+pub fn variant_dash(variant: &str) -> Option<(i32, i32)> {
+    if variant == "corrected" {
+        Some((8, 5))
+    } else {
+        None
+    }
+}
+
+/// Markers of the corrected variant are hollow, the others filled.
+pub fn variant_filled(variant: &str) -> bool {
+    variant != "corrected"
+}
+
+/// A dash this long never ends within a panel: a solid line drawn by the dashed-path element.
+pub const SOLID: i32 = 1_000_000;
+
+/// A chart with linear f64 axes on the SVG backend.
+pub type Chart2d<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// How one mean curve is drawn.
+#[derive(Debug, Clone)]
+pub struct LineStyle {
+    pub colour: RGBColor,
+    /// (dash, gap) in pixels; `None` solid.
+    pub dash: Option<(i32, i32)>,
+    /// Marker outline (see [`marker_points`]) and whether it is filled.
+    pub marker: (Vec<(i32, i32)>, bool),
+    pub width: u32,
+}
+
+/// Draws a curve (its finite points; a non-finite y breaks the line) with about 8 markers,
+/// staggered by `stagger` in `0..1` so that markers of overlapping curves do not coincide, and
+/// a legend entry `label` (line and marker) when given.
+pub fn draw_curve<'a, 'b: 'a>(
+    chart: &mut Chart2d<'a, 'b>,
+    pts: &[(f64, f64)],
+    style: &LineStyle,
+    stagger: f64,
+    label: Option<String>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::element::DashedPathElement;
+    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for &(x, y) in pts {
+        if y.is_finite() {
+            segments.last_mut().expect("one segment").push((x, y));
+        } else if !segments.last().expect("one segment").is_empty() {
+            segments.push(Vec::new());
+        }
+    }
+    segments.retain(|s| !s.is_empty());
+    let (dash_len, gap) = style.dash.unwrap_or((SOLID, 0));
+    let line_style = style.colour.stroke_width(style.width);
+    let (mpts, filled) = style.marker.clone();
+    let col = style.colour;
+    let mut label = label;
+    for seg in &segments {
+        let series = chart.draw_series(std::iter::once(DashedPathElement::new(
+            seg.clone(),
+            dash_len,
+            gap,
+            line_style,
+        )))?;
+        if let Some(l) = label.take() {
+            let lpts = mpts.clone();
+            series.label(l).legend(move |(x, y)| {
+                let (fill, outline) = icon_parts(&lpts, 13, filled, col, 1);
+                EmptyElement::at((x, y))
+                    + DashedPathElement::new(vec![(0, 0), (26, 0)], dash_len, gap, line_style)
+                    + fill
+                    + outline
+            });
+        }
+    }
+    let finite: Vec<(f64, f64)> = segments.iter().flatten().copied().collect();
+    let step = (finite.len() / 8).max(1);
+    let offset = ((stagger.clamp(0.0, 0.999) * step as f64) as usize).min(step - 1);
+    chart.draw_series(
+        finite
+            .iter()
+            .skip(offset)
+            .step_by(step)
+            .map(|&pt| marker(pt, &mpts, filled, col, 1)),
+    )?;
+    Ok(())
 }
 
 /// The fixed KLC axis range of an environment: 0 .. ln(number of achievable cells), which is the
@@ -265,4 +432,145 @@ pub fn file_safe(s: &str) -> String {
 /// Tick labels for epochs: integers, without the ".0" plotters prints for f64 by default.
 pub fn fmt_epoch(v: &f64) -> String {
     format!("{:.0}", v)
+}
+
+/// A linear f64 axis whose ticks are exactly `keys` (e.g. the centres of categories), labelled by
+/// the chart's `x_label_formatter`. (plotters' `with_key_points` on an f64 range has no value
+/// formatter, so its mesh cannot be configured.)
+#[derive(Debug, Clone)]
+pub struct KeyedAxis {
+    pub range: std::ops::Range<f64>,
+    pub keys: Vec<f64>,
+}
+
+impl plotters::coord::ranged1d::Ranged for KeyedAxis {
+    type FormatOption = plotters::coord::ranged1d::NoDefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        plotters::coord::types::RangedCoordf64::from(self.range.clone()).map(value, limit)
+    }
+
+    fn key_points<Hint: plotters::coord::ranged1d::KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.max_num_points() == 0 {
+            Vec::new()
+        } else {
+            self.keys.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.range.clone()
+    }
+}
+
+impl plotters::coord::ranged1d::ValueFormatter<f64> for KeyedAxis {
+    fn format(value: &f64) -> String {
+        format!("{value}")
+    }
+}
+
+/// The icon of a legend entry drawn outside the plots (see [`legend_strip`]).
+#[derive(Debug, Clone)]
+pub enum Icon {
+    /// A line segment, optionally dashed, optionally with a marker in its middle.
+    Line {
+        colour: RGBColor,
+        dash: Option<(i32, i32)>,
+        width: u32,
+        marker: Option<(Vec<(i32, i32)>, bool)>,
+    },
+    /// A marker alone.
+    Marker {
+        colour: RGBColor,
+        points: Vec<(i32, i32)>,
+        filled: bool,
+        stroke: u32,
+    },
+    /// A vertical whisker (a confidence interval) with a horizontal bar (the mean).
+    Whisker { colour: RGBColor },
+    /// A shaded box (a band).
+    Band { colour: RGBColor },
+}
+
+/// Width of the icon column of a legend entry, in pixels.
+const ICON_W: i32 = 30;
+
+/// Lays out `items` left to right, wrapping to a new row when the area is full, in a strip drawn
+/// under the panels (so that no legend hides data). Text widths are estimated from the character
+/// count, deterministically. Returns the height used.
+pub fn legend_strip(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    items: &[(Icon, String)],
+    font_size: u32,
+) -> Result<i32, Box<dyn std::error::Error>> {
+    use plotters::element::DashedPathElement;
+    let (w, _) = area.dim_in_pixel();
+    let row_h = font_size as i32 + 10;
+    let (mut x, mut y) = (16, row_h / 2 + 2);
+    for (icon, label) in items {
+        let text_w = (label.chars().count() as f64 * font_size as f64 * 0.56).ceil() as i32;
+        let item_w = ICON_W + 8 + text_w + 22;
+        if x > 16 && x + item_w > w as i32 {
+            x = 16;
+            y += row_h;
+        }
+        match icon {
+            Icon::Line {
+                colour,
+                dash,
+                width,
+                marker: m,
+            } => {
+                let (d, g) = dash.unwrap_or((SOLID, 0));
+                area.draw(&DashedPathElement::new(
+                    vec![(x, y), (x + ICON_W, y)],
+                    d,
+                    g,
+                    colour.stroke_width(*width),
+                ))?;
+                if let Some((pts, filled)) = m {
+                    area.draw(&marker((x + ICON_W / 2, y), pts, *filled, *colour, 1))?;
+                }
+            }
+            Icon::Marker {
+                colour,
+                points,
+                filled,
+                stroke,
+            } => {
+                area.draw(&marker(
+                    (x + ICON_W / 2, y),
+                    points,
+                    *filled,
+                    *colour,
+                    *stroke,
+                ))?;
+            }
+            Icon::Whisker { colour } => {
+                let c = x + ICON_W / 2;
+                area.draw(&PathElement::new(
+                    vec![(c, y - 8), (c, y + 8)],
+                    colour.stroke_width(2),
+                ))?;
+                area.draw(&PathElement::new(
+                    vec![(c - 7, y), (c + 7, y)],
+                    BLACK.stroke_width(3),
+                ))?;
+            }
+            Icon::Band { colour } => {
+                area.draw(&Rectangle::new(
+                    [(x, y - 6), (x + ICON_W, y + 6)],
+                    colour.mix(0.25).filled(),
+                ))?;
+            }
+        }
+        area.draw(&Text::new(
+            label.clone(),
+            (x + ICON_W + 8, y - font_size as i32 / 2 - 1),
+            (FONT, font_size),
+        ))?;
+        x += item_w;
+    }
+    Ok(y + row_h / 2)
 }

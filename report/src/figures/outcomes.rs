@@ -7,7 +7,10 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{FONT, FigureFile, algo_name, algo_slot, colour, env_name, file_safe, write_svg};
+use super::{
+    FONT, FigureFile, algo_slot, colour, condition_name, env_name, file_safe, sampler_name,
+    write_svg,
+};
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
 use crate::load::{Run, Store};
@@ -122,17 +125,19 @@ fn object_word(env: &str) -> &'static str {
     }
 }
 
-/// `RGE-VAE, kde, 10 latents, faithful` etc.
+/// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.
 pub fn describe(c: &ConditionSummary) -> String {
-    let mut s = algo_name(&c.key.algo);
-    if !matches!(c.key.sampler.as_str(), "none") {
-        s.push_str(&format!(", {}", c.key.sampler));
+    describe_key(&c.key)
+}
+
+/// [`describe`] of a condition key.
+pub fn describe_key(k: &crate::load::ConditionKey) -> String {
+    let mut s = condition_name(&k.algo, &k.variant);
+    if !matches!(k.sampler.as_str(), "none" | "uniform") {
+        s.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
     }
-    if c.key.latents != 0 {
-        s.push_str(&format!(", {} latents", c.key.latents));
-    }
-    if c.key.variant != "none" {
-        s.push_str(&format!(", {}", c.key.variant));
+    if k.latents != 0 {
+        s.push_str(&format!(", {} latents", k.latents));
     }
     s
 }

@@ -7,19 +7,33 @@ use std::fmt::Write as _;
 
 use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
+use crate::campaigns::Campaigns;
 use crate::figures::outcomes::describe;
 use crate::figures::{FigureFile, env_name};
-use crate::load::Store;
+use crate::load::{Store, campaign_display};
+use crate::neural::{BudgetAnalysis, VariantPair};
 use crate::paper::PaperTable;
+
+pub mod neural;
 
 /// Everything the markdown is made of.
 pub struct Inputs<'a> {
     pub opts: &'a ReportOptions,
+    pub campaigns: &'a Campaigns,
+    /// The main campaign's runs.
     pub store: &'a Store,
     pub paper: &'a PaperTable,
+    /// The main campaign's conditions.
     pub conditions: &'a [ConditionSummary],
     pub klc_figures: &'a [FigureFile],
     pub outcome_figures: &'a [FigureFile],
+    /// KDE-vs-Gaussian figures (the paper's Figure 4 for RGE-VAE first).
+    pub sampler_figures: &'a [FigureFile],
+    pub variant_pairs: &'a [VariantPair<'a>],
+    pub variants_figure: Option<&'a FigureFile>,
+    pub budget: &'a BudgetAnalysis,
+    pub budget_figures: &'a [FigureFile],
+    pub loss_figure: Option<&'a FigureFile>,
 }
 
 /// The text of the epoch-label note (PAPER-NOTES section 4).
@@ -71,20 +85,16 @@ fn distinct(values: impl Iterator<Item = Option<String>>) -> String {
     parts.join(", ")
 }
 
-fn plural(n: usize) -> &'static str {
+pub(crate) fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
 
 fn campaign_name(c: &str) -> String {
-    if c.is_empty() {
-        "(top level)".into()
-    } else {
-        c.to_string()
-    }
+    campaign_display(c)
 }
 
 /// Seeds as a compact list: `0–4` when contiguous, else `0, 2, 7`.
-fn fmt_seeds(seeds: &[i64]) -> String {
+pub(crate) fn fmt_seeds(seeds: &[i64]) -> String {
     let mut s = seeds.to_vec();
     s.sort_unstable();
     s.dedup();
@@ -102,6 +112,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
     let mut md = String::new();
     let store = inp.store;
     let runs = &store.runs;
+    let main = campaign_name(&inp.campaigns.main.name);
     let w = &mut md;
 
     let _ = writeln!(w, "# ugl-bench: replication report\n");
@@ -114,9 +125,19 @@ pub fn render(inp: &Inputs<'_>) -> String {
         inp.paper.looked_at.display()
     );
 
-    // --- Reduced budget: prominently, before anything else.
-    let reduced: Vec<&crate::load::Run> = runs
+    // --- Reduced budget: prominently, before anything else (main and budget campaigns).
+    let used: Vec<&crate::load::Run> = runs
         .iter()
+        .chain(
+            inp.campaigns
+                .budget
+                .iter()
+                .flat_map(|c| c.store.runs.iter()),
+        )
+        .collect();
+    let reduced: Vec<&crate::load::Run> = used
+        .iter()
+        .copied()
         .filter(|r| r.manifest.reduced_budget())
         .collect();
     if !reduced.is_empty() {
@@ -137,7 +158,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
              relative to the paper's; their numbers are not directly comparable with the paper's. \
              Conditions with such runs are marked † in the tables.",
             reduced.len(),
-            runs.len()
+            used.len()
         );
         for (note, camps) in &notes {
             let camps: Vec<&str> = camps.iter().map(String::as_str).collect();
@@ -152,7 +173,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
             inp.paper.looked_at.display()
         );
     }
-    let reduced_keys: BTreeSet<_> = reduced.iter().map(|r| r.key.slug()).collect();
+    let reduced_keys: BTreeSet<_> = reduced
+        .iter()
+        .filter(|r| r.campaign == inp.campaigns.main.name)
+        .map(|r| r.key.slug())
+        .collect();
     let dagger = |c: &ConditionSummary| {
         if reduced_keys.contains(&c.key.slug()) {
             " †"
@@ -162,25 +187,37 @@ pub fn render(inp: &Inputs<'_>) -> String {
     };
 
     // --- What was run.
-    let _ = writeln!(w, "## What was run\n");
-    let mut campaigns: BTreeMap<String, usize> = BTreeMap::new();
-    for r in runs {
-        *campaigns.entry(campaign_name(&r.campaign)).or_default() += 1;
+    let _ = writeln!(w, "## What was run (main campaign `{main}`)\n");
+    neural::campaigns_line(w, inp);
+    let _ = writeln!(
+        w,
+        "- **Runs:** {} complete runs of {} conditions in the main campaign `{main}`{}.",
+        runs.len(),
+        inp.conditions.len(),
+        if store.incomplete.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} more incomplete (still running or interrupted; listed at the end)",
+                store.incomplete.len()
+            )
+        }
+    );
+    let mut seed_counts: BTreeMap<usize, usize> = BTreeMap::new();
+    for c in inp.conditions {
+        *seed_counts.entry(c.seeds.len()).or_default() += 1;
     }
-    let camp_list: Vec<String> = campaigns
+    let seed_counts: Vec<String> = seed_counts
         .iter()
-        .map(|(c, n)| format!("`{c}` ({n} run{})", plural(*n)))
+        .rev()
+        .map(|(s, n)| format!("{s} seed{} ({n} condition{})", plural(*s), plural(*n)))
         .collect();
     let _ = writeln!(
         w,
-        "- **Runs:** {} complete runs of {} conditions, from {}.",
-        runs.len(),
-        inp.conditions.len(),
-        camp_list.join(", ")
+        "- **Seeds per condition:** {} (the *seeds* column below and *n* in every table say \
+         which).",
+        seed_counts.join(", ")
     );
-    let seed_counts: BTreeSet<usize> = inp.conditions.iter().map(|c| c.seeds.len()).collect();
-    let seed_counts: Vec<String> = seed_counts.iter().map(usize::to_string).collect();
-    let _ = writeln!(w, "- **Seeds per condition:** {}.", seed_counts.join(", "));
     let mut last_epochs: BTreeSet<i64> = BTreeSet::new();
     for c in inp.conditions {
         last_epochs.extend(c.final_epochs.iter().copied());
@@ -262,7 +299,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
             w,
             "| {} | {}{} | {} | {} | {} | {} ({}) | {} | {} |",
             env_name(&c.key.env),
-            c.key.algo,
+            crate::figures::algo_name(&c.key.algo),
             dagger(c),
             c.key.sampler,
             if c.key.latents == 0 {
@@ -278,6 +315,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         );
     }
     let _ = writeln!(w);
+    neural::training_budgets(w, inp);
 
     // --- Figures.
     let _ = writeln!(w, "## KL-coverage during exploration\n");
@@ -288,7 +326,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
          Lower is better; the y axis spans 0 to the KL-coverage of outcomes all in one cell \
          (ln 756 = 6.63 for ArmBall, ln 22680 = 10.03 for ArmArrow). The baselines appear in every \
          panel of their environment, as in the paper. Hollow stars: the paper's final values \
-         (single runs, read off its plots at the point labelled 4900), drawn at our last epoch.\n",
+         (single runs, read off its plots at the point labelled 4900), drawn at our last epoch. \
+         As in the paper's figure, only KDE goals for the learned spaces: the Gaussian-goal runs \
+         are in the Figure 4 section. Colour and marker shape identify the algorithm; the \
+         *faithful* variant is solid with filled markers, the *corrected* one dashed with hollow \
+         markers. *n* in the legend: seeds.\n",
         inp.opts.n_boot, inp.opts.bootstrap_seed
     );
     for f in inp.klc_figures {
@@ -358,6 +400,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
         let _ = writeln!(w);
     }
 
+    neural::figure4(w, inp);
+    neural::variants(w, inp);
+    neural::budget(w, inp);
+    neural::training_loss(w, inp);
+
     // --- Outcome scatters.
     let _ = writeln!(w, "## Object positions reached\n");
     let _ = writeln!(
@@ -377,6 +424,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
     // --- Deviations and notes.
     let _ = writeln!(w, "## Deviations and notes\n");
     let _ = writeln!(w, "- {EPOCH_NOTE}");
+    neural::deviations(w, inp);
     let _ = writeln!(
         w,
         "- The paper's curves are **single runs** (one per condition, no seeds, no confidence band); \

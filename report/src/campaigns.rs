@@ -1,0 +1,176 @@
+//! The store's campaigns and what the report does with each.
+//!
+//! A campaign is a sub-directory of the store (`data/results/<campaign>/`; runs directly in the
+//! store form the campaign `""`, shown as "(top level)"). Campaigns are separate experiments: the
+//! same run id may appear in two of them (the `paper` campaign and a `budget-vae-3000` campaign
+//! share their seeds), and conditions are never merged across campaigns.
+//!
+//! - The **main** campaign ([`crate::ReportOptions::main_campaign`], default `paper`) feeds the
+//!   sections that reproduce the paper: the KL-coverage curves (its Figure 2), the outcome
+//!   scatters (Figure 3), Figure 4 (RGE-VAE with KDE vs Gaussian goals), the faithful-vs-corrected
+//!   comparison and the final table against the paper's values.
+//! - Campaigns named `budget-*` feed the training-budget sensitivity section.
+//! - Any other campaign is listed as present but not used (its runs are not even read).
+
+use std::path::{Path, PathBuf};
+
+use crate::ReportError;
+use crate::load::{Store, campaign_display, scan_store};
+
+/// The prefix of the training-budget campaigns.
+pub const BUDGET_PREFIX: &str = "budget-";
+
+/// A campaign that was read.
+#[derive(Debug, Clone)]
+pub struct Campaign {
+    /// Directory name (`""` for the store's top level).
+    pub name: String,
+    pub path: PathBuf,
+    /// Its runs; may be empty (only incomplete runs so far) for a budget campaign.
+    pub store: Store,
+}
+
+/// A campaign present in the store that the report does not use.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Unused {
+    pub name: String,
+    pub complete: usize,
+    pub incomplete: usize,
+}
+
+/// The store, split by campaign.
+#[derive(Debug, Clone)]
+pub struct Campaigns {
+    pub main: Campaign,
+    /// `budget-*` campaigns, sorted by name with numbers in numeric order (`budget-vae-300`
+    /// before `budget-vae-1000`).
+    pub budget: Vec<Campaign>,
+    /// Everything else, sorted by name.
+    pub unused: Vec<Unused>,
+}
+
+impl Campaigns {
+    /// Runs the report uses (main and budget campaigns).
+    pub fn n_used_runs(&self) -> usize {
+        self.main.store.runs.len()
+            + self
+                .budget
+                .iter()
+                .map(|c| c.store.runs.len())
+                .sum::<usize>()
+    }
+}
+
+/// Sort key of a name with numbers in numeric order: its runs of digits compare as numbers.
+pub fn natural_key(name: &str) -> Vec<(String, u128)> {
+    let mut out = Vec::new();
+    let mut text = String::new();
+    let mut chars = name.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c.is_ascii_digit() {
+            let mut digits = c.to_string();
+            while let Some(&d) = chars.peek().filter(|d| d.is_ascii_digit()) {
+                digits.push(d);
+                chars.next();
+            }
+            out.push((
+                std::mem::take(&mut text),
+                digits.parse().unwrap_or(u128::MAX),
+            ));
+        } else {
+            text.push(c);
+        }
+    }
+    out.push((text, 0));
+    out
+}
+
+/// Whether a campaign feeds the budget-sensitivity section.
+pub fn is_budget_campaign(name: &str) -> bool {
+    name.starts_with(BUDGET_PREFIX)
+}
+
+/// Reads the main campaign `main` and the budget campaigns of the store `dir`; counts the others.
+///
+/// Errors: the store missing or empty as for [`crate::load::load_store`]; the main campaign
+/// absent ([`ReportError::MissingMainCampaign`], listing the campaigns found) or without a
+/// complete run ([`ReportError::NoCompleteRuns`]); any schema problem in a run that is read.
+pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> {
+    let dirs = scan_store(dir)?;
+    if dirs.is_empty() {
+        return Err(ReportError::EmptyResults(dir.to_path_buf()));
+    }
+    let Some(main_dir) = dirs.iter().find(|d| d.name == main) else {
+        return Err(ReportError::MissingMainCampaign {
+            dir: dir.to_path_buf(),
+            main: campaign_display(main),
+            found: dirs.iter().map(|d| campaign_display(&d.name)).collect(),
+        });
+    };
+    let store = main_dir.load()?;
+    if store.runs.is_empty() {
+        return Err(ReportError::NoCompleteRuns {
+            dir: main_dir.path.clone(),
+            incomplete: store.incomplete.len(),
+        });
+    }
+    let main_campaign = Campaign {
+        name: main_dir.name.clone(),
+        path: main_dir.path.clone(),
+        store,
+    };
+    let mut budget = Vec::new();
+    let mut unused = Vec::new();
+    for d in &dirs {
+        if d.name == main {
+            continue;
+        }
+        if is_budget_campaign(&d.name) {
+            budget.push(Campaign {
+                name: d.name.clone(),
+                path: d.path.clone(),
+                store: d.load()?,
+            });
+        } else {
+            unused.push(Unused {
+                name: d.name.clone(),
+                complete: d.n_complete(),
+                incomplete: d.n_incomplete(),
+            });
+        }
+    }
+    budget.sort_by_key(|c| natural_key(&c.name));
+    Ok(Campaigns {
+        main: main_campaign,
+        budget,
+        unused,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn natural_order_puts_numbers_in_numeric_order() {
+        let mut v = vec![
+            "budget-vae-10000",
+            "budget-vae-300",
+            "budget-vae-3000",
+            "budget-vae-1000",
+            "budget-ae-50",
+        ];
+        v.sort_by_key(|n| natural_key(n));
+        assert_eq!(
+            v,
+            [
+                "budget-ae-50",
+                "budget-vae-300",
+                "budget-vae-1000",
+                "budget-vae-3000",
+                "budget-vae-10000"
+            ]
+        );
+        assert!(is_budget_campaign("budget-vae-300") && !is_budget_campaign("paper"));
+    }
+}

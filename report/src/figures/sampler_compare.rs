@@ -1,0 +1,296 @@
+//! The paper's Figure 4: RGE-VAE exploring with goals from a KDE of the training latents against
+//! goals from the VAE's isotropic Gaussian prior N(0, I), in four panels (ArmBall 10 / 2 latents,
+//! ArmArrow 10 / 3 latents). As in the paper ("mean and standard deviation over 5 independent
+//! runs"), each curve is the mean over seeds with a ±1 sd band (not the bootstrap CI of the other
+//! curve figures). Our two variants are both drawn: faithful solid with filled markers, corrected
+//! dashed with hollow markers; KDE blue circles, Gaussian vermillion triangles.
+//!
+//! The same figure for another algorithm (RGE-RFVAE, which the paper did not plot) is drawn when
+//! its Gaussian-goal runs exist.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{
+    FONT, FigureFile, LineStyle, draw_curve, env_name, fmt_epoch, icon_parts, klc_max, marker,
+    marker_points, panel_order, sampler_colour, sampler_marker_slot, sampler_name, star_points,
+    variant_dash, variant_filled, write_svg,
+};
+use crate::ReportError;
+use crate::aggregate::ConditionSummary;
+use crate::figures::algo_name;
+
+const PANEL_W: u32 = 620;
+const PANEL_H: u32 = 440;
+const TITLE_H: u32 = 36;
+/// The samplers compared, in legend order.
+pub const SAMPLERS: [&str; 2] = ["kde", "gaussian"];
+/// The variants, in legend order (`none` for learners without variants).
+pub const VARIANTS: [&str; 3] = ["none", "faithful", "corrected"];
+
+/// One panel: an environment and latent size, with the conditions of the algorithm drawn there.
+#[derive(Debug, Clone)]
+pub struct SamplerPanel<'a> {
+    pub env: String,
+    pub latents: i64,
+    /// (sampler, variant, condition), in [`SAMPLERS`] then [`VARIANTS`] order.
+    pub members: Vec<(&'a str, &'a str, &'a ConditionSummary)>,
+}
+
+impl SamplerPanel<'_> {
+    pub fn title(&self) -> String {
+        format!("{}, {} latents", env_name(&self.env), self.latents)
+    }
+
+    /// The member with this sampler and variant.
+    pub fn get(&self, sampler: &str, variant: &str) -> Option<&ConditionSummary> {
+        self.members
+            .iter()
+            .find(|(s, v, _)| *s == sampler && *v == variant)
+            .map(|m| m.2)
+    }
+}
+
+/// The panels of `algo`: every (env, latents) where it ran with KDE or Gaussian goals, in the
+/// paper's order (ArmBall before ArmArrow, 10 latents before the true dimension).
+pub fn panels<'a>(conditions: &'a [ConditionSummary], algo: &str) -> Vec<SamplerPanel<'a>> {
+    let mut out: Vec<SamplerPanel<'a>> = Vec::new();
+    for c in conditions.iter().filter(|c| c.key.algo == algo) {
+        let Some(&s) = SAMPLERS.iter().find(|s| **s == c.key.sampler) else {
+            continue;
+        };
+        let Some(&v) = VARIANTS.iter().find(|v| **v == c.key.variant) else {
+            continue;
+        };
+        match out
+            .iter_mut()
+            .find(|p| p.env == c.key.env && p.latents == c.key.latents)
+        {
+            Some(p) => p.members.push((s, v, c)),
+            None => out.push(SamplerPanel {
+                env: c.key.env.clone(),
+                latents: c.key.latents,
+                members: vec![(s, v, c)],
+            }),
+        }
+    }
+    out.sort_by_key(|p| panel_order(&p.env, p.latents));
+    for p in &mut out {
+        p.members.sort_by_key(|(s, v, _)| {
+            (
+                SAMPLERS.iter().position(|x| x == s),
+                VARIANTS.iter().position(|x| x == v),
+            )
+        });
+    }
+    out
+}
+
+/// Whether `algo` has Gaussian-goal runs (the figure is about nothing otherwise).
+pub fn has_gaussian(conditions: &[ConditionSummary], algo: &str) -> bool {
+    conditions
+        .iter()
+        .any(|c| c.key.algo == algo && c.key.sampler == "gaussian")
+}
+
+/// Draws `fig_dir/<name>` for `algo` if it has Gaussian-goal runs; 2 panels a row.
+pub fn draw(
+    conditions: &[ConditionSummary],
+    algo: &str,
+    name: &str,
+    fig_dir: &Path,
+) -> Result<Option<FigureFile>, ReportError> {
+    if !has_gaussian(conditions, algo) {
+        return Ok(None);
+    }
+    let panels = panels(conditions, algo);
+    let cols = panels.len().min(2);
+    let rows = panels.len().div_ceil(2);
+    let path = fig_dir.join(name);
+    let title = format!(
+        "{}: KDE vs Gaussian goals, mean over seeds ± 1 sd",
+        algo_name(algo)
+    );
+    write_svg(
+        &path,
+        (PANEL_W * cols as u32, PANEL_H * rows as u32 + TITLE_H),
+        |root| {
+            let area = root.titled(&title, (FONT, 18))?;
+            let areas = area.split_evenly((rows, cols));
+            for (p, a) in panels.iter().zip(areas.iter()) {
+                draw_panel(a, p)?;
+            }
+            Ok(())
+        },
+    )?;
+    let titles: Vec<String> = panels.iter().map(SamplerPanel::title).collect();
+    Ok(Some(FigureFile {
+        path,
+        link: format!("figures/{name}"),
+        caption: format!(
+            "{}: KL-coverage with KDE vs Gaussian goals, faithful solid, corrected dashed ({})",
+            algo_name(algo),
+            titles.join("; ")
+        ),
+        env: String::new(),
+    }))
+}
+
+/// Legend label: `KDE goals, faithful, n=5`.
+fn label(sampler: &str, variant: &str, c: &ConditionSummary) -> String {
+    let mut s = format!("{} goals", sampler_name(sampler));
+    if variant != "none" {
+        s.push_str(&format!(", {variant}"));
+    }
+    s.push_str(&format!(", n={}", c.seeds.len()));
+    s
+}
+
+fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    panel: &SamplerPanel<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let x_last = panel
+        .members
+        .iter()
+        .map(|m| m.2.last_epoch())
+        .max()
+        .unwrap_or(1)
+        .max(1) as f64;
+    let band = |p: &crate::aggregate::CurveStat| match p.std {
+        Some(sd) if p.mean.is_finite() => Some((p.mean - sd, p.mean + sd)),
+        _ => None,
+    };
+    let finite = panel
+        .members
+        .iter()
+        .flat_map(|m| {
+            m.2.curve
+                .iter()
+                .flat_map(|p| {
+                    let (lo, hi) = band(p).unwrap_or((p.mean, p.mean));
+                    [lo, hi]
+                })
+                .chain(m.2.paper.iter().map(|p| p.klc))
+        })
+        .filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let y_max = klc_max(&panel.env).unwrap_or(if hi.is_finite() { hi * 1.05 } else { 1.0 });
+    // Zoom on the curves: the bottom of the axis just under the lowest band.
+    let y_min = if lo.is_finite() {
+        (lo - 0.08 * (y_max - lo)).max(0.0).min(y_max - 0.5)
+    } else {
+        0.0
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(panel.title(), (FONT, 17))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(56)
+        .build_cartesian_2d(-0.01 * x_last..x_last * 1.04, y_min..y_max)?;
+    chart
+        .configure_mesh()
+        .x_desc("exploration epochs")
+        .y_desc("KL-coverage (nats, lower is better)")
+        .x_label_formatter(&fmt_epoch)
+        .y_label_formatter(&|v| format!("{v:.1}"))
+        .x_labels(8)
+        .y_labels(8)
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .max_light_lines(4)
+        .light_line_style(RGBColor(0xEE, 0xEE, 0xEE))
+        .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
+        .draw()?;
+    let clamp = |v: f64| v.clamp(y_min, y_max);
+
+    for &(sampler, _, c) in &panel.members {
+        let pts: Vec<(f64, (f64, f64))> = c
+            .curve
+            .iter()
+            .filter_map(|p| band(p).map(|b| (p.epoch as f64, b)))
+            .collect();
+        if pts.len() < 2 {
+            continue;
+        }
+        let mut poly: Vec<(f64, f64)> = pts.iter().map(|(x, b)| (*x, clamp(b.1))).collect();
+        poly.extend(pts.iter().rev().map(|(x, b)| (*x, clamp(b.0))));
+        chart.draw_series(std::iter::once(Polygon::new(
+            poly,
+            sampler_colour(sampler).mix(0.12).filled(),
+        )))?;
+    }
+    let n = panel.members.len().max(1);
+    for (i, &(sampler, variant, c)) in panel.members.iter().enumerate() {
+        let (mpts, _) = marker_points(sampler_marker_slot(sampler), 4.5);
+        let style = LineStyle {
+            colour: sampler_colour(sampler),
+            dash: variant_dash(variant),
+            marker: (mpts, variant_filled(variant)),
+            width: 2,
+        };
+        let pts: Vec<(f64, f64)> = c
+            .curve
+            .iter()
+            .map(|p| {
+                let y = if p.mean.is_finite() {
+                    clamp(p.mean)
+                } else {
+                    p.mean
+                };
+                (p.epoch as f64, y)
+            })
+            .collect();
+        draw_curve(
+            &mut chart,
+            &pts,
+            &style,
+            i as f64 / n as f64,
+            Some(label(sampler, variant, c)),
+        )?;
+    }
+
+    // The paper's single-run values (its Figure 4 has ArmBall 10 latents only in our table).
+    let star = star_points(8.0, 3.5);
+    let mut any_paper = false;
+    let mut drawn: Vec<&str> = Vec::new();
+    for &(sampler, _, c) in &panel.members {
+        if let Some(p) = &c.paper
+            && !drawn.contains(&sampler)
+        {
+            drawn.push(sampler);
+            any_paper = true;
+            let at = (c.last_epoch() as f64, clamp(p.klc));
+            chart.draw_series(std::iter::once(marker(
+                at,
+                &star,
+                false,
+                sampler_colour(sampler),
+                2,
+            )))?;
+        }
+    }
+    if any_paper {
+        let star = star.clone();
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+            .label("paper: final value (1 run)")
+            .legend(move |(x, y)| {
+                let (fill, outline) = icon_parts(&star, 13, false, BLACK, 2);
+                EmptyElement::at((x, y)) + fill + outline
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .legend_area_size(32)
+        .margin(8)
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(0x99, 0x99, 0x99))
+        .draw()?;
+    Ok(())
+}

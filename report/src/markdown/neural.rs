@@ -1,0 +1,551 @@
+//! The markdown sections about campaigns and the neural learners: the campaigns line, the training
+//! budgets against the paper's, the paper's Figure 4 (RGE-VAE with KDE vs Gaussian goals),
+//! faithful vs corrected, the training-budget sensitivity, the training losses, and their lines in
+//! the deviations.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::{Inputs, fmt_klc, fmt_seeds, plural};
+use crate::aggregate::ConditionSummary;
+use crate::figures::budget::series_title;
+use crate::figures::sampler_compare::{self, SAMPLERS};
+use crate::figures::{algo_name, condition_name, env_name, learner_name, sampler_name};
+use crate::load::campaign_display;
+use crate::neural::{self, BudgetPoint, PAPER_TRAINING, paper_training};
+use crate::stats::Summary;
+
+/// What faithful and corrected mean, for the report's readers.
+pub const VARIANT_NOTE: &str = "*Faithful* reproduces the original code's behaviour, defects \
+included: the VAE's reparameterisation noise is one draw shared by the whole batch; the RFVAE \
+shares that noise, broadcasts its log-determinant term to a batch × batch matrix, and encodes \
+outcomes as the flow output of a freshly sampled z0 while its KDE is fitted on flow-less z0 samples \
+(goals and outcomes in different spaces). *Corrected* fixes these defects (per-sample noise, \
+per-sample log-determinant, deterministic encoding of the mean through the flows, for both). The AE \
+has no documented defect and runs once (PAPER-NOTES section 5).";
+
+fn campaign(name: &str) -> String {
+    format!("`{}`", campaign_display(name))
+}
+
+/// `- **Campaigns:** ...`: the main one, the budget ones, and those present but not used.
+pub fn campaigns_line(w: &mut String, inp: &Inputs<'_>) {
+    let c = inp.campaigns;
+    let n = c.main.store.runs.len();
+    let mut parts = vec![format!(
+        "main {} ({n} run{}: the paper's figures and table)",
+        campaign(&c.main.name),
+        plural(n)
+    )];
+    if !c.budget.is_empty() {
+        let b: Vec<String> = c
+            .budget
+            .iter()
+            .map(|b| {
+                let n = b.store.runs.len();
+                format!("{} ({n} run{})", campaign(&b.name), plural(n))
+            })
+            .collect();
+        parts.push(format!("training-budget sensitivity {}", b.join(", ")));
+    }
+    if !c.unused.is_empty() {
+        let u: Vec<String> = c
+            .unused
+            .iter()
+            .map(|u| {
+                format!(
+                    "{} ({} run{})",
+                    campaign(&u.name),
+                    u.complete,
+                    plural(u.complete)
+                )
+            })
+            .collect();
+        parts.push(format!("present but not used: {}", u.join(", ")));
+    }
+    let _ = writeln!(w, "- **Campaigns:** {}.", parts.join("; "));
+}
+
+/// Distinct values with run counts, numbers in numeric order: `1000` or `300 (3 runs), 1000 (2 runs)`.
+fn values(m: &BTreeMap<String, usize>) -> String {
+    let mut v: Vec<(&String, &usize)> = m.iter().collect();
+    v.sort_by(|a, b| {
+        let (x, y) = (a.0.parse::<f64>().ok(), b.0.parse::<f64>().ok());
+        match (x, y) {
+            (Some(x), Some(y)) => x.total_cmp(&y),
+            _ => a.0.cmp(b.0),
+        }
+    });
+    if v.len() == 1 {
+        return v[0].0.clone();
+    }
+    v.iter()
+        .map(|(k, n)| format!("{k} ({n} run{})", plural(**n)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The training budgets actually used by the main campaign, next to the paper's.
+pub fn training_budgets(w: &mut String, inp: &Inputs<'_>) {
+    let used = neural::budgets_used(inp.store);
+    let _ = writeln!(w, "### Neural training budgets\n");
+    if used.is_empty() {
+        let _ = writeln!(
+            w,
+            "No run of the main campaign trained a neural representation (AE, VAE, RFVAE).\n"
+        );
+        return;
+    }
+    let _ = writeln!(
+        w,
+        "What the main campaign's neural learners were trained with, read from each run's manifest \
+         (`train.config`), under the paper's settings (PAPER-NOTES section 5; dense networks on the \
+         4900 pixels, batch 100). A training is shared by the runs that differ only in their goal \
+         sampler; *trainings* counts distinct ones, and the fit time (data set and training) is \
+         their mean.\n"
+    );
+    let _ = writeln!(
+        w,
+        "| learner | | iterations | hidden layers | batch | learning rate | warm-up | runs (trainings) | fit time (mean) |"
+    );
+    let _ = writeln!(w, "|---|---|---:|---|---:|---:|---:|---:|---:|");
+    for b in &used {
+        let rfvae = b.learner == "rfvae";
+        let fit = b
+            .mean_fit_s
+            .map(super::fmt_duration)
+            .unwrap_or_else(|| "—".into());
+        let _ = writeln!(
+            w,
+            "| {} | ours | {} | {} | {} | {} | {} | {} ({}) | {} |",
+            learner_name(&b.learner),
+            values(&b.iterations),
+            values(&b.hidden),
+            values(&b.batch),
+            values(&b.lr),
+            if rfvae {
+                values(&b.warmup)
+            } else {
+                "—".into()
+            },
+            b.runs,
+            b.trainings,
+            fit
+        );
+        if b.unrecorded > 0 {
+            let _ = writeln!(
+                w,
+                "| | (no `train` record: {} run{}) | | | | | | | |",
+                b.unrecorded,
+                plural(b.unrecorded)
+            );
+        }
+        if let Some(p) = paper_training(&b.learner) {
+            let _ = writeln!(
+                w,
+                "| | paper | {} | [{}, {}] | {} | {:e} ({}) | {} | 1 per condition | |",
+                p.iterations,
+                p.hidden[0],
+                p.hidden[1],
+                p.batch,
+                p.lr,
+                p.optimiser,
+                p.warmup
+                    .map(|v| v.to_string())
+                    .unwrap_or_else(|| "—".into()),
+            );
+        }
+    }
+    let _ = writeln!(w);
+}
+
+/// One-line summary of the budgets for the deviations: `RGE-AE 2000 of the paper's 200000
+/// iterations (1.0%)`, plus the hidden layers where they differ.
+fn budget_deviation(inp: &Inputs<'_>) -> Option<String> {
+    let used = neural::budgets_used(inp.store);
+    let mut parts = Vec::new();
+    let mut hidden = Vec::new();
+    for b in &used {
+        let Some(p) = paper_training(&b.learner) else {
+            continue;
+        };
+        let its: Vec<i64> = b.iterations.keys().filter_map(|k| k.parse().ok()).collect();
+        if its.iter().any(|&i| i != p.iterations) {
+            let pct: Vec<String> = its
+                .iter()
+                .map(|&i| format!("{i} ({:.1}%)", 100.0 * i as f64 / p.iterations as f64))
+                .collect();
+            parts.push(format!(
+                "{} {} of the paper's {} iterations",
+                learner_name(&b.learner),
+                pct.join(", "),
+                p.iterations
+            ));
+        }
+        let paper_hidden = format!("[{}, {}]", p.hidden[0], p.hidden[1]);
+        for h in b.hidden.keys() {
+            if *h != paper_hidden && !hidden.contains(h) {
+                hidden.push(h.clone());
+            }
+        }
+    }
+    if parts.is_empty() && hidden.is_empty() {
+        return None;
+    }
+    let mut s = format!(
+        "**Neural training budgets differ from the paper's** (main campaign, from the manifests): {}",
+        parts.join("; ")
+    );
+    if !hidden.is_empty() {
+        let _ = write!(
+            s,
+            "{}hidden layers {} instead of [{}, {}]",
+            if parts.is_empty() { "" } else { "; " },
+            hidden.join(", "),
+            PAPER_TRAINING[0].hidden[0],
+            PAPER_TRAINING[0].hidden[1]
+        );
+    }
+    s.push_str(
+        ". Conclusions about RGE-AE, RGE-VAE and RGE-RFVAE hold for these budgets; the \
+         training-budget section measures how RGE-VAE's final KL-coverage depends on it.",
+    );
+    Some(s)
+}
+
+/// `4.123 ± 0.100 (n=5)`; `—` when absent.
+fn cell(c: Option<&ConditionSummary>) -> String {
+    match c {
+        None => "—".into(),
+        Some(c) => summary_cell(&c.final_klc),
+    }
+}
+
+fn summary_cell(s: &Summary) -> String {
+    match s.std {
+        Some(sd) => format!("{} ± {sd:.3} (n={})", fmt_klc(s.mean), s.n),
+        None => format!("{} (n={})", fmt_klc(s.mean), s.n),
+    }
+}
+
+fn ci(s: &Summary) -> String {
+    format!("[{}, {}]", fmt_klc(s.ci_lo), fmt_klc(s.ci_hi))
+}
+
+fn signed(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:+.3}")
+    } else {
+        fmt_klc(v)
+    }
+}
+
+/// The paper's Figure 4 (RGE-VAE, KDE vs Gaussian goals), and the same for RGE-RFVAE if drawn.
+pub fn figure4(w: &mut String, inp: &Inputs<'_>) {
+    let _ = writeln!(
+        w,
+        "## RGE-VAE: KDE vs Gaussian goals (the paper's Figure 4)\n"
+    );
+    let _ = writeln!(
+        w,
+        "The paper compared goals sampled from a KDE of the training latents with goals from the \
+         VAE's isotropic Gaussian prior N(0, I), and found no significant difference (its Figure \
+         4, mean and standard deviation over 5 runs; its notebook's single run on ArmBall with 10 \
+         latents ends at 4.25 with KDE and 3.84 with Gaussian goals). Curves: mean over seeds with \
+         a ±1 sd band; KDE blue circles, Gaussian vermillion triangles; faithful solid with filled \
+         markers, corrected dashed with hollow markers. Table: final KL-coverage, mean ± sd over \
+         seeds (*n* seeds).\n"
+    );
+    for (algo, name) in crate::SAMPLER_FIGURES {
+        let fig = inp
+            .sampler_figures
+            .iter()
+            .find(|f| f.link == format!("figures/{name}"));
+        if algo != "rge-vae" && fig.is_none() {
+            continue;
+        }
+        if algo != "rge-vae" {
+            let _ = writeln!(
+                w,
+                "### {} (not in the paper)\n",
+                condition_name(algo, "none")
+            );
+        }
+        let Some(fig) = fig else {
+            let _ = writeln!(
+                w,
+                "No {} run with Gaussian goals in the main campaign {}: no figure.\n",
+                algo_name(algo),
+                campaign(&inp.campaigns.main.name)
+            );
+            continue;
+        };
+        let _ = writeln!(w, "![{}]({})\n", fig.caption, fig.link);
+        let panels = sampler_compare::panels(inp.conditions, algo);
+        let _ = writeln!(
+            w,
+            "| panel | KDE, faithful | KDE, corrected | Gaussian, faithful | Gaussian, corrected | paper (KDE / Gaussian) |"
+        );
+        let _ = writeln!(w, "|---|---:|---:|---:|---:|---:|");
+        for p in &panels {
+            let paper: Vec<String> = SAMPLERS
+                .iter()
+                .map(|s| {
+                    p.members
+                        .iter()
+                        .find(|m| m.0 == *s)
+                        .and_then(|m| m.2.paper.as_ref())
+                        .map(|v| format!("{:.2}", v.klc))
+                        .unwrap_or_else(|| "—".into())
+                })
+                .collect();
+            // A learner without variants (none) fills the faithful column.
+            let get = |s: &str, v: &str| {
+                p.get(s, v)
+                    .or_else(|| (v == "faithful").then(|| p.get(s, "none")).flatten())
+            };
+            let _ = writeln!(
+                w,
+                "| {} | {} | {} | {} | {} | {} |",
+                p.title(),
+                cell(get("kde", "faithful")),
+                cell(get("kde", "corrected")),
+                cell(get("gaussian", "faithful")),
+                cell(get("gaussian", "corrected")),
+                paper.join(" / ")
+            );
+        }
+        let _ = writeln!(w);
+    }
+}
+
+/// Faithful vs corrected: the figure and the paired-difference table.
+pub fn variants(w: &mut String, inp: &Inputs<'_>) {
+    let _ = writeln!(w, "## Faithful vs corrected variants\n");
+    let _ = writeln!(w, "{VARIANT_NOTE}\n");
+    let Some(fig) = inp.variants_figure else {
+        let _ = writeln!(
+            w,
+            "No RGE-VAE or RGE-RFVAE run with a faithful or corrected variant in the main campaign \
+             {}: nothing to compare.\n",
+            campaign(&inp.campaigns.main.name)
+        );
+        return;
+    };
+    let _ = writeln!(
+        w,
+        "The two runs of a seed share their initial weights, their training batches and their \
+         exploration streams, so the comparison is paired: *corrected − faithful* is the mean over \
+         seeds of the per-seed difference of final KL-coverage (negative: the corrected variant \
+         covers better), with its 90% percentile-bootstrap CI over the pairs ({} resamples). A CI \
+         that excludes 0 is a difference at this training budget; with 5 pairs the CI is rough.\n",
+        inp.opts.n_boot
+    );
+    let _ = writeln!(w, "![{}]({})\n", fig.caption, fig.link);
+    let _ = writeln!(
+        w,
+        "| panel | algorithm | goals | faithful: mean (n) | corrected: mean (n) | corrected − faithful | 90% CI | pairs (seeds) |"
+    );
+    let _ = writeln!(w, "|---|---|---|---:|---:|---:|---:|---:|");
+    let mean_n = |c: Option<&ConditionSummary>| match c {
+        Some(c) => format!("{} ({})", fmt_klc(c.final_klc.mean), c.final_klc.n),
+        None => "— (0)".into(),
+    };
+    for p in inp.variant_pairs {
+        let (diff, dci) = match &p.diff {
+            Some(d) => (
+                signed(d.mean),
+                format!("[{}, {}]", signed(d.ci_lo), signed(d.ci_hi)),
+            ),
+            None => ("—".into(), "—".into()),
+        };
+        let seeds: Vec<i64> = p.differences.iter().map(|d| d.0).collect();
+        let _ = writeln!(
+            w,
+            "| {}, {} latents | {} | {} | {} | {} | {} | {} | {} ({}) |",
+            env_name(&p.env),
+            p.latents,
+            algo_name(&p.algo),
+            sampler_name(&p.sampler),
+            mean_n(p.faithful),
+            mean_n(p.corrected),
+            diff,
+            dci,
+            p.differences.len(),
+            if seeds.is_empty() {
+                "—".into()
+            } else {
+                fmt_seeds(&seeds)
+            }
+        );
+    }
+    let _ = writeln!(w);
+}
+
+fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str) {
+    let seeds: Vec<i64> = p.values.iter().map(|v| v.0).collect();
+    let _ = writeln!(
+        w,
+        "| {} | {} | {} ({}) | {} | {} |",
+        p.iterations,
+        origin,
+        p.summary.n,
+        fmt_seeds(&seeds),
+        summary_cell(&p.summary)
+            .split(" (n=")
+            .next()
+            .unwrap_or_default(),
+        ci(&p.summary)
+    );
+}
+
+/// Training-budget sensitivity: the `budget-*` campaigns.
+pub fn budget(w: &mut String, inp: &Inputs<'_>) {
+    let _ = writeln!(w, "## Training-budget sensitivity\n");
+    let camps = &inp.campaigns.budget;
+    if camps.is_empty() {
+        let _ = writeln!(
+            w,
+            "No `budget-*` campaign in the store: the dependence of the results on the neural \
+             training budget is not measured here (no figure).\n"
+        );
+        return;
+    }
+    let list: Vec<String> = camps
+        .iter()
+        .map(|c| {
+            let n = c.store.runs.len();
+            let mut s = format!("{} ({n} run{}", campaign(&c.name), plural(n));
+            if !c.store.incomplete.is_empty() {
+                let _ = write!(s, ", {} incomplete", c.store.incomplete.len());
+            }
+            s.push(')');
+            s
+        })
+        .collect();
+    let _ = writeln!(
+        w,
+        "The same condition trained for different numbers of iterations (read from each run's \
+         `train.config.iterations`), from the campaigns {}. The seeds are the main campaign's: a \
+         seed starts from the same weights and draws the same batches at every budget. Each dot \
+         is a seed's final KL-coverage; diamonds the mean with its 90% bootstrap CI; the star the \
+         main campaign {} at its own budget; horizontal lines the mean final KL-coverage of \
+         RGE-EFR and RPE in the main campaign. The paper trained the VAE for 100,000 iterations.\n",
+        list.join(", "),
+        campaign(&inp.campaigns.main.name)
+    );
+    for f in inp.budget_figures {
+        let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+    }
+    for s in &inp.budget.series {
+        let _ = writeln!(w, "### {}\n", series_title(s));
+        let _ = writeln!(
+            w,
+            "| training iterations | campaign | n seeds | final KLC mean ± sd | 90% CI |"
+        );
+        let _ = writeln!(w, "|---:|---|---:|---:|---:|");
+        for p in &s.points {
+            let names: Vec<String> = p.campaigns.iter().map(|c| campaign(c)).collect();
+            budget_row(w, p, &names.join(", "));
+        }
+        for p in &s.main {
+            budget_row(
+                w,
+                p,
+                &format!("{} (main)", campaign(&inp.campaigns.main.name)),
+            );
+        }
+        if !s.references.is_empty() {
+            let refs: Vec<String> = s
+                .references
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{} {} (n={})",
+                        algo_name(&r.algo),
+                        fmt_klc(r.summary.mean),
+                        r.summary.n
+                    )
+                })
+                .collect();
+            let _ = writeln!(
+                w,
+                "\nReference levels on {} (main campaign, mean final KL-coverage): {}.",
+                env_name(&s.key.env),
+                refs.join(", ")
+            );
+        }
+        let _ = writeln!(w);
+    }
+    if !inp.budget.unrecorded.is_empty() {
+        let _ = writeln!(
+            w,
+            "Left out, no `train.config.iterations` in the manifest ({}): {}.\n",
+            inp.budget.unrecorded.len(),
+            inp.budget
+                .unrecorded
+                .iter()
+                .map(|r| format!("`{r}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+}
+
+/// The training-loss figure, if any run recorded its loss.
+pub fn training_loss(w: &mut String, inp: &Inputs<'_>) {
+    let Some(f) = inp.loss_figure else {
+        return;
+    };
+    let _ = writeln!(w, "## Training losses\n");
+    let _ = writeln!(
+        w,
+        "The loss each neural learner minimised, as recorded during training (`train.losses` in \
+         the manifests), averaged over the main campaign's distinct trainings: blue the 10-latent \
+         spaces, orange the true dimension; faithful (and the AE) solid, corrected dashed. The \
+         y axis is cut above the second recorded point: the untrained network's first loss can be \
+         far higher. Levels differ between learners (the VAE adds its KL term, the RFVAE \
+         subtracts its flows' log-determinant and anneals the rest), not their quality.\n"
+    );
+    let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+}
+
+/// The neural learners' lines in the deviations.
+pub fn deviations(w: &mut String, inp: &Inputs<'_>) {
+    if let Some(s) = budget_deviation(inp) {
+        let _ = writeln!(w, "- {s}");
+    }
+    if !inp.variant_pairs.is_empty() {
+        let _ = writeln!(
+            w,
+            "- The paper ran its original code only, i.e. our *faithful* variant; the *corrected* \
+             variant is ours. Its final values are compared with the same paper value in the table."
+        );
+    }
+    let max = inp
+        .conditions
+        .iter()
+        .map(|c| c.seeds.len())
+        .max()
+        .unwrap_or(0);
+    let fewer: Vec<String> = inp
+        .conditions
+        .iter()
+        .filter(|c| c.seeds.len() < max)
+        .map(|c| {
+            format!(
+                "{} {} ({})",
+                env_name(&c.key.env),
+                crate::figures::outcomes::describe(c),
+                c.seeds.len()
+            )
+        })
+        .collect();
+    if !fewer.is_empty() {
+        let _ = writeln!(
+            w,
+            "- Conditions with fewer seeds than the others ({max}): {}.",
+            fewer.join("; ")
+        );
+    }
+}

@@ -1,0 +1,485 @@
+//! The neural learners (AE, VAE, RFVAE; PAPER-NOTES section 5): their training budgets as recorded
+//! in the manifests (`train.config`), the faithful-vs-corrected comparison of the VAE and RFVAE
+//! (paired by seed), the training-budget sensitivity of RGE-VAE (the `budget-*` campaigns) and
+//! the recorded training losses.
+//!
+//! *Faithful* reproduces the original code, defects included (the VAE's reparameterisation noise
+//! shared by the whole batch; the RFVAE's shared noise, log-det broadcast and encoding mismatch);
+//! *corrected* fixes them. The AE has no documented defect and runs once (variant `none`).
+//! Runs of the two variants with the same seed start from the same weights and draw the same
+//! batches, so their difference is measured per seed.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use serde_json::Value;
+
+use crate::aggregate::ConditionSummary;
+use crate::campaigns::Campaign;
+use crate::load::{ConditionKey, Manifest, Run, Store, rank};
+use crate::stats::{self, Summary};
+
+/// The neural learners, in the paper's order.
+pub const LEARNERS: [&str; 3] = ["ae", "vae", "rfvae"];
+
+/// The algorithms compared faithful vs corrected.
+pub const VARIANT_ALGOS: [&str; 2] = ["rge-vae", "rge-rfvae"];
+
+/// The paper's training of one learner (PAPER-NOTES section 5; the original `src/network.py`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperTraining {
+    pub learner: &'static str,
+    pub iterations: i64,
+    pub hidden: [i64; 2],
+    pub batch: i64,
+    pub lr: f64,
+    pub optimiser: &'static str,
+    /// RFVAE: iterations of the warm-up `min(1, 0.01 + step / 10⁴)` on KL and reconstruction.
+    pub warmup: Option<i64>,
+}
+
+/// AE 200,000 iterations (Adagrad), VAE 100,000 (Adam), RFVAE 50,000 (Adam, 10,000 warm-up);
+/// all 4900-1200-1200 dense networks, batch 100, learning rate 1e-3.
+pub const PAPER_TRAINING: [PaperTraining; 3] = [
+    PaperTraining {
+        learner: "ae",
+        iterations: 200_000,
+        hidden: [1200, 1200],
+        batch: 100,
+        lr: 1e-3,
+        optimiser: "Adagrad",
+        warmup: None,
+    },
+    PaperTraining {
+        learner: "vae",
+        iterations: 100_000,
+        hidden: [1200, 1200],
+        batch: 100,
+        lr: 1e-3,
+        optimiser: "Adam",
+        warmup: None,
+    },
+    PaperTraining {
+        learner: "rfvae",
+        iterations: 50_000,
+        hidden: [1200, 1200],
+        batch: 100,
+        lr: 1e-3,
+        optimiser: "Adam",
+        warmup: Some(10_000),
+    },
+];
+
+pub fn paper_training(learner: &str) -> Option<&'static PaperTraining> {
+    PAPER_TRAINING.iter().find(|p| p.learner == learner)
+}
+
+/// What a manifest's `train` object records (every field optional: the schema belongs to the
+/// runner).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Training {
+    pub iterations: Option<i64>,
+    pub hidden: Option<Vec<i64>>,
+    pub batch: Option<i64>,
+    pub lr: Option<f64>,
+    pub warmup: Option<i64>,
+    /// Model-cache status: `hit`, `miss`, `rebuilt` or `off`.
+    pub cache: Option<String>,
+    /// Hash of the training configuration and data: runs with the same key share one training
+    /// (e.g. the KDE and Gaussian-goal runs of a cell).
+    pub key: Option<String>,
+    /// (iteration, loss), as recorded, sorted by iteration.
+    pub losses: Vec<(i64, f64)>,
+}
+
+/// The `train` object of a manifest, if the run trained a neural representation.
+pub fn training(m: &Manifest) -> Option<Training> {
+    let t = m.raw.get("train")?.as_object()?;
+    let cfg = t.get("config").and_then(Value::as_object);
+    let int = |name: &str| {
+        cfg.and_then(|c| c.get(name))
+            .and_then(|v| v.as_i64().or_else(|| v.as_f64().map(|f| f as i64)))
+    };
+    let hidden = cfg
+        .and_then(|c| c.get("hidden"))
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_i64).collect());
+    let mut losses: Vec<(i64, f64)> = t
+        .get("losses")
+        .and_then(Value::as_array)
+        .map(|a| {
+            a.iter()
+                .filter_map(|p| {
+                    let p = p.as_array()?;
+                    Some((p.first()?.as_i64()?, p.get(1)?.as_f64()?))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    losses.sort_by_key(|&(i, _)| i);
+    Some(Training {
+        iterations: int("iterations"),
+        hidden,
+        batch: int("batch"),
+        lr: cfg.and_then(|c| c.get("lr")).and_then(Value::as_f64),
+        warmup: int("warmup"),
+        cache: t.get("cache").and_then(Value::as_str).map(str::to_string),
+        key: t.get("key").and_then(Value::as_str).map(str::to_string),
+        losses,
+    })
+}
+
+/// The neural learner of a run: the manifest's `learner`, else derived from the algorithm
+/// (`rge-vae` → `vae`); `None` for runs without a neural representation.
+pub fn learner(run: &Run) -> Option<String> {
+    if let Some(l) = run.manifest.raw.get("learner").and_then(Value::as_str)
+        && LEARNERS.contains(&l)
+    {
+        return Some(l.to_string());
+    }
+    let l = run.key.algo.strip_prefix("rge-")?;
+    LEARNERS.contains(&l).then(|| l.to_string())
+}
+
+/// Training iterations of a run, from `train.config.iterations`.
+pub fn iterations(run: &Run) -> Option<i64> {
+    training(&run.manifest).and_then(|t| t.iterations)
+}
+
+/// The training budget of one learner in one campaign: each recorded value with its run count.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BudgetUsed {
+    pub learner: String,
+    pub runs: usize,
+    /// Runs whose manifest has no `train` record.
+    pub unrecorded: usize,
+    pub iterations: BTreeMap<String, usize>,
+    pub hidden: BTreeMap<String, usize>,
+    pub batch: BTreeMap<String, usize>,
+    pub lr: BTreeMap<String, usize>,
+    pub warmup: BTreeMap<String, usize>,
+    /// Distinct trainings (training keys; a training is shared by the samplers of a cell).
+    pub trainings: usize,
+    /// Mean `fit_s` (data set + training) over distinct trainings, seconds.
+    pub mean_fit_s: Option<f64>,
+}
+
+/// The learners' budgets actually used by `store`'s runs, in the paper's learner order.
+pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
+    let mut by: BTreeMap<String, BudgetUsed> = BTreeMap::new();
+    let mut keys: BTreeMap<String, BTreeMap<String, Option<f64>>> = BTreeMap::new();
+    for r in &store.runs {
+        let Some(l) = learner(r) else { continue };
+        let b = by.entry(l.clone()).or_insert_with(|| BudgetUsed {
+            learner: l.clone(),
+            ..Default::default()
+        });
+        b.runs += 1;
+        let Some(t) = training(&r.manifest) else {
+            b.unrecorded += 1;
+            continue;
+        };
+        let count = |m: &mut BTreeMap<String, usize>, v: Option<String>| {
+            *m.entry(v.unwrap_or_else(|| "not recorded".into()))
+                .or_default() += 1;
+        };
+        count(&mut b.iterations, t.iterations.map(|v| v.to_string()));
+        count(
+            &mut b.hidden,
+            t.hidden.as_ref().map(|h| {
+                let s: Vec<String> = h.iter().map(i64::to_string).collect();
+                format!("[{}]", s.join(", "))
+            }),
+        );
+        count(&mut b.batch, t.batch.map(|v| v.to_string()));
+        count(&mut b.lr, t.lr.map(|v| format!("{v:e}")));
+        count(&mut b.warmup, t.warmup.map(|v| v.to_string()));
+        let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
+        keys.entry(l)
+            .or_default()
+            .insert(key, r.manifest.number(&["fit_s"]));
+    }
+    for (l, ks) in keys {
+        let b = by.get_mut(&l).expect("learner seen");
+        b.trainings = ks.len();
+        let fits: Vec<f64> = ks.values().flatten().copied().collect();
+        b.mean_fit_s = (!fits.is_empty()).then(|| fits.iter().sum::<f64>() / fits.len() as f64);
+    }
+    let mut out: Vec<BudgetUsed> = by.into_values().collect();
+    out.sort_by_key(|b| (rank(&b.learner, &LEARNERS), b.learner.clone()));
+    out
+}
+
+/// The faithful and corrected variants of one (env, algo, sampler, latents) cell.
+#[derive(Debug, Clone)]
+pub struct VariantPair<'a> {
+    pub env: String,
+    pub algo: String,
+    pub sampler: String,
+    pub latents: i64,
+    pub faithful: Option<&'a ConditionSummary>,
+    pub corrected: Option<&'a ConditionSummary>,
+    /// corrected − faithful per seed, for the seeds both have.
+    pub differences: Vec<(i64, f64)>,
+    /// Mean paired difference with its 90% bootstrap CI; `None` without a pair.
+    pub diff: Option<Summary>,
+}
+
+/// Every cell of [`VARIANT_ALGOS`] with a faithful or corrected condition, in the report's order.
+pub fn variant_pairs<'a>(
+    conditions: &'a [ConditionSummary],
+    bootstrap_seed: u64,
+    n_boot: usize,
+) -> Vec<VariantPair<'a>> {
+    type Cell = (String, String, String, i64);
+    let mut cells: BTreeMap<Cell, (Option<&ConditionSummary>, Option<&ConditionSummary>)> =
+        BTreeMap::new();
+    for c in conditions {
+        let k = &c.key;
+        if !VARIANT_ALGOS.contains(&k.algo.as_str()) {
+            continue;
+        }
+        let cell = (k.env.clone(), k.algo.clone(), k.sampler.clone(), k.latents);
+        let e = cells.entry(cell).or_default();
+        match k.variant.as_str() {
+            "faithful" => e.0 = Some(c),
+            "corrected" => e.1 = Some(c),
+            _ => {}
+        }
+    }
+    let mut out: Vec<VariantPair<'a>> = cells
+        .into_iter()
+        .filter(|(_, (f, c))| f.is_some() || c.is_some())
+        .map(|((env, algo, sampler, latents), (f, c))| {
+            let (differences, diff) = match (f, c) {
+                (Some(f), Some(c)) => {
+                    let label =
+                        format!("variants|{env}_{algo}_{sampler}_{latents}|corrected-faithful");
+                    let seed = stats::derive_seed(bootstrap_seed, &label);
+                    (
+                        stats::paired_differences(&f.final_by_seed, &c.final_by_seed),
+                        stats::paired_summary(&f.final_by_seed, &c.final_by_seed, n_boot, seed),
+                    )
+                }
+                _ => (Vec::new(), None),
+            };
+            VariantPair {
+                env,
+                algo,
+                sampler,
+                latents,
+                faithful: f,
+                corrected: c,
+                differences,
+                diff,
+            }
+        })
+        .collect();
+    out.sort_by_key(|p| {
+        (
+            crate::figures::panel_order(&p.env, p.latents),
+            rank(&p.algo, &VARIANT_ALGOS),
+            rank(&p.sampler, &["kde", "gaussian"]),
+            p.sampler.clone(),
+        )
+    });
+    out
+}
+
+/// The final KLC of one group of runs at one training budget.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BudgetPoint {
+    /// Training iterations (`train.config.iterations`).
+    pub iterations: i64,
+    /// Campaigns the runs came from, sorted.
+    pub campaigns: Vec<String>,
+    /// (seed, final KLC), in seed order.
+    pub values: Vec<(i64, f64)>,
+    pub summary: Summary,
+}
+
+/// A reference level from the main campaign (RGE-EFR, RPE on the same environment).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    pub algo: String,
+    pub summary: Summary,
+}
+
+/// Final KLC against training iterations for one condition of the budget campaigns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BudgetSeries {
+    pub key: ConditionKey,
+    /// The budget campaigns' points, by iterations.
+    pub points: Vec<BudgetPoint>,
+    /// The same condition in the main campaign, at its own budget(s).
+    pub main: Vec<BudgetPoint>,
+    /// RGE-EFR and RPE of the main campaign on the same environment (those present).
+    pub references: Vec<Reference>,
+}
+
+/// The budget-sensitivity analysis.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BudgetAnalysis {
+    pub series: Vec<BudgetSeries>,
+    /// Budget-campaign runs without `train.config.iterations`, left out.
+    pub unrecorded: Vec<String>,
+}
+
+fn point(
+    iterations: i64,
+    runs: &[&Run],
+    label: &str,
+    bootstrap_seed: u64,
+    n_boot: usize,
+) -> BudgetPoint {
+    let mut values: Vec<(i64, f64)> = runs.iter().map(|r| (r.seed, r.final_point().klc)).collect();
+    values.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let xs: Vec<f64> = values.iter().map(|v| v.1).collect();
+    let campaigns: BTreeSet<String> = runs.iter().map(|r| r.campaign.clone()).collect();
+    BudgetPoint {
+        iterations,
+        campaigns: campaigns.into_iter().collect(),
+        values,
+        summary: stats::summarize(
+            &xs,
+            n_boot,
+            stats::derive_seed(bootstrap_seed, &format!("budget|{label}|it={iterations}")),
+        ),
+    }
+}
+
+/// Groups the budget campaigns' runs by condition and training iterations; adds the main
+/// campaign's runs of the same condition and its RGE-EFR / RPE levels.
+pub fn budget_analysis(
+    budget: &[Campaign],
+    main: &Store,
+    main_conditions: &[ConditionSummary],
+    bootstrap_seed: u64,
+    n_boot: usize,
+) -> BudgetAnalysis {
+    let mut groups: BTreeMap<ConditionKey, BTreeMap<i64, Vec<&Run>>> = BTreeMap::new();
+    let mut unrecorded = Vec::new();
+    for c in budget {
+        for r in &c.store.runs {
+            match iterations(r) {
+                Some(it) => groups
+                    .entry(r.key.clone())
+                    .or_default()
+                    .entry(it)
+                    .or_default()
+                    .push(r),
+                None => unrecorded.push(format!("{}/{}", c.name, r.run_id)),
+            }
+        }
+    }
+    let mut series: Vec<BudgetSeries> = groups
+        .into_iter()
+        .map(|(key, by_it)| {
+            let slug = key.slug();
+            let points = by_it
+                .iter()
+                .map(|(&it, runs)| {
+                    point(it, runs, &format!("{slug}|budget"), bootstrap_seed, n_boot)
+                })
+                .collect();
+            let mut main_by_it: BTreeMap<i64, Vec<&Run>> = BTreeMap::new();
+            for r in main.runs.iter().filter(|r| r.key == key) {
+                if let Some(it) = iterations(r) {
+                    main_by_it.entry(it).or_default().push(r);
+                }
+            }
+            let main_points = main_by_it
+                .iter()
+                .map(|(&it, runs)| point(it, runs, &format!("{slug}|main"), bootstrap_seed, n_boot))
+                .collect();
+            let references = ["rge-efr", "rpe"]
+                .iter()
+                .filter_map(|algo| {
+                    main_conditions
+                        .iter()
+                        .find(|c| c.key.env == key.env && c.key.algo == *algo)
+                        .map(|c| Reference {
+                            algo: algo.to_string(),
+                            summary: c.final_klc.clone(),
+                        })
+                })
+                .collect();
+            BudgetSeries {
+                key,
+                points,
+                main: main_points,
+                references,
+            }
+        })
+        .collect();
+    series.sort_by_key(|s| s.key.order_key());
+    unrecorded.sort();
+    BudgetAnalysis { series, unrecorded }
+}
+
+/// The mean recorded training loss of one (env, learner, variant, latents) group.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LossCurve {
+    pub env: String,
+    pub learner: String,
+    /// The runs' variant (`none` for the AE).
+    pub variant: String,
+    pub latents: i64,
+    /// Distinct trainings averaged (runs sharing a training key count once).
+    pub trainings: usize,
+    /// (iteration, mean loss over the trainings that recorded it).
+    pub points: Vec<(i64, f64)>,
+}
+
+/// Mean training-loss curves of `store`'s neural runs, one training counted once.
+pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
+    type Group = (String, String, String, i64);
+    let mut groups: BTreeMap<Group, BTreeMap<String, Vec<(i64, f64)>>> = BTreeMap::new();
+    for r in &store.runs {
+        let (Some(l), Some(t)) = (learner(r), training(&r.manifest)) else {
+            continue;
+        };
+        if t.losses.is_empty() {
+            continue;
+        }
+        let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
+        groups
+            .entry((r.key.env.clone(), l, r.key.variant.clone(), r.key.latents))
+            .or_default()
+            .entry(key)
+            .or_insert(t.losses);
+    }
+    let mut out: Vec<LossCurve> = groups
+        .into_iter()
+        .map(|((env, learner, variant, latents), trainings)| {
+            let mut by_it: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
+            for losses in trainings.values() {
+                for &(i, v) in losses {
+                    by_it.entry(i).or_default().push(v);
+                }
+            }
+            LossCurve {
+                env,
+                learner,
+                variant,
+                latents,
+                trainings: trainings.len(),
+                points: by_it
+                    .into_iter()
+                    .map(|(i, vs)| (i, stats::mean(&vs)))
+                    .collect(),
+            }
+        })
+        .collect();
+    out.sort_by_key(|c| {
+        (
+            rank(&c.env, &["armball", "armarrow"]),
+            c.env.clone(),
+            rank(&c.learner, &LEARNERS),
+            c.learner.clone(),
+            std::cmp::Reverse(c.latents),
+            rank(&c.variant, &["none", "faithful", "corrected"]),
+            c.variant.clone(),
+        )
+    });
+    out
+}

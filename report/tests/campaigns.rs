@@ -1,0 +1,504 @@
+//! Campaigns and the neural sections, end to end on small synthetic stores written with polars:
+//! the main campaign against the `budget-*` ones and the unused ones, the missing-main-campaign
+//! error, the faithful-vs-corrected paired differences, the budget section's iterations (read from
+//! the manifests), and byte-identical renders.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::*;
+use ugl_report::{ReportError, ReportOptions, render_report};
+
+const EPOCHS: [i64; 6] = [0, 100, 200, 300, 400, 500];
+
+/// One synthetic run.
+#[derive(Debug, Clone)]
+struct Spec {
+    env: &'static str,
+    algo: &'static str,
+    sampler: &'static str,
+    latents: i64,
+    variant: &'static str,
+    seed: i64,
+    /// Final KLC = kmax − drop (falls linearly over the epochs).
+    drop: f64,
+    /// `train.config.iterations` (neural runs only).
+    iterations: Option<i64>,
+    /// What the curve file's `variant` column holds; `None`: the variant (ugl-bench wrote `none`).
+    curve_variant: Option<&'static str>,
+}
+
+fn spec(env: &'static str, algo: &'static str, seed: i64, drop: f64) -> Spec {
+    let (sampler, latents) = match algo {
+        "rpe" => ("none", 0),
+        "rge-efr" => ("uniform", 0),
+        _ => ("kde", 10),
+    };
+    Spec {
+        env,
+        algo,
+        sampler,
+        latents,
+        variant: "none",
+        seed,
+        drop,
+        iterations: None,
+        curve_variant: None,
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn neural(
+    env: &'static str,
+    algo: &'static str,
+    sampler: &'static str,
+    latents: i64,
+    variant: &'static str,
+    seed: i64,
+    drop: f64,
+    iterations: i64,
+) -> Spec {
+    Spec {
+        env,
+        algo,
+        sampler,
+        latents,
+        variant,
+        seed,
+        drop,
+        iterations: Some(iterations),
+        curve_variant: None,
+    }
+}
+
+fn kmax(env: &str) -> f64 {
+    if env == "armball" {
+        756f64.ln()
+    } else {
+        22680f64.ln()
+    }
+}
+
+/// The run id as ugl-bench spells it: `armball.rge-vae.faithful.kde.l10.s3`.
+fn run_id(s: &Spec) -> String {
+    let mut id = format!("{}.{}", s.env, s.algo);
+    if s.variant != "none" {
+        id.push_str(&format!(".{}", s.variant));
+    }
+    if s.latents != 0 {
+        id.push_str(&format!(".{}.l{}", s.sampler, s.latents));
+    }
+    format!("{id}.s{}", s.seed)
+}
+
+fn write_parquet(path: &Path, df: &mut DataFrame) {
+    let mut f = File::create(path).unwrap();
+    ParquetWriter::new(&mut f).finish(df).unwrap();
+}
+
+fn learner(algo: &str) -> Option<&str> {
+    algo.strip_prefix("rge-")
+        .filter(|l| ["ae", "vae", "rfvae"].contains(l))
+}
+
+fn write_run(dir: &Path, s: &Spec) {
+    std::fs::create_dir_all(dir).unwrap();
+    let id = run_id(s);
+    let n = EPOCHS.len();
+    let rge = s.algo != "rpe";
+    let n_outcomes: Vec<i64> = EPOCHS.iter().map(|&e| e + i64::from(rge)).collect();
+    let mut curve = df!(
+        "run_id" => vec![id.as_str(); n],
+        "env" => vec![s.env; n],
+        "algo" => vec![s.algo; n],
+        "sampler" => vec![s.sampler; n],
+        "latents" => vec![s.latents; n],
+        "variant" => vec![s.curve_variant.unwrap_or(s.variant); n],
+        "seed" => vec![s.seed; n],
+        "epoch" => EPOCHS.to_vec(),
+        "n_outcomes" => n_outcomes.clone(),
+        "klc" => EPOCHS.iter().map(|&e| kmax(s.env) - s.drop * e as f64 / 500.0).collect::<Vec<f64>>(),
+        "n_moved" => n_outcomes.iter().map(|o| o / 3).collect::<Vec<i64>>(),
+        "coverage" => EPOCHS.iter().map(|&e| e as f64 / 1000.0).collect::<Vec<f64>>(),
+    )
+    .unwrap();
+    write_parquet(&dir.join(format!("{id}.parquet")), &mut curve);
+
+    let epochs: Vec<i64> = if rge {
+        (0..=500).collect()
+    } else {
+        (1..=500).collect()
+    };
+    let m = epochs.len();
+    let x: Vec<f64> = (0..m)
+        .map(|i| ((i * 37) % 200) as f64 / 100.0 - 1.0)
+        .collect();
+    let y: Vec<f64> = (0..m)
+        .map(|i| ((i * 53 + s.seed as usize) % 140) as f64 / 100.0 - 0.7)
+        .collect();
+    let mut outcomes = df!(
+        "run_id" => vec![id.as_str(); m],
+        "index" => (0..m as i64).collect::<Vec<i64>>(),
+        "epoch" => epochs,
+        "x" => x,
+        "y" => y,
+        "angle" => (0..m).map(|i| (s.env == "armarrow").then_some((i % 20) as f64 / 10.0 - 1.0)).collect::<Vec<Option<f64>>>(),
+        "moved" => (0..m).map(|i| i % 3 == 2).collect::<Vec<bool>>(),
+    )
+    .unwrap();
+    write_parquet(&dir.join(format!("{id}.outcomes.parquet")), &mut outcomes);
+
+    let mut manifest = serde_json::json!({
+        "run_id": id, "env": s.env, "algo": s.algo, "sampler": s.sampler,
+        "latents": s.latents, "variant": s.variant, "seed": s.seed,
+        "campaign": dir.file_name().unwrap().to_string_lossy(),
+        "profile": "test", "git_revision": "abc1234", "toolchain": "rustc 1.95.0",
+        "threads": 1, "host": "testhost", "wall_s": 10.0, "reduced_budget": false,
+        "budget_note": "",
+    });
+    if let (Some(l), Some(it)) = (learner(s.algo), s.iterations) {
+        let m = manifest.as_object_mut().unwrap();
+        m.insert("learner".into(), l.into());
+        m.insert("reduced_budget".into(), true.into());
+        m.insert(
+            "budget_note".into(),
+            format!("{it} training iterations; hidden layers [512, 256]").into(),
+        );
+        m.insert("fit_s".into(), 60.0.into());
+        m.insert(
+            "train".into(),
+            serde_json::json!({
+                "config": {"iterations": it, "hidden": [512, 256], "batch": 100, "lr": 0.001,
+                           "variant": if s.variant == "corrected" { "corrected" } else { "faithful" },
+                           "log_every": 100, "warmup": 100},
+                "losses": [[0, 3400.0], [100, 600.0 + s.seed as f64], [200, 450.0], [300, 420.0]],
+                "cache": "miss",
+                // One training per (env, learner, latents, variant, seed): shared by the samplers.
+                "key": format!("{}-{l}-{}-{}-{}-{it}", s.env, s.latents, s.variant, s.seed),
+            }),
+        );
+    }
+    std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
+}
+
+fn paper_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper")
+}
+
+fn opts(results: &Path, out: &Path) -> ReportOptions {
+    let mut o = ReportOptions::new(results.to_path_buf(), out.to_path_buf());
+    o.paper_dir = paper_dir();
+    o.n_boot = 2_000;
+    o
+}
+
+/// The faithful final KLC drop of a VAE run, and the corrected one: exactly 0.25 lower KLC.
+fn vae_drop(seed: i64) -> f64 {
+    [1.5, 2.0, 1.75][seed as usize]
+}
+
+/// A main campaign `paper` with baselines, RGE-AE, and RGE-VAE / RGE-RFVAE in both variants with
+/// KDE and Gaussian goals on ArmBall (10 and 2 latents), 3 seeds; two budget campaigns and an
+/// unused one.
+fn neural_store(root: &Path) {
+    let main = root.join("paper");
+    for seed in 0..3 {
+        write_run(&main, &spec("armball", "rpe", seed, 0.2));
+        write_run(
+            &main,
+            &spec("armball", "rge-efr", seed, 1.5 + 0.1 * seed as f64),
+        );
+        write_run(
+            &main,
+            &neural("armball", "rge-ae", "kde", 10, "none", seed, 1.6, 2000),
+        );
+        for latents in [10, 2] {
+            for sampler in ["kde", "gaussian"] {
+                for algo in ["rge-vae", "rge-rfvae"] {
+                    let it = if algo == "rge-vae" { 1000 } else { 500 };
+                    let d = vae_drop(seed) + if sampler == "gaussian" { 0.1 } else { 0.0 };
+                    write_run(
+                        &main,
+                        &neural("armball", algo, sampler, latents, "faithful", seed, d, it),
+                    );
+                    write_run(
+                        &main,
+                        &neural(
+                            "armball",
+                            algo,
+                            sampler,
+                            latents,
+                            "corrected",
+                            seed,
+                            d + 0.25,
+                            it,
+                        ),
+                    );
+                }
+            }
+        }
+    }
+    // Budget campaigns: the directory name says 300 / 3000, the manifests 1234 / 4321.
+    for (dir, it, extra) in [
+        ("budget-vae-300", 1234, 0.0),
+        ("budget-vae-3000", 4321, 0.5),
+    ] {
+        for seed in 0..3 {
+            write_run(
+                &root.join(dir),
+                &neural(
+                    "armball",
+                    "rge-vae",
+                    "kde",
+                    10,
+                    "faithful",
+                    seed,
+                    vae_drop(seed) + extra,
+                    it,
+                ),
+            );
+        }
+    }
+    // An old campaign holding a run with the same id as one of the main campaign's.
+    write_run(&root.join("baselines"), &spec("armball", "rpe", 0, 0.9));
+}
+
+fn read(out: &Path) -> String {
+    std::fs::read_to_string(out.join("REPORT.md")).unwrap()
+}
+
+fn line<'a>(md: &'a str, starts: &str, contains: &str) -> &'a str {
+    md.lines()
+        .find(|l| l.starts_with(starts) && l.contains(contains))
+        .unwrap_or_else(|| panic!("no line starting `{starts}` containing `{contains}` in\n{md}"))
+}
+
+#[test]
+fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    neural_store(&results);
+    let out = tmp.path().join("out");
+    let s = render_report(&opts(&results, &out)).unwrap();
+    let n_main = 3 * (3 + 2 * 2 * 2 * 2);
+    assert_eq!(s.n_main_runs, n_main);
+    assert_eq!(s.n_runs, n_main + 6);
+    assert_eq!(s.budget_campaigns, ["budget-vae-300", "budget-vae-3000"]);
+    assert_eq!(s.unused_campaigns, ["baselines"]);
+    let fig = |n: &str| out.join("figures").join(n);
+    for name in [
+        "klc_armball.svg",
+        "fig4_vae_kde_vs_gaussian.svg",
+        "rfvae_kde_vs_gaussian.svg",
+        "variants.svg",
+        "budget_vae.svg",
+        "training_loss.svg",
+        "outcomes_armball_rge-vae_kde_10_faithful.svg",
+        "outcomes_armball_rge-vae_kde_10_corrected.svg",
+        "outcomes_armball_rge-vae_gaussian_2_corrected.svg",
+    ] {
+        assert!(fig(name).is_file(), "{name}");
+        assert!(s.files.contains(&fig(name)), "{name}");
+    }
+
+    let md = read(&out);
+    assert!(
+        md.contains(
+            "- **Campaigns:** main `paper` (57 runs: the paper's figures and table); \
+             training-budget sensitivity `budget-vae-300` (3 runs), `budget-vae-3000` (3 runs); \
+             present but not used: `baselines` (1 run)."
+        ),
+        "{md}"
+    );
+    // Display names with variants; 3 seeds on every row.
+    assert!(
+        md.contains("| RGE-VAE (corrected), Gaussian goals, 2 latents † | 3 |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| RGE-AE, KDE goals, 10 latents † | 3 |"),
+        "{md}"
+    );
+    // The main RPE is the main campaign's (drop 0.2), not the unused campaign's copy (drop 0.9).
+    let rpe = line(&md, "| RPE", "± 0.000");
+    assert!(
+        rpe.contains(&format!("{:.3}", kmax("armball") - 0.2)),
+        "{rpe}"
+    );
+
+    // Faithful vs corrected: the corrected runs cover exactly 0.25 better on every seed.
+    let row = line(&md, "| ArmBall, 10 latents | RGE-VAE | KDE |", "");
+    assert!(
+        row.contains("| -0.250 | [-0.250, -0.250] | 3 (0–2) |"),
+        "{row}"
+    );
+    let row = line(&md, "| ArmBall, 2 latents | RGE-RFVAE | Gaussian |", "");
+    assert!(
+        row.contains("| -0.250 | [-0.250, -0.250] | 3 (0–2) |"),
+        "{row}"
+    );
+    assert!(md.contains("*Faithful* reproduces the original code's behaviour, defects included"));
+
+    // Figure 4 table: ArmBall 10 latents, the paper's 4.25 / 3.84.
+    let f4 = line(&md, "| ArmBall, 10 latents |", "4.25 / 3.84");
+    let mean = kmax("armball") - (1.5 + 2.0 + 1.75) / 3.0;
+    assert!(f4.contains(&format!("| {mean:.3} ± 0.250 (n=3) |")), "{f4}");
+
+    // Budgets from the manifests, not the directory names.
+    assert!(md.contains("| 1234 | `budget-vae-300` | 3 (0–2) |"), "{md}");
+    assert!(
+        md.contains("| 4321 | `budget-vae-3000` | 3 (0–2) |"),
+        "{md}"
+    );
+    assert!(md.contains("| 1000 | `paper` (main) | 3 (0–2) |"), "{md}");
+    assert!(!md.contains("| 300 |") && !md.contains("| 3000 |"));
+    assert!(
+        md.contains("Reference levels on ArmBall (main campaign, mean final KL-coverage): RGE-EFR")
+    );
+
+    // Training budgets table and the deviation line.
+    assert!(
+        md.contains("| VAE | ours | 1000 | [512, 256] | 100 | 1e-3 | — | 24 (12) | 60.0 s |"),
+        "{md}"
+    );
+    assert!(
+        md.contains(
+            "| | paper | 100000 | [1200, 1200] | 100 | 1e-3 (Adam) | — | 1 per condition | |"
+        ),
+        "{md}"
+    );
+    assert!(
+        md.contains("| RFVAE | ours | 500 | [512, 256] | 100 | 1e-3 | 100 | 24 (12) |"),
+        "{md}"
+    );
+    assert!(md.contains("**Neural training budgets differ from the paper's**"));
+    assert!(
+        md.contains("VAE 1000 (1.0%) of the paper's 100000 iterations"),
+        "{md}"
+    );
+    assert!(md.contains("(figures/training_loss.svg)"));
+}
+
+#[test]
+fn rendering_the_neural_store_twice_gives_identical_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    neural_store(&results);
+    let read_all = |dir: &Path| {
+        let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("figures"))
+            .unwrap()
+            .map(|e| {
+                let p = e.unwrap().path();
+                (p.display().to_string(), std::fs::read(&p).unwrap())
+            })
+            .map(|(p, b)| (p.rsplit('/').next().unwrap().to_string(), b))
+            .collect();
+        v.push((
+            "REPORT.md".into(),
+            std::fs::read(dir.join("REPORT.md")).unwrap(),
+        ));
+        v.sort();
+        v
+    };
+    let (o1, o2) = (tmp.path().join("o1"), tmp.path().join("o2"));
+    let s1 = render_report(&opts(&results, &o1)).unwrap();
+    render_report(&opts(&results, &o2)).unwrap();
+    let a = read_all(&o1);
+    assert_eq!(a.len(), s1.files.len());
+    assert_eq!(a, read_all(&o2));
+    if let Some(keep) = std::env::var_os("UGL_REPORT_TEST_KEEP") {
+        // UGL_REPORT_TEST_KEEP=/tmp/neural cargo test -p ugl-report --test campaigns
+        render_report(&opts(&results, Path::new(&keep))).unwrap();
+    }
+}
+
+#[test]
+fn a_missing_main_campaign_is_an_error_listing_the_campaigns_found() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    write_run(
+        &results.join("budget-vae-300"),
+        &spec("armball", "rpe", 0, 0.2),
+    );
+    write_run(&results.join("baselines"), &spec("armball", "rpe", 0, 0.2));
+    write_run(&results, &spec("armball", "rge-efr", 0, 1.0));
+    std::fs::create_dir_all(results.join("models")).unwrap(); // no run files: not a campaign
+    let err = render_report(&opts(&results, &tmp.path().join("out"))).unwrap_err();
+    match &err {
+        ReportError::MissingMainCampaign { main, found, .. } => {
+            assert_eq!(main, "paper");
+            assert_eq!(found, &["(top level)", "baselines", "budget-vae-300"]);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    let msg = err.to_string();
+    assert!(
+        msg.contains("main campaign `paper` not found")
+            && msg.contains("campaigns found: (top level), baselines, budget-vae-300"),
+        "{msg}"
+    );
+    // Another main campaign works, and the top level can be one.
+    let mut o = opts(&results, &tmp.path().join("out"));
+    o.main_campaign = "baselines".into();
+    let s = render_report(&o).unwrap();
+    assert_eq!(s.unused_campaigns, [""]);
+    assert_eq!(s.budget_campaigns, ["budget-vae-300"]);
+    o.main_campaign = String::new();
+    assert_eq!(render_report(&o).unwrap().n_main_runs, 1);
+}
+
+#[test]
+fn the_variant_comes_from_the_manifest_when_the_curve_file_says_none() {
+    // ugl-bench's curve files wrote `variant = none` for every run: the faithful and corrected
+    // runs must still be two conditions of 2 seeds each, not one of 4 runs with repeated seeds.
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let main = results.join("paper");
+    for seed in 0..2 {
+        write_run(&main, &spec("armball", "rge-efr", seed, 1.5));
+        for (variant, d) in [("faithful", 1.0), ("corrected", 1.5)] {
+            let mut s = neural("armball", "rge-vae", "kde", 10, variant, seed, d, 1000);
+            s.curve_variant = Some("none");
+            write_run(&main, &s);
+        }
+    }
+    let out = tmp.path().join("out");
+    render_report(&opts(&results, &out)).unwrap();
+    let md = read(&out);
+    assert!(
+        md.contains("| RGE-VAE (faithful), KDE goals, 10 latents † | 2 |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| RGE-VAE (corrected), KDE goals, 10 latents † | 2 |"),
+        "{md}"
+    );
+    let row = line(&md, "| ArmBall, 10 latents | RGE-VAE | KDE |", "");
+    assert!(
+        row.contains("| -0.500 | [-0.500, -0.500] | 2 (0, 1) |"),
+        "{row}"
+    );
+    // No budget campaign and no Gaussian goals: said so, no figure.
+    assert!(md.contains("No `budget-*` campaign in the store"));
+    assert!(
+        md.contains("No RGE-VAE run with Gaussian goals in the main campaign `paper`: no figure.")
+    );
+    assert!(!out.join("figures/budget_vae.svg").exists());
+    assert!(!out.join("figures/fig4_vae_kde_vs_gaussian.svg").exists());
+}
+
+#[test]
+fn stale_neural_figures_are_removed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    neural_store(&results);
+    let out = tmp.path().join("out");
+    render_report(&opts(&results, &out)).unwrap();
+    assert!(out.join("figures/budget_vae.svg").is_file());
+    for dir in ["budget-vae-300", "budget-vae-3000"] {
+        std::fs::remove_dir_all(results.join(dir)).unwrap();
+    }
+    render_report(&opts(&results, &out)).unwrap();
+    assert!(!out.join("figures/budget_vae.svg").exists());
+    assert!(out.join("figures/variants.svg").is_file());
+}
