@@ -26,13 +26,14 @@ check-toolchain:
 	if [ "$$(printf '%s\n%s\n' "$(MIN_RUST)" "$$v" | sort -V | head -1)" != "$(MIN_RUST)" ]; then \
 	  echo "error: rustc $$v is too old; ugl-bench needs Rust $(MIN_RUST) or newer (rustup update)" >&2; exit 1; fi
 
-# The report renders from the committed results; if there are none yet, the baselines campaign
-# (about 10 s on 2 cores) is run first.
+# The report renders from the committed results of the MAIN campaign (default: paper) plus the
+# budget-* campaigns. Without results, run `make campaign PROFILE=paper` first (about 2 h on 2
+# cores; `make report MAIN=quick` after `make campaign PROFILE=quick` for a 15-minute look).
+MAIN ?= paper
 report: check-toolchain
-	@if ! ls $(RESULTS)/*/*.json >/dev/null 2>&1; then \
-	  echo "no results in $(RESULTS): running the baselines campaign first"; \
-	  $(UGL) campaign --config data/campaigns/baselines.toml --out $(RESULTS)/baselines $(if $(JOBS),--jobs $(JOBS)); fi
-	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT)
+	@if ! ls $(RESULTS)/$(MAIN)/*.json >/dev/null 2>&1; then \
+	  echo "error: no results in $(RESULTS)/$(MAIN): run 'make campaign PROFILE=$(MAIN)' first" >&2; exit 2; fi
+	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT) --main $(MAIN)
 	@echo "report: $(REPORT_OUT)/REPORT.md"
 
 test: check-toolchain

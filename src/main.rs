@@ -178,6 +178,10 @@ enum Command {
         /// The paper's reference values.
         #[arg(long, default_value = "data/paper")]
         paper: PathBuf,
+        /// The campaign (sub-directory of --results) the figures and tables are drawn from;
+        /// `budget-*` campaigns feed the training-budget section.
+        #[arg(long = "main", default_value = "paper")]
+        main_campaign: String,
     },
 }
 
@@ -367,9 +371,11 @@ fn dispatch(cmd: Command) -> Result<()> {
             results,
             out,
             paper,
+            main_campaign,
         } => {
             let mut opts = ugl_report::ReportOptions::new(results, out);
             opts.paper_dir = paper;
+            opts.main_campaign = main_campaign;
             let s = ugl_report::render_report(&opts)?;
             eprintln!(
                 "report: {} runs -> {} files in {}",
