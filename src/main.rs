@@ -239,8 +239,7 @@ impl CacheArgs {
 
 /// Progress bars for neural trainings, one per representation, above `main` (if any).
 fn training_bars(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<TrainSink> {
-    let bars: std::sync::Mutex<std::collections::HashMap<String, ProgressBar>> =
-        Default::default();
+    let bars: std::sync::Mutex<std::collections::HashMap<String, ProgressBar>> = Default::default();
     let mp = mp.clone();
     let main = main.cloned();
     Arc::new(move |label: &str, p| {
@@ -529,8 +528,7 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
             a.algo
         );
     }
-    if a.sampler == SamplerKind::Gaussian && !a.algo.learner().is_some_and(|l| l.may_have_prior())
-    {
+    if a.sampler == SamplerKind::Gaussian && !a.algo.learner().is_some_and(|l| l.may_have_prior()) {
         bail!(
             "--sampler gaussian needs a goal-space prior: rge-vae, rge-rfvae or rge-external, not {} (use kde)",
             a.algo
@@ -600,7 +598,9 @@ fn compare(a: CompareArgs) -> Result<()> {
             .chars()
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
     {
-        bail!("--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'");
+        bail!(
+            "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
+        );
     }
     let registered: Vec<Learner> = Learner::ALL
         .into_iter()
@@ -645,7 +645,15 @@ fn compare(a: CompareArgs) -> Result<()> {
     let out = a
         .out
         .unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
-    run_config(&cfg, &cfg.campaign.name.clone(), Some(out), a.jobs, a.quiet, None, &a.cache)
+    run_config(
+        &cfg,
+        &cfg.campaign.name.clone(),
+        Some(out),
+        a.jobs,
+        a.quiet,
+        None,
+        &a.cache,
+    )
 }
 
 fn run_config(

@@ -687,10 +687,7 @@ fn neural_run_errors() {
         &args(&["--algo", "rge-ae", "--variant", "faithful"]),
         "--variant",
     );
-    assert_one_line_error(
-        &args(&["--algo", "rge-vae", "--variant", "fixed"]),
-        "fixed",
-    );
+    assert_one_line_error(&args(&["--algo", "rge-vae", "--variant", "fixed"]), "fixed");
     assert_one_line_error(
         &args(&["--algo", "rge-isomap", "--sampler", "gaussian"]),
         "prior",

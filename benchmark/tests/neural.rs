@@ -469,13 +469,15 @@ fn configuration_serde() {
         assert_eq!((p.batch, p.lr, p.variant), (100, 1e-3, Variant::Faithful));
         let text = toml::to_string(&p).unwrap();
         assert_eq!(toml::from_str::<NeuralConfig>(&text).unwrap(), p);
-        assert_eq!(NeuralSection::default().resolve(model, Variant::Faithful), p);
+        assert_eq!(
+            NeuralSection::default().resolve(model, Variant::Faithful),
+            p
+        );
     }
     assert_eq!(NeuralConfig::paper(Model::Ae).iterations, 200_000);
     assert_eq!(NeuralConfig::paper(Model::Vae).iterations, 100_000);
     assert_eq!(NeuralConfig::paper(Model::Rfvae).iterations, 50_000);
-    let s: NeuralSection =
-        toml::from_str("iterations = 500\nhidden = [512, 256]").unwrap();
+    let s: NeuralSection = toml::from_str("iterations = 500\nhidden = [512, 256]").unwrap();
     let c = s.resolve(Model::Rfvae, Variant::Corrected);
     assert_eq!(
         (c.iterations, c.variant, c.hidden, c.batch),

@@ -171,10 +171,8 @@ impl LearnersConfig {
             Learner::External => serde_json::to_value(&self.external).expect("serialisable"),
             Learner::Ae | Learner::Vae | Learner::Rfvae => {
                 let model = learner.model().expect("neural");
-                serde_json::to_value(
-                    self.neural_config(model, variant.unwrap_or_default()),
-                )
-                .expect("serialisable")
+                serde_json::to_value(self.neural_config(model, variant.unwrap_or_default()))
+                    .expect("serialisable")
             }
         };
         serde_json::json!({ learner.name(): v })
@@ -303,7 +301,9 @@ impl CampaignConfig {
             return Err("matrix.latents must list at least one latent size".into());
         }
         if self.matrix.variants.is_empty() {
-            return Err("matrix.variants must list at least one variant (faithful, corrected)".into());
+            return Err(
+                "matrix.variants must list at least one variant (faithful, corrected)".into(),
+            );
         }
         for model in Model::ALL {
             if model != Model::Rfvae && self.learners.neural(model).warmup.is_some() {

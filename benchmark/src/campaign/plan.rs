@@ -50,10 +50,7 @@ impl RunSpec {
         variant: Variant,
         seed: u64,
     ) -> Self {
-        let variant = algo
-            .learner()
-            .filter(|l| l.has_variants())
-            .map(|_| variant);
+        let variant = algo.learner().filter(|l| l.has_variants()).map(|_| variant);
         RunSpec {
             env,
             algo,
@@ -111,10 +108,11 @@ impl RunSpec {
     /// the same env, learner, variant, latent size, data-set size and repetition); None for
     /// baselines. It groups runs, shards and names the model cache entry.
     pub fn representation_identity(&self, images: usize) -> Option<String> {
-        self.learner_seed_identity(images).map(|id| match self.variant {
-            Some(v) => format!("{id}/variant={v}"),
-            None => id,
-        })
+        self.learner_seed_identity(images)
+            .map(|id| match self.variant {
+                Some(v) => format!("{id}/variant={v}"),
+                None => id,
+            })
     }
 
     /// The identity the learner's random stream derives from: the representation identity
@@ -163,9 +161,7 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
                             LatentSize::TrueDim => env.state_dim(),
                         };
                         for seed in 0..cfg.campaign.reps as u64 {
-                            runs.push(RunSpec::learned(
-                                env, algo, sampler, latents, variant, seed,
-                            ));
+                            runs.push(RunSpec::learned(env, algo, sampler, latents, variant, seed));
                         }
                     }
                 }
@@ -269,10 +265,7 @@ mod tests {
             variant: Some(Variant::Faithful),
             ..v.clone()
         };
-        assert_ne!(
-            v.representation_identity(10),
-            f.representation_identity(10)
-        );
+        assert_ne!(v.representation_identity(10), f.representation_identity(10));
         assert_eq!(
             v.learner_seed_identity(10),
             f.learner_seed_identity(10),

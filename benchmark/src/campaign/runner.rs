@@ -1,9 +1,9 @@
 //! Executes runs: environment + explorer, then the results store.
 
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use serde::Serialize;
@@ -227,9 +227,8 @@ fn fit_neural(
                 let label = representation_label(spec);
                 l = l.with_progress(Arc::new(move |p| sink(&label, p)));
             }
-            let mut train = || {
-                neural::train(model, &l.config, images, spec.latents, rng, l.progress())
-            };
+            let mut train =
+                || neural::train(model, &l.config, images, spec.latents, rng, l.progress());
             let enc = if ctx.train_threads > 0 {
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(ctx.train_threads)
@@ -464,11 +463,7 @@ pub fn execute(
         algo: spec.algo.name().into(),
         sampler: spec.sampler.name().into(),
         latents: spec.latents,
-        variant: spec
-            .variant
-            .map(|v| v.name())
-            .unwrap_or("none")
-            .into(),
+        variant: spec.variant.map(|v| v.name()).unwrap_or("none").into(),
         learner: learner_name,
         seed: spec.seed,
         run_seed: run_seed(ctx.campaign_seed, &spec.identity()),

@@ -232,7 +232,13 @@ mod tests {
             ..NeuralConfig::paper(model)
         };
         let net = init_net(model, &cfg, 12, 3, &mut stream_named(1, "cache-test"));
-        NeuralEncoder::new(model, Variant::Corrected, net, vec![(0, 1.5), (9, 0.25)], [7; 32])
+        NeuralEncoder::new(
+            model,
+            Variant::Corrected,
+            net,
+            vec![(0, 1.5), (9, 0.25)],
+            [7; 32],
+        )
     }
 
     #[test]
@@ -245,7 +251,11 @@ mod tests {
             assert_eq!(back.losses, enc.losses);
             assert_eq!(back.encode_seed, enc.encode_seed);
             assert_eq!((back.model, back.variant), (enc.model, enc.variant));
-            assert!(from_bytes("k2", &bytes).unwrap_err().contains("key mismatch"));
+            assert!(
+                from_bytes("k2", &bytes)
+                    .unwrap_err()
+                    .contains("key mismatch")
+            );
             for cut in [0, 5, 40, bytes.len() / 2, bytes.len() - 1] {
                 assert!(from_bytes("k1", &bytes[..cut]).is_err(), "cut at {cut}");
             }
