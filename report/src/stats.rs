@@ -5,9 +5,18 @@
 //!
 //! KL-coverage can be `+inf`. A mean over values that include `+inf` is `+inf` (and says so through
 //! [`Summary::n_inf`]); it is never turned into NaN. The standard deviation is `None` then.
+//!
+//! The rliable statistics (interquartile mean, stratified bootstrap, probability of improvement,
+//! area under a curve) live in [`rliable`] and are re-exported here.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+pub mod rliable;
+pub use rliable::{
+    AucError, area_under_curve, iqm, probability_of_improvement, probability_of_improvement_ci,
+    stratified_bootstrap_ci,
+};
 
 /// Summary of one sample (one value per run).
 #[derive(Debug, Clone, PartialEq)]
