@@ -49,11 +49,8 @@ bench: check-toolchain
 # (`tests/verify_smoke.rs`, also part of `make test`, so CI builds the binary once). A change that
 # alters results shows up here, and in review as a change of data/checksums/smoke.sha256
 # (`make verify-update`).
-VERIFY_DIR ?= target/verify-smoke
 verify: check-toolchain
 	$(CARGO) test --test verify_smoke
 
 verify-update: check-toolchain
-	rm -rf $(VERIFY_DIR)
-	$(UGL) campaign --config data/campaigns/smoke.toml --out $(VERIFY_DIR) --quiet
-	mkdir -p data/checksums && cd $(VERIFY_DIR) && sha256sum *.parquet > $(CURDIR)/data/checksums/smoke.sha256
+	UGL_VERIFY_UPDATE=1 $(CARGO) test --test verify_smoke -- --nocapture
