@@ -10,6 +10,10 @@
 //!   scatters (Figure 3), Figure 4 (RGE-VAE with KDE vs Gaussian goals), the faithful-vs-corrected
 //!   comparison and the final table against the paper's values.
 //! - Campaigns named `budget-*` feed the training-budget sensitivity section.
+//! - Campaigns named `compare-*` (written by `ugl compare --learner NAME`) hold a new learner run
+//!   on the main campaign's cells and seeds: the leaderboard ranks it against the paper's
+//!   algorithms and the KL-coverage figures draw it. Their runs of the external learner are
+//!   labelled `rge-<NAME>` (the learner's name from the manifest), not `rge-external`.
 //! - Any other campaign is listed as present but not used (its runs are not even read).
 
 use std::path::{Path, PathBuf};
@@ -19,6 +23,9 @@ use crate::load::{Store, campaign_display, scan_store};
 
 /// The prefix of the training-budget campaigns.
 pub const BUDGET_PREFIX: &str = "budget-";
+
+/// The prefix of the campaigns `ugl compare` writes.
+pub const COMPARE_PREFIX: &str = "compare-";
 
 /// A campaign that was read.
 #[derive(Debug, Clone)]
@@ -45,17 +52,20 @@ pub struct Campaigns {
     /// `budget-*` campaigns, sorted by name with numbers in numeric order (`budget-vae-300`
     /// before `budget-vae-1000`).
     pub budget: Vec<Campaign>,
+    /// `compare-*` campaigns, sorted by name, external learners relabelled `rge-<name>`.
+    pub compare: Vec<Campaign>,
     /// Everything else, sorted by name.
     pub unused: Vec<Unused>,
 }
 
 impl Campaigns {
-    /// Runs the report uses (main and budget campaigns).
+    /// Runs the report uses (main, budget and compare campaigns).
     pub fn n_used_runs(&self) -> usize {
         self.main.store.runs.len()
             + self
                 .budget
                 .iter()
+                .chain(&self.compare)
                 .map(|c| c.store.runs.len())
                 .sum::<usize>()
     }
@@ -83,6 +93,24 @@ pub fn natural_key(name: &str) -> Vec<(String, u128)> {
     }
     out.push((text, 0));
     out
+}
+
+/// Whether a campaign holds a new learner to rank (`ugl compare`).
+pub fn is_compare_campaign(name: &str) -> bool {
+    name.starts_with(COMPARE_PREFIX)
+}
+
+/// Gives the runs of the external learner their learner's name: `rge-external` becomes
+/// `rge-<learner>` (the manifest's `learner`), so that two compared programs stay apart.
+pub fn relabel_external(store: &mut Store) {
+    for run in &mut store.runs {
+        if run.key.algo == "rge-external"
+            && let Some(name) = run.manifest.get(&["learner"]).and_then(|v| v.as_str())
+            && !name.is_empty()
+        {
+            run.key.algo = format!("rge-{name}");
+        }
+    }
 }
 
 /// Whether a campaign feeds the budget-sensitivity section.
@@ -120,6 +148,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
         store,
     };
     let mut budget = Vec::new();
+    let mut compare = Vec::new();
     let mut unused = Vec::new();
     for d in &dirs {
         if d.name == main {
@@ -130,6 +159,14 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
                 name: d.name.clone(),
                 path: d.path.clone(),
                 store: d.load()?,
+            });
+        } else if is_compare_campaign(&d.name) {
+            let mut store = d.load()?;
+            relabel_external(&mut store);
+            compare.push(Campaign {
+                name: d.name.clone(),
+                path: d.path.clone(),
+                store,
             });
         } else {
             unused.push(Unused {
@@ -143,6 +180,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
     Ok(Campaigns {
         main: main_campaign,
         budget,
+        compare,
         unused,
     })
 }

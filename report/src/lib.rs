@@ -8,8 +8,10 @@
 
 pub mod aggregate;
 pub mod campaigns;
+pub mod claims;
 pub mod error;
 pub mod figures;
+pub mod leaderboard;
 pub mod load;
 pub mod markdown;
 pub mod neural;
@@ -27,7 +29,8 @@ pub struct ReportOptions {
     /// campaign `""`).
     pub results: PathBuf,
     /// The campaign that reproduces the paper (curves, scatters, Figure 4, variants, the table
-    /// against the paper). Campaigns named `budget-*` feed the training-budget section; others
+    /// against the paper). Campaigns named `budget-*` feed the training-budget section,
+    /// `compare-*` ones the leaderboard and the KL-coverage figures; others
     /// are listed as unused. `""` selects the runs at the store's top level.
     pub main_campaign: String,
     /// Where `REPORT.md` and `figures/*.svg` are written (created if missing).
@@ -61,7 +64,7 @@ impl ReportOptions {
 /// What `render_report` did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReportSummary {
-    /// Complete runs the report used (main and budget campaigns).
+    /// Complete runs the report used (main, budget and compare campaigns).
     pub n_runs: usize,
     /// Complete runs of the main campaign.
     pub n_main_runs: usize,
@@ -92,10 +95,67 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     );
     let losses = neural::loss_curves(store);
 
+    let claims_path = opts.paper_dir.join(claims::FILE);
+    let claims_file = if claims_path.exists() {
+        Some(claims::load_claims(&claims_path)?)
+    } else {
+        None
+    };
+    let claim_results = claims_file
+        .as_ref()
+        .map(|f| claims::evaluate(f, &conditions, store, opts.bootstrap_seed))
+        .unwrap_or_default();
+    let claims_input = match &claims_file {
+        Some(f) => markdown::claims::ClaimsInput::Evaluated {
+            path: &claims_path,
+            confidence: f.settings.confidence,
+            n_boot: f.settings.n_boot,
+            margin: f.settings.margin,
+            results: &claim_results,
+        },
+        None => markdown::claims::ClaimsInput::Missing(&claims_path),
+    };
+
+    // New learners (`compare-*` campaigns): aggregated like the main campaign, ranked with it in
+    // the leaderboard and drawn with it in the KL-coverage figures.
+    let compare_conditions: Vec<Vec<aggregate::ConditionSummary>> = camps
+        .compare
+        .iter()
+        .map(|c| aggregate::aggregate(&c.store, &paper, opts.bootstrap_seed, opts.n_boot))
+        .collect();
+    let mut sources = vec![leaderboard::Source {
+        campaign: &camps.main.name,
+        store,
+        conditions: &conditions,
+    }];
+    for (c, conds) in camps.compare.iter().zip(&compare_conditions) {
+        sources.push(leaderboard::Source {
+            campaign: &c.name,
+            store: &c.store,
+            conditions: conds,
+        });
+    }
+    let board = leaderboard::build(
+        &sources,
+        LEADERBOARD_CONFIDENCE,
+        opts.n_boot,
+        opts.bootstrap_seed,
+    );
+    let mut curve_conditions = conditions.clone();
+    for conds in &compare_conditions {
+        curve_conditions.extend(
+            conds
+                .iter()
+                .filter(|c| !conditions.iter().any(|m| m.key == c.key))
+                .cloned(),
+        );
+    }
+    curve_conditions.sort_by_key(|c| c.key.order_key());
+
     let fig_dir = opts.out.join("figures");
     create_dir(&fig_dir)?;
 
-    let klc_figs = figures::klc_curves::draw_all(&conditions, &fig_dir)?;
+    let klc_figs = figures::klc_curves::draw_all(&curve_conditions, &fig_dir)?;
     let outcome_figs = figures::outcomes::draw_all(store, &conditions, &fig_dir)?;
     let mut sampler_figs = Vec::new();
     for (algo, name) in SAMPLER_FIGURES {
@@ -132,6 +192,8 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         budget: &budget,
         budget_figures: &budget_figs,
         loss_figure: loss_fig.as_ref(),
+        claims: &claims_input,
+        leaderboard: &board,
     });
     let report_path = opts.out.join("REPORT.md");
     write_file(&report_path, md.as_bytes())?;
@@ -147,6 +209,9 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         files,
     })
 }
+
+/// Level of the leaderboard's stratified bootstrap intervals (rliable's default).
+pub const LEADERBOARD_CONFIDENCE: f64 = 0.95;
 
 /// The KDE-vs-Gaussian figures: the paper's Figure 4 (RGE-VAE), and the same for RGE-RFVAE,
 /// which the paper did not plot (drawn when its Gaussian-goal runs exist).

@@ -14,8 +14,8 @@ use rand_chacha::ChaCha8Rng;
 
 pub mod rliable;
 pub use rliable::{
-    AucError, area_under_curve, iqm, probability_of_improvement, probability_of_improvement_ci,
-    stratified_bootstrap_ci,
+    AucError, area_under_curve, difference_of_means_ci, iqm, probability_of_improvement,
+    probability_of_improvement_ci, stratified_bootstrap_ci,
 };
 
 /// Summary of one sample (one value per run).

@@ -502,3 +502,73 @@ fn stale_neural_figures_are_removed() {
     assert!(!out.join("figures/budget_vae.svg").exists());
     assert!(out.join("figures/variants.svg").is_file());
 }
+
+/// A `compare-*` campaign (what `ugl compare --learner NAME --command ...` writes): its
+/// `rge-external` runs are ranked in the leaderboard under the learner's name and drawn in the
+/// KL-coverage figure; the main campaign's claims are evaluated and counted at the top.
+#[test]
+fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    neural_store(&results);
+    let cmp = results.join("compare-random-projection");
+    for (seed, latents) in (0..3).flat_map(|s| [(s, 10), (s, 2)]) {
+        let mut s = spec("armball", "rge-external", seed, 2.5);
+        s.latents = latents;
+        write_run(&cmp, &s);
+        // The learner's name, as the runner records it for an external program.
+        let id = run_id(&s);
+        let path = cmp.join(format!("{id}.json"));
+        let mut m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        m["learner"] = "random-projection".into();
+        std::fs::write(&path, m.to_string()).unwrap();
+    }
+    let out = tmp.path().join("out");
+    let s = render_report(&opts(&results, &out)).unwrap();
+    assert_eq!(s.unused_campaigns, ["baselines"]);
+    let md = read(&out);
+    // The largest drop of the store: ranked first, marked new, with its campaign.
+    let row = line(&md, "| 1 |", "RGE-RANDOM-PROJECTION");
+    assert!(
+        row.contains("(new)") && row.contains("compare-random-projection"),
+        "{row}"
+    );
+    assert!(md.contains("1 `compare-*` campaign in the store"));
+    let svg = std::fs::read_to_string(out.join("figures/klc_armball.svg")).unwrap();
+    assert!(
+        svg.contains("RGE-RANDOM-PROJECTION"),
+        "the new learner is not in the figure"
+    );
+    // Claims: the committed claims file is evaluated, and the verdicts are counted.
+    assert!(md.contains("## The paper's claims"));
+    let summary = line(&md, "**The paper's claims**", "of 15 claims");
+    assert!(summary.contains("reproduced"), "{summary}");
+    assert!(md.contains("| `rfvae-worse` |"));
+}
+
+#[test]
+fn a_malformed_claims_file_is_an_error_naming_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    write_run(&results.join("paper"), &spec("armball", "rpe", 0, 0.2));
+    let paper = tmp.path().join("paper");
+    std::fs::create_dir_all(&paper).unwrap();
+    std::fs::write(
+        paper.join("claims.toml"),
+        "[settings]\nconfidence = 2.0\nn_boot = 10\nmargin = 0.2\n",
+    )
+    .unwrap();
+    let mut o = opts(&results, &tmp.path().join("out"));
+    o.paper_dir = paper.clone();
+    let msg = render_report(&o).unwrap_err().to_string();
+    assert!(
+        msg.contains("claims.toml") && msg.contains("settings.confidence"),
+        "{msg}"
+    );
+    // No claims file at all: the report says so and renders.
+    std::fs::remove_file(paper.join("claims.toml")).unwrap();
+    render_report(&o).unwrap();
+    let md = read(&tmp.path().join("out"));
+    assert!(md.contains("No claims file at"), "{md}");
+}

@@ -14,6 +14,7 @@ use crate::load::{Store, campaign_display};
 use crate::neural::{BudgetAnalysis, VariantPair};
 use crate::paper::PaperTable;
 
+pub mod claims;
 pub mod neural;
 
 /// Everything the markdown is made of.
@@ -34,6 +35,10 @@ pub struct Inputs<'a> {
     pub budget: &'a BudgetAnalysis,
     pub budget_figures: &'a [FigureFile],
     pub loss_figure: Option<&'a FigureFile>,
+    /// The paper's claims, evaluated on the main campaign.
+    pub claims: &'a claims::ClaimsInput<'a>,
+    /// Main and `compare-*` campaigns, ranked.
+    pub leaderboard: &'a crate::leaderboard::Leaderboard,
 }
 
 /// The text of the epoch-label note (PAPER-NOTES section 4).
@@ -166,6 +171,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         }
         let _ = writeln!(w);
     }
+    claims::summary_line(w, inp);
     if inp.paper.path.is_none() {
         let _ = writeln!(
             w,
@@ -400,6 +406,8 @@ pub fn render(inp: &Inputs<'_>) -> String {
         let _ = writeln!(w);
     }
 
+    claims::claims(w, inp);
+    claims::leaderboard(w, inp);
     neural::figure4(w, inp);
     neural::variants(w, inp);
     neural::budget(w, inp);

@@ -1,0 +1,704 @@
+//! The paper's claims (`data/paper/claims.toml`) as testable statements, evaluated on the
+//! main campaign's results with the bootstrap of [`crate::stats`].
+//!
+//! A claim compares *subject* conditions with *reference* conditions, paired on some fields (the
+//! same environment, say). Each comparison is the difference `subject - reference` of the mean
+//! over seeds of a statistic (final KLC, area under the KLC curve, episodes that moved the
+//! object), with a percentile-bootstrap confidence interval resampling the seeds of each side
+//! independently. The claim's relation is a set of differences (`d < 0`, `|d| < margin`, ...):
+//! a comparison is reproduced when its whole interval lies inside the set, not reproduced when it
+//! lies entirely outside, inconclusive otherwise. A claim is reproduced when every comparison is,
+//! not reproduced when any is not, inconclusive otherwise (and when nothing matched).
+//!
+//! The file format is documented at the top of `data/paper/claims.toml`.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use serde::Deserialize;
+
+use crate::ReportError;
+use crate::aggregate::ConditionSummary;
+use crate::load::{ConditionKey, Store};
+use crate::stats::{self, area_under_curve};
+
+/// The claims file name inside the paper directory.
+pub const FILE: &str = "claims.toml";
+
+/// `claims.toml`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClaimsFile {
+    pub settings: Settings,
+    #[serde(rename = "claim", default)]
+    pub claims: Vec<Claim>,
+}
+
+/// How every claim is evaluated.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Settings {
+    /// Level of the bootstrap confidence intervals, in (0, 1).
+    pub confidence: f64,
+    /// Bootstrap resamples per comparison (at least 1).
+    pub n_boot: usize,
+    /// Default margin of `much_less`, `at_most`, `at_least` and `similar`.
+    pub margin: f64,
+}
+
+/// One claim.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Claim {
+    pub id: String,
+    /// Where in the paper.
+    pub source: String,
+    /// The paper's words.
+    pub quote: String,
+    /// The testable statement, in words, matching the fields below.
+    pub statement: String,
+    pub statistic: Statistic,
+    pub relation: Relation,
+    pub subject: Selector,
+    pub reference: Selector,
+    /// Fields on which a reference condition must agree with the subject condition.
+    #[serde(default)]
+    pub pair_on: Vec<Field>,
+    /// Overrides `settings.margin` for this claim.
+    #[serde(default)]
+    pub margin: Option<f64>,
+}
+
+/// What is compared between conditions (one value per seed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Statistic {
+    /// KL-coverage at the run's last epoch (lower is better).
+    FinalKlc,
+    /// Area under the KLC curve divided by the epoch span (lower is faster exploration).
+    Auc,
+    /// Episodes in which the object moved, at the last epoch.
+    Moved,
+}
+
+impl Statistic {
+    pub fn label(self) -> &'static str {
+        match self {
+            Statistic::FinalKlc => "final KLC",
+            Statistic::Auc => "area under the KLC curve",
+            Statistic::Moved => "episodes that moved the object",
+        }
+    }
+}
+
+/// The set of differences `d = subject - reference` for which a comparison holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Relation {
+    /// `d < 0`.
+    Less,
+    /// `d > 0`.
+    Greater,
+    /// `d < -margin`.
+    MuchLess,
+    /// `d < margin`.
+    AtMost,
+    /// `d > -margin`.
+    AtLeast,
+    /// `-margin < d < margin`.
+    Similar,
+}
+
+impl Relation {
+    /// The open interval of differences that satisfy the relation.
+    pub fn interval(self, margin: f64) -> (f64, f64) {
+        match self {
+            Relation::Less => (f64::NEG_INFINITY, 0.0),
+            Relation::Greater => (0.0, f64::INFINITY),
+            Relation::MuchLess => (f64::NEG_INFINITY, -margin),
+            Relation::AtMost => (f64::NEG_INFINITY, margin),
+            Relation::AtLeast => (-margin, f64::INFINITY),
+            Relation::Similar => (-margin, margin),
+        }
+    }
+
+    /// The set in words, e.g. `d < 0.2`.
+    pub fn describe(self, margin: f64) -> String {
+        match self {
+            Relation::Less => "Δ < 0".into(),
+            Relation::Greater => "Δ > 0".into(),
+            Relation::MuchLess => format!("Δ < −{margin}"),
+            Relation::AtMost => format!("Δ < {margin}"),
+            Relation::AtLeast => format!("Δ > −{margin}"),
+            Relation::Similar => format!("|Δ| < {margin}"),
+        }
+    }
+}
+
+/// A field of a condition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Field {
+    Env,
+    Algo,
+    Sampler,
+    Latents,
+    Variant,
+}
+
+/// A latent-size selector: a number, or `"true"` for the environment's true dimension.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(untagged)]
+pub enum LatentsSelector {
+    Size(i64),
+    Named(String),
+}
+
+/// Which conditions a side of a claim covers; a missing field matches anything.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Selector {
+    pub env: Option<Vec<String>>,
+    pub algo: Option<Vec<String>>,
+    pub sampler: Option<Vec<String>>,
+    pub variant: Option<Vec<String>>,
+    pub latents: Option<LatentsSelector>,
+}
+
+/// The true dimension of an environment's outcome space (2 for ArmBall, 3 for ArmArrow).
+pub fn true_dimension(env: &str) -> Option<i64> {
+    match env {
+        "armball" => Some(2),
+        "armarrow" => Some(3),
+        _ => None,
+    }
+}
+
+impl Selector {
+    pub fn matches(&self, key: &ConditionKey) -> bool {
+        let within = |set: &Option<Vec<String>>, v: &str| {
+            set.as_ref().is_none_or(|s| s.iter().any(|x| x == v))
+        };
+        within(&self.env, &key.env)
+            && within(&self.algo, &key.algo)
+            && within(&self.sampler, &key.sampler)
+            && within(&self.variant, &key.variant)
+            && match &self.latents {
+                None => true,
+                Some(LatentsSelector::Size(n)) => key.latents == *n,
+                Some(LatentsSelector::Named(_)) => true_dimension(&key.env) == Some(key.latents),
+            }
+    }
+}
+
+fn same_on(fields: &[Field], a: &ConditionKey, b: &ConditionKey) -> bool {
+    fields.iter().all(|f| match f {
+        Field::Env => a.env == b.env,
+        Field::Algo => a.algo == b.algo,
+        Field::Sampler => a.sampler == b.sampler,
+        Field::Latents => a.latents == b.latents,
+        Field::Variant => a.variant == b.variant,
+    })
+}
+
+/// Reads and validates `claims.toml`: any problem is a [`ReportError::Invalid`] naming the file
+/// and the claim or key.
+pub fn load_claims(path: &Path) -> Result<ClaimsFile, ReportError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_claims(&text, path)
+}
+
+/// [`load_claims`] on a string (`path` is only for messages).
+pub fn parse_claims(text: &str, path: &Path) -> Result<ClaimsFile, ReportError> {
+    let invalid = |problem: String| ReportError::Invalid {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let file: ClaimsFile =
+        toml::from_str(text).map_err(|e| invalid(e.to_string().trim().replace('\n', " ")))?;
+    let s = &file.settings;
+    if !(s.confidence > 0.0 && s.confidence < 1.0) {
+        return Err(invalid(format!(
+            "settings.confidence must be in (0, 1), got {}",
+            s.confidence
+        )));
+    }
+    if s.n_boot == 0 {
+        return Err(invalid("settings.n_boot must be at least 1".into()));
+    }
+    check_margin(s.margin).map_err(|m| invalid(format!("settings.margin {m}")))?;
+    let mut ids = BTreeSet::new();
+    for c in &file.claims {
+        if c.id.trim().is_empty() {
+            return Err(invalid("a claim has an empty id".into()));
+        }
+        if !ids.insert(c.id.as_str()) {
+            return Err(invalid(format!("claim id `{}` appears twice", c.id)));
+        }
+        if let Some(m) = c.margin {
+            check_margin(m).map_err(|m| invalid(format!("claim `{}`: margin {m}", c.id)))?;
+        }
+        for (side, sel) in [("subject", &c.subject), ("reference", &c.reference)] {
+            if let Some(LatentsSelector::Named(n)) = &sel.latents
+                && n != "true"
+            {
+                return Err(invalid(format!(
+                    "claim `{}`: {side}.latents must be a number or \"true\", got \"{n}\"",
+                    c.id
+                )));
+            }
+            for (name, set) in [
+                ("env", &sel.env),
+                ("algo", &sel.algo),
+                ("sampler", &sel.sampler),
+                ("variant", &sel.variant),
+            ] {
+                if set.as_ref().is_some_and(|s| s.is_empty()) {
+                    return Err(invalid(format!(
+                        "claim `{}`: {side}.{name} is an empty list (it would match nothing)",
+                        c.id
+                    )));
+                }
+            }
+        }
+    }
+    Ok(file)
+}
+
+fn check_margin(m: f64) -> Result<(), String> {
+    if m.is_finite() && m >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("must be a finite number >= 0, got {m}"))
+    }
+}
+
+/// The outcome of a comparison or of a claim.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Verdict {
+    Reproduced,
+    Inconclusive,
+    NotReproduced,
+}
+
+impl Verdict {
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::Inconclusive => "inconclusive",
+            Verdict::NotReproduced => "not reproduced",
+        }
+    }
+
+    /// Where the interval `[lo, hi]` lies relative to the open set `(a, b)`.
+    pub fn of_interval(lo: f64, hi: f64, (a, b): (f64, f64)) -> Verdict {
+        if lo.is_nan() || hi.is_nan() {
+            Verdict::Inconclusive
+        } else if lo > a && hi < b {
+            Verdict::Reproduced
+        } else if hi <= a || lo >= b {
+            Verdict::NotReproduced
+        } else {
+            Verdict::Inconclusive
+        }
+    }
+
+    /// A claim's verdict from its comparisons': any not reproduced wins, then any inconclusive;
+    /// no comparison at all is inconclusive.
+    pub fn combine(vs: impl IntoIterator<Item = Verdict>) -> Verdict {
+        vs.into_iter().max().unwrap_or(Verdict::Inconclusive)
+    }
+}
+
+/// One subject condition against one reference condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    pub subject: ConditionKey,
+    pub reference: ConditionKey,
+    pub n_subject: usize,
+    pub n_reference: usize,
+    pub subject_mean: f64,
+    pub reference_mean: f64,
+    /// `subject_mean - reference_mean`, and its bootstrap interval.
+    pub diff: f64,
+    pub lo: f64,
+    pub hi: f64,
+    pub verdict: Verdict,
+}
+
+/// A claim with its comparisons.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClaimResult {
+    pub claim: Claim,
+    pub margin: f64,
+    pub comparisons: Vec<Comparison>,
+    pub verdict: Verdict,
+}
+
+/// The per-seed values of `statistic` for a condition (seed order). Runs whose curve has no area
+/// (fewer than two points) are left out of `auc`.
+pub fn values(store: &Store, cond: &ConditionSummary, statistic: Statistic) -> Vec<f64> {
+    cond.runs
+        .iter()
+        .filter_map(|&i| {
+            let run = &store.runs[i];
+            match statistic {
+                Statistic::FinalKlc => Some(run.final_point().klc),
+                Statistic::Moved => Some(run.final_point().n_moved as f64),
+                Statistic::Auc => {
+                    let e: Vec<f64> = run.curve.iter().map(|p| p.epoch as f64).collect();
+                    let v: Vec<f64> = run.curve.iter().map(|p| p.klc).collect();
+                    area_under_curve(&e, &v).ok()
+                }
+            }
+        })
+        .collect()
+}
+
+/// Evaluates every claim on the conditions of one campaign (`store` holds their runs). The
+/// bootstrap of each comparison is seeded from `seed`, the claim id and both conditions.
+pub fn evaluate(
+    file: &ClaimsFile,
+    conditions: &[ConditionSummary],
+    store: &Store,
+    seed: u64,
+) -> Vec<ClaimResult> {
+    let alpha = 1.0 - file.settings.confidence;
+    file.claims
+        .iter()
+        .map(|claim| {
+            let margin = claim.margin.unwrap_or(file.settings.margin);
+            let set = claim.relation.interval(margin);
+            let mut comparisons = Vec::new();
+            for s in conditions.iter().filter(|c| claim.subject.matches(&c.key)) {
+                for r in conditions.iter().filter(|c| {
+                    c.key != s.key
+                        && claim.reference.matches(&c.key)
+                        && same_on(&claim.pair_on, &s.key, &c.key)
+                }) {
+                    let xs = values(store, s, claim.statistic);
+                    let ys = values(store, r, claim.statistic);
+                    let label = format!("claim|{}|{}|{}", claim.id, s.key.slug(), r.key.slug());
+                    let Some((diff, lo, hi)) = stats::difference_of_means_ci(
+                        &xs,
+                        &ys,
+                        file.settings.n_boot,
+                        alpha,
+                        stats::derive_seed(seed, &label),
+                    ) else {
+                        continue;
+                    };
+                    comparisons.push(Comparison {
+                        subject: s.key.clone(),
+                        reference: r.key.clone(),
+                        n_subject: xs.len(),
+                        n_reference: ys.len(),
+                        subject_mean: stats::mean(&xs),
+                        reference_mean: stats::mean(&ys),
+                        diff,
+                        lo,
+                        hi,
+                        verdict: Verdict::of_interval(lo, hi, set),
+                    });
+                }
+            }
+            ClaimResult {
+                verdict: Verdict::combine(comparisons.iter().map(|c| c.verdict)),
+                claim: claim.clone(),
+                margin,
+                comparisons,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    #[test]
+    fn verdict_of_interval_against_open_sets() {
+        let less = Relation::Less.interval(0.2);
+        assert_eq!(Verdict::of_interval(-0.5, -0.1, less), Verdict::Reproduced);
+        assert_eq!(Verdict::of_interval(0.1, 0.5, less), Verdict::NotReproduced);
+        assert_eq!(Verdict::of_interval(-0.1, 0.1, less), Verdict::Inconclusive);
+        // Touching the boundary is not inside the open set.
+        assert_eq!(Verdict::of_interval(-0.5, 0.0, less), Verdict::Inconclusive);
+        assert_eq!(Verdict::of_interval(0.0, 0.5, less), Verdict::NotReproduced);
+        let sim = Relation::Similar.interval(0.2);
+        assert_eq!(Verdict::of_interval(-0.1, 0.15, sim), Verdict::Reproduced);
+        assert_eq!(Verdict::of_interval(0.25, 0.4, sim), Verdict::NotReproduced);
+        assert_eq!(
+            Verdict::of_interval(-0.4, -0.3, sim),
+            Verdict::NotReproduced
+        );
+        assert_eq!(Verdict::of_interval(-0.3, 0.0, sim), Verdict::Inconclusive);
+        let much = Relation::MuchLess.interval(0.2);
+        assert_eq!(Verdict::of_interval(-0.5, -0.25, much), Verdict::Reproduced);
+        assert_eq!(
+            Verdict::of_interval(-0.15, -0.05, much),
+            Verdict::NotReproduced
+        );
+        assert_eq!(
+            Verdict::of_interval(f64::NAN, 0.0, much),
+            Verdict::Inconclusive
+        );
+        assert_eq!(
+            Verdict::of_interval(1.0, f64::INFINITY, Relation::AtMost.interval(0.2)),
+            Verdict::NotReproduced
+        );
+    }
+
+    #[test]
+    fn combining_verdicts() {
+        use Verdict::*;
+        assert_eq!(Verdict::combine([Reproduced, Reproduced]), Reproduced);
+        assert_eq!(Verdict::combine([Reproduced, Inconclusive]), Inconclusive);
+        assert_eq!(
+            Verdict::combine([Inconclusive, NotReproduced, Reproduced]),
+            NotReproduced
+        );
+        assert_eq!(Verdict::combine([]), Inconclusive);
+    }
+
+    fn key(env: &str, algo: &str, sampler: &str, latents: i64, variant: &str) -> ConditionKey {
+        ConditionKey {
+            env: env.into(),
+            algo: algo.into(),
+            sampler: sampler.into(),
+            latents,
+            variant: variant.into(),
+        }
+    }
+
+    #[test]
+    fn selectors_and_true_dimension() {
+        let sel = Selector {
+            algo: Some(vec!["rge-vae".into()]),
+            latents: Some(LatentsSelector::Named("true".into())),
+            ..Selector::default()
+        };
+        assert!(sel.matches(&key("armball", "rge-vae", "kde", 2, "faithful")));
+        assert!(sel.matches(&key("armarrow", "rge-vae", "kde", 3, "faithful")));
+        assert!(!sel.matches(&key("armarrow", "rge-vae", "kde", 2, "faithful")));
+        assert!(!sel.matches(&key("armball", "rge-ae", "kde", 2, "none")));
+        assert!(Selector::default().matches(&key("x", "y", "z", 0, "none")));
+        let ten = Selector {
+            latents: Some(LatentsSelector::Size(10)),
+            ..Selector::default()
+        };
+        assert!(ten.matches(&key("armball", "rge-ae", "kde", 10, "none")));
+        assert!(!ten.matches(&key("armball", "rge-ae", "kde", 2, "none")));
+    }
+
+    const GOOD: &str = r#"
+[settings]
+confidence = 0.95
+n_boot = 100
+margin = 0.2
+
+[[claim]]
+id = "a"
+source = "s"
+quote = "q"
+statement = "t"
+statistic = "final_klc"
+relation = "less"
+subject = { algo = ["rge-vae"], latents = "true" }
+reference = { algo = ["rge-efr"] }
+pair_on = ["env"]
+"#;
+
+    #[test]
+    fn parses_the_documented_format() {
+        let f = parse_claims(GOOD, Path::new("c.toml")).unwrap();
+        assert_eq!(f.claims.len(), 1);
+        assert_eq!(f.claims[0].relation, Relation::Less);
+        assert_eq!(f.claims[0].pair_on, vec![Field::Env]);
+    }
+
+    #[test]
+    fn bad_claims_files_name_the_problem() {
+        let cases = [
+            (GOOD.replace("0.95", "1.5"), "settings.confidence"),
+            (GOOD.replace("n_boot = 100", "n_boot = 0"), "n_boot"),
+            (GOOD.replace("margin = 0.2", "margin = -1.0"), "margin"),
+            (GOOD.replace("\"less\"", "\"smaller\""), "smaller"),
+            (GOOD.replace("\"true\"", "\"ten\""), "latents"),
+            (GOOD.replace("pair_on", "pair_with"), "pair_with"),
+            (
+                GOOD.replace("\"rge-efr\"", "").replace("[]", "[]"),
+                "reference.algo",
+            ),
+            (
+                format!("{GOOD}{}", &GOOD[GOOD.find("[[claim]]").unwrap()..]),
+                "twice",
+            ),
+        ];
+        for (text, needle) in cases {
+            let err = parse_claims(&text, Path::new("c.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(needle), "{needle:?} not in {err}");
+            assert!(err.starts_with("c.toml"), "{err}");
+        }
+    }
+
+    #[test]
+    fn the_committed_claims_file_is_valid() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper/claims.toml");
+        let f = load_claims(&path).unwrap();
+        assert!(f.claims.len() >= 10);
+    }
+
+    /// A store with one condition per `(algo, latents, final KLC per seed)`, on ArmBall; every
+    /// run's curve goes linearly from ln 756 at epoch 0 to its final value at epoch 100.
+    pub(crate) fn synthetic(conds: &[(&str, i64, &[f64])]) -> (Store, Vec<ConditionSummary>) {
+        use crate::load::{CurvePoint, Manifest, Run};
+        let mut runs = Vec::new();
+        for (algo, latents, finals) in conds {
+            for (seed, &f) in finals.iter().enumerate() {
+                let start = 756f64.ln();
+                let curve = (0..=10)
+                    .map(|i| CurvePoint {
+                        epoch: i * 10,
+                        n_outcomes: i * 10,
+                        klc: start + (f - start) * i as f64 / 10.0,
+                        n_moved: (100.0 * (start - f)) as i64,
+                        coverage: 0.0,
+                    })
+                    .collect();
+                runs.push(Run {
+                    run_id: format!("{algo}.l{latents}.s{seed}"),
+                    campaign: "paper".into(),
+                    key: key(
+                        "armball",
+                        algo,
+                        if *latents == 0 { "uniform" } else { "kde" },
+                        *latents,
+                        "none",
+                    ),
+                    seed: seed as i64,
+                    curve,
+                    outcomes: Vec::new(),
+                    manifest: Manifest {
+                        raw: serde_json::json!({}),
+                    },
+                    curve_path: Default::default(),
+                    outcomes_path: Default::default(),
+                    manifest_path: Default::default(),
+                });
+            }
+        }
+        let store = Store {
+            runs,
+            incomplete: Vec::new(),
+        };
+        let conditions =
+            crate::aggregate::aggregate(&store, &crate::paper::PaperTable::default(), 0, 100);
+        (store, conditions)
+    }
+
+    fn claim(relation: &str, subject: &str, reference: &str, pair_on: &str) -> String {
+        format!(
+            "[settings]\nconfidence = 0.95\nn_boot = 2000\nmargin = 0.2\n\n[[claim]]\n\
+             id = \"c\"\nsource = \"s\"\nquote = \"q\"\nstatement = \"t\"\n\
+             statistic = \"final_klc\"\nrelation = \"{relation}\"\nsubject = {subject}\n\
+             reference = {reference}\npair_on = {pair_on}\n"
+        )
+    }
+
+    fn verdict_of(text: &str, store: &Store, conds: &[ConditionSummary]) -> ClaimResult {
+        let f = parse_claims(text, Path::new("c.toml")).unwrap();
+        evaluate(&f, conds, store, 0).remove(0)
+    }
+
+    #[test]
+    fn evaluator_on_synthetic_results_with_known_verdicts() {
+        let efr: &[f64] = &[4.5, 4.6, 4.4, 4.55, 4.45];
+        let (store, conds) = synthetic(&[
+            ("rge-efr", 0, efr),
+            // Clearly better than EFR (by ~0.5).
+            ("rge-pca", 10, &[4.0, 4.1, 3.9, 4.05, 3.95]),
+            // Clearly worse (by ~1).
+            ("rge-rfvae", 10, &[5.5, 5.6, 5.4, 5.55, 5.45]),
+            // Same mean as EFR, tiny spread: similar within the margin.
+            ("rge-ae", 10, &[4.5, 4.52, 4.48, 4.51, 4.49]),
+            // Wild spread around EFR: no interval can decide.
+            ("rge-vae", 10, &[3.0, 6.0, 3.2, 5.8, 4.5]),
+            ("rge-pca", 2, &[4.0, 4.1, 3.9, 4.05, 3.95]),
+        ]);
+        let efr_sel = "{ algo = [\"rge-efr\"] }";
+        let on_env = "[\"env\"]";
+        let v = |rel: &str, algo: &str| {
+            let subject = format!("{{ algo = [\"{algo}\"] }}");
+            verdict_of(&claim(rel, &subject, efr_sel, on_env), &store, &conds)
+        };
+        assert_eq!(v("less", "rge-pca").verdict, Verdict::Reproduced);
+        assert_eq!(v("much_less", "rge-pca").verdict, Verdict::Reproduced);
+        assert_eq!(v("greater", "rge-pca").verdict, Verdict::NotReproduced);
+        assert_eq!(v("greater", "rge-rfvae").verdict, Verdict::Reproduced);
+        assert_eq!(v("at_most", "rge-rfvae").verdict, Verdict::NotReproduced);
+        assert_eq!(v("similar", "rge-ae").verdict, Verdict::Reproduced);
+        assert_eq!(v("similar", "rge-pca").verdict, Verdict::NotReproduced);
+        assert_eq!(v("less", "rge-vae").verdict, Verdict::Inconclusive);
+        assert_eq!(v("similar", "rge-vae").verdict, Verdict::Inconclusive);
+        // PCA has two conditions (2 and 10 latents): two comparisons, both reproduced.
+        let r = v("less", "rge-pca");
+        assert_eq!(r.comparisons.len(), 2);
+        assert!((r.comparisons[0].diff - -0.5).abs() < 1e-9);
+        assert_eq!(
+            (r.comparisons[0].n_subject, r.comparisons[0].n_reference),
+            (5, 5)
+        );
+        // One failing comparison among passing ones makes the claim not reproduced.
+        let any = "{ algo = [\"rge-pca\", \"rge-rfvae\"] }";
+        let r = verdict_of(&claim("less", any, efr_sel, on_env), &store, &conds);
+        assert_eq!(r.verdict, Verdict::NotReproduced);
+        // Pairing on latents: PCA 10 against PCA 2, identical values, similar.
+        let r = verdict_of(
+            &claim(
+                "similar",
+                "{ algo = [\"rge-pca\"], latents = 10 }",
+                "{ latents = \"true\" }",
+                "[\"env\", \"algo\", \"sampler\", \"variant\"]",
+            ),
+            &store,
+            &conds,
+        );
+        assert_eq!(r.comparisons.len(), 1);
+        assert_eq!(r.comparisons[0].reference.latents, 2);
+        assert_eq!(r.verdict, Verdict::Reproduced);
+        // Nothing matches: inconclusive, with no comparison.
+        let r = verdict_of(
+            &claim("less", "{ algo = [\"rge-nothing\"] }", efr_sel, on_env),
+            &store,
+            &conds,
+        );
+        assert!(r.comparisons.is_empty());
+        assert_eq!(r.verdict, Verdict::Inconclusive);
+        // Same inputs, same result (seeded bootstrap).
+        assert_eq!(v("less", "rge-vae"), v("less", "rge-vae"));
+    }
+
+    #[test]
+    fn auc_and_moved_statistics() {
+        let (store, conds) =
+            synthetic(&[("rge-efr", 0, &[4.5, 4.6]), ("rge-pca", 10, &[4.0, 4.1])]);
+        let efr = conds.iter().find(|c| c.key.algo == "rge-efr").unwrap();
+        // A linear ramp from ln 756 to f has area (ln 756 + f) / 2.
+        let auc = values(&store, efr, Statistic::Auc);
+        assert!((auc[0] - (756f64.ln() + 4.5) / 2.0).abs() < 1e-9);
+        assert_eq!(values(&store, efr, Statistic::FinalKlc), vec![4.5, 4.6]);
+        assert_eq!(
+            values(&store, efr, Statistic::Moved),
+            vec![
+                (100.0 * (756f64.ln() - 4.5)) as i64 as f64,
+                (100.0 * (756f64.ln() - 4.6)) as i64 as f64
+            ]
+        );
+    }
+}

@@ -1,0 +1,254 @@
+//! The leaderboard: every algorithm (with its goal sampler and variant) of the main campaign and
+//! of the `compare-*` campaigns, ranked with rliable's aggregate statistics over the paper's four
+//! tasks (ArmBall and ArmArrow, each with 10 latents and with the true dimension).
+//!
+//! Scores are normalised so that tasks can be pooled: a KL-coverage divided by the KL-coverage of
+//! outcomes all in one cell (`ln 756` on ArmBall, `ln 22680` on ArmArrow), so 0 is a perfect
+//! cover and 1 is "never moved the object". For each entry:
+//!
+//! * **IQM** of the normalised final KLC over the runs of all its tasks, with a stratified
+//!   bootstrap interval (runs resampled within each task);
+//! * **IQM** of the normalised area under the KLC curve (speed of exploration), likewise;
+//! * **probability of improvement** over RGE-EFR, `P(X < EFR)` averaged over the tasks, with its
+//!   stratified bootstrap interval;
+//! * the paper's value where it has one for every task of the entry: the mean of its (single-run)
+//!   normalised final KLC values.
+//!
+//! Baselines (RPE, RGE-EFR) do not depend on the latent size: their runs serve both tasks of an
+//! environment. Entries are ranked by the IQM of the normalised final KLC (lower first); entries
+//! that miss some task are ranked after the complete ones.
+
+use std::collections::BTreeMap;
+
+use crate::aggregate::ConditionSummary;
+use crate::claims::{self, Statistic};
+use crate::figures::klc_max;
+use crate::load::{Store, rank};
+use crate::stats::{self, iqm, probability_of_improvement_ci, stratified_bootstrap_ci};
+
+/// A campaign's conditions with the store holding their runs.
+pub struct Source<'a> {
+    pub campaign: &'a str,
+    pub store: &'a Store,
+    pub conditions: &'a [ConditionSummary],
+}
+
+/// A task: an environment and a latent size (the size a learned goal space was given).
+pub type Task = (String, i64);
+
+/// One row of the leaderboard.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    pub campaign: String,
+    pub algo: String,
+    pub sampler: String,
+    pub variant: String,
+    /// The tasks it has runs on, in task order.
+    pub tasks: Vec<Task>,
+    pub n_runs: usize,
+    /// (point, lo, hi) of the IQM of the normalised final KLC.
+    pub final_iqm: (f64, f64, f64),
+    /// (point, lo, hi) of the IQM of the normalised area under the curve.
+    pub auc_iqm: Option<(f64, f64, f64)>,
+    /// (point, lo, hi) of `P(X < RGE-EFR)`; `None` for EFR itself or without EFR runs.
+    pub poi_vs_efr: Option<(f64, f64, f64)>,
+    /// The paper's mean normalised final KLC over the same tasks.
+    pub paper: Option<f64>,
+}
+
+impl Entry {
+    pub fn is_complete(&self, n_tasks: usize) -> bool {
+        self.tasks.len() == n_tasks
+    }
+}
+
+/// The leaderboard.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Leaderboard {
+    /// The tasks of the main campaign, in order (environment, then latent size).
+    pub tasks: Vec<Task>,
+    /// Ranked.
+    pub entries: Vec<Entry>,
+    pub confidence: f64,
+    pub n_boot: usize,
+}
+
+type EntryKey = (String, String, String, String);
+
+/// Builds the leaderboard. `sources[0]` is the main campaign: its learned conditions define the
+/// tasks. Conditions of environments without a known KLC maximum are left out.
+pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) -> Leaderboard {
+    let mut tasks: Vec<Task> = Vec::new();
+    if let Some(main) = sources.first() {
+        for c in main.conditions {
+            let t = (c.key.env.clone(), c.key.latents);
+            if c.key.latents > 0 && klc_max(&c.key.env).is_some() && !tasks.contains(&t) {
+                tasks.push(t);
+            }
+        }
+    }
+    tasks.sort_by_key(|(env, l)| (rank(env, &["armball", "armarrow"]), env.clone(), -*l));
+    let alpha = 1.0 - confidence;
+
+    // entry -> task -> (final values, auc values, paper value)
+    type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>)>;
+    let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
+    for src in sources {
+        for c in src.conditions {
+            let Some(max) = klc_max(&c.key.env) else {
+                continue;
+            };
+            let key: EntryKey = (
+                src.campaign.to_string(),
+                c.key.algo.clone(),
+                c.key.sampler.clone(),
+                c.key.variant.clone(),
+            );
+            let finals: Vec<f64> = claims::values(src.store, c, Statistic::FinalKlc)
+                .iter()
+                .map(|v| v / max)
+                .collect();
+            let aucs: Vec<f64> = claims::values(src.store, c, Statistic::Auc)
+                .iter()
+                .map(|v| v / max)
+                .collect();
+            let paper_value = c.paper.as_ref().map(|p| p.klc / max);
+            for (ti, (env, l)) in tasks.iter().enumerate() {
+                // A baseline (latents 0) serves every task of its environment.
+                if *env == c.key.env && (c.key.latents == *l || c.key.latents == 0) {
+                    groups
+                        .entry(key.clone())
+                        .or_default()
+                        .insert(ti, (finals.clone(), aucs.clone(), paper_value));
+                }
+            }
+        }
+    }
+
+    // RGE-EFR of the main campaign, per task, for the probability of improvement.
+    let efr: BTreeMap<usize, Vec<f64>> = groups
+        .iter()
+        .find(|((camp, algo, _, _), _)| {
+            Some(camp.as_str()) == sources.first().map(|s| s.campaign) && algo == "rge-efr"
+        })
+        .map(|(_, per)| per.iter().map(|(t, v)| (*t, v.0.clone())).collect())
+        .unwrap_or_default();
+
+    let mut entries: Vec<Entry> = groups
+        .into_iter()
+        .filter_map(|(key, per)| {
+            let (campaign, algo, sampler, variant) = key.clone();
+            let finals: Vec<Vec<f64>> = per.values().map(|v| v.0.clone()).collect();
+            let aucs: Vec<Vec<f64>> = per.values().map(|v| v.1.clone()).collect();
+            let label = format!("leaderboard|{campaign}|{algo}|{sampler}|{variant}");
+            let final_iqm = stratified_bootstrap_ci(
+                &finals,
+                iqm,
+                n_boot,
+                alpha,
+                stats::derive_seed(seed, &format!("{label}|final")),
+            )?;
+            let auc_iqm = stratified_bootstrap_ci(
+                &aucs,
+                iqm,
+                n_boot,
+                alpha,
+                stats::derive_seed(seed, &format!("{label}|auc")),
+            );
+            let poi_vs_efr = if algo == "rge-efr" || !per.keys().all(|t| efr.contains_key(t)) {
+                None
+            } else {
+                let ys: Vec<Vec<f64>> = per.keys().map(|t| efr[t].clone()).collect();
+                probability_of_improvement_ci(
+                    &finals,
+                    &ys,
+                    n_boot,
+                    alpha,
+                    stats::derive_seed(seed, &format!("{label}|poi")),
+                )
+            };
+            let papers: Vec<f64> = per.values().filter_map(|v| v.2).collect();
+            let paper = (papers.len() == per.len()).then(|| stats::mean(&papers));
+            Some(Entry {
+                campaign,
+                algo,
+                sampler,
+                variant,
+                tasks: per.keys().map(|&t| tasks[t].clone()).collect(),
+                n_runs: finals.iter().map(Vec::len).sum(),
+                final_iqm,
+                auc_iqm,
+                poi_vs_efr,
+                paper,
+            })
+        })
+        .collect();
+    let n_tasks = tasks.len();
+    entries.sort_by(|a, b| {
+        b.is_complete(n_tasks)
+            .cmp(&a.is_complete(n_tasks))
+            .then(a.final_iqm.0.total_cmp(&b.final_iqm.0))
+            .then_with(|| {
+                (&a.campaign, &a.algo, &a.sampler, &a.variant).cmp(&(
+                    &b.campaign,
+                    &b.algo,
+                    &b.sampler,
+                    &b.variant,
+                ))
+            })
+    });
+    Leaderboard {
+        tasks,
+        entries,
+        confidence,
+        n_boot,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::claims::tests::synthetic;
+
+    #[test]
+    fn ranks_by_normalised_iqm_and_compares_with_efr() {
+        let (store, conds) = synthetic(&[
+            ("rpe", 0, &[6.5, 6.5, 6.5, 6.5]),
+            ("rge-efr", 0, &[4.5, 4.6, 4.4, 4.55]),
+            ("rge-pca", 10, &[4.0, 4.1, 3.9, 4.05]),
+            ("rge-pca", 2, &[4.0, 4.1, 3.9, 4.05]),
+            ("rge-ae", 10, &[4.2, 4.3]),
+        ]);
+        let lb = build(
+            &[Source {
+                campaign: "paper",
+                store: &store,
+                conditions: &conds,
+            }],
+            0.95,
+            500,
+            0,
+        );
+        assert_eq!(
+            lb.tasks,
+            vec![("armball".to_string(), 10), ("armball".to_string(), 2)]
+        );
+        let names: Vec<&str> = lb.entries.iter().map(|e| e.algo.as_str()).collect();
+        // AE lacks the 2-latent task: ranked last although its IQM beats EFR's.
+        assert_eq!(names, ["rge-pca", "rge-efr", "rpe", "rge-ae"]);
+        let pca = &lb.entries[0];
+        let max = 756f64.ln();
+        // IQM of the 8 pooled runs: drop the 2 lowest and the 2 highest.
+        let mut v = vec![4.0, 4.1, 3.9, 4.05, 4.0, 4.1, 3.9, 4.05];
+        v.sort_by(f64::total_cmp);
+        let expect = v[2..6].iter().sum::<f64>() / 4.0 / max;
+        assert!((pca.final_iqm.0 - expect).abs() < 1e-12);
+        // Every PCA run beats every EFR run: P = 1 with a degenerate interval.
+        assert_eq!(pca.poi_vs_efr, Some((1.0, 1.0, 1.0)));
+        assert_eq!(lb.entries[2].poi_vs_efr, Some((0.0, 0.0, 0.0)));
+        assert_eq!(lb.entries[1].poi_vs_efr, None);
+        // EFR's runs serve both tasks.
+        assert_eq!(lb.entries[1].n_runs, 8);
+        assert!(!lb.entries[3].is_complete(2));
+    }
+}

@@ -1,0 +1,269 @@
+//! The claims table and the leaderboard of `REPORT.md`.
+
+use std::fmt::Write as _;
+
+use super::{Inputs, fmt_klc, plural};
+use crate::claims::{ClaimResult, Comparison, Statistic, Verdict};
+use crate::figures::outcomes::describe_key;
+use crate::figures::{condition_name, env_name, sampler_name};
+use crate::leaderboard::Entry;
+
+/// Where the claims come from, as the report shows it.
+pub enum ClaimsInput<'a> {
+    /// Evaluated from this file.
+    Evaluated {
+        path: &'a std::path::Path,
+        confidence: f64,
+        n_boot: usize,
+        margin: f64,
+        results: &'a [ClaimResult],
+    },
+    /// No claims file where the report looked.
+    Missing(&'a std::path::Path),
+}
+
+fn verdict_mark(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Reproduced => "✅ reproduced",
+        Verdict::NotReproduced => "❌ not reproduced",
+        Verdict::Inconclusive => "❔ inconclusive",
+    }
+}
+
+fn value(statistic: Statistic, v: f64) -> String {
+    match statistic {
+        Statistic::Moved if v.is_finite() => format!("{v:.0}"),
+        _ => fmt_klc(v),
+    }
+}
+
+fn signed(statistic: Statistic, v: f64) -> String {
+    let s = value(statistic, v);
+    if v > 0.0 && !s.starts_with('+') {
+        format!("+{s}")
+    } else {
+        s
+    }
+}
+
+/// One comparison on one line: `ArmBall, RGE-VAE (faithful), KDE goals, 2 latents − RGE-EFR:
+/// Δ = −0.52 [−0.71, −0.33] ✅`.
+fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
+    let mark = match c.verdict {
+        Verdict::Reproduced => "✅",
+        Verdict::NotReproduced => "❌",
+        Verdict::Inconclusive => "❔",
+    };
+    format!(
+        "{}: {} vs {}: Δ = {} [{}, {}] {mark}",
+        env_name(&c.subject.env),
+        describe_key(&c.subject),
+        describe_key(&c.reference),
+        signed(statistic, c.diff),
+        signed(statistic, c.lo),
+        signed(statistic, c.hi),
+    )
+}
+
+/// The one-line count of verdicts for the top of the report, if claims were evaluated.
+pub fn summary_line(w: &mut String, inp: &Inputs<'_>) {
+    if let ClaimsInput::Evaluated { results, .. } = inp.claims {
+        let count = |v: Verdict| results.iter().filter(|r| r.verdict == v).count();
+        let _ = writeln!(
+            w,
+            "**The paper's claims** ([details](#the-papers-claims)): {} reproduced, {} not \
+             reproduced, {} inconclusive, of {} claims evaluated on these results.\n",
+            count(Verdict::Reproduced),
+            count(Verdict::NotReproduced),
+            count(Verdict::Inconclusive),
+            results.len()
+        );
+    }
+}
+
+/// The claims section.
+pub fn claims(w: &mut String, inp: &Inputs<'_>) {
+    let _ = writeln!(w, "## The paper's claims\n");
+    let (path, confidence, n_boot, margin, results) = match inp.claims {
+        ClaimsInput::Missing(p) => {
+            let _ = writeln!(
+                w,
+                "No claims file at `{}`: nothing evaluated.\n",
+                p.display()
+            );
+            return;
+        }
+        ClaimsInput::Evaluated {
+            path,
+            confidence,
+            n_boot,
+            margin,
+            results,
+        } => (path, *confidence, *n_boot, *margin, *results),
+    };
+    let _ = writeln!(
+        w,
+        "Each claim of the paper's Sections 4 and 5, written as a testable statement in `{}` and \
+         evaluated on the main campaign (no verdict is written by hand). A claim compares \
+         *subject* conditions with *reference* conditions; each comparison is Δ = subject − \
+         reference of the mean over seeds (final KLC, area under the KLC curve divided by the \
+         epoch span, or episodes that moved the object), with a {:.0}% percentile-bootstrap \
+         interval ({n_boot} resamples; the seeds of each side resampled independently; seeded). \
+         A comparison is *reproduced* (✅) when its whole interval lies in the set of differences \
+         the claim requires, *not reproduced* (❌) when the interval lies entirely outside it, \
+         and *inconclusive* (❔) otherwise: too few seeds to tell. A claim is reproduced when \
+         every comparison is, not reproduced when any is not. \"No worse\" and \"similar\" allow \
+         a margin of {margin} (KLC nats unless the claim sets its own). Intervals are not \
+         corrected for multiple comparisons.",
+        path.display(),
+        confidence * 100.0
+    );
+    if inp.conditions.iter().any(|c| {
+        c.runs
+            .iter()
+            .any(|&i| inp.store.runs[i].manifest.reduced_budget())
+    }) {
+        let _ = writeln!(
+            w,
+            "Verdicts on the neural learners (AE, VAE, RFVAE) hold for the reduced training \
+             budgets of this campaign (†), not necessarily for the paper's."
+        );
+    }
+    let _ = writeln!(w);
+    let _ = writeln!(
+        w,
+        "| claim | the paper says | testable statement | requires | evidence | verdict |"
+    );
+    let _ = writeln!(w, "|---|---|---|---|---|---|");
+    for r in results {
+        let evidence = if r.comparisons.is_empty() {
+            "no condition of the main campaign matches".to_string()
+        } else {
+            r.comparisons
+                .iter()
+                .map(|c| comparison_line(c, r.claim.statistic))
+                .collect::<Vec<_>>()
+                .join("<br>")
+        };
+        let _ = writeln!(
+            w,
+            "| `{}` | *“{}”* ({}) | {} | {}, Δ of the {} | {} | **{}** |",
+            r.claim.id,
+            cell(&r.claim.quote),
+            cell(&r.claim.source),
+            cell(&r.claim.statement),
+            r.claim.relation.describe(r.margin),
+            r.claim.statistic.label(),
+            evidence,
+            verdict_mark(r.verdict)
+        );
+    }
+    let _ = writeln!(w);
+}
+
+/// Text safe inside a table cell.
+fn cell(s: &str) -> String {
+    s.replace('|', "\\|").replace('\n', " ")
+}
+
+fn ci3(t: (f64, f64, f64)) -> String {
+    format!("{:.3} [{:.3}, {:.3}]", t.0, t.1, t.2)
+}
+
+fn tasks_cell(e: &Entry, all: usize) -> String {
+    if e.tasks.len() == all {
+        format!("all {all}")
+    } else {
+        let names: Vec<String> = e
+            .tasks
+            .iter()
+            .map(|(env, l)| format!("{} {l}", env_name(env)))
+            .collect();
+        format!("{} of {all}: {}", e.tasks.len(), names.join(", "))
+    }
+}
+
+/// The leaderboard section.
+pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
+    let lb = inp.leaderboard;
+    if lb.entries.is_empty() {
+        return;
+    }
+    let _ = writeln!(w, "## Leaderboard (rliable statistics)\n");
+    let tasks: Vec<String> = lb
+        .tasks
+        .iter()
+        .map(|(env, l)| format!("{} with {l} latents", env_name(env)))
+        .collect();
+    let _ = writeln!(
+        w,
+        "Every algorithm of the main campaign, and every learner added with `ugl compare` \
+         (campaigns `compare-*`, run on the same cells and seeds), ranked over the {} tasks ({}) \
+         with the statistics of Agarwal et al. (2021, *rliable*). Scores are normalised so that \
+         tasks pool: KLC divided by the KLC of outcomes all in one cell (ln 756 on ArmBall, \
+         ln 22680 on ArmArrow), so 0 is a perfect cover and 1 is \"the object never moved\"; \
+         lower is better. *Final*: interquartile mean (IQM) of the normalised final KLC over all \
+         runs of all tasks; *speed*: IQM of the normalised area under the KLC curve (the mean \
+         KLC during exploration); *P(better than EFR)*: probability that a run beats a run of \
+         RGE-EFR on the same task, averaged over tasks (0.5: no difference). Brackets: {:.0}% \
+         stratified bootstrap intervals ({} resamples, runs resampled within each task, seeded). \
+         Baselines do not depend on the latent size: their runs serve both tasks of an \
+         environment. *Paper*: the mean of the paper's normalised single-run final values on the \
+         same tasks, where it gives all of them. Ranked by *final*; entries missing a task come \
+         last.\n",
+        lb.tasks.len(),
+        tasks.join(", "),
+        lb.confidence * 100.0,
+        lb.n_boot
+    );
+    let _ = writeln!(
+        w,
+        "| rank | algorithm | goal sampler | campaign | tasks | runs | final (IQM) | speed (IQM) | P(better than EFR) | paper |"
+    );
+    let _ = writeln!(w, "|---:|---|---|---|---|---:|---:|---:|---:|---:|");
+    let n = lb.tasks.len();
+    for (i, e) in lb.entries.iter().enumerate() {
+        let new = e.campaign != inp.campaigns.main.name;
+        let name = condition_name(&e.algo, &e.variant);
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            if e.is_complete(n) {
+                (i + 1).to_string()
+            } else {
+                "—".into()
+            },
+            if new {
+                format!("**{name}** (new)")
+            } else {
+                name
+            },
+            sampler_name(&e.sampler),
+            super::campaign_name(&e.campaign),
+            tasks_cell(e, n),
+            e.n_runs,
+            ci3(e.final_iqm),
+            e.auc_iqm.map(ci3).unwrap_or_else(|| "—".into()),
+            e.poi_vs_efr.map(ci3).unwrap_or_else(|| "—".into()),
+            e.paper
+                .map(|p| format!("{p:.3}"))
+                .unwrap_or_else(|| "—".into())
+        );
+    }
+    let new = inp.campaigns.compare.len();
+    let _ = writeln!(
+        w,
+        "\n{}",
+        if new == 0 {
+            "No `compare-*` campaign in the store: to rank a new learner, run `ugl compare \
+             --learner NAME [--command CMD]` (README, *Add your own learner*) and re-render."
+                .to_string()
+        } else {
+            format!(
+                "{new} `compare-*` campaign{} in the store; new learners are in **bold**.",
+                plural(new)
+            )
+        }
+    );
+    let _ = writeln!(w);
+}
