@@ -156,6 +156,15 @@ impl Manifest {
     pub fn wall_time_s(&self) -> Option<f64> {
         self.number(&["wall_time_s", "wall_s", "wall_seconds", "wall_time"])
     }
+    /// Seconds spent fitting the run's representation (data set and training; a cache hit
+    /// records the load time). `None` for RPE and EFR, which fit nothing.
+    pub fn fit_time_s(&self) -> Option<f64> {
+        self.number(&["fit_s"])
+    }
+    /// Seconds spent encoding outcomes into the learned goal space.
+    pub fn encode_time_s(&self) -> Option<f64> {
+        self.number(&["encode_s"])
+    }
     pub fn reduced_budget(&self) -> bool {
         self.flag(&["reduced_budget"])
     }

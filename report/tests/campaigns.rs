@@ -285,6 +285,16 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     assert_eq!(s.n_runs, n_main + 6);
     assert_eq!(s.budget_campaigns, ["budget-vae-300", "budget-vae-3000"]);
     assert_eq!(s.unused_campaigns, ["baselines"]);
+    // 27 distinct trainings of 60 s (the KDE and Gaussian runs of a cell share one) and 57 runs
+    // of 10 s exploration.
+    let md = read(&out);
+    let compute = line(&md, "- **Compute:**", "worker time");
+    assert!(
+        compute.contains("36.5 min of worker time")
+            && compute.contains("27.0 min fitting 27 representations")
+            && compute.contains("and 9.5 min exploring"),
+        "{compute}"
+    );
     let fig = |n: &str| out.join("figures").join(n);
     for name in [
         "klc_armball.svg",

@@ -258,7 +258,7 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("`abc1234` (12 runs)"));
     assert!(md.contains("`testhost` (12 runs)"));
     assert!(md.contains(
-        "- **Wall time:** 2.2 min in total; per run 11.0 s on average (min 10.0 s, max 12.0 s)."
+        "- **Exploration wall time:** 2.2 min in total; per run 11.0 s on average (min 10.0 s, max 12.0 s)."
     ));
     assert!(md.contains("| 3 (0–2) |"));
     // Paper conditions not run are listed.

@@ -113,6 +113,43 @@ fn fmt_epochs(e: &[i64]) -> String {
     e.iter().map(i64::to_string).collect::<Vec<_>>().join(", ")
 }
 
+/// The campaign's compute: exploration plus representation fits, a shared fit (the KDE and
+/// Gaussian runs of a neural cell share one training, identified by `train.key`) counted once.
+fn compute_line(w: &mut String, runs: &[crate::load::Run]) {
+    let explore: f64 = runs
+        .iter()
+        .filter_map(|r| Some(r.manifest.wall_time_s()? + r.manifest.encode_time_s().unwrap_or(0.0)))
+        .sum();
+    let mut fits: BTreeMap<String, f64> = BTreeMap::new();
+    for r in runs {
+        if let Some(f) = r.manifest.fit_time_s() {
+            let key = crate::neural::training(&r.manifest)
+                .and_then(|t| t.key)
+                .unwrap_or_else(|| format!("{}/{}", r.campaign, r.run_id));
+            let e = fits.entry(key).or_insert(0.0);
+            *e = e.max(f);
+        }
+    }
+    if fits.is_empty() && explore == 0.0 {
+        return;
+    }
+    let fit: f64 = fits.values().sum();
+    let total = explore + fit;
+    let _ = writeln!(
+        w,
+        "- **Compute:** {} of worker time, the sum of the manifests' times (a campaign may run \
+         in several resumed chunks): {} fitting {} representation{} (rendering the UGL data set \
+         and training; a fit shared by several runs counted once) and {} exploring and encoding. \
+         With one worker per core, that is about {} of wall time on 2 cores.",
+        fmt_duration(total),
+        fmt_duration(fit),
+        fits.len(),
+        plural(fits.len()),
+        fmt_duration(explore),
+        fmt_duration(total / 2.0)
+    );
+}
+
 pub fn render(inp: &Inputs<'_>) -> String {
     let mut md = String::new();
     let store = inp.store;
@@ -244,7 +281,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         .filter_map(|r| r.manifest.wall_time_s())
         .collect();
     if walls.is_empty() {
-        let _ = writeln!(w, "- **Wall time:** not recorded.");
+        let _ = writeln!(w, "- **Exploration wall time:** not recorded.");
     } else {
         let total: f64 = walls.iter().sum();
         let min = walls.iter().copied().fold(f64::INFINITY, f64::min);
@@ -252,7 +289,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         let missing = runs.len() - walls.len();
         let _ = writeln!(
             w,
-            "- **Wall time:** {} in total; per run {} on average (min {}, max {}){}.",
+            "- **Exploration wall time:** {} in total; per run {} on average (min {}, max {}){}.",
             fmt_duration(total),
             fmt_duration(total / walls.len() as f64),
             fmt_duration(min),
@@ -264,6 +301,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
             }
         );
     }
+    compute_line(w, runs);
     let _ = writeln!(
         w,
         "- **Host:** {}.",
