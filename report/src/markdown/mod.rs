@@ -580,5 +580,52 @@ pub fn render(inp: &Inputs<'_>) -> String {
             let _ = writeln!(w, "  - `{}`: missing {}", rel.display(), missing.join(", "));
         }
     }
+    reproduce(w, inp);
     md
+}
+
+/// How to regenerate every campaign this report used, then the report.
+fn reproduce(w: &mut String, inp: &Inputs<'_>) {
+    let _ = writeln!(w, "\n## How to reproduce\n");
+    let _ = writeln!(
+        w,
+        "From a clone of the repository, with Rust 1.95 or newer (each campaign is resumable: \
+         rerunning it after an interruption redoes only the runs that did not finish):\n"
+    );
+    let _ = writeln!(w, "```sh");
+    let profile = |name: &str| {
+        if name.is_empty() {
+            "# (top-level runs: see their manifests' `profile`)".to_string()
+        } else {
+            format!("make campaign PROFILE={name}")
+        }
+    };
+    let _ = writeln!(w, "{}", profile(&inp.campaigns.main.name));
+    for c in &inp.campaigns.budget {
+        let _ = writeln!(w, "{}", profile(&c.name));
+    }
+    for c in &inp.campaigns.compare {
+        let learner = c.name.trim_start_matches(crate::campaigns::COMPARE_PREFIX);
+        let _ = writeln!(
+            w,
+            "cargo run --bin ugl -- compare --learner {learner}   # add --command '...' for an external program (README)"
+        );
+    }
+    let _ = writeln!(
+        w,
+        "make report{}",
+        if inp.campaigns.main.name == ReportOptions::DEFAULT_MAIN_CAMPAIGN {
+            String::new()
+        } else {
+            format!(" MAIN={}", inp.campaigns.main.name)
+        }
+    );
+    let _ = writeln!(w, "```\n");
+    let _ = writeln!(
+        w,
+        "Every random draw comes from a seeded stream derived from the run's identity, so the same \
+         campaign on the same thread count gives byte-identical result files (`make verify` checks \
+         this for the `smoke` profile against committed checksums); the bootstrap of this report is \
+         seeded too, so rendering the same results gives the same bytes."
+    );
 }
