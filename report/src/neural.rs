@@ -302,6 +302,8 @@ pub struct BudgetPoint {
 pub struct Reference {
     pub algo: String,
     pub summary: Summary,
+    /// Its final KLC per seed.
+    pub values: Vec<f64>,
 }
 
 /// Final KLC against training iterations for one condition of the budget campaigns.
@@ -400,6 +402,7 @@ pub fn budget_analysis(
                         .map(|c| Reference {
                             algo: algo.to_string(),
                             summary: c.final_klc.clone(),
+                            values: c.final_by_seed.iter().map(|v| v.1).collect(),
                         })
                 })
                 .collect();
