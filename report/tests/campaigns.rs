@@ -358,7 +358,10 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     assert!(md.contains("| 1234 | `budget-vae-300` | 3 (0–2) |"), "{md}");
     // VAE drops 1.5, 2.0, 1.75 against RGE-EFR's 1.5, 1.6, 1.7: 0.15 lower KLC on average.
     let row = line(&md, "| 1234 |", "budget-vae-300");
-    assert!(row.trim_end().ends_with("|") && row.contains("| -0.150 ["), "{row}");
+    assert!(
+        row.trim_end().ends_with("|") && row.contains("| -0.150 ["),
+        "{row}"
+    );
     assert!(
         md.contains("| 4321 | `budget-vae-3000` | 3 (0–2) |"),
         "{md}"

@@ -490,6 +490,8 @@ pub fn execute(
         fit_s,
         encode_s: explored.encode_s,
         train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
+        external: (spec.algo.learner() == Some(Learner::External))
+            .then(|| serde_json::to_value(&ctx.learners.external).expect("serialisable")),
         host: host_name().into(),
         summary: summary.clone(),
     };

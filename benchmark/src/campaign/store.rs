@@ -88,6 +88,10 @@ pub struct Manifest {
     /// Training of a neural representation: configuration, loss curve, model-cache status.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub train: Option<serde_json::Value>,
+    /// The external learner program (`[learners.external]`: name, command) of an `rge-external`
+    /// run, so that the run can be reproduced from its manifest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external: Option<serde_json::Value>,
     pub host: String,
     pub summary: Summary,
 }

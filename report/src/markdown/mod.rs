@@ -606,9 +606,18 @@ fn reproduce(w: &mut String, inp: &Inputs<'_>) {
     }
     for c in &inp.campaigns.compare {
         let learner = c.name.trim_start_matches(crate::campaigns::COMPARE_PREFIX);
+        // An external program's command, as its runs' manifests recorded it.
+        let command = c.store.runs.iter().find_map(|r| {
+            let cmd = r.manifest.raw.get("external")?.get("command")?.as_str()?;
+            Some(cmd.replace('\'', "'\\''"))
+        });
         let _ = writeln!(
             w,
-            "cargo run --bin ugl -- compare --learner {learner}   # add --command '...' for an external program (README)"
+            "cargo run --bin ugl -- compare --learner {learner}{}",
+            match command {
+                Some(cmd) => format!(" --command '{cmd}'"),
+                None => String::new(),
+            }
         );
     }
     let _ = writeln!(
