@@ -1,5 +1,7 @@
 //! The campaign engine: bad configurations, worker-count independence, resume after kill -9.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -16,23 +18,6 @@ fn run(args: &[&str]) -> Output {
 
 fn p(path: &Path) -> &str {
     path.to_str().unwrap()
-}
-
-/// Every file of a results store except manifests (which hold wall times and hosts), by name.
-fn result_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_str().unwrap().to_string(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]
@@ -162,7 +147,7 @@ fn results_do_not_depend_on_the_worker_count() {
         .status
         .success()
     );
-    let (ra, rb) = (result_bytes(&a), result_bytes(&b));
+    let (ra, rb) = (common::parquet_files(&a), common::parquet_files(&b));
     // Per env: rpe, rge-efr, rge-pca (kde; no prior for gaussian goals), rge-vae x 2 variants
     // x 2 samplers; 2 reps; 2 files per run. With 1 worker the VAE trains on 2 threads, with 2
     // workers on 1 thread each: the bytes must not differ.
@@ -187,7 +172,7 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
         .status
         .success()
     );
-    let expected = result_bytes(&reference);
+    let expected = common::parquet_files(&reference);
 
     let out = dir.path().join("killed");
     let mut child = ugl()
@@ -231,7 +216,7 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
     }
     let _ = child.kill();
     let _ = child.wait();
-    let partial = result_bytes(&out);
+    let partial = common::parquet_files(&out);
     // Whatever was stored is complete and correct.
     for (name, bytes) in &partial {
         let reference = expected
@@ -246,7 +231,7 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
     let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
-        result_bytes(&out) == expected,
+        common::parquet_files(&out) == expected,
         "resumed campaign differs from the uninterrupted one"
     );
     // A changed configuration reruns the runs whose config hash changed, never reuses them.

@@ -1,5 +1,7 @@
 //! Integration tests of the `ugl` command line: the contract other tools depend on.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -406,22 +408,6 @@ fn run_with_an_external_learner() {
     assert_one_line_error(&o, "learners.external");
 }
 
-fn data_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_str().unwrap().ends_with(".parquet"))
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_str().unwrap().to_string(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn shards_merge_into_the_whole_campaign() {
     let dir = tempfile::tempdir().unwrap();
@@ -470,8 +456,8 @@ fn shards_merge_into_the_whole_campaign() {
     let o = ugl(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
-        data_files(&whole),
-        data_files(&merged),
+        common::parquet_files(&whole),
+        common::parquet_files(&merged),
         "the union of the shards equals the whole campaign"
     );
     // Merging again is a no-op; a conflicting run is refused.
