@@ -252,9 +252,15 @@ fn training_bars(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<TrainSin
             };
             b.set_style(
                 ProgressStyle::with_template(
-                    "  train {prefix:32} {bar:25} {pos}/{len} it  {per_sec}  ETA {eta}  loss {msg}",
+                    "  train {prefix:32} {bar:25} {pos}/{len} it  {rate}  ETA {eta}  loss {msg}",
                 )
-                .expect("valid template"),
+                .expect("valid template")
+                .with_key(
+                    "rate",
+                    |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = write!(w, "{:.1} it/s", s.per_sec());
+                    },
+                ),
             );
             b.set_prefix(label.to_string());
             b
