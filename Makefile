@@ -28,7 +28,7 @@ check-toolchain:
 
 # The report renders from the committed results of the MAIN campaign (default: paper) plus the
 # budget-* campaigns. Without results, run `make campaign PROFILE=paper` first (about 2 h on 2
-# cores; `make report MAIN=quick` after `make campaign PROFILE=quick` for a 15-minute look).
+# cores; `make report MAIN=quick` after `make campaign PROFILE=quick` for an 11-minute look).
 MAIN ?= paper
 report: check-toolchain
 	@if ! ls $(RESULTS)/$(MAIN)/*.json >/dev/null 2>&1; then \
