@@ -27,7 +27,7 @@ check-toolchain:
 	  echo "error: rustc $$v is too old; ugl-bench needs Rust $(MIN_RUST) or newer (rustup update)" >&2; exit 1; fi
 
 # The report renders from the committed results of the MAIN campaign (default: paper) plus the
-# budget-* campaigns. Without results, run `make campaign PROFILE=paper` first (about 2 h on 2
+# budget-* campaigns. Without results, run `make campaign PROFILE=paper` first (about 2-2.5 h on 2
 # cores; `make report MAIN=quick` after `make campaign PROFILE=quick` for an 11-minute look).
 MAIN ?= paper
 report: check-toolchain
