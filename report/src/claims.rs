@@ -374,12 +374,12 @@ pub fn evaluate(
             let set = claim.relation.interval(margin);
             let mut comparisons = Vec::new();
             for s in conditions.iter().filter(|c| claim.subject.matches(&c.key)) {
+                let xs = values(store, s, claim.statistic);
                 for r in conditions.iter().filter(|c| {
                     c.key != s.key
                         && claim.reference.matches(&c.key)
                         && same_on(&claim.pair_on, &s.key, &c.key)
                 }) {
-                    let xs = values(store, s, claim.statistic);
                     let ys = values(store, r, claim.statistic);
                     let label = format!("claim|{}|{}|{}", claim.id, s.key.slug(), r.key.slug());
                     let Some((diff, lo, hi)) = stats::difference_of_means_ci(
