@@ -22,12 +22,18 @@ pub enum ClaimsInput<'a> {
     Missing(&'a std::path::Path),
 }
 
-fn verdict_mark(v: Verdict) -> &'static str {
+/// The symbol of a verdict.
+fn mark(v: Verdict) -> &'static str {
     match v {
-        Verdict::Reproduced => "✅ reproduced",
-        Verdict::NotReproduced => "❌ not reproduced",
-        Verdict::Inconclusive => "❔ inconclusive",
+        Verdict::Reproduced => "✅",
+        Verdict::NotReproduced => "❌",
+        Verdict::Inconclusive => "❔",
     }
+}
+
+/// The symbol and the verdict in words: `✅ reproduced`.
+fn verdict_mark(v: Verdict) -> String {
+    format!("{} {}", mark(v), v.label())
 }
 
 fn value(statistic: Statistic, v: f64) -> String {
@@ -49,19 +55,15 @@ fn signed(statistic: Statistic, v: f64) -> String {
 /// One comparison on one line: `ArmBall, RGE-VAE (faithful), KDE goals, 2 latents − RGE-EFR:
 /// Δ = −0.52 [−0.71, −0.33] ✅`.
 fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
-    let mark = match c.verdict {
-        Verdict::Reproduced => "✅",
-        Verdict::NotReproduced => "❌",
-        Verdict::Inconclusive => "❔",
-    };
     format!(
-        "{}: {} vs {}: Δ = {} [{}, {}] {mark}",
+        "{}: {} vs {}: Δ = {} [{}, {}] {}",
         env_name(&c.subject.env),
         describe_key(&c.subject),
         describe_key(&c.reference),
         signed(statistic, c.diff),
         signed(statistic, c.lo),
         signed(statistic, c.hi),
+        mark(c.verdict),
     )
 }
 
