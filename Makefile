@@ -11,7 +11,7 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test campaign bench verify verify-update check-toolchain
+.PHONY: help report test campaign bench verify verify-update check-toolchain check-shared-build
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
@@ -51,6 +51,15 @@ bench: check-toolchain
 # (`make verify-update`).
 verify: check-toolchain
 	$(CARGO) test --test verify_smoke
+
+# `make report` / `make campaign` (cargo run) must reuse the artifacts of `make test` (cargo test
+# --workspace): one feature resolution for both (root Cargo.toml, "Feature unification"). Run after
+# `make test` (CI does): fails if building the binary would compile any crate again.
+check-shared-build: check-toolchain
+	@rebuilt=$$($(CARGO) build --bin ugl --message-format=json 2>/dev/null | grep -c '"fresh":false' || true); \
+	if [ "$$rebuilt" != "0" ]; then \
+	  echo "error: cargo run --bin ugl recompiles $$rebuilt crates after cargo test --workspace: the feature sets differ (see Cargo.toml, Feature unification)" >&2; exit 1; fi; \
+	echo "check-shared-build: make report reuses the test build (0 crates recompiled)"
 
 verify-update: check-toolchain
 	UGL_VERIFY_UPDATE=1 $(CARGO) test --test verify_smoke -- --nocapture

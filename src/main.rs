@@ -103,6 +103,15 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// rge-external: the command line of a program speaking the external-learner protocol
+        /// (docs/external-learners.md), run with `sh -c`; replaces the profile's
+        /// [learners.external] command.
+        #[arg(long)]
+        command: Option<String>,
+        /// rge-external: the program's name in results and the report (default: the profile's
+        /// [learners.external] name, else `external`).
+        #[arg(long)]
+        name: Option<String>,
         #[command(flatten)]
         cache: CacheArgs,
     },
@@ -331,6 +340,8 @@ fn dispatch(cmd: Command) -> Result<()> {
             epochs,
             profile,
             out,
+            command,
+            name,
             cache,
         } => run(
             RunArgs {
@@ -342,6 +353,8 @@ fn dispatch(cmd: Command) -> Result<()> {
                 images,
                 seed,
                 epochs,
+                command,
+                name,
             },
             &profile,
             &out,
@@ -488,6 +501,8 @@ struct RunArgs {
     images: Option<usize>,
     seed: u64,
     epochs: Option<usize>,
+    command: Option<String>,
+    name: Option<String>,
 }
 
 fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
@@ -540,11 +555,38 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
             a.algo
         );
     }
-    if a.algo.learner() == Some(Learner::External) && cfg.learners.external.is_none() {
+    let external = a.algo.learner() == Some(Learner::External);
+    if !external && (a.command.is_some() || a.name.is_some()) {
         bail!(
-            "--algo rge-external needs a [learners.external] section (name, command) in the profile {}",
-            path.display()
+            "--command and --name apply to --algo rge-external only, not {}",
+            a.algo
         );
+    }
+    if external {
+        if let Some(cmd) = &a.command {
+            if cmd.trim().is_empty() {
+                bail!("--command must not be empty");
+            }
+            let name = a
+                .name
+                .clone()
+                .or_else(|| cfg.learners.external.as_ref().map(|e| e.name.clone()))
+                .unwrap_or_else(|| "external".into());
+            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
+                name,
+                command: cmd.clone(),
+            });
+        } else if let (Some(name), Some(e)) = (&a.name, cfg.learners.external.as_mut()) {
+            e.name = name.clone();
+        }
+        if cfg.learners.external.is_none() {
+            bail!(
+                "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                path.display()
+            );
+        }
+        cfg.validate()
+            .map_err(|m| anyhow::anyhow!("--name/--command: {m}"))?;
     }
     check_out_dir(out)?;
     let cache = cache.resolve(out);

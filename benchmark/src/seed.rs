@@ -29,6 +29,10 @@ pub enum Component {
     Dataset,
     /// Learner initialisation and mini-batches.
     Learner,
+    /// The sampling noise of a stochastic encoder while a run encodes its outcomes (the
+    /// faithful RFVAE encodes with fresh noise). Drawn from the run's own seed, never from the
+    /// fitted model, so that runs sharing an encoder do not depend on each other's order.
+    Encoding,
 }
 
 impl Component {
@@ -41,6 +45,7 @@ impl Component {
             Component::Noise => "noise",
             Component::Dataset => "dataset",
             Component::Learner => "learner",
+            Component::Encoding => "encoding",
         }
     }
 }

@@ -149,6 +149,13 @@ impl Manifest {
     pub fn host(&self) -> Option<String> {
         self.text(&["host", "hostname"])
     }
+    /// `CPU model (SIMD level)`, from the manifest's `cpu` object.
+    pub fn cpu(&self) -> Option<String> {
+        let cpu = self.raw.get("cpu")?;
+        let model = cpu.get("model").and_then(Value::as_str)?;
+        let simd = cpu.get("simd").and_then(Value::as_str).unwrap_or("?");
+        Some(format!("{model} ({simd})"))
+    }
     pub fn threads(&self) -> Option<String> {
         self.text(&["threads", "n_threads", "thread_count"])
     }

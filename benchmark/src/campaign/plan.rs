@@ -87,6 +87,21 @@ impl RunSpec {
         }
     }
 
+    /// The identity the run's exploration streams derive from (random/goal choice, motor
+    /// parameters, goals, meta-policy noise, encoding noise): for a learned goal space
+    /// `explore/env=armball/sampler=kde/latents=10/seed=3`, without the learner and the
+    /// variant, so that every learner of a cell draws the same streams and runs pair across
+    /// learners (`ugl compare`, probability of improvement). Baselines use [`Self::identity`].
+    pub fn exploration_identity(&self) -> String {
+        match self.algo.learner() {
+            None => self.identity(),
+            Some(_) => format!(
+                "explore/env={}/sampler={}/latents={}/seed={}",
+                self.env, self.sampler, self.latents, self.seed
+            ),
+        }
+    }
+
     /// File-name-safe identity: `armball.rge-efr.s3`, `armball.rge-pca.kde.l10.s3`,
     /// `armball.rge-vae.corrected.kde.l10.s3`.
     pub fn run_id(&self) -> String {

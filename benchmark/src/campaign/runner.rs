@@ -10,6 +10,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::config::{CampaignConfig, LearnersConfig, UglConfig};
+use super::machine::{cpu_info, host_name};
 use super::plan::{RunSpec, plan};
 use super::store::{self, Manifest, StoreError, Summary};
 use crate::env::{EnvConfig, Environment, make_env};
@@ -20,6 +21,7 @@ use crate::explore::{
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
+use crate::repr::evidence::TrainingEvidence;
 use crate::repr::external::ExternalLearner;
 use crate::repr::isomap::Isomap;
 use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
@@ -28,7 +30,10 @@ use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 /// Bumped whenever a change alters results for the same configuration.
-pub const RESULTS_VERSION: u32 = 1;
+/// 2: exploration streams of learned goal spaces derive from
+/// [`RunSpec::exploration_identity`] (paired across learners), and a stochastic encoder draws
+/// its noise from the run's own stream (order-independent results).
+pub const RESULTS_VERSION: u32 = 2;
 
 /// Errors of a run or campaign.
 #[derive(Debug, Error)]
@@ -131,6 +136,9 @@ pub struct TrainInfo {
     pub cache: &'static str,
     /// The cache key (BLAKE3 of everything the model depends on).
     pub key: String,
+    /// The final loss against the data set's mean-image loss (the plateau), and whether the
+    /// network left it ([`TrainingEvidence`]).
+    pub evidence: TrainingEvidence,
 }
 
 /// Build the learner of an algorithm from the configuration; `variant` is used by the
@@ -245,11 +253,13 @@ fn fit_neural(
         }
     };
     let z = enc.training_latents(images)?;
+    let evidence = TrainingEvidence::new(images, &enc.losses, cfg.iterations);
     let info = TrainInfo {
         config: cfg,
         losses: enc.losses.clone(),
         cache: status,
         key,
+        evidence,
     };
     Ok((Box::new(enc), z, info))
 }
@@ -323,7 +333,7 @@ pub fn explore(
     ctx: &RunContext,
     repr: Option<&mut Representation>,
 ) -> Result<Explored, RunError> {
-    let seed = run_seed(ctx.campaign_seed, &spec.identity());
+    let seed = run_seed(ctx.campaign_seed, &spec.exploration_identity());
     let env = make_env(spec.env, ctx.env);
     let env: &dyn Environment = env.as_ref();
     let d = env.state_dim();
@@ -364,6 +374,7 @@ pub fn explore(
                     ))));
                 }
             };
+            repr.encoder.begin_run(stream(seed, Component::Encoding));
             let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
             let log = run_rge(env, &mut space, sampler.as_mut(), ctx.explore, seed);
             if let Some(e) = space.error.take() {
@@ -449,6 +460,12 @@ pub fn execute(
                 t.config.hidden, p.hidden
             ));
         }
+        if t.config.init != p.init {
+            notes.push(format!(
+                "{} weight init instead of the paper's truncated normal (std 0.001)",
+                t.config.init
+            ));
+        }
         if t.config.batch != p.batch || t.config.lr != p.lr {
             notes.push(format!(
                 "batch {} / lr {} instead of the paper's {} / {}",
@@ -466,7 +483,7 @@ pub fn execute(
         variant: spec.variant.map(|v| v.name()).unwrap_or("none").into(),
         learner: learner_name,
         seed: spec.seed,
-        run_seed: run_seed(ctx.campaign_seed, &spec.identity()),
+        run_seed: run_seed(ctx.campaign_seed, &spec.exploration_identity()),
         campaign: ctx.campaign.into(),
         campaign_seed: ctx.campaign_seed,
         profile: ctx.profile.into(),
@@ -493,6 +510,7 @@ pub fn execute(
         external: (spec.algo.learner() == Some(Learner::External))
             .then(|| serde_json::to_value(&ctx.learners.external).expect("serialisable")),
         host: host_name().into(),
+        cpu: Some(cpu_info().clone()),
         summary: summary.clone(),
     };
     store::write_run(out, spec, &log, &manifest)?;
@@ -684,18 +702,5 @@ pub fn git_revision() -> &'static str {
             }
             None => "unknown".into(),
         }
-    })
-}
-
-/// The host name (from /etc/hostname or $HOSTNAME).
-pub fn host_name() -> &'static str {
-    static HOST: OnceLock<String> = OnceLock::new();
-    HOST.get_or_init(|| {
-        std::fs::read_to_string("/etc/hostname")
-            .ok()
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-            .or_else(|| std::env::var("HOSTNAME").ok())
-            .unwrap_or_else(|| "unknown".into())
     })
 }

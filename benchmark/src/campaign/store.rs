@@ -56,7 +56,8 @@ pub struct Manifest {
     #[serde(default)]
     pub learner: Option<String>,
     pub seed: u64,
-    /// The RNG seed derived from (campaign seed, identity).
+    /// The seed of the run's exploration streams, derived from (campaign seed,
+    /// [`super::RunSpec::exploration_identity`]).
     pub run_seed: u64,
     pub campaign: String,
     pub campaign_seed: u64,
@@ -93,6 +94,9 @@ pub struct Manifest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub external: Option<serde_json::Value>,
     pub host: String,
+    /// The CPU model and SIMD level (absent in manifests written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu: Option<super::machine::CpuInfo>,
     pub summary: Summary,
 }
 

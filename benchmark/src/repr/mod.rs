@@ -9,6 +9,7 @@
 pub mod ae;
 pub mod cache;
 pub mod dataset;
+pub mod evidence;
 pub mod external;
 pub mod isomap;
 pub mod nets;
@@ -108,6 +109,14 @@ pub trait Encoder: Send {
     /// The model's prior over latents, where it has one (VAE-type models).
     fn prior(&self) -> Option<GaussianPrior> {
         None
+    }
+    /// Start encoding for a new run: a stochastic encoder (one that draws noise when it
+    /// encodes) takes all its noise from `rng` from now on. The harness calls it before every
+    /// run with the run's own stream ([`crate::seed::Component::Encoding`]), so a run's
+    /// encodings depend on its identity only, never on which runs used the encoder before it.
+    /// Deterministic encoders ignore it (the default).
+    fn begin_run(&mut self, rng: Stream) {
+        let _ = rng;
     }
 }
 

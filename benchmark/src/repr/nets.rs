@@ -2,8 +2,9 @@
 //! flattened pixels, on burn's `flex` CPU backend.
 //!
 //! - [`HostNet`]: the weights on the host (`Vec<f32>`, row-major `[in, out]` like TF's
-//!   `tf.matmul(x, W)`), initialised from the learner's stream ([`HostNet::init`]: truncated
-//!   normal, std 0.001, cut at 2 std, biases 0), and a sparse-aware single-image forward pass
+//!   `tf.matmul(x, W)`), initialised from the learner's stream ([`HostNet::init`], [`Init`]:
+//!   the paper's truncated normal with std 0.001, or He / Glorot; biases 0), and a sparse-aware
+//!   single-image forward pass
 //!   used for every encoding.
 //! - [`DenseNet`]: the same weights as a burn module (six [`Linear`] layers) for training.
 //! - [`bce_with_logits_sum`], [`kl_std_normal`]: the loss pieces.
@@ -22,6 +23,7 @@ use burn::nn::Linear;
 use burn::optim::{Optimizer, RecordState, StateSink, StateSource};
 use burn::tensor::activation::{log_sigmoid, relu};
 use burn::tensor::{Device, Tensor, TensorData};
+use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -31,6 +33,64 @@ use crate::seed::Stream;
 
 /// Standard deviation of the initial weights (all of the original's dense layers).
 pub const INIT_STD: f64 = 0.001;
+
+/// How the weights of a network are drawn (`init` in `[learners.ae|vae|rfvae]`). Biases start
+/// at 0 in every scheme. Every draw comes from the learner's stream.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Init {
+    /// The original code's: TF `truncated_normal(stddev = 0.001)` for every layer
+    /// ([`INIT_STD`]). With 4900-512-256 layers its ReLUs die and training stays on the
+    /// mean-image plateau for thousands of iterations (README "Neural goal spaces").
+    #[default]
+    Paper,
+    /// He (Kaiming) normal for ReLU layers, as Keras' `he_normal`: a normal truncated at 2 std
+    /// with std `sqrt(2 / fan_in) / 0.8796` (the truncation's variance loss corrected), so
+    /// the weights' variance is `2 / fan_in` (He et al. 2015, eq. 10).
+    He,
+    /// Glorot (Xavier) uniform: `U(-a, a)`, `a = sqrt(6 / (fan_in + fan_out))` (Glorot and
+    /// Bengio 2010, eq. 16); `fan_out` is the width of the block being drawn.
+    Glorot,
+}
+
+impl Init {
+    /// Every scheme, in the order of the docs.
+    pub const ALL: [Init; 3] = [Init::Paper, Init::He, Init::Glorot];
+
+    /// The name in TOML files and manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            Init::Paper => "paper",
+            Init::He => "he",
+            Init::Glorot => "glorot",
+        }
+    }
+
+    /// `fan_in x fan_out` weights, row-major, drawn from `rng`.
+    pub fn draw(self, rng: &mut Stream, fan_in: usize, fan_out: usize) -> Vec<f32> {
+        let n = fan_in * fan_out;
+        match self {
+            Init::Paper => truncated_normal(rng, n, INIT_STD),
+            Init::He => {
+                // Std of a standard normal truncated to [-2, 2].
+                const TRUNC_STD: f64 = 0.879_625_676_687_676_9;
+                truncated_normal(rng, n, (2.0 / fan_in as f64).sqrt() / TRUNC_STD)
+            }
+            Init::Glorot => {
+                let a = (6.0 / (fan_in + fan_out) as f64).sqrt();
+                (0..n)
+                    .map(|_| (a * (2.0 * rng.random::<f64>() - 1.0)) as f32)
+                    .collect()
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Init {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// `n` draws of TF's `truncated_normal(stddev = std)`: a standard normal redrawn until it lies
 /// within 2 standard deviations, times `std`.
@@ -59,12 +119,12 @@ pub struct HostLayer {
 impl HostLayer {
     /// Truncated-normal weights (one block per entry of `widths`, drawn in order and laid side
     /// by side as columns), zero biases.
-    fn init(rng: &mut Stream, inp: usize, widths: &[usize]) -> HostLayer {
+    fn init(rng: &mut Stream, init: Init, inp: usize, widths: &[usize]) -> HostLayer {
         let out: usize = widths.iter().sum();
         let mut w = vec![0.0f32; inp * out];
         let mut col = 0;
         for &width in widths {
-            let block = truncated_normal(rng, inp * width, INIT_STD);
+            let block = init.draw(rng, inp, width);
             for i in 0..inp {
                 w[i * out + col..i * out + col + width]
                     .copy_from_slice(&block[i * width..(i + 1) * width]);
@@ -147,18 +207,19 @@ impl HostNet {
     /// the head blocks (`head_blocks`, in order), then the decoder layers.
     pub fn init(
         rng: &mut Stream,
+        init: Init,
         dim: usize,
         hidden: [usize; 2],
         latents: usize,
         head_blocks: &[usize],
     ) -> HostNet {
         let [h1, h2] = hidden;
-        let enc1 = HostLayer::init(rng, dim, &[h1]);
-        let enc2 = HostLayer::init(rng, h1, &[h2]);
-        let head = HostLayer::init(rng, h2, head_blocks);
-        let dec1 = HostLayer::init(rng, latents, &[h2]);
-        let dec2 = HostLayer::init(rng, h2, &[h1]);
-        let dec_out = HostLayer::init(rng, h1, &[dim]);
+        let enc1 = HostLayer::init(rng, init, dim, &[h1]);
+        let enc2 = HostLayer::init(rng, init, h1, &[h2]);
+        let head = HostLayer::init(rng, init, h2, head_blocks);
+        let dec1 = HostLayer::init(rng, init, latents, &[h2]);
+        let dec2 = HostLayer::init(rng, init, h2, &[h1]);
+        let dec_out = HostLayer::init(rng, init, h1, &[dim]);
         HostNet {
             dim,
             hidden,
@@ -493,5 +554,72 @@ impl Optimizer for TfAdagrad {
 
     fn to_device<const D: usize>(state: Self::State<D>, _device: &Device) -> Self::State<D> {
         state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seed::stream_named;
+
+    fn moments(w: &[f32]) -> (f64, f64, f64) {
+        let n = w.len() as f64;
+        let mean = w.iter().map(|&v| v as f64).sum::<f64>() / n;
+        let var = w.iter().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / n;
+        let max = w.iter().map(|v| v.abs() as f64).fold(0.0, f64::max);
+        (mean, var.sqrt(), max)
+    }
+
+    #[test]
+    fn each_init_has_its_documented_scale() {
+        let (fan_in, fan_out) = (400, 300);
+        let draw = |init: Init| init.draw(&mut stream_named(3, "init-test"), fan_in, fan_out);
+        // Paper: truncated normal, std 0.001 before truncation (0.00088 after), cut at 2 std.
+        let (m, s, max) = moments(&draw(Init::Paper));
+        assert!(
+            m.abs() < 1e-5 && (s - 0.001 * 0.8796).abs() < 2e-5,
+            "{m} {s}"
+        );
+        assert!(max <= 0.002 + 1e-9);
+        // The paper's draws are exactly the original truncated normal's.
+        assert_eq!(
+            draw(Init::Paper),
+            truncated_normal(
+                &mut stream_named(3, "init-test"),
+                fan_in * fan_out,
+                INIT_STD
+            )
+        );
+        // He: variance 2 / fan_in.
+        let (m, s, _) = moments(&draw(Init::He));
+        let he = (2.0 / fan_in as f64).sqrt();
+        assert!(
+            m.abs() < 1e-3 && (s / he - 1.0).abs() < 0.01,
+            "{m} {s} vs {he}"
+        );
+        // Glorot: uniform on +-sqrt(6 / (fan_in + fan_out)), std a / sqrt(3).
+        let (m, s, max) = moments(&draw(Init::Glorot));
+        let a = (6.0 / (fan_in + fan_out) as f64).sqrt();
+        assert!(
+            m.abs() < 1e-3 && (s / (a / 3f64.sqrt()) - 1.0).abs() < 0.01,
+            "{m} {s}"
+        );
+        assert!(max <= a && max > 0.99 * a);
+        // Same stream, same weights; another scheme, other weights.
+        assert_eq!(draw(Init::He), draw(Init::He));
+        assert_ne!(draw(Init::He), draw(Init::Glorot));
+    }
+
+    #[test]
+    fn init_names_round_trip_through_toml() {
+        #[derive(Deserialize)]
+        struct T {
+            init: Init,
+        }
+        for init in Init::ALL {
+            let t: T = toml::from_str(&format!("init = \"{init}\"")).unwrap();
+            assert_eq!(t.init, init);
+        }
+        assert!(toml::from_str::<T>("init = \"kaiming-normal\"").is_err());
     }
 }

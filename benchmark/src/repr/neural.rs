@@ -27,6 +27,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use super::nets::Init;
 use super::nets::{DenseNet, HostNet, Scratch, TfAdagrad, TfAdam};
 use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_input, check_latents};
 use crate::repr::{ae, rfvae, vae};
@@ -145,6 +146,10 @@ pub struct NeuralConfig {
     /// RFVAE only: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000
     /// of 50,000); ignored by the AE and VAE.
     pub warmup: usize,
+    /// How the weights are drawn (paper: truncated normal, std 0.001). Absent in manifests
+    /// written before it was configurable, which all used the paper's.
+    #[serde(default)]
+    pub init: Init,
 }
 
 impl NeuralConfig {
@@ -161,6 +166,7 @@ impl NeuralConfig {
                 Model::Rfvae => rfvae::ANNEAL_STEPS,
                 Model::Ae | Model::Vae => 0,
             },
+            init: Init::Paper,
         }
     }
 
@@ -221,6 +227,8 @@ pub struct NeuralSection {
     pub log_every: Option<usize>,
     /// RFVAE warm-up iterations (only valid in `[learners.rfvae]`).
     pub warmup: Option<usize>,
+    /// Weight initialisation: `paper`, `he` or `glorot` ([`Init`]).
+    pub init: Option<Init>,
 }
 
 impl NeuralSection {
@@ -235,6 +243,7 @@ impl NeuralSection {
             variant,
             log_every: self.log_every.unwrap_or(p.log_every),
             warmup: self.warmup.unwrap_or(p.warmup),
+            init: self.init.unwrap_or(p.init),
         }
     }
 }
@@ -337,9 +346,12 @@ pub struct NeuralEncoder {
     pub variant: Variant,
     pub net: HostNet,
     pub losses: Vec<(usize, f64)>,
-    /// The seed of the encoder's own stream (drawn from the learner stream after training).
+    /// The seed of the encoder's own stream (drawn from the learner stream after training):
+    /// it draws the faithful RFVAE's training latents (z0 samples the KDE is fitted on).
     pub encode_seed: [u8; 32],
-    /// The stream of the faithful RFVAE's stochastic encoding (unused by the others).
+    /// The stream of the faithful RFVAE's stochastic encoding (unused by the others): seeded
+    /// from `encode_seed`, then replaced by each run's own stream
+    /// ([`Encoder::begin_run`]).
     rng: Stream,
     scratch: Scratch,
 }
@@ -404,7 +416,8 @@ impl NeuralEncoder {
     }
 
     /// The training latents (what the KDE is fitted on). Faithful RFVAE: z0 samples
-    /// `mu + eps sigma` (the original's `transform(X, sampling=True)`); otherwise the encoding.
+    /// `mu + eps sigma` (the original's `transform(X, sampling=True)`), with noise from a fresh
+    /// stream seeded by `encode_seed` (a function of the model alone); otherwise the encoding.
     pub fn training_latents(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
         if !self.is_stochastic() {
             return self.encode(images);
@@ -412,9 +425,12 @@ impl NeuralEncoder {
         self.check_dim(images.dim)?;
         let d = self.net.latents;
         let mut data = vec![0.0; images.n * d];
+        // A fresh stream from the model's own seed: the same training latents whenever this is
+        // called, whatever was encoded before.
+        let mut rng = Stream::from_seed(self.encode_seed);
         for (i, out) in data.chunks_exact_mut(d).enumerate() {
             let head = self.net.encode_head(images.row(i), &mut self.scratch);
-            rfvae::z0_sample(&head, d, &mut self.rng, out);
+            rfvae::z0_sample(&head, d, &mut rng, out);
         }
         let z = Latents {
             n: images.n,
@@ -429,6 +445,10 @@ impl NeuralEncoder {
 impl Encoder for NeuralEncoder {
     fn latents(&self) -> usize {
         self.net.latents
+    }
+
+    fn begin_run(&mut self, rng: Stream) {
+        self.rng = rng;
     }
 
     fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
@@ -516,7 +536,14 @@ pub fn init_net(
     latents: usize,
     rng: &mut Stream,
 ) -> HostNet {
-    HostNet::init(rng, dim, cfg.hidden, latents, &model.head_blocks(latents))
+    HostNet::init(
+        rng,
+        cfg.init,
+        dim,
+        cfg.hidden,
+        latents,
+        &model.head_blocks(latents),
+    )
 }
 
 /// Draw the mini-batch: the first `k` entries of a fresh uniform permutation of `perm`'s

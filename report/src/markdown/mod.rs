@@ -309,6 +309,12 @@ pub fn render(inp: &Inputs<'_>) -> String {
     );
     let _ = writeln!(
         w,
+        "- **CPU (SIMD level):** {}. Results are bit-for-bit reproducible within one SIMD level \
+         (README, Reproducibility).",
+        distinct(runs.iter().map(|r| r.manifest.cpu()))
+    );
+    let _ = writeln!(
+        w,
         "- **Threads:** {}.",
         distinct(runs.iter().map(|r| r.manifest.threads()))
     );
