@@ -33,6 +33,9 @@ pub enum Component {
     /// faithful RFVAE encodes with fresh noise). Drawn from the run's own seed, never from the
     /// fitted model, so that runs sharing an encoder do not depend on each other's order.
     Encoding,
+    /// The held-out images on which a representation's latent quality is measured (states and,
+    /// for a stochastic encoder, its encoding noise), drawn from the data set's seed.
+    HeldOut,
 }
 
 impl Component {
@@ -46,6 +49,7 @@ impl Component {
             Component::Dataset => "dataset",
             Component::Learner => "learner",
             Component::Encoding => "encoding",
+            Component::HeldOut => "held-out",
         }
     }
 }

@@ -100,6 +100,32 @@ fn python_random_projection_protocol() {
     ));
     enc.encode_one(set.row(3), &mut out).unwrap();
 
+    // The helper module reports the program's own fit time on the READY line.
+    let fit_s = enc
+        .reported_fit_s()
+        .expect("ugl_protocol.serve reports fit_s");
+    assert!((0.0..60.0).contains(&fit_s), "{fit_s}");
+
+    // Repeated images are answered from the run's cache: one request per distinct image.
+    enc.begin_run(stream_named(0, "encoding"));
+    let sent = enc.requests_sent;
+    for _ in 0..5 {
+        enc.encode_one(set.row(11), &mut out).unwrap();
+    }
+    assert!(close(&out, z.row(11)));
+    assert_eq!(
+        enc.requests_sent,
+        sent + 1,
+        "one request for 5 identical images"
+    );
+    enc.begin_run(stream_named(1, "encoding"));
+    enc.encode_one(set.row(11), &mut out).unwrap();
+    assert_eq!(
+        enc.requests_sent,
+        sent + 2,
+        "a new run starts with an empty cache"
+    );
+
     // Same stream, same model; another stream, another model.
     let (enc2, z2) = fit_external(&learner, &set, 5, 42).unwrap();
     assert_eq!(z.data, z2.data, "same seed, same latents");
@@ -431,4 +457,95 @@ fn round_trip_timing() {
         "external random projection (python3 + numpy), latents 10: encode_one round trip {one:?} per image ({reps} calls); batch encode of 1000 images {batch:?} per image"
     );
     enc.shutdown().unwrap();
+}
+
+#[test]
+fn ready_line_may_carry_the_fit_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let z = npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+    let t = dir.path().join("z.npy");
+    std::fs::write(&t, &z).unwrap();
+    let with = |ready: &str| {
+        format!(
+            "cat '{}' > \"$UGL_TRAIN_LATENTS\"; echo '{ready}'; cat > /dev/null",
+            t.display()
+        )
+    };
+    let (enc, _) =
+        fit_external(&sh("timed", &with("READY fit_s=12.25")), &images(3), 2, 0).unwrap();
+    assert_eq!(enc.reported_fit_s(), Some(12.25));
+    let (enc, _) = fit_external(&sh("plain", &with("READY")), &images(3), 2, 0).unwrap();
+    assert_eq!(enc.reported_fit_s(), None);
+    let m = external_msg(fit_external(
+        &sh("bad", &with("READY fit_s=soon")),
+        &images(3),
+        2,
+        0,
+    ));
+    assert!(m.contains("fit_s must be a number"), "{m}");
+    let m = external_msg(fit_external(
+        &sh("bad", &with("READY loss=3")),
+        &images(3),
+        2,
+        0,
+    ));
+    assert!(m.contains("unknown field") && m.contains("loss=3"), "{m}");
+}
+
+#[test]
+fn identical_images_are_sent_once_per_run() {
+    // A learner that answers every request with the number of requests answered so far: a
+    // cached answer is visible as an unchanged count.
+    if Command::new("python3")
+        .arg("-c")
+        .arg("pass")
+        .status()
+        .is_err()
+    {
+        eprintln!("SKIPPED: python3 not found");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let z = npy_f64(3, 1, &[0.0, 0.0, 0.0]);
+    let t = dir.path().join("z.npy");
+    std::fs::write(&t, &z).unwrap();
+    let script = dir.path().join("count.py");
+    std::fs::write(
+        &script,
+        r#"import struct, sys
+inp, out = sys.stdin.buffer, sys.stdout.buffer
+out.write(b"READY\n"); out.flush()
+count = 0
+while True:
+    head = inp.read(10)
+    if len(head) < 10:
+        break
+    hlen = int.from_bytes(head[8:10], "little")
+    inp.read(hlen + 4900 * 4)
+    count += 1
+    h = "{'descr': '<f8', 'fortran_order': False, 'shape': (1, 1), }"
+    h = h + " " * (-(10 + len(h) + 1) % 64) + "\n"
+    out.write(b"\x93NUMPY\x01\x00" + len(h).to_bytes(2, "little") + h.encode() + struct.pack("<d", count))
+    out.flush()
+"#,
+    )
+    .unwrap();
+    let cmd = format!(
+        "cat '{}' > \"$UGL_TRAIN_LATENTS\"; exec python3 '{}'",
+        t.display(),
+        script.display()
+    );
+    let (mut enc, _) = fit_external(&sh("counter", &cmd), &images(3), 1, 0).unwrap();
+    let set = images(3);
+    let mut out = [0.0];
+    let mut got = Vec::new();
+    for i in [0, 1, 0, 0, 2, 1] {
+        enc.encode_one(set.row(i), &mut out).unwrap();
+        got.push(out[0]);
+    }
+    assert_eq!(got, [1.0, 2.0, 1.0, 1.0, 3.0, 2.0]);
+    assert_eq!((enc.requests_sent, enc.cache_hits), (3, 3));
+    enc.begin_run(stream_named(0, "encoding"));
+    enc.encode_one(set.row(0), &mut out).unwrap();
+    assert_eq!(out[0], 4.0, "the cache is per run");
 }

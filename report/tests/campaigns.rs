@@ -175,7 +175,17 @@ fn write_run(dir: &Path, s: &Spec) {
                 "cache": "miss",
                 // One training per (env, learner, latents, variant, seed): shared by the samplers.
                 "key": format!("{}-{l}-{}-{}-{}-{it}", s.env, s.latents, s.variant, s.seed),
+                // Seed 0 stays on the plateau, the others learn.
+                "evidence": {"plateau_loss": 440.0, "final_loss": if s.seed == 0 { 430.0 } else { 88.0 },
+                             "loss_fraction": if s.seed == 0 { 430.0 / 440.0 } else { 0.2 },
+                             "trained": s.seed != 0, "untrained_fraction": 0.8},
             }),
+        );
+    }
+    if s.latents > 0 {
+        manifest.as_object_mut().unwrap().insert(
+            "latent_quality".into(),
+            serde_json::json!({"linear_r2_mean": 0.5 + 0.1 * s.seed as f64, "knn_r2_mean": 0.9}),
         );
     }
     std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
@@ -295,6 +305,19 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
             && compute.contains("and 9.5 min exploring"),
         "{compute}"
     );
+    // The goal-space quality table: seed 0 of every neural cell is untrained.
+    let q = &md[md
+        .find("## Did the goal spaces learn?")
+        .expect("quality section")..];
+    let row = q
+        .lines()
+        .find(|l| l.starts_with("| ArmBall | RGE-VAE | faithful |"))
+        .expect("a VAE row");
+    assert!(
+        row.contains("**1 of 3**") && row.contains("| 0.600 | 0.900 |"),
+        "{row}"
+    );
+    assert!(q.contains("did not leave the plateau"), "{q}");
     let fig = |n: &str| out.join("figures").join(n);
     for name in [
         "klc_armball.svg",

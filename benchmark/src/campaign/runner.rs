@@ -26,13 +26,15 @@ use crate::repr::external::ExternalLearner;
 use crate::repr::isomap::Isomap;
 use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
 use crate::repr::pca::{CentredPca, TruncatedSvd};
+use crate::repr::quality::{self, LatentQuality};
 use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 /// Bumped whenever a change alters results for the same configuration.
 /// 2: exploration streams of learned goal spaces derive from
 /// [`RunSpec::exploration_identity`] (paired across learners), and a stochastic encoder draws
-/// its noise from the run's own stream (order-independent results).
+/// its noise from the run's own stream (order-independent results); the KDE's square root of
+/// its covariance comes from faer's symmetric eigen-solver (was: cyclic Jacobi).
 pub const RESULTS_VERSION: u32 = 2;
 
 /// Errors of a run or campaign.
@@ -122,6 +124,40 @@ pub struct Representation {
     pub learner_name: String,
     /// Training details of a neural representation.
     pub training: Option<TrainInfo>,
+    /// How well the true object state can be read off the latents (None if it could not be
+    /// measured; the reason is logged).
+    pub quality: Option<LatentQuality>,
+}
+
+/// Held-out images of the latent-quality measure, and training images it encodes.
+pub const QUALITY_HELDOUT: usize = 1000;
+pub const QUALITY_TRAIN: usize = 2000;
+
+/// Measure the latent quality of a fitted encoder: regressions fitted on the encodings of the
+/// first [`QUALITY_TRAIN`] training images, scored on [`QUALITY_HELDOUT`] fresh images from the
+/// data set's held-out stream. A stochastic encoder draws its noise from that stream too, and
+/// every run resets it ([`Encoder::begin_run`]), so this changes no run's results.
+fn measure_quality(
+    encoder: &mut dyn Encoder,
+    env: &dyn Environment,
+    data: &crate::repr::dataset::UglDataset,
+    ds_seed: u64,
+) -> Result<LatentQuality, ReprError> {
+    let d = env.state_dim();
+    let mut rng = stream(ds_seed, Component::HeldOut);
+    let heldout = generate(env, QUALITY_HELDOUT, &mut rng)?;
+    encoder.begin_run(rng);
+    let n = data.images.n.min(QUALITY_TRAIN);
+    let train_images = ImageSet::new(
+        n,
+        data.images.dim,
+        data.images.data[..n * data.images.dim].to_vec(),
+    )?;
+    let z_train = encoder.encode(&train_images)?;
+    let z_heldout = encoder.encode(&heldout.images)?;
+    let (y_train, names) = quality::targets(&data.states[..n * d], d);
+    let (y_heldout, _) = quality::targets(&heldout.states, d);
+    quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)
 }
 
 /// How a neural representation was obtained, recorded in the manifests of its runs.
@@ -294,13 +330,20 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
         .learner_seed_identity(ctx.ugl.images)
         .expect("learned algorithm");
     let mut rng = stream(run_seed(ctx.campaign_seed, &seed_id), Component::Learner);
-    let (encoder, train, info) = if learner.model().is_some() {
+    let (mut encoder, train, info) = if learner.model().is_some() {
         let (e, z, info) = fit_neural(spec, ctx, &data.images, &mut rng)?;
         (e, z, Some(info))
     } else {
         let l = make_learner(learner, ctx.learners, spec.variant)?;
         let (e, z) = l.fit(&data.images, spec.latents, &mut rng)?;
         (e, z, None)
+    };
+    let quality = match measure_quality(encoder.as_mut(), env.as_ref(), &data, ds_seed) {
+        Ok(q) => Some(q),
+        Err(e) => {
+            tracing::warn!("{}: latent quality not measured: {e}", spec.run_id());
+            None
+        }
     };
     let learner_name = match learner {
         Learner::External => ctx
@@ -317,6 +360,7 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
         fit_s: t0.elapsed().as_secs_f64(),
         learner_name,
         training: info,
+        quality,
     })
 }
 
@@ -424,8 +468,10 @@ pub fn execute(
         }
     };
     let fit_s = repr.as_ref().map(|r| r.fit_s);
+    let learner_fit_s = repr.as_ref().and_then(|r| r.encoder.reported_fit_s());
     let learner_name = repr.as_ref().map(|r| r.learner_name.clone());
     let train = repr.as_ref().and_then(|r| r.training.clone());
+    let latent_quality = repr.as_ref().and_then(|r| r.quality.clone());
     let t0 = Instant::now();
     let explored = explore(spec, ctx, repr)?;
     let wall_s = t0.elapsed().as_secs_f64();
@@ -505,12 +551,14 @@ pub fn execute(
         threads: ctx.threads,
         wall_s,
         fit_s,
+        learner_fit_s,
         encode_s: explored.encode_s,
         train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
         external: (spec.algo.learner() == Some(Learner::External))
             .then(|| serde_json::to_value(&ctx.learners.external).expect("serialisable")),
         host: host_name().into(),
         cpu: Some(cpu_info().clone()),
+        latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
         summary: summary.clone(),
     };
     store::write_run(out, spec, &log, &manifest)?;

@@ -83,6 +83,10 @@ pub struct Manifest {
     /// samplers of a cell in a campaign).
     #[serde(default)]
     pub fit_s: Option<f64>,
+    /// External learners: the fit time the program reported itself (`READY fit_s=...`),
+    /// without its start-up, imports and file I/O, which `fit_s` includes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learner_fit_s: Option<f64>,
     /// Seconds spent rendering and encoding outcomes during exploration.
     #[serde(default)]
     pub encode_s: Option<f64>,
@@ -97,6 +101,10 @@ pub struct Manifest {
     /// The CPU model and SIMD level (absent in manifests written before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cpu: Option<super::machine::CpuInfo>,
+    /// Learned goal spaces: held-out R² of a linear and a k-NN map from latents to the true
+    /// object state (`repr::quality::LatentQuality`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub latent_quality: Option<serde_json::Value>,
     pub summary: Summary,
 }
 

@@ -4,11 +4,12 @@
 //! factor^2 x data covariance. Sampling = a training latent chosen uniformly + the kernel's
 //! Gaussian noise (`gaussian_kde.resample`).
 
+use faer::linalg::solvers::SelfAdjointEigen;
+use faer::{MatRef, Side};
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 
 use super::GoalSampler;
-use crate::repr::pca::jacobi_eigen;
 use crate::repr::{Latents, ReprError};
 use crate::seed::Stream;
 
@@ -32,6 +33,12 @@ impl KdeGoals {
         if n < 2 || d == 0 {
             return Err(ReprError::InvalidInput(format!(
                 "KDE needs at least 2 points of dimension >= 1, got {n} x {d}"
+            )));
+        }
+        if d >= n {
+            return Err(ReprError::InvalidInput(format!(
+                "KDE: {d} latents need more than {d} training points to estimate a covariance, \
+                 got {n}; use fewer latents or more UGL images"
             )));
         }
         if data.data.iter().any(|v| !v.is_finite()) {
@@ -60,13 +67,19 @@ impl KdeGoals {
             .iter()
             .map(|c| c / (n as f64 - 1.0) * factor * factor)
             .collect();
-        let (vals, vecs) = jacobi_eigen(&covariance, d);
+        // The symmetric eigen-decomposition (faer) of the covariance: S = V sqrt(max(L, 0)).
+        let eig =
+            SelfAdjointEigen::new(MatRef::from_row_major_slice(&covariance, d, d), Side::Lower)
+                .map_err(|e| {
+                    ReprError::Numerical(format!("KDE: eigen-decomposition failed: {e:?}"))
+                })?;
+        let (vals, vecs) = (eig.S().column_vector(), eig.U());
         let mut sqrt = vec![0.0; d * d];
-        for &(l, c) in &vals {
-            let s = l.max(0.0).sqrt();
+        for c in 0..d {
+            let s = vals[c].max(0.0).sqrt();
             for r in 0..d {
                 // Column c of the eigenvectors scaled by sqrt(lambda).
-                sqrt[r * d + c] = vecs[r * d + c] * s;
+                sqrt[r * d + c] = vecs[(r, c)] * s;
             }
         }
         Ok(KdeGoals {

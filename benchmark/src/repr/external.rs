@@ -319,6 +319,10 @@ impl Encoder for ExternalEncoder {
         self.seen.clear();
     }
 
+    fn reported_fit_s(&self) -> Option<f64> {
+        self.session.reported_fit_s
+    }
+
     fn prior(&self) -> Option<GaussianPrior> {
         self.prior.clone()
     }
@@ -335,7 +339,8 @@ struct ReadRequest {
 }
 
 enum FromReader {
-    Ready,
+    /// `READY`, with the fit time the program reported (`READY fit_s=12.5`), if any.
+    Ready(Option<f64>),
     Answer(Vec<f64>),
     /// Protocol violation or end of stdout; the thread has stopped.
     Failed(String, bool),
@@ -400,6 +405,8 @@ struct Session {
     status: Option<ExitStatus>,
     /// Set after a failure: the message, returned for every later request.
     broken: Option<String>,
+    /// The fit time the program reported on its READY line.
+    reported_fit_s: Option<f64>,
     // Dropped last, after the process is gone.
     _workdir: WorkDir,
 }
@@ -452,6 +459,7 @@ impl Session {
             stderr: tail.clone(),
             status: None,
             broken: None,
+            reported_fit_s: None,
             _workdir: workdir,
         };
         // On a thread-spawn failure the session drops here, which kills and reaps the child.
@@ -468,7 +476,10 @@ impl Session {
 
     fn wait_ready(&mut self, timeout: Duration) -> Result<(), ReprError> {
         match self.from_reader.recv_timeout(timeout) {
-            Ok(FromReader::Ready) => Ok(()),
+            Ok(FromReader::Ready(fit_s)) => {
+                self.reported_fit_s = fit_s;
+                Ok(())
+            }
             Ok(FromReader::Failed(m, eof)) => Err(self.fail(m, eof)),
             Ok(FromReader::Answer(_)) => {
                 Err(self.fail("unexpected answer before READY".into(), false))
@@ -516,7 +527,7 @@ impl Session {
         match self.from_reader.recv_timeout(remaining(Instant::now())) {
             Ok(FromReader::Answer(buf)) => *answer = buf,
             Ok(FromReader::Failed(m, eof)) => return Err(self.fail(m, eof)),
-            Ok(FromReader::Ready) => unreachable!("READY is sent once"),
+            Ok(FromReader::Ready(_)) => unreachable!("READY is sent once"),
             Err(RecvTimeoutError::Timeout) => {
                 let what = match self.from_writer.try_recv() {
                     Err(TryRecvError::Empty) => "did not read the whole request",
@@ -689,6 +700,35 @@ fn writer_loop(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>, tx: Sender<Result<V
     // Dropping `stdin` closes the pipe: the program's shutdown signal.
 }
 
+/// The `READY` line: `READY`, or `READY fit_s=SECONDS` (the program's own fit time). None: not
+/// a READY line; Some(Err): a READY line with a bad field.
+fn parse_ready(line: &str) -> Option<Result<Option<f64>, String>> {
+    let mut words = line.split_whitespace();
+    if words.next() != Some("READY") {
+        return None;
+    }
+    let mut fit_s = None;
+    for w in words {
+        match w.split_once('=') {
+            Some(("fit_s", v)) => match v.parse::<f64>() {
+                Ok(x) if x.is_finite() && x >= 0.0 => fit_s = Some(x),
+                _ => {
+                    return Some(Err(format!(
+                        "READY line: fit_s must be a number of seconds >= 0, got {v:?}"
+                    )));
+                }
+            },
+            _ => {
+                return Some(Err(format!(
+                    "READY line: unknown field {:?} (allowed: fit_s=SECONDS)",
+                    truncate(w, 100)
+                )));
+            }
+        }
+    }
+    Some(Ok(fit_s))
+}
+
 fn reader_loop(stdout: ChildStdout, rx: Receiver<ReadRequest>, tx: Sender<FromReader>) {
     let mut r = BufReader::with_capacity(1 << 16, stdout);
     let mut line = Vec::new();
@@ -699,24 +739,24 @@ fn reader_loop(stdout: ChildStdout, rx: Receiver<ReadRequest>, tx: Sender<FromRe
         )),
         Ok(_) => {
             let text = String::from_utf8_lossy(&line);
-            if text.trim() == "READY" {
-                Ok(())
-            } else {
-                Err((
+            match parse_ready(&text) {
+                Some(Ok(fit_s)) => Ok(fit_s),
+                Some(Err(m)) => Err((m, false)),
+                None => Err((
                     format!(
                         "expected the line READY on stdout, got {:?} (stdout is reserved for the \
                          protocol: log to stderr)",
                         truncate(&text, 200)
                     ),
                     false,
-                ))
+                )),
             }
         }
         Err(e) => Err((format!("reading stdout: {e}"), true)),
     };
     match msg {
-        Ok(()) => {
-            if tx.send(FromReader::Ready).is_err() {
+        Ok(fit_s) => {
+            if tx.send(FromReader::Ready(fit_s)).is_err() {
                 return;
             }
         }

@@ -15,6 +15,7 @@ pub mod isomap;
 pub mod nets;
 pub mod neural;
 pub mod pca;
+pub mod quality;
 pub mod rfvae;
 pub mod sparse;
 pub mod vae;
@@ -117,6 +118,11 @@ pub trait Encoder: Send {
     /// Deterministic encoders ignore it (the default).
     fn begin_run(&mut self, rng: Stream) {
         let _ = rng;
+    }
+    /// The fit time the learner measured itself, where it reports one (an external program's
+    /// `READY fit_s=...`: its fit without interpreter start-up, imports and file I/O).
+    fn reported_fit_s(&self) -> Option<f64> {
+        None
     }
 }
 

@@ -16,6 +16,7 @@ use crate::paper::PaperTable;
 
 pub mod claims;
 pub mod neural;
+pub mod quality;
 
 /// Everything the markdown is made of.
 pub struct Inputs<'a> {
@@ -309,6 +310,12 @@ pub fn render(inp: &Inputs<'_>) -> String {
     );
     let _ = writeln!(
         w,
+        "- **Results version:** {} (`RESULTS_VERSION` of the code that wrote them; a campaign \
+         resumed with code of another version reruns those runs).",
+        distinct(runs.iter().map(|r| r.manifest.text(&["results_version"])))
+    );
+    let _ = writeln!(
+        w,
         "- **CPU (SIMD level):** {}. Results are bit-for-bit reproducible within one SIMD level \
          (README, Reproducibility).",
         distinct(runs.iter().map(|r| r.manifest.cpu()))
@@ -456,6 +463,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
     neural::variants(w, inp);
     neural::budget(w, inp);
     neural::training_loss(w, inp);
+    quality::section(w, inp);
 
     // --- Outcome scatters.
     let _ = writeln!(w, "## Object positions reached\n");

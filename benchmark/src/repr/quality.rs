@@ -1,0 +1,290 @@
+//! Latent quality: how well the true object state can be read off a goal space (issue: trained
+//! goal spaces; the original code's `src/measures.py` measured embeddings too).
+//!
+//! For a fitted representation, the targets are the engineered states of its training images
+//! (ball x, y; arrow x, y and the angle as cos / sin, since the angle wraps around) and of a
+//! held-out set of freshly rendered images. Two regressions from latents to targets are fitted on
+//! the training latents and scored on the held-out latents:
+//! - **linear**: least squares with an intercept on standardised latents (a tiny ridge, 1e-9 of
+//!   the trace, keeps collapsed latents solvable);
+//! - **k-NN**: the mean target of the `k` nearest training latents (Euclidean), `k` =
+//!   [`KNN_K`], with every latent tied with the k-th nearest included.
+//!
+//! Each reports R² = 1 - SSE / SST per target and their mean. An untrained random projection
+//! scores well on the linear map only when it keeps the object's position; a collapsed encoder
+//! scores about 0.
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+use serde::{Deserialize, Serialize};
+
+use super::{Latents, ReprError};
+
+/// Neighbours of the k-NN regression.
+pub const KNN_K: usize = 10;
+
+/// R² of the two regressions, per target and on average.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LatentQuality {
+    /// Target names (`x`, `y`, `cos_angle`, `sin_angle`).
+    pub targets: Vec<String>,
+    /// Held-out R² of the linear map, per target.
+    pub linear_r2: Vec<f64>,
+    /// Held-out R² of the k-NN regression, per target.
+    pub knn_r2: Vec<f64>,
+    /// Means over the targets.
+    pub linear_r2_mean: f64,
+    pub knn_r2_mean: f64,
+    /// Training and held-out set sizes, and `k`.
+    pub n_train: usize,
+    pub n_heldout: usize,
+    pub k: usize,
+}
+
+/// The regression targets of engineered states (`state_dim` 2: ball x, y; 3: arrow x, y, angle
+/// in units of pi, given as cos and sin): row-major `n x targets`, and the names.
+pub fn targets(states: &[f64], state_dim: usize) -> (Vec<f64>, Vec<String>) {
+    let mut out = Vec::new();
+    for s in states.chunks_exact(state_dim) {
+        out.extend_from_slice(&s[..2]);
+        if state_dim == 3 {
+            let a = s[2] * std::f64::consts::PI;
+            out.extend([a.cos(), a.sin()]);
+        }
+    }
+    let mut names = vec!["x".to_string(), "y".to_string()];
+    if state_dim == 3 {
+        names.extend(["cos_angle".to_string(), "sin_angle".to_string()]);
+    }
+    (out, names)
+}
+
+/// Score `train` / `heldout` latents against their targets (row-major `n x t`).
+pub fn latent_quality(
+    train: &Latents,
+    train_targets: &[f64],
+    heldout: &Latents,
+    heldout_targets: &[f64],
+    names: Vec<String>,
+) -> Result<LatentQuality, ReprError> {
+    let t = names.len();
+    let d = train.latents;
+    if train.n < 2 || heldout.n < 2 || heldout.latents != d {
+        return Err(ReprError::InvalidInput(format!(
+            "latent quality needs at least 2 training and 2 held-out latents of one dimension, \
+             got {} x {d} and {} x {}",
+            train.n, heldout.n, heldout.latents
+        )));
+    }
+    if train_targets.len() != train.n * t || heldout_targets.len() != heldout.n * t {
+        return Err(ReprError::InvalidInput(
+            "latent quality: targets do not match the latents".into(),
+        ));
+    }
+    let linear = linear_predictions(train, train_targets, heldout, t)?;
+    let knn = knn_predictions(train, train_targets, heldout, t);
+    let linear_r2 = r2(&linear, heldout_targets, t);
+    let knn_r2 = r2(&knn, heldout_targets, t);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    Ok(LatentQuality {
+        targets: names,
+        linear_r2_mean: mean(&linear_r2),
+        knn_r2_mean: mean(&knn_r2),
+        linear_r2,
+        knn_r2,
+        n_train: train.n,
+        n_heldout: heldout.n,
+        k: KNN_K.min(train.n),
+    })
+}
+
+/// Per-column mean and standard deviation (1 where the column is constant).
+fn standardiser(z: &Latents) -> (Vec<f64>, Vec<f64>) {
+    let (n, d) = (z.n as f64, z.latents);
+    let mut mean = vec![0.0; d];
+    for i in 0..z.n {
+        for (m, v) in mean.iter_mut().zip(z.row(i)) {
+            *m += v / n;
+        }
+    }
+    let mut sd = vec![0.0; d];
+    for i in 0..z.n {
+        for ((s, v), m) in sd.iter_mut().zip(z.row(i)).zip(&mean) {
+            *s += (v - m).powi(2) / n;
+        }
+    }
+    let sd = sd
+        .into_iter()
+        .map(|v| if v.sqrt() > 0.0 { v.sqrt() } else { 1.0 })
+        .collect();
+    (mean, sd)
+}
+
+fn linear_predictions(
+    train: &Latents,
+    y: &[f64],
+    heldout: &Latents,
+    t: usize,
+) -> Result<Vec<f64>, ReprError> {
+    let d = train.latents;
+    let (mean, sd) = standardiser(train);
+    let design = |z: &Latents| {
+        Mat::<f64>::from_fn(z.n, d + 1, |i, j| {
+            if j == d {
+                1.0
+            } else {
+                (z.row(i)[j] - mean[j]) / sd[j]
+            }
+        })
+    };
+    let x = design(train);
+    let yt = Mat::<f64>::from_fn(train.n, t, |i, j| y[i * t + j]);
+    let mut gram = x.transpose() * &x;
+    let trace: f64 = (0..=d).map(|j| gram[(j, j)]).sum();
+    for j in 0..=d {
+        gram[(j, j)] += 1e-9 * trace;
+    }
+    let rhs = x.transpose() * &yt;
+    let llt = gram
+        .llt(Side::Lower)
+        .map_err(|e| ReprError::Numerical(format!("latent quality: {e:?}")))?;
+    let beta = llt.solve(&rhs);
+    let pred = design(heldout) * &beta;
+    Ok((0..heldout.n)
+        .flat_map(|i| (0..t).map(move |j| (i, j)))
+        .map(|(i, j)| pred[(i, j)])
+        .collect())
+}
+
+fn knn_predictions(train: &Latents, y: &[f64], heldout: &Latents, t: usize) -> Vec<f64> {
+    use rayon::prelude::*;
+    let k = KNN_K.min(train.n);
+    let mut out = vec![0.0; heldout.n * t];
+    out.par_chunks_mut(t).enumerate().for_each(|(q, o)| {
+        let zq = heldout.row(q);
+        // (distance, index), kept sorted; ties broken by index (deterministic).
+        let mut best: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
+        for i in 0..train.n {
+            let dist: f64 = train
+                .row(i)
+                .iter()
+                .zip(zq)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum();
+            if best.len() < k || dist < best[k - 1].0 {
+                let pos = best.partition_point(|&(bd, _)| bd <= dist);
+                best.insert(pos, (dist, i));
+                best.truncate(k);
+            }
+        }
+        // Every training latent tied with the k-th nearest counts too, so the prediction does
+        // not depend on the order of the training set (a collapsed encoder: all tied).
+        let radius = best[k - 1].0;
+        let mut count = 0usize;
+        for i in 0..train.n {
+            let dist: f64 = train
+                .row(i)
+                .iter()
+                .zip(zq)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum();
+            if dist <= radius {
+                count += 1;
+                for (o, v) in o.iter_mut().zip(&y[i * t..(i + 1) * t]) {
+                    *o += v;
+                }
+            }
+        }
+        o.iter_mut().for_each(|v| *v /= count as f64);
+    });
+    out
+}
+
+/// R² per target column.
+fn r2(pred: &[f64], truth: &[f64], t: usize) -> Vec<f64> {
+    let n = truth.len() / t;
+    (0..t)
+        .map(|j| {
+            let mean = (0..n).map(|i| truth[i * t + j]).sum::<f64>() / n as f64;
+            let sst: f64 = (0..n).map(|i| (truth[i * t + j] - mean).powi(2)).sum();
+            let sse: f64 = (0..n)
+                .map(|i| (truth[i * t + j] - pred[i * t + j]).powi(2))
+                .sum();
+            if sst > 0.0 { 1.0 - sse / sst } else { f64::NAN }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seed::stream_named;
+    use rand::RngExt;
+
+    fn latents(n: usize, d: usize, data: Vec<f64>) -> Latents {
+        Latents {
+            n,
+            latents: d,
+            data,
+        }
+    }
+
+    /// Latents = a linear map of the state, a non-linear one, and constants: the scores say so.
+    #[test]
+    fn scores_know_linear_nonlinear_and_collapsed_latents() {
+        let mut rng = stream_named(5, "quality-test");
+        let mut states =
+            |n: usize| -> Vec<f64> { (0..2 * n).map(|_| rng.random_range(-1.0..1.0)).collect() };
+        let (s_tr, s_te) = (states(2000), states(500));
+        let (y_tr, names) = targets(&s_tr, 2);
+        let (y_te, _) = targets(&s_te, 2);
+        let map = |s: &[f64], f: &dyn Fn(f64, f64) -> Vec<f64>, d: usize| {
+            let data: Vec<f64> = s.chunks(2).flat_map(|p| f(p[0], p[1])).collect();
+            latents(s.len() / 2, d, data)
+        };
+        let lin = |x: f64, y: f64| vec![2.0 * x - y + 3.0, x + 0.5 * y, 7.0];
+        let q = latent_quality(
+            &map(&s_tr, &lin, 3),
+            &y_tr,
+            &map(&s_te, &lin, 3),
+            &y_te,
+            names.clone(),
+        )
+        .unwrap();
+        assert!(q.linear_r2_mean > 0.999999, "{q:?}");
+        assert!(q.knn_r2_mean > 0.98, "{q:?}");
+        // A non-linear but invertible map: k-NN recovers it, the linear map does not fully.
+        let nonlin = |x: f64, y: f64| vec![x.powi(3), y.powi(3)];
+        let q = latent_quality(
+            &map(&s_tr, &nonlin, 2),
+            &y_tr,
+            &map(&s_te, &nonlin, 2),
+            &y_te,
+            names.clone(),
+        )
+        .unwrap();
+        assert!(q.knn_r2_mean > 0.97 && q.linear_r2_mean < 0.9, "{q:?}");
+        // Collapsed: constant latents explain nothing.
+        let flat = |_: f64, _: f64| vec![1.0, 1.0];
+        let q = latent_quality(
+            &map(&s_tr, &flat, 2),
+            &y_tr,
+            &map(&s_te, &flat, 2),
+            &y_te,
+            names,
+        )
+        .unwrap();
+        assert!(
+            q.linear_r2_mean.abs() < 0.02 && q.knn_r2_mean.abs() < 0.05,
+            "{q:?}"
+        );
+    }
+
+    #[test]
+    fn arrow_targets_wrap_the_angle() {
+        let (y, names) = targets(&[0.1, 0.2, 1.0, 0.0, 0.0, -1.0], 3);
+        assert_eq!(names, ["x", "y", "cos_angle", "sin_angle"]);
+        // angle 1 and -1 (in units of pi) are the same direction.
+        assert!((y[2] - y[6]).abs() < 1e-12 && (y[3] - y[7]).abs() < 1e-12);
+    }
+}
