@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::plan::parse_shard;
-use ugl_bench::campaign::runner::TrainSink;
+use ugl_bench::campaign::runner::{MessageSink, TrainSink};
 use ugl_bench::campaign::{CampaignOptions, Progress, RunContext, RunSpec, plan, run_campaign};
 use ugl_bench::env::render::{Image70, PIXELS, write_npy, write_png};
 use ugl_bench::env::{EnvConfig, EnvKind, PARAMS, make_env};
@@ -280,6 +280,42 @@ fn training_bars(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<TrainSin
             bar.finish_and_clear();
             mp.remove(bar);
             bars.remove(label);
+        }
+    })
+}
+
+/// One line per external learner while it fits, above `main` (if any): its label and the last
+/// line it wrote to stderr (the whole stderr is in `OUT/<label>.learner.log`).
+fn learner_lines(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<MessageSink> {
+    let bars: std::sync::Mutex<std::collections::HashMap<String, ProgressBar>> = Default::default();
+    let mp = mp.clone();
+    let main = main.cloned();
+    Arc::new(move |label: &str, line: Option<&str>| {
+        let mut bars = bars.lock().expect("progress bars");
+        match line {
+            Some(line) => {
+                let bar = bars.entry(label.to_string()).or_insert_with(|| {
+                    let b = ProgressBar::new_spinner();
+                    let b = match &main {
+                        Some(m) => mp.insert_before(m, b),
+                        None => mp.add(b),
+                    };
+                    b.set_style(
+                        ProgressStyle::with_template("  fit   {prefix:32} {elapsed:>5}  {wide_msg}")
+                            .expect("valid template"),
+                    );
+                    b.set_prefix(label.to_string());
+                    b.enable_steady_tick(std::time::Duration::from_millis(500));
+                    b
+                });
+                bar.set_message(line.to_string());
+            }
+            None => {
+                if let Some(bar) = bars.remove(label) {
+                    bar.finish_and_clear();
+                    mp.remove(&bar);
+                }
+            }
         }
     })
 }
@@ -606,6 +642,8 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
         cache: cache.as_ref(),
         train_progress: Some(training_bars(&mp, None)),
         train_threads: 0,
+        log_dir: Some(out),
+        learner_messages: Some(learner_lines(&mp, None)),
     };
     let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
     println!("{}", serde_json::to_string(&summary)?);
@@ -774,6 +812,7 @@ fn run_config(
         shard,
         cache: cache.as_ref(),
         train_progress: Some(training_bars(&mp, Some(&bar))),
+        learner_messages: Some(learner_lines(&mp, Some(&bar))),
     };
     let done = run_campaign(cfg, &out, &opts, &on)?;
     bar.finish_and_clear();

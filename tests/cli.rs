@@ -395,7 +395,34 @@ fn run_with_an_external_learner() {
     .unwrap();
     assert_eq!(m["learner"], "random-projection");
     assert_eq!(m["reduced_budget"], true);
-    // Without the [learners.external] section: a one-line error.
+    // The program's own fit time, and its stderr kept beside the run.
+    assert!(m["learner_fit_s"].as_f64().is_some_and(|t| t >= 0.0), "{m}");
+    let log = std::fs::read_to_string(out.join("armball.rge-external.l3.s0.learner.log")).unwrap();
+    assert!(log.contains("random projection: 200 images -> 3 dims"), "{log}");
+    assert!(m["latent_quality"]["linear_r2_mean"].is_f64(), "{m}");
+
+    // `--command` / `--name` instead of the section; paired with a built-in learner of the
+    // same cell: the same exploration seed.
+    let o = ugl(&[
+        "run", "--env", "armball", "--algo", "rge-external", "--latents", "3",
+        "--command", "python3 scripts/external_learners/random_projection.py",
+        "--name", "rp-cli", "--seed", "1", "--epochs", "100", "--images", "200",
+        "--profile", "smoke", "--out", p(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = ugl(&[
+        "run", "--env", "armball", "--algo", "rge-pca", "--latents", "3", "--seed", "1",
+        "--epochs", "100", "--images", "200", "--profile", "smoke", "--out", p(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ext = manifest(&out.join("armball.rge-external.kde.l3.s1.json"));
+    let pca = manifest(&out.join("armball.rge-pca.kde.l3.s1.json"));
+    assert_eq!(ext["learner"], "rp-cli");
+    assert_eq!(ext["external"]["command"], "python3 scripts/external_learners/random_projection.py");
+    assert_eq!(ext["run_seed"], pca["run_seed"], "paired exploration streams");
+    assert_ne!(ext["identity"], pca["identity"]);
+
+    // Without the [learners.external] section or --command: a one-line error.
     let o = ugl(&[
         "run",
         "--env",
@@ -405,7 +432,14 @@ fn run_with_an_external_learner() {
         "--out",
         p(&out),
     ]);
-    assert_one_line_error(&o, "learners.external");
+    assert_one_line_error(&o, "--command");
+    // --command is for rge-external only; an empty one is refused.
+    let o = ugl(&["run", "--env", "armball", "--algo", "rge-pca", "--command", "x", "--out", p(&out)]);
+    assert_one_line_error(&o, "rge-external only");
+    let o = ugl(&[
+        "run", "--env", "armball", "--algo", "rge-external", "--command", " ", "--out", p(&out),
+    ]);
+    assert_one_line_error(&o, "must not be empty");
 }
 
 #[test]

@@ -22,7 +22,7 @@ use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::repr::evidence::TrainingEvidence;
-use crate::repr::external::ExternalLearner;
+use crate::repr::external::{ExternalLearner, LineSink};
 use crate::repr::isomap::Isomap;
 use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
 use crate::repr::pca::{CentredPca, TruncatedSvd};
@@ -70,6 +70,10 @@ struct HashInput<'a> {
 /// (`armball.rge-vae.faithful.l10.s0`) and the progress.
 pub type TrainSink = dyn Fn(&str, TrainProgress) + Send + Sync;
 
+/// Receives the stderr lines of external learners while they fit: the representation's label,
+/// then `Some(line)` for each line and `None` when the fit is over.
+pub type MessageSink = dyn Fn(&str, Option<&str>) + Send + Sync;
+
 /// Everything needed to execute one run.
 #[derive(Clone)]
 pub struct RunContext<'a> {
@@ -89,6 +93,11 @@ pub struct RunContext<'a> {
     /// pool of `cores / jobs` threads: two 1-thread trainings side by side beat one 2-thread
     /// training on 2 cores; STACK-NOTES.md).
     pub train_threads: usize,
+    /// Where an external learner's stderr is kept: `<log_dir>/<representation label>.learner.log`
+    /// (the results directory; None: not kept).
+    pub log_dir: Option<&'a Path>,
+    /// External learners' stderr lines, as they come.
+    pub learner_messages: Option<Arc<MessageSink>>,
 }
 
 impl RunContext<'_> {
@@ -197,16 +206,19 @@ pub fn make_learner(
             n_neighbors: cfg.isomap.n_neighbors,
             disconnected: cfg.isomap.disconnected,
         }),
-        Learner::External => {
-            let e = cfg.external.as_ref().ok_or_else(|| {
-                ReprError::InvalidInput(
-                    "rge-external needs a [learners.external] section (name, command)".into(),
-                )
-            })?;
-            Box::new(ExternalLearner::new(e.name.clone(), e.command.clone()))
-        }
+        Learner::External => Box::new(external_learner(cfg)?),
         Learner::Ae | Learner::Vae | Learner::Rfvae => unreachable!("handled above"),
     })
+}
+
+/// The configured external learner (`[learners.external]`).
+fn external_learner(cfg: &LearnersConfig) -> Result<ExternalLearner, ReprError> {
+    let e = cfg.external.as_ref().ok_or_else(|| {
+        ReprError::InvalidInput(
+            "rge-external needs a [learners.external] section (name, command)".into(),
+        )
+    })?;
+    Ok(ExternalLearner::new(e.name.clone(), e.command.clone()))
 }
 
 /// The model-cache key of a neural representation: BLAKE3 of everything it depends on (the
@@ -333,6 +345,23 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
     let (mut encoder, train, info) = if learner.model().is_some() {
         let (e, z, info) = fit_neural(spec, ctx, &data.images, &mut rng)?;
         (e, z, Some(info))
+    } else if learner == Learner::External {
+        // The program's stderr: a log file beside the runs, and the last line to the caller.
+        let mut l = external_learner(ctx.learners)?;
+        let label = representation_label(spec);
+        l.log_file = ctx
+            .log_dir
+            .map(|d| d.join(format!("{label}.learner.log")));
+        if let Some(sink) = &ctx.learner_messages {
+            let (sink, label) = (sink.clone(), label.clone());
+            l.on_stderr = Some(LineSink(Arc::new(move |line| sink(&label, Some(line)))));
+        }
+        let fitted = l.fit(&data.images, spec.latents, &mut rng);
+        if let Some(sink) = &ctx.learner_messages {
+            sink(&label, None);
+        }
+        let (e, z) = fitted?;
+        (e, z, None)
     } else {
         let l = make_learner(learner, ctx.learners, spec.variant)?;
         let (e, z) = l.fit(&data.images, spec.latents, &mut rng)?;
@@ -591,6 +620,8 @@ pub struct CampaignOptions<'a> {
     pub cache: Option<&'a ModelCache>,
     /// Training progress of neural representations.
     pub train_progress: Option<Arc<TrainSink>>,
+    /// External learners' stderr lines.
+    pub learner_messages: Option<Arc<MessageSink>>,
 }
 
 /// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
@@ -614,6 +645,8 @@ pub fn run_campaign(
         train_progress: opts.train_progress.clone(),
         // Each worker's own pool is the training's (see below).
         train_threads: 0,
+        log_dir: Some(out),
+        learner_messages: opts.learner_messages.clone(),
     };
     let all = match opts.shard {
         None => plan(cfg),

@@ -76,6 +76,27 @@ pub struct ExternalLearner {
     pub ready_timeout: Duration,
     /// Time allowed for each encode request.
     pub answer_timeout: Duration,
+    /// Every line the program writes to stderr is appended to this file (created), besides
+    /// going to `tracing` (level INFO) and to [`Self::on_stderr`].
+    pub log_file: Option<PathBuf>,
+    /// Called with each stderr line (e.g. to show the last one under a progress bar).
+    pub on_stderr: Option<LineSink>,
+}
+
+/// A callback receiving the lines of a learner's stderr.
+#[derive(Clone)]
+pub struct LineSink(pub Arc<dyn Fn(&str) + Send + Sync>);
+
+impl std::fmt::Debug for LineSink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LineSink")
+    }
+}
+
+impl PartialEq for LineSink {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 impl ExternalLearner {
@@ -86,6 +107,8 @@ impl ExternalLearner {
             command: command.into(),
             ready_timeout: DEFAULT_READY_TIMEOUT,
             answer_timeout: DEFAULT_ANSWER_TIMEOUT,
+            log_file: None,
+            on_stderr: None,
         }
     }
 }
@@ -464,7 +487,20 @@ impl Session {
         };
         // On a thread-spawn failure the session drops here, which kills and reaps the child.
         let name = learner.name.clone();
-        spawn_thread("ugl-ext-stderr", move || stderr_loop(stderr, tail, name))?;
+        let log = match &learner.log_file {
+            Some(path) => Some(
+                fs::OpenOptions::new()
+                    .create(true)
+                    .append(true)
+                    .open(path)
+                    .map_err(|e| ReprError::Io(format!("learner log {}: {e}", path.display())))?,
+            ),
+            None => None,
+        };
+        let sink = learner.on_stderr.clone();
+        spawn_thread("ugl-ext-stderr", move || {
+            stderr_loop(stderr, tail, name, log, sink)
+        })?;
         spawn_thread("ugl-ext-stdin", move || {
             writer_loop(stdin, writer_rx, writer_tx)
         })?;
@@ -789,7 +825,13 @@ fn reader_loop(stdout: ChildStdout, rx: Receiver<ReadRequest>, tx: Sender<FromRe
     }
 }
 
-fn stderr_loop(stderr: ChildStderr, tail: Arc<Mutex<StderrTail>>, name: String) {
+fn stderr_loop(
+    stderr: ChildStderr,
+    tail: Arc<Mutex<StderrTail>>,
+    name: String,
+    mut log: Option<File>,
+    sink: Option<LineSink>,
+) {
     let mut r = BufReader::new(stderr);
     let mut line = Vec::new();
     loop {
@@ -800,6 +842,14 @@ fn stderr_loop(stderr: ChildStderr, tail: Arc<Mutex<StderrTail>>, name: String) 
                 let text = String::from_utf8_lossy(&line);
                 let text = text.trim_end();
                 tracing::info!(learner = %name, "{text}");
+                if let Some(f) = &mut log
+                    && writeln!(f, "{text}").is_err()
+                {
+                    log = None;
+                }
+                if let Some(s) = &sink {
+                    (s.0)(text);
+                }
                 if let Ok(mut t) = tail.lock() {
                     if t.lines.len() == STDERR_TAIL_LINES {
                         t.lines.pop_front();
