@@ -115,6 +115,10 @@ enum Command {
         #[command(flatten)]
         cache: CacheArgs,
     },
+    /// Export a goal space: fit (or load from the model cache) the representation of one cell
+    /// and seed, as a run would, and write the latents of its training images and of a grid of
+    /// object positions as .npy files. Prints a JSON summary (files, latent quality).
+    Embed(EmbedArgs),
     /// List the run ids of a campaign, one per line.
     Plan {
         /// Campaign file (data/campaigns/NAME.toml).
@@ -192,6 +196,44 @@ enum Command {
         #[arg(long = "main", default_value = "paper")]
         main_campaign: String,
     },
+}
+
+#[derive(clap::Args, Debug)]
+struct EmbedArgs {
+    /// armball or armarrow.
+    #[arg(long)]
+    env: EnvKind,
+    /// A registered learner (pca, pca-centred, isomap, ae, vae, rfvae), or with --command the
+    /// name of an external program.
+    #[arg(long)]
+    learner: String,
+    /// External learners: the command line of the program (docs/external-learners.md).
+    #[arg(long)]
+    command: Option<String>,
+    /// vae / rfvae: faithful (default) or corrected.
+    #[arg(long)]
+    variant: Option<Variant>,
+    /// Latent size.
+    #[arg(long, default_value_t = 10)]
+    latents: usize,
+    /// Repetition index (the data set and the learner's stream derive from it).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Override the profile's number of UGL training images.
+    #[arg(long)]
+    images: Option<usize>,
+    /// Budget profile: a name in data/campaigns/ or a path to a .toml file.
+    #[arg(long, default_value = "paper")]
+    profile: String,
+    /// The grid of object positions: GRID x GRID over [-1, 1]^2 (ArmArrow: angle 0).
+    #[arg(long, default_value_t = 21)]
+    grid: usize,
+    /// The training latents' file (.npy, float64, (n, latents)); beside it OUT-stem.states.npy
+    /// (n, state dim), OUT-stem.grid.npy (GRID^2, latents) and OUT-stem.grid_states.npy.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    cache: CacheArgs,
 }
 
 #[derive(clap::Args, Debug)]
@@ -301,8 +343,10 @@ fn learner_lines(mp: &MultiProgress, main: Option<&ProgressBar>) -> Arc<MessageS
                         None => mp.add(b),
                     };
                     b.set_style(
-                        ProgressStyle::with_template("  fit   {prefix:32} {elapsed:>5}  {wide_msg}")
-                            .expect("valid template"),
+                        ProgressStyle::with_template(
+                            "  fit   {prefix:32} {elapsed:>5}  {wide_msg}",
+                        )
+                        .expect("valid template"),
                     );
                     b.set_prefix(label.to_string());
                     b.enable_steady_tick(std::time::Duration::from_millis(500));
@@ -421,6 +465,7 @@ fn dispatch(cmd: Command) -> Result<()> {
         } => slurm(&config, shards, out, &scripts, cpus, &time),
         Command::Merge { into, sources } => merge(&into, &sources),
         Command::Compare(a) => compare(a),
+        Command::Embed(a) => embed(a),
         Command::Report {
             results,
             out,
@@ -675,6 +720,128 @@ fn campaign(
     run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
 }
 
+/// `ugl embed`: the latents of one fitted goal space.
+fn embed(a: EmbedArgs) -> Result<()> {
+    let path = resolve_profile(&a.profile)?;
+    let mut cfg = CampaignConfig::load(&path)?;
+    if let Some(n) = a.images {
+        if n < 2 {
+            bail!("--images must be at least 2, got {n}");
+        }
+        cfg.ugl.images = n;
+    }
+    let learner = resolve_learner(&a.learner, a.command.as_deref(), &mut cfg)?;
+    if a.variant.is_some() && !learner.has_variants() {
+        bail!("--variant applies to vae and rfvae only, not {}", a.learner);
+    }
+    if a.latents == 0 || a.latents >= cfg.ugl.images {
+        bail!(
+            "--latents must be between 1 and the number of images - 1 ({}), got {}",
+            cfg.ugl.images - 1,
+            a.latents
+        );
+    }
+    if !(2..=1000).contains(&a.grid) {
+        bail!("--grid must be between 2 and 1000, got {}", a.grid);
+    }
+    if a.out.extension().and_then(|e| e.to_str()) != Some("npy") {
+        bail!("--out {}: the file name must end in .npy", a.out.display());
+    }
+    let dir = a
+        .out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    check_out_dir(dir)?;
+    let spec = RunSpec::learned(
+        a.env,
+        Algo::Rge(learner),
+        SamplerKind::Kde,
+        a.latents,
+        a.variant.unwrap_or_default(),
+        a.seed,
+    );
+    let cache = a.cache.resolve(dir);
+    let mp = MultiProgress::new();
+    if !std::io::stderr().is_terminal() {
+        mp.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    let ctx = RunContext {
+        campaign: &cfg.campaign.name,
+        campaign_seed: cfg.campaign.seed,
+        profile: &a.profile,
+        explore: &cfg.explore,
+        env: &cfg.env,
+        ugl: &cfg.ugl,
+        learners: &cfg.learners,
+        threads: rayon::current_num_threads(),
+        cache: cache.as_ref(),
+        train_progress: Some(training_bars(&mp, None)),
+        train_threads: 0,
+        log_dir: Some(dir),
+        learner_messages: Some(learner_lines(&mp, None)),
+    };
+    let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid)?;
+    let stem = a.out.with_extension("");
+    let sibling = |suffix: &str| PathBuf::from(format!("{}.{suffix}.npy", stem.display()));
+    let files = [
+        (a.out.clone(), e.train.n, e.train.latents, &e.train.data),
+        (sibling("states"), e.train.n, e.state_dim, &e.train_states),
+        (sibling("grid"), e.grid.n, e.grid.latents, &e.grid.data),
+        (
+            sibling("grid_states"),
+            e.grid.n,
+            e.state_dim,
+            &e.grid_states,
+        ),
+    ];
+    for (path, rows, cols, data) in &files {
+        ugl_bench::campaign::embed::write_npy_f64(path, *rows, *cols, data)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    println!(
+        "{}",
+        serde_json::json!({
+            "representation": ugl_bench::campaign::runner::representation_label(&spec),
+            "files": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
+            "latent_quality": e.quality,
+        })
+    );
+    Ok(())
+}
+
+/// The learner named `name`: a registered one, or with `command` an external program (set in
+/// `cfg.learners.external`).
+fn resolve_learner(name: &str, command: Option<&str>, cfg: &mut CampaignConfig) -> Result<Learner> {
+    let registered: Vec<Learner> = Learner::ALL
+        .into_iter()
+        .filter(|l| *l != Learner::External)
+        .collect();
+    match (registered.iter().find(|l| l.name() == name), command) {
+        (Some(l), None) => Ok(*l),
+        (Some(_), Some(_)) => bail!(
+            "--learner {name} is a registered learner: drop --command, or give the external program another name"
+        ),
+        (None, Some(cmd)) => {
+            if cmd.trim().is_empty() {
+                bail!("--command must not be empty");
+            }
+            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
+                name: name.to_string(),
+                command: cmd.to_string(),
+            });
+            Ok(Learner::External)
+        }
+        (None, None) => {
+            let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
+            bail!(
+                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
+                names.join(", ")
+            )
+        }
+    }
+}
+
 /// `ugl compare`: the paper's matrix cells and seeds for one more learner.
 fn compare(a: CompareArgs) -> Result<()> {
     let mut cfg = CampaignConfig::load(&a.config)?;
@@ -688,33 +855,7 @@ fn compare(a: CompareArgs) -> Result<()> {
             "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
         );
     }
-    let registered: Vec<Learner> = Learner::ALL
-        .into_iter()
-        .filter(|l| *l != Learner::External)
-        .collect();
-    let algo = match (registered.iter().find(|l| l.name() == name), &a.command) {
-        (Some(l), None) => Algo::Rge(*l),
-        (Some(_), Some(_)) => bail!(
-            "--learner {name} is a registered learner: drop --command, or give the external program another name"
-        ),
-        (None, Some(cmd)) => {
-            if cmd.trim().is_empty() {
-                bail!("--command must not be empty");
-            }
-            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
-                name: name.clone(),
-                command: cmd.clone(),
-            });
-            Algo::Rge(Learner::External)
-        }
-        (None, None) => {
-            let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
-            bail!(
-                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
-                names.join(", ")
-            )
-        }
-    };
+    let algo = Algo::Rge(resolve_learner(&name, a.command.as_deref(), &mut cfg)?);
     // Same campaign seed, matrix cells, reps and budgets as the base campaign: the same run
     // seeds and UGL data sets, so the new learner is compared on paired runs.
     let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));

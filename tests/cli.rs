@@ -398,28 +398,69 @@ fn run_with_an_external_learner() {
     // The program's own fit time, and its stderr kept beside the run.
     assert!(m["learner_fit_s"].as_f64().is_some_and(|t| t >= 0.0), "{m}");
     let log = std::fs::read_to_string(out.join("armball.rge-external.l3.s0.learner.log")).unwrap();
-    assert!(log.contains("random projection: 200 images -> 3 dims"), "{log}");
+    assert!(
+        log.contains("random projection: 200 images -> 3 dims"),
+        "{log}"
+    );
     assert!(m["latent_quality"]["linear_r2_mean"].is_f64(), "{m}");
 
     // `--command` / `--name` instead of the section; paired with a built-in learner of the
     // same cell: the same exploration seed.
     let o = ugl(&[
-        "run", "--env", "armball", "--algo", "rge-external", "--latents", "3",
-        "--command", "python3 scripts/external_learners/random_projection.py",
-        "--name", "rp-cli", "--seed", "1", "--epochs", "100", "--images", "200",
-        "--profile", "smoke", "--out", p(&out),
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-external",
+        "--latents",
+        "3",
+        "--command",
+        "python3 scripts/external_learners/random_projection.py",
+        "--name",
+        "rp-cli",
+        "--seed",
+        "1",
+        "--epochs",
+        "100",
+        "--images",
+        "200",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&out),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = ugl(&[
-        "run", "--env", "armball", "--algo", "rge-pca", "--latents", "3", "--seed", "1",
-        "--epochs", "100", "--images", "200", "--profile", "smoke", "--out", p(&out),
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-pca",
+        "--latents",
+        "3",
+        "--seed",
+        "1",
+        "--epochs",
+        "100",
+        "--images",
+        "200",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&out),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let ext = manifest(&out.join("armball.rge-external.kde.l3.s1.json"));
     let pca = manifest(&out.join("armball.rge-pca.kde.l3.s1.json"));
     assert_eq!(ext["learner"], "rp-cli");
-    assert_eq!(ext["external"]["command"], "python3 scripts/external_learners/random_projection.py");
-    assert_eq!(ext["run_seed"], pca["run_seed"], "paired exploration streams");
+    assert_eq!(
+        ext["external"]["command"],
+        "python3 scripts/external_learners/random_projection.py"
+    );
+    assert_eq!(
+        ext["run_seed"], pca["run_seed"],
+        "paired exploration streams"
+    );
     assert_ne!(ext["identity"], pca["identity"]);
 
     // Without the [learners.external] section or --command: a one-line error.
@@ -434,10 +475,28 @@ fn run_with_an_external_learner() {
     ]);
     assert_one_line_error(&o, "--command");
     // --command is for rge-external only; an empty one is refused.
-    let o = ugl(&["run", "--env", "armball", "--algo", "rge-pca", "--command", "x", "--out", p(&out)]);
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-pca",
+        "--command",
+        "x",
+        "--out",
+        p(&out),
+    ]);
     assert_one_line_error(&o, "rge-external only");
     let o = ugl(&[
-        "run", "--env", "armball", "--algo", "rge-external", "--command", " ", "--out", p(&out),
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-external",
+        "--command",
+        " ",
+        "--out",
+        p(&out),
     ]);
     assert_one_line_error(&o, "must not be empty");
 }
@@ -796,4 +855,98 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
         "registered learner",
     );
     assert_one_line_error(&args(&["--learner", "Bad Name"]), "--learner");
+}
+
+#[test]
+fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("emb").join("pca.npy");
+    let o = ugl(&[
+        "embed",
+        "--env",
+        "armarrow",
+        "--learner",
+        "pca",
+        "--latents",
+        "3",
+        "--grid",
+        "4",
+        "--images",
+        "300",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
+    assert_eq!(s["representation"], "armarrow.rge-pca.l3.s0");
+    assert_eq!(s["latent_quality"]["targets"].as_array().unwrap().len(), 4);
+    // npy v1 headers: (n, d) of the training set, (grid^2, d) of the grid, and their states.
+    let header = |name: &str| {
+        let b = std::fs::read(dir.path().join("emb").join(name)).unwrap();
+        let len = u16::from_le_bytes([b[8], b[9]]) as usize;
+        String::from_utf8_lossy(&b[10..10 + len]).to_string()
+    };
+    assert!(
+        header("pca.npy").contains("'shape': (300, 3, )"),
+        "{}",
+        header("pca.npy")
+    );
+    assert!(header("pca.states.npy").contains("'shape': (300, 3, )"));
+    assert!(header("pca.grid.npy").contains("'shape': (16, 3, )"));
+    assert!(header("pca.grid_states.npy").contains("'<f8'"));
+    // The training latents are the ones a run of the same cell fits: same bytes twice.
+    let first = std::fs::read(&out).unwrap();
+    assert!(
+        ugl(&[
+            "embed",
+            "--env",
+            "armarrow",
+            "--learner",
+            "pca",
+            "--latents",
+            "3",
+            "--grid",
+            "4",
+            "--images",
+            "300",
+            "--profile",
+            "smoke",
+            "--out",
+            p(&out),
+        ])
+        .status
+        .success()
+    );
+    assert_eq!(first, std::fs::read(&out).unwrap());
+    // Errors: one line each.
+    let bad = |args: &[&str], needle: &str| {
+        let mut a = vec!["embed", "--env", "armball", "--profile", "smoke"];
+        a.extend_from_slice(args);
+        assert_one_line_error(&ugl(&a), needle);
+    };
+    bad(
+        &["--learner", "umap", "--out", p(&out)],
+        "not a registered learner",
+    );
+    bad(
+        &["--learner", "pca", "--out", "/tmp/x.csv"],
+        "must end in .npy",
+    );
+    bad(
+        &["--learner", "pca", "--grid", "1", "--out", p(&out)],
+        "--grid",
+    );
+    bad(
+        &[
+            "--learner",
+            "pca",
+            "--variant",
+            "corrected",
+            "--out",
+            p(&out),
+        ],
+        "vae and rfvae only",
+    );
 }

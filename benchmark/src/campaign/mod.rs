@@ -2,6 +2,7 @@
 //! (DESIGN.md: `config -> plan -> runner -> store`).
 
 pub mod config;
+pub mod embed;
 pub mod machine;
 pub mod plan;
 pub mod runner;

@@ -324,6 +324,14 @@ pub fn representation_label(spec: &RunSpec) -> String {
 
 /// Generate the UGL data set of the spec's repetition and fit its learner.
 pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representation, ReprError> {
+    fit_with_data(spec, ctx).map(|(r, _, _)| r)
+}
+
+/// [`fit_representation`], also returning the UGL data set it was fitted on and its seed.
+pub fn fit_with_data(
+    spec: &RunSpec,
+    ctx: &RunContext,
+) -> Result<(Representation, crate::repr::dataset::UglDataset, u64), ReprError> {
     let learner = spec.algo.learner().ok_or_else(|| {
         ReprError::InvalidInput(format!("{} learns no representation", spec.algo))
     })?;
@@ -349,9 +357,7 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
         // The program's stderr: a log file beside the runs, and the last line to the caller.
         let mut l = external_learner(ctx.learners)?;
         let label = representation_label(spec);
-        l.log_file = ctx
-            .log_dir
-            .map(|d| d.join(format!("{label}.learner.log")));
+        l.log_file = ctx.log_dir.map(|d| d.join(format!("{label}.learner.log")));
         if let Some(sink) = &ctx.learner_messages {
             let (sink, label) = (sink.clone(), label.clone());
             l.on_stderr = Some(LineSink(Arc::new(move |line| sink(&label, Some(line)))));
@@ -383,14 +389,15 @@ pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representa
             .unwrap_or_default(),
         _ => learner.name().to_string(),
     };
-    Ok(Representation {
+    let repr = Representation {
         encoder,
         train,
         fit_s: t0.elapsed().as_secs_f64(),
         learner_name,
         training: info,
         quality,
-    })
+    };
+    Ok((repr, data, ds_seed))
 }
 
 /// What an exploration produced, with its timings.

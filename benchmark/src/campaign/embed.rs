@@ -1,0 +1,83 @@
+//! `ugl embed`: the latents of a fitted goal space, for figures and for comparing embeddings
+//! (the paper's Figure 3 argument: a good goal space lays the object's positions out smoothly).
+//!
+//! The representation is fitted exactly as for a run of the same cell and seed (same data set,
+//! same learner stream, same model cache), then encodes:
+//! - the training images (the UGL data set), with their true states;
+//! - a `grid x grid` lattice of object positions over [-1, 1]^2 (ArmArrow: angle 0), with its
+//!   states.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use super::plan::RunSpec;
+use super::runner::{RunContext, fit_with_data};
+use crate::env::make_env;
+use crate::env::render::PIXELS;
+use crate::repr::quality::LatentQuality;
+use crate::repr::{ImageSet, Latents, ReprError};
+use crate::seed::{Component, stream};
+
+/// What `ugl embed` writes.
+pub struct Embedding {
+    pub state_dim: usize,
+    /// Encodings of the training images, and their states (row-major `n x state_dim`).
+    pub train: Latents,
+    pub train_states: Vec<f64>,
+    /// Encodings of the grid images, and their states.
+    pub grid: Latents,
+    pub grid_states: Vec<f64>,
+    /// The representation's held-out latent quality, if measured.
+    pub quality: Option<LatentQuality>,
+}
+
+/// Fit (or load) the representation of `spec` and encode its training images and a grid of
+/// `grid x grid` object positions. A stochastic encoder draws its noise from the data set's
+/// encoding stream.
+pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding, ReprError> {
+    if grid < 2 {
+        return Err(ReprError::InvalidInput(format!(
+            "the grid needs at least 2 x 2 positions, got {grid}"
+        )));
+    }
+    let (mut repr, data, ds_seed) = fit_with_data(spec, ctx)?;
+    let env = make_env(spec.env, ctx.env);
+    let d = env.state_dim();
+    repr.encoder.begin_run(stream(ds_seed, Component::Encoding));
+    let train = repr.encoder.encode(&data.images)?;
+    let mut grid_states = Vec::with_capacity(grid * grid * d);
+    let mut pixels = vec![0f32; grid * grid * PIXELS];
+    for (k, img) in pixels.chunks_exact_mut(PIXELS).enumerate() {
+        let (i, j) = (k / grid, k % grid);
+        let at = |t: usize| -1.0 + 2.0 * t as f64 / (grid - 1) as f64;
+        let mut s = vec![at(i), at(j)];
+        s.resize(d, 0.0);
+        env.render_into(&s, img);
+        grid_states.extend_from_slice(&s);
+    }
+    let grid_latents = repr
+        .encoder
+        .encode(&ImageSet::new(grid * grid, PIXELS, pixels)?)?;
+    Ok(Embedding {
+        state_dim: d,
+        train,
+        train_states: data.states,
+        grid: grid_latents,
+        grid_states,
+        quality: repr.quality,
+    })
+}
+
+/// Write a float64 `rows x cols` array as .npy (C order).
+pub fn write_npy_f64(path: &Path, rows: usize, cols: usize, data: &[f64]) -> std::io::Result<()> {
+    use npyz::WriterBuilder;
+    let file = File::create(path)?;
+    let mut writer = npyz::WriteOptions::<f64>::new()
+        .default_dtype()
+        .shape(&[rows as u64, cols as u64])
+        .writer(BufWriter::new(file))
+        .begin_nd()?;
+    writer.extend(data.iter().copied())?;
+    writer.finish()
+}
