@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # When does a network leave the mean-image plateau? Trains one network per line of the matrix
 # below with `ugl run` (10,000 ArmBall/ArmArrow images, the product path, no model cache) and
-# prints, from its manifest, the loss every `log_every` iterations and the first iteration whose
-# loss is below FRACTION x the plateau (the data set's mean-image loss).
+# prints, from its manifest, the training loss every 4 x `log_every` iterations, the final
+# reconstruction loss as a fraction of the plateau (the mean-image loss), and the latent quality.
 #
 #   scripts/init_escape.sh OUT_DIR "model hidden1 hidden2 init iterations lr env latents seed" ...
 #
@@ -45,6 +45,10 @@ TOML
 import json, glob, sys
 m = json.load(open(glob.glob(sys.argv[1] + "/*.json")[0]))
 losses = m["train"]["losses"]
-print(sys.argv[2], f"({sys.argv[3]} s):", " ".join(f"{i}:{l:.0f}" for i, l in losses[::4]), flush=True)
+ev = m["train"].get("evidence") or {}
+q = m.get("latent_quality") or {}
+print(sys.argv[2], f"({sys.argv[3]} s):", " ".join(f"{i}:{l:.0f}" for i, l in losses[::4]),
+      f"| reconstruction/plateau {ev.get('loss_fraction', float('nan')):.3f}",
+      f"R2 lin {q.get('linear_r2_mean', float('nan')):.3f} knn {q.get('knn_r2_mean', float('nan')):.3f}", flush=True)
 PY
 done

@@ -21,7 +21,7 @@ use crate::explore::{
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
-use crate::repr::evidence::TrainingEvidence;
+use crate::repr::evidence::{EVIDENCE_IMAGES, TrainingEvidence, mean_image_loss};
 use crate::repr::external::{ExternalLearner, LineSink};
 use crate::repr::isomap::Isomap;
 use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
@@ -301,7 +301,13 @@ fn fit_neural(
         }
     };
     let z = enc.training_latents(images)?;
-    let evidence = TrainingEvidence::new(images, &enc.losses, cfg.iterations);
+    let evidence = {
+        let n = images.n.min(EVIDENCE_IMAGES);
+        let head = ImageSet::new(n, images.dim, images.data[..n * images.dim].to_vec())?;
+        let plateau = mean_image_loss(&head);
+        let rec = neural::reconstruction_loss(enc.model, &enc.net, &head, n);
+        TrainingEvidence::new(plateau, rec, n)
+    };
     let info = TrainInfo {
         config: cfg,
         losses: enc.losses.clone(),

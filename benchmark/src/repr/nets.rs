@@ -262,6 +262,19 @@ impl HostNet {
     }
 
     /// The burn module holding these weights on `device`.
+    /// The decoder on the host: pixel logits of a latent code (`latents` values).
+    pub fn decode_logits(&self, z: &[f32], scratch: &mut Scratch) -> Vec<f32> {
+        scratch.h2.resize(self.dec1.out, 0.0);
+        scratch.h1.resize(self.dec2.out, 0.0);
+        self.dec1.forward_into(z, &mut scratch.h2);
+        scratch.h2.iter_mut().for_each(|v| *v = v.max(0.0));
+        self.dec2.forward_into(&scratch.h2, &mut scratch.h1);
+        scratch.h1.iter_mut().for_each(|v| *v = v.max(0.0));
+        let mut out = vec![0.0; self.dec_out.out];
+        self.dec_out.forward_into(&scratch.h1, &mut out);
+        out
+    }
+
     pub fn to_module(&self, device: &Device) -> DenseNet {
         DenseNet {
             enc1: self.enc1.to_linear(device),

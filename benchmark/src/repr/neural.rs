@@ -705,6 +705,41 @@ pub fn train(
     ))
 }
 
+/// The reconstruction loss of a trained network on (at most `max`) `images`: the Bernoulli
+/// loss summed over pixels and averaged over images, of the decoder applied to each image's
+/// noise-free code (AE: its sigmoid latents; VAE: mu; RFVAE: the flows applied to mu). No KL
+/// term and no flow log-determinant, so it is comparable with the mean-image loss
+/// ([`super::evidence::mean_image_loss`]) for every model.
+pub fn reconstruction_loss(model: Model, net: &HostNet, images: &ImageSet, max: usize) -> f64 {
+    let n = images.n.min(max);
+    let d = net.latents;
+    let per_image: Vec<f64> = (0..n)
+        .into_par_iter()
+        .map_init(Scratch::default, |scratch, i| {
+            let x = images.row(i);
+            let head = net.encode_head(x, scratch);
+            let mut code = vec![0.0f64; d];
+            match model {
+                Model::Ae => ae::encoding(&head, d, &mut code),
+                Model::Vae => vae::encoding(&head, d, &mut code),
+                Model::Rfvae => rfvae::mean_code(&head, d, &mut code),
+            }
+            let z: Vec<f32> = code.iter().map(|&v| v as f32).collect();
+            let logits = net.decode_logits(&z, scratch);
+            // softplus(l) - x l, stably.
+            logits
+                .iter()
+                .zip(x)
+                .map(|(&l, &t)| {
+                    let l = f64::from(l);
+                    l.max(0.0) + (-l.abs()).exp().ln_1p() - f64::from(t) * l
+                })
+                .sum::<f64>()
+        })
+        .collect();
+    per_image.iter().sum::<f64>() / n as f64
+}
+
 /// Floating-point operations of one training iteration, counted as `3 x` the forward pass's
 /// `2 m n k` per dense layer (`m` = batch).
 pub fn flops_per_iteration(
@@ -737,4 +772,41 @@ pub fn fit(
 /// Helper for the model files: a `[rows, cols]` tensor from host values.
 pub fn tensor2(values: Vec<f32>, rows: usize, cols: usize, device: &Device) -> Tensor<2> {
     Tensor::from_data(TensorData::new(values, [rows, cols]), device)
+}
+
+#[cfg(test)]
+mod evidence_tests {
+    use super::*;
+    use crate::repr::evidence::mean_image_loss;
+    use crate::seed::stream_named;
+
+    /// A decoder that outputs the mean image's logits whatever the code has exactly the
+    /// plateau loss; one that outputs 0 logits has 4900 ln 2 per image (any model).
+    #[test]
+    fn reconstruction_loss_of_constant_decoders() {
+        let (n, dim) = (40, 30);
+        let data: Vec<f32> = (0..n * dim)
+            .map(|k| if (k * 7 + k / dim) % 5 == 0 { 1.0 } else { 0.0 })
+            .collect();
+        let images = ImageSet::new(n, dim, data).unwrap();
+        let plateau = mean_image_loss(&images);
+        for model in Model::ALL {
+            let cfg = NeuralConfig {
+                hidden: [8, 6],
+                ..NeuralConfig::paper(model)
+            };
+            let mut net = init_net(model, &cfg, dim, 3, &mut stream_named(2, "ev"));
+            net.dec_out.w.iter_mut().for_each(|w| *w = 0.0);
+            net.dec_out.b.iter_mut().for_each(|b| *b = 0.0);
+            let zero = reconstruction_loss(model, &net, &images, n);
+            assert!((zero - dim as f64 * 2f64.ln()).abs() < 1e-4, "{model:?}: {zero}");
+            for (p, b) in net.dec_out.b.iter_mut().enumerate() {
+                let m = (0..n).map(|i| images.row(i)[p] as f64).sum::<f64>() / n as f64;
+                let m = m.clamp(1e-7, 1.0 - 1e-7);
+                *b = (m / (1.0 - m)).ln() as f32;
+            }
+            let mean = reconstruction_loss(model, &net, &images, n);
+            assert!((mean - plateau).abs() < 1e-3 * plateau, "{model:?}: {mean} vs {plateau}");
+        }
+    }
 }

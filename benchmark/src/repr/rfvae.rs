@@ -173,7 +173,7 @@ pub fn flow_step_host(z: &mut [f64], c: &[f64], a_raw: f64, b_raw: f64) -> f64 {
 }
 
 /// All flows of one image on the host, from the head outputs; `z` holds `z0` on entry.
-fn flows_host(head: &[f32], d: usize, z: &mut [f64]) {
+pub fn flows_host(head: &[f32], d: usize, z: &mut [f64]) {
     let c0 = 2 * d;
     let b0 = c0 + FLOWS * d;
     let a0 = b0 + FLOWS;
@@ -207,6 +207,14 @@ pub fn encoding(head: &[f32], d: usize, variant: Variant, rng: &mut Stream, out:
 }
 
 /// The deterministic (corrected) encoding: the flows applied to mu.
+/// The noise-free code: `z_K` of `z0 = mu` (both variants; the corrected variant's encoding).
+pub fn mean_code(head: &[f32], d: usize, out: &mut [f64]) {
+    for (o, &m) in out.iter_mut().zip(&head[..d]) {
+        *o = f64::from(m);
+    }
+    flows_host(head, d, out);
+}
+
 pub fn encoding_deterministic(head: &[f32], d: usize, variant: Variant, out: &mut [f64]) {
     debug_assert_eq!(
         variant,

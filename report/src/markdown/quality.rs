@@ -112,10 +112,11 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
         w,
         "For each learned goal space of the main campaign (one representation per cell and seed; \
          the Gaussian-goal runs share the KDE runs' representation):\n\n\
-         - **untrained**: neural runs whose final training loss (mean of the last 10% of the \
-         recorded iterations) is not below 0.8 x the *plateau*, the loss of the data set's mean \
-         image (the best constant prediction, computed exactly); such a goal space is an \
-         untrained random projection. **loss / plateau** is the median of that ratio;\n\
+         - **untrained**: neural runs whose reconstruction loss after training (the decoder \
+         applied to each image's noise-free code, on 2000 training images; no KL or flow term) is \
+         not below 0.8 x the *plateau*, the loss of those images' mean image (the best constant \
+         prediction, computed exactly); such a goal space is an untrained random projection. \
+         **loss / plateau** is the median of that ratio;\n\
          - **R² linear / k-NN**: how well the true object state (ball x, y; arrow x, y and its \
          angle as cos, sin) is predicted from the latents of 1000 held-out images, by a linear \
          map and by 10-nearest-neighbour regression fitted on 2000 training images (mean over \
