@@ -275,6 +275,11 @@ struct CacheArgs {
     /// Do not read or write the model cache (always train).
     #[arg(long, conflicts_with = "cache")]
     no_cache: bool,
+    /// Save a checkpoint of each neural training every N iterations in the model cache (0:
+    /// never). A training killed mid-way resumes from its latest checkpoint and ends
+    /// bit-identical to an uninterrupted one.
+    #[arg(long, default_value_t = 1000)]
+    checkpoint_every: usize,
 }
 
 impl CacheArgs {
@@ -670,6 +675,7 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
             .map_err(|m| anyhow::anyhow!("--name/--command: {m}"))?;
     }
     check_out_dir(out)?;
+    let checkpoint_every = cache.checkpoint_every;
     let cache = cache.resolve(out);
     let mp = MultiProgress::new();
     if !std::io::stderr().is_terminal() {
@@ -689,6 +695,7 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
         train_threads: 0,
         log_dir: Some(out),
         learner_messages: Some(learner_lines(&mp, None)),
+        checkpoint_every,
     };
     let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
     println!("{}", serde_json::to_string(&summary)?);
@@ -780,6 +787,7 @@ fn embed(a: EmbedArgs) -> Result<()> {
         train_threads: 0,
         log_dir: Some(dir),
         learner_messages: Some(learner_lines(&mp, None)),
+        checkpoint_every: a.cache.checkpoint_every,
     };
     let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid)?;
     let stem = a.out.with_extension("");
@@ -922,6 +930,7 @@ fn run_config(
         mp.set_draw_target(ProgressDrawTarget::hidden());
     }
     let bar = mp.add(ProgressBar::new(0));
+    let checkpoint_every = cache.checkpoint_every;
     let cache = cache.resolve(&out);
     bar.set_style(
         ProgressStyle::with_template(
@@ -954,6 +963,7 @@ fn run_config(
         cache: cache.as_ref(),
         train_progress: Some(training_bars(&mp, Some(&bar))),
         learner_messages: Some(learner_lines(&mp, Some(&bar))),
+        checkpoint_every,
     };
     let done = run_campaign(cfg, &out, &opts, &on)?;
     bar.finish_and_clear();

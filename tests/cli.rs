@@ -950,3 +950,93 @@ fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
         "vae and rfvae only",
     );
 }
+
+/// `kill -9` of `ugl run` in the middle of a neural training: the rerun resumes from the
+/// latest checkpoint (in the model cache) and gives the bytes of an uninterrupted run.
+#[test]
+fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("ckpt.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"ckpt\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
+         [ugl]\nimages = 300\n[explore]\nepochs = 100\n\
+         [learners.vae]\niterations = 600\nhidden = [32, 16]\ninit = \"he\"\n",
+    )
+    .unwrap();
+    let args = |out: &Path| -> Vec<String> {
+        [
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-vae",
+            "--latents",
+            "2",
+            "--profile",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([p(&cfg).to_string(), "--out".into(), p(out).to_string()])
+        .chain(["--checkpoint-every".into(), "50".into()])
+        .collect()
+    };
+    let reference = dir.path().join("reference");
+    let a = args(&reference);
+    let o = ugl(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let out = dir.path().join("killed");
+    let a = args(&out);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args(&a)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let models = out.join("models");
+    let t0 = Instant::now();
+    let checkpointed = loop {
+        let found = std::fs::read_dir(&models)
+            .map(|d| {
+                d.flatten().any(|e| {
+                    e.file_name().to_string_lossy().contains(".ckpt.")
+                        && e.path().join("state.json").exists()
+                })
+            })
+            .unwrap_or(false);
+        if found || child.try_wait().unwrap().is_some() || t0.elapsed() > Duration::from_secs(120) {
+            break found;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(
+        checkpointed,
+        "no checkpoint appeared before the training ended"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args(&a)
+        .env("UGL_LOG", "info")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("resuming"), "{}", stderr(&o));
+    assert!(
+        common::parquet_files(&out) == common::parquet_files(&reference),
+        "the resumed run differs from the uninterrupted one"
+    );
+    let leftovers = std::fs::read_dir(&models)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains(".ckpt."))
+        .count();
+    assert_eq!(
+        leftovers, 0,
+        "checkpoints are removed once the training is done"
+    );
+}

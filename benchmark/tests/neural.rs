@@ -607,3 +607,118 @@ fn fingerprint_for_thread_count_comparison() {
         }
     }
 }
+
+/// A training killed after its second checkpoint (a panic in the progress callback stands for
+/// the `kill -9`: nothing after it runs) resumes from that checkpoint and ends bit-identical to
+/// an uninterrupted training: weights, loss curve and encoder seed.
+#[test]
+fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
+    use ugl_bench::repr::neural::{CheckpointSpec, train, train_with_checkpoints};
+    let set = images(EnvKind::ArmBall, 120);
+    for model in Model::ALL {
+        let cfg = NeuralConfig {
+            log_every: 5,
+            warmup: 10,
+            ..tiny(model, Variant::Faithful, 60)
+        };
+        let learner_stream = || stream_named(9, "checkpoint-learner");
+        let reference = train(model, &cfg, &set, 3, &mut learner_stream(), None).unwrap();
+
+        let dir = tempfile::tempdir().unwrap();
+        let spec = CheckpointSpec {
+            dir: dir.path().to_path_buf(),
+            key: format!("test-{}", model.name()),
+            every: 20,
+        };
+        let killer: ugl_bench::repr::neural::ProgressFn = Arc::new(|p| {
+            if p.iteration == 47 {
+                panic!("killed at iteration 47");
+            }
+        });
+        let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            train_with_checkpoints(
+                model,
+                &cfg,
+                &set,
+                3,
+                &mut learner_stream(),
+                Some(&killer),
+                Some(&spec),
+            )
+        }));
+        assert!(killed.is_err(), "the training was interrupted");
+        let left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(
+            left,
+            [format!("test-{}.ckpt.40", model.name())],
+            "only the latest"
+        );
+
+        // Resume: counts iterations from 41.
+        let seen = Arc::new(AtomicUsize::new(usize::MAX));
+        let first = seen.clone();
+        let watch: ugl_bench::repr::neural::ProgressFn = Arc::new(move |p| {
+            first.fetch_min(p.iteration, Ordering::SeqCst);
+        });
+        let resumed = train_with_checkpoints(
+            model,
+            &cfg,
+            &set,
+            3,
+            &mut learner_stream(),
+            Some(&watch),
+            Some(&spec),
+        )
+        .unwrap();
+        assert_eq!(
+            seen.load(Ordering::SeqCst),
+            41,
+            "{model:?} resumed after iteration 40"
+        );
+        assert_eq!(resumed.net, reference.net, "{model:?}: weights differ");
+        assert_eq!(
+            resumed.losses, reference.losses,
+            "{model:?}: loss curve differs"
+        );
+        assert_eq!(resumed.encode_seed, reference.encode_seed);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "checkpoints removed"
+        );
+
+        // A damaged checkpoint is ignored: training starts over, same result.
+        let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            train_with_checkpoints(
+                model,
+                &cfg,
+                &set,
+                3,
+                &mut learner_stream(),
+                Some(&killer),
+                Some(&spec),
+            )
+        }));
+        assert!(killed.is_err());
+        let ckpt = dir.path().join(format!("test-{}.ckpt.40", model.name()));
+        let optim = ckpt.join("optim.bpk");
+        let mut bytes = std::fs::read(&optim).unwrap();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 1;
+        std::fs::write(&optim, bytes).unwrap();
+        let again = train_with_checkpoints(
+            model,
+            &cfg,
+            &set,
+            3,
+            &mut learner_stream(),
+            None,
+            Some(&spec),
+        )
+        .unwrap();
+        assert_eq!(again.net, reference.net);
+    }
+}

@@ -98,6 +98,9 @@ pub struct RunContext<'a> {
     pub log_dir: Option<&'a Path>,
     /// External learners' stderr lines, as they come.
     pub learner_messages: Option<Arc<MessageSink>>,
+    /// Neural trainings save a checkpoint in the model cache every this many iterations
+    /// (0: never); a killed training resumes from its latest one, bit-identically.
+    pub checkpoint_every: usize,
 }
 
 impl RunContext<'_> {
@@ -283,8 +286,25 @@ fn fit_neural(
                 let label = representation_label(spec);
                 l = l.with_progress(Arc::new(move |p| sink(&label, p)));
             }
-            let mut train =
-                || neural::train(model, &l.config, images, spec.latents, rng, l.progress());
+            let ckpt =
+                ctx.cache
+                    .filter(|_| ctx.checkpoint_every > 0)
+                    .map(|c| neural::CheckpointSpec {
+                        dir: c.dir.clone(),
+                        key: key.clone(),
+                        every: ctx.checkpoint_every,
+                    });
+            let mut train = || {
+                neural::train_with_checkpoints(
+                    model,
+                    &l.config,
+                    images,
+                    spec.latents,
+                    rng,
+                    l.progress(),
+                    ckpt.as_ref(),
+                )
+            };
             let enc = if ctx.train_threads > 0 {
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(ctx.train_threads)
@@ -635,6 +655,8 @@ pub struct CampaignOptions<'a> {
     pub train_progress: Option<Arc<TrainSink>>,
     /// External learners' stderr lines.
     pub learner_messages: Option<Arc<MessageSink>>,
+    /// [`RunContext::checkpoint_every`].
+    pub checkpoint_every: usize,
 }
 
 /// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
@@ -660,6 +682,7 @@ pub fn run_campaign(
         train_threads: 0,
         log_dir: Some(out),
         learner_messages: opts.learner_messages.clone(),
+        checkpoint_every: opts.checkpoint_every,
     };
     let all = match opts.shard {
         None => plan(cfg),

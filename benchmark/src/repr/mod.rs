@@ -8,6 +8,7 @@
 
 pub mod ae;
 pub mod cache;
+pub mod checkpoint;
 pub mod dataset;
 pub mod evidence;
 pub mod external;

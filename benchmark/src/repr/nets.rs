@@ -18,7 +18,7 @@
 //! column blocks of one `[H2, P]` layer; each block is drawn separately, in that order, as the
 //! original's separate variables are.
 
-use burn::module::{Module, Param};
+use burn::module::{Module, Param, ParamId};
 use burn::nn::Linear;
 use burn::optim::{Optimizer, RecordState, StateSink, StateSource};
 use burn::tensor::activation::{log_sigmoid, relu};
@@ -168,6 +168,20 @@ impl HostLayer {
         }
     }
 
+    /// As [`Self::to_linear`], with given parameter ids (a resumed training: the optimiser's
+    /// saved state is keyed by them).
+    fn to_linear_with_ids(&self, device: &Device, ids: [u64; 2]) -> Linear {
+        let w: Tensor<2> = Tensor::from_data(
+            TensorData::new(self.w.clone(), [self.inp, self.out]),
+            device,
+        );
+        let b: Tensor<1> = Tensor::from_data(TensorData::new(self.b.clone(), [self.out]), device);
+        Linear {
+            weight: Param::initialized(ParamId::from(ids[0]), w.require_grad()),
+            bias: Some(Param::initialized(ParamId::from(ids[1]), b.require_grad())),
+        }
+    }
+
     fn from_linear(l: &Linear) -> Result<HostLayer, ReprError> {
         let [inp, out] = l.weight.val().dims();
         let read = |t: Tensor<1>| {
@@ -275,6 +289,21 @@ impl HostNet {
         out
     }
 
+    /// The module with the given parameter ids ([`DenseNet::param_ids`] of the saved one).
+    pub fn to_module_with_ids(&self, device: &Device, ids: &[u64; 12]) -> DenseNet {
+        let l = |layer: &HostLayer, k: usize| {
+            layer.to_linear_with_ids(device, [ids[2 * k], ids[2 * k + 1]])
+        };
+        DenseNet {
+            enc1: l(&self.enc1, 0),
+            enc2: l(&self.enc2, 1),
+            head: l(&self.head, 2),
+            dec1: l(&self.dec1, 3),
+            dec2: l(&self.dec2, 4),
+            dec_out: l(&self.dec_out, 5),
+        }
+    }
+
     pub fn to_module(&self, device: &Device) -> DenseNet {
         DenseNet {
             enc1: self.enc1.to_linear(device),
@@ -334,6 +363,26 @@ impl DenseNet {
     }
 
     /// Decoder: `[B, d] -> [B, dim]` logits.
+    /// The parameter ids, weight then bias, of enc1, enc2, head, dec1, dec2, dec_out.
+    pub fn param_ids(&self) -> [u64; 12] {
+        let mut ids = [0u64; 12];
+        for (k, l) in [
+            &self.enc1,
+            &self.enc2,
+            &self.head,
+            &self.dec1,
+            &self.dec2,
+            &self.dec_out,
+        ]
+        .iter()
+        .enumerate()
+        {
+            ids[2 * k] = l.weight.id.val();
+            ids[2 * k + 1] = l.bias.as_ref().expect("every layer has a bias").id.val();
+        }
+        ids
+    }
+
     pub fn decode(&self, z: Tensor<2>) -> Tensor<2> {
         let h = relu(self.dec1.forward(z));
         let h = relu(self.dec2.forward(h));

@@ -17,6 +17,7 @@
 //! runs on the host ([`HostNet::encode_head`]), image by image, so a batch encode and
 //! `encode_one` agree bit for bit and neither depends on the thread count.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use burn::module::Module as _;
@@ -656,6 +657,71 @@ impl<'a> Trainer<'a> {
         Ok(value)
     }
 
+    /// The state a checkpoint keeps besides the weights and the optimiser: parameter ids (the
+    /// optimiser's state is keyed by them) and the batch permutation.
+    pub fn resume_state(&self) -> ([u64; 12], &[usize]) {
+        let net = self
+            .net
+            .as_ref()
+            .expect("the module is present between steps");
+        (net.param_ids(), &self.perm)
+    }
+
+    /// Save the optimiser's state (burn's record format).
+    pub fn save_optimizer(&self, path: &Path) -> Result<(), ReprError> {
+        self.opt
+            .save(path)
+            .map_err(|e| ReprError::Io(format!("saving optimiser state {}: {e:?}", path.display())))
+    }
+
+    /// A trainer continuing from a checkpoint: weights `net` with parameter ids `ids`, the
+    /// optimiser state in `optimizer`, the batch permutation and the iterations done. The
+    /// caller restores the stream's position.
+    pub fn resume(
+        model: Model,
+        cfg: &NeuralConfig,
+        images: &'a ImageSet,
+        latents: usize,
+        state: ResumeState<'_>,
+    ) -> Result<Self, ReprError> {
+        cfg.validate(model, model.name())?;
+        check_fit_input(images, latents)?;
+        if state.perm.len() != images.n
+            || state.net.dim != images.dim
+            || state.net.latents != latents
+            || state.net.hidden != cfg.hidden
+        {
+            return Err(ReprError::InvalidInput(
+                "checkpoint does not match the training".into(),
+            ));
+        }
+        let device = training_device();
+        let net = state.net.to_module_with_ids(&device, state.ids);
+        let opt: ModuleOptimizer = match model {
+            Model::Ae => TfAdagrad::default().into(),
+            Model::Vae | Model::Rfvae => TfAdam::default().into(),
+        };
+        let opt = opt.load(state.optimizer).map_err(|e| {
+            ReprError::Io(format!(
+                "loading optimiser state {}: {e:?}",
+                state.optimizer.display()
+            ))
+        })?;
+        let k = cfg.batch.min(images.n);
+        Ok(Trainer {
+            model,
+            cfg: cfg.clone(),
+            images,
+            latents,
+            device,
+            net: Some(net),
+            opt,
+            perm: state.perm.to_vec(),
+            xbuf: vec![0.0; k * images.dim],
+            step: state.step,
+        })
+    }
+
     /// The current weights on the host.
     pub fn host_net(&self) -> Result<HostNet, ReprError> {
         let net = self
@@ -665,6 +731,24 @@ impl<'a> Trainer<'a> {
             .valid();
         HostNet::from_module(&net, self.images.dim, self.cfg.hidden, self.latents)
     }
+}
+
+/// What [`Trainer::resume`] continues from.
+pub struct ResumeState<'s> {
+    pub net: &'s HostNet,
+    pub ids: &'s [u64; 12],
+    pub optimizer: &'s Path,
+    pub perm: &'s [usize],
+    pub step: usize,
+}
+
+/// Mid-training checkpoints: where, under which key, and how often.
+#[derive(Clone, Debug)]
+pub struct CheckpointSpec {
+    pub dir: PathBuf,
+    pub key: String,
+    /// Save every this many iterations (and never at the end: the model cache keeps that).
+    pub every: usize,
 }
 
 /// Train `model` on `images` and return the encoder. The stream is used for: the initial
@@ -678,12 +762,45 @@ pub fn train(
     rng: &mut Stream,
     progress: Option<&ProgressFn>,
 ) -> Result<NeuralEncoder, ReprError> {
-    let mut trainer = Trainer::new(model, cfg, images, latents, rng)?;
-    let mut losses = Vec::new();
-    for step in 0..cfg.iterations {
+    train_with_checkpoints(model, cfg, images, latents, rng, progress, None)
+}
+
+/// [`train`], saving a checkpoint every `ckpt.every` iterations and starting from the latest
+/// valid checkpoint of `ckpt.key` if there is one. The result is bit-identical to an
+/// uninterrupted training (the weights, the optimiser state, the batch permutation and the
+/// stream's position are all restored; tested). The checkpoints are removed at the end.
+pub fn train_with_checkpoints(
+    model: Model,
+    cfg: &NeuralConfig,
+    images: &ImageSet,
+    latents: usize,
+    rng: &mut Stream,
+    progress: Option<&ProgressFn>,
+    ckpt: Option<&CheckpointSpec>,
+) -> Result<NeuralEncoder, ReprError> {
+    let start = rng.clone();
+    let resumed = match ckpt {
+        Some(c) => super::checkpoint::load_latest(c, model, cfg, images, latents, rng)?,
+        None => None,
+    };
+    let (mut trainer, mut losses) = match resumed {
+        Some(r) => r,
+        None => {
+            *rng = start;
+            (Trainer::new(model, cfg, images, latents, rng)?, Vec::new())
+        }
+    };
+    for step in trainer.step..cfg.iterations {
         let value = trainer.step(rng)?;
         if step % cfg.log_every == 0 || step + 1 == cfg.iterations {
             losses.push((step, value));
+        }
+        if let Some(c) = ckpt
+            && c.every > 0
+            && (step + 1) % c.every == 0
+            && step + 1 < cfg.iterations
+        {
+            super::checkpoint::save(c, &trainer, rng, &losses)?;
         }
         if let Some(p) = progress {
             p(TrainProgress {
@@ -694,6 +811,9 @@ pub fn train(
         }
     }
     let trained = trainer.host_net()?;
+    if let Some(c) = ckpt {
+        super::checkpoint::remove_all(c);
+    }
     let mut seed = [0u8; 32];
     rng.fill_bytes(&mut seed);
     Ok(NeuralEncoder::new(
@@ -799,14 +919,20 @@ mod evidence_tests {
             net.dec_out.w.iter_mut().for_each(|w| *w = 0.0);
             net.dec_out.b.iter_mut().for_each(|b| *b = 0.0);
             let zero = reconstruction_loss(model, &net, &images, n);
-            assert!((zero - dim as f64 * 2f64.ln()).abs() < 1e-4, "{model:?}: {zero}");
+            assert!(
+                (zero - dim as f64 * 2f64.ln()).abs() < 1e-4,
+                "{model:?}: {zero}"
+            );
             for (p, b) in net.dec_out.b.iter_mut().enumerate() {
                 let m = (0..n).map(|i| images.row(i)[p] as f64).sum::<f64>() / n as f64;
                 let m = m.clamp(1e-7, 1.0 - 1e-7);
                 *b = (m / (1.0 - m)).ln() as f32;
             }
             let mean = reconstruction_loss(model, &net, &images, n);
-            assert!((mean - plateau).abs() < 1e-3 * plateau, "{model:?}: {mean} vs {plateau}");
+            assert!(
+                (mean - plateau).abs() < 1e-3 * plateau,
+                "{model:?}: {mean} vs {plateau}"
+            );
         }
     }
 }
