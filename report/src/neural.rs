@@ -82,6 +82,9 @@ pub struct Training {
     pub batch: Option<i64>,
     pub lr: Option<f64>,
     pub warmup: Option<i64>,
+    /// Weight initialisation (`paper`, `he`, `glorot`); absent in manifests written before it
+    /// was configurable, which all used the paper's.
+    pub init: Option<String>,
     /// Model-cache status: `hit`, `miss`, `rebuilt` or `off`.
     pub cache: Option<String>,
     /// Hash of the training configuration and data: runs with the same key share one training
@@ -122,6 +125,10 @@ pub fn training(m: &Manifest) -> Option<Training> {
         batch: int("batch"),
         lr: cfg.and_then(|c| c.get("lr")).and_then(Value::as_f64),
         warmup: int("warmup"),
+        init: cfg
+            .and_then(|c| c.get("init"))
+            .and_then(Value::as_str)
+            .map(str::to_string),
         cache: t.get("cache").and_then(Value::as_str).map(str::to_string),
         key: t.get("key").and_then(Value::as_str).map(str::to_string),
         losses,
@@ -157,6 +164,7 @@ pub struct BudgetUsed {
     pub batch: BTreeMap<String, usize>,
     pub lr: BTreeMap<String, usize>,
     pub warmup: BTreeMap<String, usize>,
+    pub init: BTreeMap<String, usize>,
     /// Distinct trainings (training keys; a training is shared by the samplers of a cell).
     pub trainings: usize,
     /// Mean `fit_s` (data set + training) over distinct trainings, seconds.
@@ -193,6 +201,10 @@ pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
         count(&mut b.batch, t.batch.map(|v| v.to_string()));
         count(&mut b.lr, t.lr.map(|v| format!("{v:e}")));
         count(&mut b.warmup, t.warmup.map(|v| v.to_string()));
+        count(
+            &mut b.init,
+            Some(t.init.clone().unwrap_or_else(|| "paper".into())),
+        );
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
         keys.entry(l)
             .or_default()

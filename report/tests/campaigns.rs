@@ -170,7 +170,8 @@ fn write_run(dir: &Path, s: &Spec) {
             serde_json::json!({
                 "config": {"iterations": it, "hidden": [512, 256], "batch": 100, "lr": 0.001,
                            "variant": if s.variant == "corrected" { "corrected" } else { "faithful" },
-                           "log_every": 100, "warmup": 100},
+                           "log_every": 100, "warmup": 100,
+                           "init": if l == "ae" { "he" } else { "paper" }},
                 "losses": [[0, 3400.0], [100, 600.0 + s.seed as f64], [200, 450.0], [300, 420.0]],
                 "cache": "miss",
                 // One training per (env, learner, latents, variant, seed): shared by the samplers.
@@ -304,6 +305,12 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
             && compute.contains("27.0 min fitting 27 representations")
             && compute.contains("and 9.5 min exploring"),
         "{compute}"
+    );
+    // A non-paper init is a listed deviation.
+    assert!(
+        md.contains("weight init AE he instead of the paper's truncated normal"),
+        "{}",
+        &md[md.find("## Deviations").unwrap()..]
     );
     // The goal-space quality table: seed 0 of every neural cell is untrained.
     let q = &md[md

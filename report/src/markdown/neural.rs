@@ -165,7 +165,14 @@ fn budget_deviation(inp: &Inputs<'_>) -> Option<String> {
     let used = neural::budgets_used(inp.store);
     let mut parts = Vec::new();
     let mut hidden = Vec::new();
+    let mut inits: Vec<String> = Vec::new();
     for b in &used {
+        for i in b.init.keys().filter(|i| *i != "paper") {
+            let s = format!("{} {i}", learner_name(&b.learner));
+            if !inits.contains(&s) {
+                inits.push(s);
+            }
+        }
         let Some(p) = paper_training(&b.learner) else {
             continue;
         };
@@ -188,6 +195,12 @@ fn budget_deviation(inp: &Inputs<'_>) -> Option<String> {
                 hidden.push(h.clone());
             }
         }
+    }
+    if !inits.is_empty() {
+        parts.push(format!(
+            "weight init {} instead of the paper's truncated normal (std 0.001)",
+            inits.join(", ")
+        ));
     }
     if parts.is_empty() && hidden.is_empty() {
         return None;
