@@ -675,13 +675,34 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
             .map_err(|m| anyhow::anyhow!("--name/--command: {m}"))?;
     }
     check_out_dir(out)?;
-    let checkpoint_every = cache.checkpoint_every;
-    let cache = cache.resolve(out);
+    let model_cache = cache.resolve(out);
+    let mp = progress_area();
+    let ctx = single_context(&cfg, profile, model_cache.as_ref(), cache, out, &mp);
+    let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
+    println!("{}", serde_json::to_string(&summary)?);
+    Ok(())
+}
+
+/// Progress bars on stderr, hidden when it is not a terminal.
+fn progress_area() -> MultiProgress {
     let mp = MultiProgress::new();
     if !std::io::stderr().is_terminal() {
         mp.set_draw_target(ProgressDrawTarget::hidden());
     }
-    let ctx = RunContext {
+    mp
+}
+
+/// The context of one run or one representation (`ugl run`, `ugl embed`): the whole machine's
+/// threads, training bars and learner lines in `mp`, learner logs and the model cache in `out`.
+fn single_context<'a>(
+    cfg: &'a CampaignConfig,
+    profile: &'a str,
+    model_cache: Option<&'a ModelCache>,
+    cache: &CacheArgs,
+    out: &'a Path,
+    mp: &MultiProgress,
+) -> RunContext<'a> {
+    RunContext {
         campaign: &cfg.campaign.name,
         campaign_seed: cfg.campaign.seed,
         profile,
@@ -690,16 +711,13 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
         ugl: &cfg.ugl,
         learners: &cfg.learners,
         threads: rayon::current_num_threads(),
-        cache: cache.as_ref(),
-        train_progress: Some(training_bars(&mp, None)),
+        cache: model_cache,
+        train_progress: Some(training_bars(mp, None)),
         train_threads: 0,
         log_dir: Some(out),
-        learner_messages: Some(learner_lines(&mp, None)),
-        checkpoint_every,
-    };
-    let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
-    println!("{}", serde_json::to_string(&summary)?);
-    Ok(())
+        learner_messages: Some(learner_lines(mp, None)),
+        checkpoint_every: cache.checkpoint_every,
+    }
 }
 
 /// An output directory must be a directory (created if missing).
@@ -768,27 +786,9 @@ fn embed(a: EmbedArgs) -> Result<()> {
         a.variant.unwrap_or_default(),
         a.seed,
     );
-    let cache = a.cache.resolve(dir);
-    let mp = MultiProgress::new();
-    if !std::io::stderr().is_terminal() {
-        mp.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    let ctx = RunContext {
-        campaign: &cfg.campaign.name,
-        campaign_seed: cfg.campaign.seed,
-        profile: &a.profile,
-        explore: &cfg.explore,
-        env: &cfg.env,
-        ugl: &cfg.ugl,
-        learners: &cfg.learners,
-        threads: rayon::current_num_threads(),
-        cache: cache.as_ref(),
-        train_progress: Some(training_bars(&mp, None)),
-        train_threads: 0,
-        log_dir: Some(dir),
-        learner_messages: Some(learner_lines(&mp, None)),
-        checkpoint_every: a.cache.checkpoint_every,
-    };
+    let model_cache = a.cache.resolve(dir);
+    let mp = progress_area();
+    let ctx = single_context(&cfg, &a.profile, model_cache.as_ref(), &a.cache, dir, &mp);
     let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid)?;
     let stem = a.out.with_extension("");
     let sibling = |suffix: &str| PathBuf::from(format!("{}.{suffix}.npy", stem.display()));

@@ -97,6 +97,23 @@ fn run_args(run_id: &str) -> Vec<String> {
     args
 }
 
+/// The parquet files of `dir` are `expected`, byte for byte; the message names those that differ.
+fn assert_same(expected: &[(String, Vec<u8>)], dir: &Path, what: &str) {
+    let got = common::parquet_files(dir);
+    let differing: Vec<&String> = expected
+        .iter()
+        .zip(&got)
+        .filter(|(x, y)| x != y)
+        .map(|(x, _)| &x.0)
+        .collect();
+    assert!(
+        differing.is_empty() && got.len() == expected.len(),
+        "{what} {differing:?} ({} files, {} expected)",
+        got.len(),
+        expected.len()
+    );
+}
+
 #[test]
 fn results_depend_on_the_run_identity_only() {
     let dir = tempfile::tempdir().unwrap();
@@ -144,17 +161,7 @@ fn results_depend_on_the_run_identity_only() {
         "2",
         "--quiet",
     ]));
-    let got = common::parquet_files(&two);
-    let differing: Vec<&String> = expected
-        .iter()
-        .zip(&got)
-        .filter(|(x, y)| x != y)
-        .map(|(x, _)| &x.0)
-        .collect();
-    assert!(
-        differing.is_empty() && got.len() == expected.len(),
-        "reversed order changes {differing:?}"
-    );
+    assert_same(&expected, &two, "reversed order changes");
 
     // 3. Each run alone, its representation fitted for it alone.
     let alone = dir.path().join("alone");
@@ -165,17 +172,7 @@ fn results_depend_on_the_run_identity_only() {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         ok(ugl(&args));
     }
-    let got = common::parquet_files(&alone);
-    let differing: Vec<&String> = expected
-        .iter()
-        .zip(&got)
-        .filter(|(x, y)| x != y)
-        .map(|(x, _)| &x.0)
-        .collect();
-    assert!(
-        differing.is_empty() && got.len() == expected.len(),
-        "a lone run differs from the campaign's: {differing:?}"
-    );
+    assert_same(&expected, &alone, "a lone run differs from the campaign's:");
 
     // 4. Killed between the two runs of every cell (the gaussian runs come second in plan
     // order), then resumed.

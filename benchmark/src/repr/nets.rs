@@ -155,21 +155,8 @@ impl HostLayer {
         }
     }
 
-    fn to_linear(&self, device: &Device) -> Linear {
-        Linear {
-            weight: Param::from_data(
-                TensorData::new(self.w.clone(), [self.inp, self.out]),
-                device,
-            ),
-            bias: Some(Param::from_data(
-                TensorData::new(self.b.clone(), [self.out]),
-                device,
-            )),
-        }
-    }
-
-    /// As [`Self::to_linear`], with given parameter ids (a resumed training: the optimiser's
-    /// saved state is keyed by them).
+    /// The layer as a burn [`Linear`] with the given parameter ids (a resumed training: the
+    /// optimiser's saved state is keyed by them).
     fn to_linear_with_ids(&self, device: &Device, ids: [u64; 2]) -> Linear {
         let w: Tensor<2> = Tensor::from_data(
             TensorData::new(self.w.clone(), [self.inp, self.out]),
@@ -264,29 +251,12 @@ impl HostNet {
 
     /// The encoder's head outputs (pre-activation, `head.out` values) for one image.
     pub fn encode_head(&self, image: &[f32], scratch: &mut Scratch) -> Vec<f32> {
-        scratch.h1.resize(self.enc1.out, 0.0);
-        scratch.h2.resize(self.enc2.out, 0.0);
-        self.enc1.forward_into(image, &mut scratch.h1);
-        scratch.h1.iter_mut().for_each(|v| *v = v.max(0.0));
-        self.enc2.forward_into(&scratch.h1, &mut scratch.h2);
-        scratch.h2.iter_mut().for_each(|v| *v = v.max(0.0));
-        let mut out = vec![0.0; self.head.out];
-        self.head.forward_into(&scratch.h2, &mut out);
-        out
+        three_layers([&self.enc1, &self.enc2, &self.head], image, scratch)
     }
 
-    /// The burn module holding these weights on `device`.
     /// The decoder on the host: pixel logits of a latent code (`latents` values).
     pub fn decode_logits(&self, z: &[f32], scratch: &mut Scratch) -> Vec<f32> {
-        scratch.h2.resize(self.dec1.out, 0.0);
-        scratch.h1.resize(self.dec2.out, 0.0);
-        self.dec1.forward_into(z, &mut scratch.h2);
-        scratch.h2.iter_mut().for_each(|v| *v = v.max(0.0));
-        self.dec2.forward_into(&scratch.h2, &mut scratch.h1);
-        scratch.h1.iter_mut().for_each(|v| *v = v.max(0.0));
-        let mut out = vec![0.0; self.dec_out.out];
-        self.dec_out.forward_into(&scratch.h1, &mut out);
-        out
+        three_layers([&self.dec1, &self.dec2, &self.dec_out], z, scratch)
     }
 
     /// The module with the given parameter ids ([`DenseNet::param_ids`] of the saved one).
@@ -304,15 +274,10 @@ impl HostNet {
         }
     }
 
+    /// The burn module holding these weights on `device`, with fresh parameter ids.
     pub fn to_module(&self, device: &Device) -> DenseNet {
-        DenseNet {
-            enc1: self.enc1.to_linear(device),
-            enc2: self.enc2.to_linear(device),
-            head: self.head.to_linear(device),
-            dec1: self.dec1.to_linear(device),
-            dec2: self.dec2.to_linear(device),
-            dec_out: self.dec_out.to_linear(device),
-        }
+        let ids: [u64; 12] = std::array::from_fn(|_| ParamId::new().val());
+        self.to_module_with_ids(device, &ids)
     }
 
     /// Read a trained module back.
@@ -337,6 +302,20 @@ impl HostNet {
 }
 
 /// Reusable hidden-layer buffers of [`HostNet::encode_head`].
+/// `ReLU(ReLU(x W1 + b1) W2 + b2) W3 + b3`: the encoder (to its heads) or the decoder (to
+/// logits), on the host, sparse-aware.
+fn three_layers(layers: [&HostLayer; 3], x: &[f32], scratch: &mut Scratch) -> Vec<f32> {
+    scratch.h1.resize(layers[0].out, 0.0);
+    scratch.h2.resize(layers[1].out, 0.0);
+    layers[0].forward_into(x, &mut scratch.h1);
+    scratch.h1.iter_mut().for_each(|v| *v = v.max(0.0));
+    layers[1].forward_into(&scratch.h1, &mut scratch.h2);
+    scratch.h2.iter_mut().for_each(|v| *v = v.max(0.0));
+    let mut out = vec![0.0; layers[2].out];
+    layers[2].forward_into(&scratch.h2, &mut out);
+    out
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     h1: Vec<f32>,

@@ -596,12 +596,33 @@ impl<'a> Trainer<'a> {
         let host = init_net(model, cfg, images.dim, latents, rng);
         let device = training_device();
         let net = host.to_module(&device);
-        let opt: ModuleOptimizer = match model {
-            Model::Ae => TfAdagrad::default().into(),
-            Model::Vae | Model::Rfvae => TfAdam::default().into(),
-        };
+        Ok(Self::assemble(
+            model,
+            cfg,
+            images,
+            latents,
+            device,
+            net,
+            optimizer(model),
+            (0..images.n).collect(),
+            0,
+        ))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        model: Model,
+        cfg: &NeuralConfig,
+        images: &'a ImageSet,
+        latents: usize,
+        device: Device,
+        net: DenseNet,
+        opt: ModuleOptimizer,
+        perm: Vec<usize>,
+        step: usize,
+    ) -> Self {
         let k = cfg.batch.min(images.n);
-        Ok(Trainer {
+        Trainer {
             model,
             cfg: cfg.clone(),
             images,
@@ -609,10 +630,10 @@ impl<'a> Trainer<'a> {
             device,
             net: Some(net),
             opt,
-            perm: (0..images.n).collect(),
+            perm,
             xbuf: vec![0.0; k * images.dim],
-            step: 0,
-        })
+            step,
+        }
     }
 
     /// One iteration: batch, noise, forward, loss, backward, optimiser step. Returns the
@@ -697,29 +718,23 @@ impl<'a> Trainer<'a> {
         }
         let device = training_device();
         let net = state.net.to_module_with_ids(&device, state.ids);
-        let opt: ModuleOptimizer = match model {
-            Model::Ae => TfAdagrad::default().into(),
-            Model::Vae | Model::Rfvae => TfAdam::default().into(),
-        };
-        let opt = opt.load(state.optimizer).map_err(|e| {
+        let opt = optimizer(model).load(state.optimizer).map_err(|e| {
             ReprError::Io(format!(
                 "loading optimiser state {}: {e:?}",
                 state.optimizer.display()
             ))
         })?;
-        let k = cfg.batch.min(images.n);
-        Ok(Trainer {
+        Ok(Self::assemble(
             model,
-            cfg: cfg.clone(),
+            cfg,
             images,
             latents,
             device,
-            net: Some(net),
+            net,
             opt,
-            perm: state.perm.to_vec(),
-            xbuf: vec![0.0; k * images.dim],
-            step: state.step,
-        })
+            state.perm.to_vec(),
+            state.step,
+        ))
     }
 
     /// The current weights on the host.
@@ -730,6 +745,14 @@ impl<'a> Trainer<'a> {
             .expect("the module is present between steps")
             .valid();
         HostNet::from_module(&net, self.images.dim, self.cfg.hidden, self.latents)
+    }
+}
+
+/// The original's optimiser of `model`: Adagrad for the AE, Adam for the VAE and RFVAE.
+fn optimizer(model: Model) -> ModuleOptimizer {
+    match model {
+        Model::Ae => TfAdagrad::default().into(),
+        Model::Vae | Model::Rfvae => TfAdam::default().into(),
     }
 }
 
