@@ -54,6 +54,9 @@ pub struct Entry {
     pub poi_vs_efr: Option<(f64, f64, f64)>,
     /// The paper's mean normalised final KLC over the same tasks.
     pub paper: Option<f64>,
+    /// Runs whose neural representation did not leave the mean-image plateau; None when no
+    /// run records it (other learners, older results).
+    pub untrained: Option<usize>,
 }
 
 impl Entry {
@@ -93,11 +96,27 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     // entry -> task -> (final values, auc values, paper value)
     type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>)>;
     let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
+    let mut untrained: BTreeMap<EntryKey, usize> = BTreeMap::new();
     for src in sources {
         for c in src.conditions {
             let Some(max) = klc_max(&c.key.env) else {
                 continue;
             };
+            let flags: Vec<bool> = c
+                .runs
+                .iter()
+                .filter_map(|&i| src.store.runs[i].manifest.trained())
+                .collect();
+            if !flags.is_empty() {
+                *untrained
+                    .entry((
+                        src.campaign.to_string(),
+                        c.key.algo.clone(),
+                        c.key.sampler.clone(),
+                        c.key.variant.clone(),
+                    ))
+                    .or_default() += flags.iter().filter(|t| !**t).count();
+            }
             let key: EntryKey = (
                 src.campaign.to_string(),
                 c.key.algo.clone(),
@@ -167,6 +186,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                     stats::derive_seed(seed, &format!("{label}|poi")),
                 )
             };
+            let untrained = untrained.get(&key).copied();
             let papers: Vec<f64> = per.values().filter_map(|v| v.2).collect();
             let paper = (papers.len() == per.len()).then(|| stats::mean(&papers));
             Some(Entry {
@@ -180,6 +200,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 auc_iqm,
                 poi_vs_efr,
                 paper,
+                untrained,
             })
         })
         .collect();

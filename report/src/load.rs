@@ -149,6 +149,15 @@ impl Manifest {
     pub fn host(&self) -> Option<String> {
         self.text(&["host", "hostname"])
     }
+    /// Whether the run's neural representation left the mean-image plateau
+    /// (`train.evidence.trained`); None for other learners and older manifests.
+    pub fn trained(&self) -> Option<bool> {
+        self.raw
+            .get("train")?
+            .get("evidence")?
+            .get("trained")?
+            .as_bool()
+    }
     /// `CPU model (SIMD level)`, from the manifest's `cpu` object.
     pub fn cpu(&self) -> Option<String> {
         let cpu = self.raw.get("cpu")?;

@@ -306,6 +306,16 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
             && compute.contains("and 9.5 min exploring"),
         "{compute}"
     );
+    // The leaderboard counts untrained runs (seed 0 of every neural cell), the claims say so.
+    let lb = &md[md.find("## Leaderboard").expect("leaderboard")..];
+    let row = lb
+        .lines()
+        .find(|l| l.contains("RGE-VAE (faithful)") && l.contains("| KDE |"))
+        .expect("a VAE entry");
+    assert!(row.contains("| **"), "{row}");
+    let efr = lb.lines().find(|l| l.contains("| RGE-EFR |")).expect("EFR");
+    assert!(efr.contains("| — |"), "{efr}");
+    assert!(md.contains("AE, VAE and RFVAE runs** did not leave the mean-image plateau"));
     // A non-paper init is a listed deviation.
     assert!(
         md.contains("weight init AE he instead of the paper's truncated normal"),

@@ -120,6 +120,39 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
         path.display(),
         confidence * 100.0
     );
+    // Untrained networks: counted, never silently part of a verdict.
+    let flags: Vec<bool> = inp
+        .store
+        .runs
+        .iter()
+        .filter_map(|r| r.manifest.trained())
+        .collect();
+    let neural = inp
+        .store
+        .runs
+        .iter()
+        .filter(|r| ["rge-ae", "rge-vae", "rge-rfvae"].contains(&r.key.algo.as_str()))
+        .count();
+    let untrained = flags.iter().filter(|t| !**t).count();
+    let _ = writeln!(
+        w,
+        "\n{}",
+        if neural == 0 {
+            String::new()
+        } else if flags.is_empty() {
+            format!(
+                "**Training evidence not recorded** for the {neural} AE, VAE and RFVAE runs of \
+                 these results (written before results version 2): verdicts on those learners \
+                 may rest on networks that never left the mean-image plateau."
+            )
+        } else {
+            format!(
+                "**{untrained} of {} AE, VAE and RFVAE runs** did not leave the mean-image \
+                 plateau (\"Did the goal spaces learn?\"); the verdicts include them.",
+                flags.len()
+            )
+        }
+    );
     if inp.conditions.iter().any(|c| {
         c.runs
             .iter()
@@ -211,8 +244,10 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          stratified bootstrap intervals ({} resamples, runs resampled within each task, seeded). \
          Baselines do not depend on the latent size: their runs serve both tasks of an \
          environment. *Paper*: the mean of the paper's normalised single-run final values on the \
-         same tasks, where it gives all of them. Ranked by *final*; entries missing a task come \
-         last.\n",
+         same tasks, where it gives all of them. *Untrained*: runs whose network did not leave \
+         the mean-image plateau (\"Did the goal spaces learn?\"); their scores are those of an \
+         untrained random projection and are counted in, not hidden. Ranked by *final*; entries \
+         missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
         lb.confidence * 100.0,
@@ -220,16 +255,16 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
     );
     let _ = writeln!(
         w,
-        "| rank | algorithm | goal sampler | campaign | tasks | runs | final (IQM) | speed (IQM) | P(better than EFR) | paper |"
+        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | final (IQM) | speed (IQM) | P(better than EFR) | paper |"
     );
-    let _ = writeln!(w, "|---:|---|---|---|---|---:|---:|---:|---:|---:|");
+    let _ = writeln!(w, "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|");
     let n = lb.tasks.len();
     for (i, e) in lb.entries.iter().enumerate() {
         let new = e.campaign != inp.campaigns.main.name;
         let name = condition_name(&e.algo, &e.variant);
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             if e.is_complete(n) {
                 (i + 1).to_string()
             } else {
@@ -244,6 +279,11 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
             super::campaign_name(&e.campaign),
             tasks_cell(e, n),
             e.n_runs,
+            match e.untrained {
+                Some(0) => "0".to_string(),
+                Some(k) => format!("**{k}**"),
+                None => "—".into(),
+            },
             ci3(e.final_iqm),
             e.auc_iqm.map(ci3).unwrap_or_else(|| "—".into()),
             e.poi_vs_efr.map(ci3).unwrap_or_else(|| "—".into()),

@@ -24,10 +24,7 @@ struct Row {
 
 fn evidence(m: &Manifest) -> Option<(f64, bool)> {
     let e = m.raw.get("train")?.get("evidence")?;
-    Some((
-        e.get("loss_fraction")?.as_f64()?,
-        e.get("trained")?.as_bool()?,
-    ))
+    Some((e.get("loss_fraction")?.as_f64()?, m.trained()?))
 }
 
 fn quality(m: &Manifest) -> Option<(f64, f64)> {
