@@ -4,7 +4,11 @@
 //!
 //! Specification (fixed; changing it changes every result):
 //! - run seed = first 8 bytes, little-endian, of
-//!   `BLAKE3("ugl-bench/run-seed/v1\0" || campaign_seed as u64 LE || identity UTF-8)`;
+//!   `BLAKE3("ugl-bench/run-seed/v1\0" || campaign_seed as u64 LE || identity UTF-8)`, where
+//!   the identity is the run's *exploration identity* (`RunSpec::exploration_identity`: for a
+//!   learned goal space env, sampler, latents and repetition, not the learner, so that every
+//!   learner of a cell draws the same exploration streams), the data set's identity, or the
+//!   learner's (`RunSpec::learner_seed_identity`);
 //! - stream seed for component `c` = `BLAKE3("ugl-bench/stream/v1\0" || run_seed LE || c UTF-8)`
 //!   (all 32 bytes), used as the key of a `ChaCha8Rng`.
 
