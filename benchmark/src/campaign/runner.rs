@@ -159,12 +159,8 @@ fn measure_quality(
     let mut rng = stream(ds_seed, Component::HeldOut);
     let heldout = generate(env, QUALITY_HELDOUT, &mut rng)?;
     encoder.begin_run(rng);
-    let n = data.images.n.min(QUALITY_TRAIN);
-    let train_images = ImageSet::new(
-        n,
-        data.images.dim,
-        data.images.data[..n * data.images.dim].to_vec(),
-    )?;
+    let train_images = data.images.head(QUALITY_TRAIN);
+    let n = train_images.n;
     let z_train = encoder.encode(&train_images)?;
     let z_heldout = encoder.encode(&heldout.images)?;
     let (y_train, names) = quality::targets(&data.states[..n * d], d);
@@ -184,8 +180,8 @@ pub struct TrainInfo {
     pub cache: &'static str,
     /// The cache key (BLAKE3 of everything the model depends on).
     pub key: String,
-    /// The final loss against the data set's mean-image loss (the plateau), and whether the
-    /// network left it ([`TrainingEvidence`]).
+    /// The reconstruction loss against the mean-image loss (the plateau) of the first training
+    /// images, and whether the network left it ([`TrainingEvidence`]).
     pub evidence: TrainingEvidence,
 }
 
@@ -322,11 +318,9 @@ fn fit_neural(
     };
     let z = enc.training_latents(images)?;
     let evidence = {
-        let n = images.n.min(EVIDENCE_IMAGES);
-        let head = ImageSet::new(n, images.dim, images.data[..n * images.dim].to_vec())?;
-        let plateau = mean_image_loss(&head);
-        let rec = neural::reconstruction_loss(enc.model, &enc.net, &head, n);
-        TrainingEvidence::new(plateau, rec, n)
+        let head = images.head(EVIDENCE_IMAGES);
+        let rec = neural::reconstruction_loss(enc.model, &enc.net, &head, head.n);
+        TrainingEvidence::new(mean_image_loss(&head), rec, head.n)
     };
     let info = TrainInfo {
         config: cfg,

@@ -50,6 +50,16 @@ impl ImageSet {
     pub fn row(&self, i: usize) -> &[f32] {
         &self.data[i * self.dim..(i + 1) * self.dim]
     }
+
+    /// The first `min(n, self.n)` images, copied.
+    pub fn head(&self, n: usize) -> ImageSet {
+        let n = n.min(self.n);
+        ImageSet {
+            n,
+            dim: self.dim,
+            data: self.data[..n * self.dim].to_vec(),
+        }
+    }
 }
 
 /// Latent vectors, row-major `n x latents`.
