@@ -591,7 +591,19 @@ struct RunArgs {
     name: Option<String>,
 }
 
+/// The results store keeps repetition indices as signed 64-bit integers (parquet `seed`).
+fn check_seed(seed: u64) -> Result<()> {
+    if seed > i64::MAX as u64 {
+        bail!(
+            "--seed must be below 2^63 = {} (the results store keeps it as a signed 64-bit integer), got {seed}",
+            i64::MAX as u64 + 1
+        );
+    }
+    Ok(())
+}
+
 fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
+    check_seed(a.seed)?;
     let path = resolve_profile(profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
     if let Some(e) = a.epochs {
@@ -747,6 +759,7 @@ fn campaign(
 
 /// `ugl embed`: the latents of one fitted goal space.
 fn embed(a: EmbedArgs) -> Result<()> {
+    check_seed(a.seed)?;
     let path = resolve_profile(&a.profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
     if let Some(n) = a.images {
@@ -905,7 +918,7 @@ fn run_config(
         .transpose()
         .map_err(|e| anyhow::anyhow!(e))?;
     let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
-    check_out_dir(&out)?;
+    // Every argument is checked before anything touches the disk.
     let jobs = jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -914,6 +927,7 @@ fn run_config(
     if jobs == 0 {
         bail!("--jobs must be at least 1");
     }
+    check_out_dir(&out)?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();

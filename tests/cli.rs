@@ -1040,3 +1040,69 @@ fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
         "checkpoints are removed once the training is done"
     );
 }
+
+/// Arguments are checked before anything touches the disk; seeds the store cannot hold are
+/// refused (they were stored as -1).
+#[test]
+fn bad_arguments_touch_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("never-created");
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--jobs",
+        "0",
+        "--out",
+        p(&out),
+    ]);
+    assert_one_line_error(&o, "--jobs must be at least 1");
+    assert!(!out.exists(), "--out was created before --jobs was checked");
+    for cmd in [
+        vec![
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--seed",
+            "18446744073709551615",
+        ],
+        vec![
+            "embed",
+            "--env",
+            "armball",
+            "--learner",
+            "pca",
+            "--seed",
+            "9223372036854775808",
+        ],
+    ] {
+        let mut args = cmd.clone();
+        args.extend(["--out", p(&out)]);
+        if cmd[0] == "embed" {
+            args.pop();
+            args.pop();
+            args.extend(["--out", "/tmp/never-written.npy"]);
+        }
+        assert_one_line_error(&ugl(&args), "--seed must be below 2^63");
+        assert!(!out.exists());
+    }
+    // The largest seed the store holds still runs.
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rpe",
+        "--seed",
+        "9223372036854775807",
+        "--epochs",
+        "50",
+        "--profile",
+        "baselines",
+        "--out",
+        p(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
