@@ -53,17 +53,6 @@ pub struct ModelCache {
     pub dir: PathBuf,
 }
 
-fn layers(net: &HostNet) -> [&HostLayer; 6] {
-    [
-        &net.enc1,
-        &net.enc2,
-        &net.head,
-        &net.dec1,
-        &net.dec2,
-        &net.dec_out,
-    ]
-}
-
 /// Serialise an encoder under `key`.
 pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
     let net = &enc.net;
@@ -74,7 +63,7 @@ pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
         dim: net.dim,
         hidden: net.hidden,
         latents: net.latents,
-        layers: layers(net).iter().map(|l| (l.inp, l.out)).collect(),
+        layers: net.layers().iter().map(|l| (l.inp, l.out)).collect(),
         losses: enc.losses.clone(),
         encode_seed: hex(&enc.encode_seed),
     };
@@ -84,7 +73,7 @@ pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     out.extend_from_slice(&(header.len() as u64).to_le_bytes());
     out.extend_from_slice(&header);
-    for l in layers(net) {
+    for l in net.layers() {
         for v in l.w.iter().chain(&l.b) {
             out.extend_from_slice(&v.to_le_bytes());
         }

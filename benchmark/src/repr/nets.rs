@@ -234,8 +234,8 @@ impl HostNet {
         }
     }
 
-    /// Number of trainable values.
-    pub fn num_params(&self) -> usize {
+    /// The layers in their fixed order: enc1, enc2, head, dec1, dec2, dec_out.
+    pub fn layers(&self) -> [&HostLayer; 6] {
         [
             &self.enc1,
             &self.enc2,
@@ -244,9 +244,11 @@ impl HostNet {
             &self.dec2,
             &self.dec_out,
         ]
-        .iter()
-        .map(|l| l.w.len() + l.b.len())
-        .sum()
+    }
+
+    /// Number of trainable values.
+    pub fn num_params(&self) -> usize {
+        self.layers().iter().map(|l| l.w.len() + l.b.len()).sum()
     }
 
     /// The encoder's head outputs (pre-activation, `head.out` values) for one image.

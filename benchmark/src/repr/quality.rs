@@ -162,37 +162,26 @@ fn knn_predictions(train: &Latents, y: &[f64], heldout: &Latents, t: usize) -> V
     let mut out = vec![0.0; heldout.n * t];
     out.par_chunks_mut(t).enumerate().for_each(|(q, o)| {
         let zq = heldout.row(q);
-        // (distance, index), kept sorted; ties broken by index (deterministic).
-        let mut best: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
-        for i in 0..train.n {
-            let dist: f64 = train
-                .row(i)
-                .iter()
-                .zip(zq)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum();
-            if best.len() < k || dist < best[k - 1].0 {
-                let pos = best.partition_point(|&(bd, _)| bd <= dist);
-                best.insert(pos, (dist, i));
-                best.truncate(k);
-            }
-        }
-        // Every training latent tied with the k-th nearest counts too, so the prediction does
-        // not depend on the order of the training set (a collapsed encoder: all tied).
-        let radius = best[k - 1].0;
+        let dist: Vec<f64> = (0..train.n)
+            .map(|i| {
+                train
+                    .row(i)
+                    .iter()
+                    .zip(zq)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum()
+            })
+            .collect();
+        // The k-th smallest distance; every training latent within it counts, ties included,
+        // so the prediction does not depend on the order of the training set (a collapsed
+        // encoder: all tied).
+        let mut sorted = dist.clone();
+        let (_, &mut radius, _) = sorted.select_nth_unstable_by(k - 1, f64::total_cmp);
         let mut count = 0usize;
-        for i in 0..train.n {
-            let dist: f64 = train
-                .row(i)
-                .iter()
-                .zip(zq)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum();
-            if dist <= radius {
-                count += 1;
-                for (o, v) in o.iter_mut().zip(&y[i * t..(i + 1) * t]) {
-                    *o += v;
-                }
+        for (i, _) in dist.iter().enumerate().filter(|(_, d)| **d <= radius) {
+            count += 1;
+            for (o, v) in o.iter_mut().zip(&y[i * t..(i + 1) * t]) {
+                *o += v;
             }
         }
         o.iter_mut().for_each(|v| *v /= count as f64);
