@@ -1,7 +1,8 @@
 //! One training iteration (batch 100: batch draw, forward, backward, optimiser step) of each of
 //! the paper's networks (PAPER-NOTES.md section 5), at the paper's architecture
 //! (4900-1200-1200, d = 10) and a reduced one (4900-512-256, d = 10), on burn's flex CPU
-//! backend; plus `encode_one` of a trained-shape encoder.
+//! backend and on the host engine (`repr/host_train.rs`); plus `encode_one` of a trained-shape
+//! encoder.
 //! Throughput is reported as FLOP/s ("elem/s"), counting `3 x 2 m n k` per dense layer.
 //! Run: `cargo bench -p ugl-bench --profile dev --bench train_step`
 //! (threads: `RAYON_NUM_THREADS=1` for a single-thread run).
@@ -13,7 +14,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
 use ugl_bench::env::render::{PIXELS, render_ball_into};
 use ugl_bench::repr::neural::{
-    Model, NeuralConfig, NeuralEncoder, Trainer, Variant, flops_per_iteration, init_net,
+    Engine, Model, NeuralConfig, NeuralEncoder, Trainer, Variant, flops_per_iteration, init_net,
 };
 use ugl_bench::repr::{Encoder, ImageSet};
 use ugl_bench::seed::stream_named;
@@ -39,9 +40,13 @@ fn bench(c: &mut Criterion) {
         g.sample_size(10);
         g.warm_up_time(Duration::from_secs(2));
         g.measurement_time(Duration::from_secs(8));
-        for model in Model::ALL {
+        for (model, engine) in Model::ALL
+            .into_iter()
+            .flat_map(|m| Engine::ALL.map(|e| (m, e)))
+        {
             let cfg = NeuralConfig {
                 hidden,
+                engine,
                 ..NeuralConfig::paper(model)
             };
             let mut rng = stream_named(1, "learner");
@@ -49,7 +54,7 @@ fn bench(c: &mut Criterion) {
             g.throughput(Throughput::Elements(flops_per_iteration(
                 model, PIXELS, hidden, latents, 100,
             ) as u64));
-            g.bench_function(model.name(), |b| {
+            g.bench_function(format!("{}/{}", model.name(), engine.name()), |b| {
                 b.iter(|| black_box(trainer.step(&mut rng).unwrap()))
             });
         }

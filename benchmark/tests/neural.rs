@@ -560,6 +560,109 @@ fn neural_learners_conform() {
     }
 }
 
+/// The host engine's loss and gradients equal burn autodiff's on the same weights, batch and
+/// noise, for every model and variant (the RFVAE inside its warm-up), to float precision: a
+/// wrong term, scale or transpose in the hand-written backward fails it.
+#[test]
+fn host_engine_gradients_match_burn_autodiff() {
+    use burn::module::ParamId;
+    use burn::optim::GradientsParams;
+    use ugl_bench::repr::host_train::{HostOptimizer, HostTrainer};
+    use ugl_bench::repr::neural::{Init, StepInput, tensor2, training_device};
+    use ugl_bench::repr::{ae, rfvae, vae};
+    let set = images(EnvKind::ArmBall, 60);
+    let (rows, d, step) = (40, 3, 3);
+    let x: Vec<f32> = (0..rows).flat_map(|i| set.row(i).to_vec()).collect();
+    for model in Model::ALL {
+        for variant in [Variant::Faithful, Variant::Corrected] {
+            let cfg = NeuralConfig {
+                warmup: 10,
+                init: Init::He,
+                ..tiny(model, variant, 5)
+            };
+            let net = init_net(model, &cfg, set.dim, d, &mut stream_named(4, "grad"));
+            let mut host = HostTrainer::new(net.clone(), HostOptimizer::new(model, &net));
+            let host_loss = host
+                .forward_backward(model, &cfg, &x, rows, step, &mut stream_named(5, "noise"))
+                .unwrap();
+            let host_grads = host.gradients();
+
+            let device = training_device();
+            let module = net.to_module(&device);
+            let input = StepInput {
+                x: tensor2(x.clone(), rows, set.dim, &device),
+                batch: rows,
+                latents: d,
+                step,
+                warmup: cfg.warmup,
+                variant,
+                device: &device,
+            };
+            let mut rng = stream_named(5, "noise");
+            let loss = match model {
+                Model::Ae => ae::loss(&module, input),
+                Model::Vae => vae::loss(&module, input, &mut rng),
+                Model::Rfvae => rfvae::loss(&module, input, &mut rng),
+            };
+            let burn_loss = f64::from(loss.clone().into_scalar::<f32>());
+            let grads = GradientsParams::from_grads(loss.backward(), &module);
+            let what = format!("{} {}", model.name(), variant.name());
+            assert!(
+                (host_loss - burn_loss).abs() <= 1e-5 * burn_loss.abs().max(1.0),
+                "{what}: loss {host_loss} vs {burn_loss}"
+            );
+            for (k, id) in module.param_ids().iter().enumerate() {
+                let id = ParamId::from(*id);
+                let data = if k % 2 == 0 {
+                    grads.get::<2>(id).unwrap().into_data()
+                } else {
+                    grads.get::<1>(id).unwrap().into_data()
+                };
+                let want = data.try_into_vec::<f32>().unwrap();
+                let got = &host_grads[k];
+                assert_eq!(got.len(), want.len(), "{what}: parameter {k}");
+                let scale = want.iter().fold(0f32, |m, v| m.max(v.abs()));
+                let err = got
+                    .iter()
+                    .zip(&want)
+                    .fold(0f32, |m, (a, b)| m.max((a - b).abs()));
+                assert!(
+                    scale > 0.0 && err <= 1e-3 * scale,
+                    "{what}: parameter {k}: max error {err} for gradients up to {scale}"
+                );
+            }
+        }
+    }
+}
+
+/// The host engine's trained weights are bit-identical with 1 and 2 threads, at a size where
+/// `gemm` and the sparse layer do run in parallel.
+#[test]
+fn host_engine_is_bit_identical_across_thread_counts() {
+    use ugl_bench::repr::neural::{Engine, Init, train};
+    let set = images(EnvKind::ArmBall, 150);
+    for model in Model::ALL {
+        let cfg = NeuralConfig {
+            hidden: [256, 128],
+            warmup: 4,
+            init: Init::He,
+            engine: Engine::Host,
+            ..tiny(model, Variant::Corrected, 6)
+        };
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| train(model, &cfg, &set, 4, &mut stream_named(3, "threads"), None))
+                .unwrap()
+        };
+        let (one, two) = (run(1), run(2));
+        assert_eq!(one.net, two.net, "{model:?}");
+        assert_eq!(one.losses, two.losses, "{model:?}");
+    }
+}
+
 /// Prints a fingerprint of trained weights and latents per model, to compare runs under
 /// different thread counts (`RAYON_NUM_THREADS=1` vs `2`; `-- --nocapture`).
 /// `UGL_FINGERPRINT_ARCH=H1,H2,iterations` sets the size (default `64,48,20`).
@@ -613,12 +716,16 @@ fn fingerprint_for_thread_count_comparison() {
 /// an uninterrupted training: weights, loss curve and encoder seed.
 #[test]
 fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
-    use ugl_bench::repr::neural::{CheckpointSpec, train, train_with_checkpoints};
+    use ugl_bench::repr::neural::{CheckpointSpec, Engine, train, train_with_checkpoints};
     let set = images(EnvKind::ArmBall, 120);
-    for model in Model::ALL {
+    for (model, engine) in Model::ALL
+        .into_iter()
+        .flat_map(|m| Engine::ALL.map(|e| (m, e)))
+    {
         let cfg = NeuralConfig {
             log_every: 5,
             warmup: 10,
+            engine,
             ..tiny(model, Variant::Faithful, 60)
         };
         let learner_stream = || stream_named(9, "checkpoint-learner");
@@ -704,7 +811,10 @@ fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
         }));
         assert!(killed.is_err());
         let ckpt = dir.path().join(format!("test-{}.ckpt.40", model.name()));
-        let optim = ckpt.join("optim.bpk");
+        let optim = ckpt.join(match engine {
+            Engine::Burn => "optim.bpk",
+            Engine::Host => "optim.bin",
+        });
         let mut bytes = std::fs::read(&optim).unwrap();
         let last = bytes.len() - 1;
         bytes[last] ^= 1;

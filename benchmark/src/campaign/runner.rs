@@ -35,7 +35,9 @@ use crate::seed::{Component, run_seed, stream};
 /// [`RunSpec::exploration_identity`] (paired across learners), and a stochastic encoder draws
 /// its noise from the run's own stream (order-independent results); the KDE's square root of
 /// its covariance comes from faer's symmetric eigen-solver (was: cyclic Jacobi).
-pub const RESULTS_VERSION: u32 = 2;
+/// 3: the neural learners train on the host engine by default (`engine = "host"`: other
+/// summation orders than burn's), and gemm/faer use their AVX-512 kernels where the CPU has them.
+pub const RESULTS_VERSION: u32 = 3;
 
 /// Errors of a run or campaign.
 #[derive(Debug, Error)]

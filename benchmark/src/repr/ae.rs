@@ -11,12 +11,21 @@ use burn::tensor::Tensor;
 use burn::tensor::activation::sigmoid;
 
 use super::nets::{DenseNet, bce_with_logits_sum};
-use super::neural::StepInput;
+use super::neural::{Latent, LatentInput, StepInput};
 
 /// The training loss of one mini-batch: `mean_b sum_pixels BCE(decode(sigmoid(head(x))), x)`.
 pub fn loss(net: &DenseNet, input: StepInput<'_>) -> Tensor<1> {
     let z = sigmoid(net.heads(input.x.clone()));
     bce_with_logits_sum(net.decode(z), input.x).mean()
+}
+
+/// The host engine's middle: `z = sigmoid(heads)`, loss = the batch-mean reconstruction.
+pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>) -> Latent {
+    Latent {
+        z: sigmoid(heads.narrow(1, 0, input.latents)),
+        extra: None,
+        rec_scale: 1.0,
+    }
 }
 
 /// Encoding from the head outputs: the sigmoid latent.

@@ -3,7 +3,8 @@
 //! A checkpoint of the training keyed `KEY` (the model-cache key) after `S` iterations is the
 //! directory `<dir>/KEY.ckpt.S/` with:
 //! - `net.model`: the weights, in the model cache's checksummed format;
-//! - `optim.bpk`: the optimiser's state (burn's record format), keyed by parameter ids;
+//! - `optim.bin` (host engine) or `optim.bpk` (burn engine, burn's record format, keyed by
+//!   parameter ids): the optimiser's state;
 //! - `state.json`, written last (atomically): the iteration count, the loss curve so far, the
 //!   learner stream's seed and word position, the batch permutation, the parameter ids, and the
 //!   BLAKE3 hashes of the two other files.
@@ -16,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::neural::{CheckpointSpec, Model, NeuralConfig, NeuralEncoder, ResumeState, Trainer};
+use super::neural::{CheckpointSpec, Engine, Model, NeuralConfig, NeuralEncoder, ResumeState, Trainer};
 use super::{ImageSet, ReprError, cache};
 use crate::seed::Stream;
 
@@ -32,6 +33,14 @@ struct State {
     param_ids: [u64; 12],
     net_blake3: String,
     optim_blake3: String,
+}
+
+/// The optimiser state's file: burn's record format (burn engine) or the host engine's.
+fn optim_file(cfg: &NeuralConfig) -> &'static str {
+    match cfg.engine {
+        Engine::Burn => "optim.bpk",
+        Engine::Host => "optim.bin",
+    }
 }
 
 fn hex(b: &[u8]) -> String {
@@ -84,7 +93,7 @@ pub fn save(
     let net_path = dir.join("net.model");
     crate::campaign::store::write_atomic(&net_path, &net_bytes)
         .map_err(|e| io("write", &net_path, e))?;
-    let optim_path = dir.join("optim.bpk");
+    let optim_path = dir.join(optim_file(&trainer.cfg));
     trainer.save_optimizer(&optim_path)?;
     let optim_bytes = std::fs::read(&optim_path).map_err(|e| io("read", &optim_path, e))?;
     let (ids, perm) = trainer.resume_state();
@@ -161,10 +170,10 @@ fn try_load<'a>(
     if blake3::hash(&net_bytes).to_hex().as_str() != state.net_blake3 {
         return Err("net.model does not match its hash".into());
     }
-    let optim_path = dir.join("optim.bpk");
+    let optim_path = dir.join(optim_file(cfg));
     let optim_bytes = std::fs::read(&optim_path).map_err(|e| e.to_string())?;
     if blake3::hash(&optim_bytes).to_hex().as_str() != state.optim_blake3 {
-        return Err("optim.bpk does not match its hash".into());
+        return Err(format!("{} does not match its hash", optim_path.display()));
     }
     let enc = cache::from_bytes(&c.key, &net_bytes)?;
     let word_pos: u128 = state

@@ -12,6 +12,7 @@ pub mod checkpoint;
 pub mod dataset;
 pub mod evidence;
 pub mod external;
+pub mod host_train;
 pub mod isomap;
 pub mod nets;
 pub mod neural;

@@ -40,7 +40,7 @@ use burn::tensor::{Device, Tensor};
 use rand_distr::{Distribution, StandardNormal};
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{self, StepInput, Variant};
+use super::neural::{self, Latent, LatentInput, StepInput, Variant};
 use super::vae::eps;
 use crate::seed::Stream;
 
@@ -144,6 +144,25 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
     match input.variant {
         Variant::Corrected => (rec.mul_scalar(ann) - logdet).mean(),
         Variant::Faithful => rec.mul_scalar(ann).mean() - logdet.mean(),
+    }
+}
+
+/// The host engine's middle (same noise draws as [`loss`]): `z_K` of the flows, loss =
+/// `ann` x (batch-mean reconstruction + batch-mean KL) - the mean log-det (the diagonal `[B]`
+/// corrected, the original's broadcast `[B, B]` faithful; see the module doc).
+pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
+    let d = input.latents;
+    let mu = heads.clone().narrow(1, 0, d);
+    let logvar = heads.clone().narrow(1, d, d);
+    let p = FlowParams::from_heads(&heads, d);
+    let e = eps(input.variant, input.batch, d, rng, input.device);
+    let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
+    let (zk, logdet) = flows(z0, &p, d, input.variant);
+    let ann = annealing(input.step, input.warmup);
+    Latent {
+        z: zk,
+        extra: Some(kl_std_normal(mu, logvar).mean().mul_scalar(ann) - logdet.mean()),
+        rec_scale: ann,
     }
 }
 

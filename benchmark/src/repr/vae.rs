@@ -13,7 +13,7 @@
 use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{StepInput, Variant, normals, tensor2};
+use super::neural::{Latent, LatentInput, StepInput, Variant, normals, tensor2};
 use crate::seed::Stream;
 
 /// The reparameterisation noise of one iteration: `[1, d]` (faithful: shared by the batch,
@@ -42,6 +42,21 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
     let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
     let rec = bce_with_logits_sum(net.decode(z), input.x);
     (rec + kl_std_normal(mu, logvar)).mean()
+}
+
+/// The host engine's middle (same noise draws as [`loss`]): `z = mu + eps exp(logvar / 2)`,
+/// loss = the batch-mean reconstruction + the batch-mean KL.
+pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
+    let d = input.latents;
+    let mu = heads.clone().narrow(1, 0, d);
+    let logvar = heads.narrow(1, d, d);
+    let e = eps(input.variant, input.batch, d, rng, input.device);
+    let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
+    Latent {
+        z,
+        extra: Some(kl_std_normal(mu, logvar).mean()),
+        rec_scale: 1.0,
+    }
 }
 
 /// Encoding from the head outputs: mu.
