@@ -192,7 +192,8 @@ enum Command {
         #[arg(long, default_value = "data/paper")]
         paper: PathBuf,
         /// The campaign (sub-directory of --results) the figures and tables are drawn from;
-        /// `budget-*` campaigns feed the training-budget section.
+        /// `budget-*` campaigns feed the training-budget section. `(top level)` or `.`: the
+        /// runs directly in --results.
         #[arg(long = "main", default_value = "paper")]
         main_campaign: String,
     },
@@ -403,10 +404,28 @@ fn main() -> ExitCode {
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
+            eprintln!("error: {}", one_line(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// An error and its causes on one line, each cause once: a cause whose text an outer message
+/// already contains (a library error that prints its source) is not repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        let text = text.trim();
+        if text.is_empty() || out.contains(text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(text);
+    }
+    out.replace('\n', " ")
 }
 
 fn dispatch(cmd: Command) -> Result<()> {
@@ -477,9 +496,20 @@ fn dispatch(cmd: Command) -> Result<()> {
             paper,
             main_campaign,
         } => {
+            if !paper.is_dir() {
+                bail!(
+                    "--paper {}: not a directory (the paper's reference values, data/paper in \
+                     the repository)",
+                    paper.display()
+                );
+            }
             let mut opts = ugl_report::ReportOptions::new(results, out);
             opts.paper_dir = paper;
-            opts.main_campaign = main_campaign;
+            // The store's top level is listed as "(top level)"; accept that spelling too.
+            opts.main_campaign = match main_campaign.as_str() {
+                "(top level)" | "." => String::new(),
+                _ => main_campaign,
+            };
             let s = ugl_report::render_report(&opts)?;
             eprintln!(
                 "report: {} runs -> {} files in {}",
@@ -616,6 +646,7 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
         if n < 2 {
             bail!("--images must be at least 2, got {n}");
         }
+        ugl_bench::limits::check_images(n).map_err(|m| anyhow::anyhow!("--images: {m}"))?;
         cfg.ugl.images = n;
     }
     let spec = match a.algo.learner() {
@@ -670,9 +701,12 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
                 .clone()
                 .or_else(|| cfg.learners.external.as_ref().map(|e| e.name.clone()))
                 .unwrap_or_else(|| "external".into());
+            let timeouts = cfg.learners.external.as_ref();
             cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
                 name,
                 command: cmd.clone(),
+                ready_timeout_s: timeouts.and_then(|e| e.ready_timeout_s),
+                answer_timeout_s: timeouts.and_then(|e| e.answer_timeout_s),
             });
         } else if let (Some(name), Some(e)) = (&a.name, cfg.learners.external.as_mut()) {
             e.name = name.clone();
@@ -766,6 +800,7 @@ fn embed(a: EmbedArgs) -> Result<()> {
         if n < 2 {
             bail!("--images must be at least 2, got {n}");
         }
+        ugl_bench::limits::check_images(n).map_err(|m| anyhow::anyhow!("--images: {m}"))?;
         cfg.ugl.images = n;
     }
     let learner = resolve_learner(&a.learner, a.command.as_deref(), &mut cfg)?;
@@ -850,6 +885,8 @@ fn resolve_learner(name: &str, command: Option<&str>, cfg: &mut CampaignConfig) 
             cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
                 name: name.to_string(),
                 command: cmd.to_string(),
+                ready_timeout_s: None,
+                answer_timeout_s: None,
             });
             Ok(Learner::External)
         }
@@ -935,6 +972,8 @@ fn run_config(
             if stop.swap(true, Ordering::SeqCst) {
                 std::process::exit(130);
             }
+            // External learners still fitting are stopped now, not waited for.
+            ugl_bench::repr::external::interrupt();
             eprintln!("\ninterrupt: finishing the runs in flight (Ctrl-C again to abort now)");
         })
         .context("cannot install the Ctrl-C handler")?;
@@ -1020,38 +1059,41 @@ fn slurm(
         }
     };
     let (config_abs, out_abs) = (abs(config), abs(&out));
+    let results_abs = out_abs.parent().unwrap_or(&out_abs).to_path_buf();
+    // The report step draws its figures from this campaign (the store may hold others), with
+    // the paper's reference values of this checkout.
+    let main_name = out_abs
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let (cwd_q, config_q, out_q) = (sh_quote(&cwd), sh_quote(&config_abs), sh_quote(&out_abs));
     let array = format!(
         "#!/usr/bin/env bash\n\
          # Generated by `ugl slurm` for campaign '{name}' ({n_runs} runs in {shards} shards).\n\
          # Each task runs one deterministic shard; all write into the same results directory\n\
          # (files are written atomically and the shards are disjoint). Rerunning a task resumes it.\n\
          #SBATCH --job-name=ugl-{name}\n#SBATCH --array=0-{last}\n#SBATCH --cpus-per-task={cpus}\n\
-         #SBATCH --time={time}\n#SBATCH --output=ugl-{name}-%A_%a.log\nset -euo pipefail\ncd {cwd}\n\
-         cargo run --quiet --bin ugl -- campaign --config {config} --out {out} --jobs {cpus} --quiet \\\n  \
+         #SBATCH --time={time}\n#SBATCH --output=ugl-{name}-%A_%a.log\nset -euo pipefail\ncd {cwd_q}\n\
+         cargo run --quiet --bin ugl -- campaign --config {config_q} --out {out_q} --jobs {cpus} --quiet \\\n  \
          --shard \"${{SLURM_ARRAY_TASK_ID}}/{shards}\"\n",
         last = shards - 1,
-        cwd = cwd.display(),
-        config = config_abs.display(),
-        out = out_abs.display(),
     );
     let merge = format!(
         "#!/usr/bin/env bash\n# Generated by `ugl slurm`: after every shard, check the campaign is complete and render\n\
          # the report.\n#SBATCH --job-name=ugl-{name}-report\n#SBATCH --cpus-per-task=1\n#SBATCH --time=00:30:00\n\
-         #SBATCH --output=ugl-{name}-report-%j.log\nset -euo pipefail\ncd {cwd}\n\
+         #SBATCH --output=ugl-{name}-report-%j.log\nset -euo pipefail\ncd {cwd_q}\n\
          # A complete campaign has nothing left to run: this executes 0 runs, or the missing ones.\n\
-         cargo run --quiet --bin ugl -- campaign --config {config} --out {out} --jobs 1 --quiet\n\
-         cargo run --quiet --bin ugl -- report --results {results} --out report/out\n",
-        cwd = cwd.display(),
-        config = config_abs.display(),
-        out = out_abs.display(),
-        results = out_abs.parent().unwrap_or(&out_abs).display(),
+         cargo run --quiet --bin ugl -- campaign --config {config_q} --out {out_q} --jobs 1 --quiet\n\
+         cargo run --quiet --bin ugl -- report --results {results} --main {main} --paper {paper} --out report/out\n",
+        results = sh_quote(&results_abs),
+        main = sh_quote(Path::new(&main_name)),
+        paper = sh_quote(&cwd.join("data/paper")),
     );
     let submit = format!(
         "#!/usr/bin/env bash\n# Submit the array job, then the report step once every task succeeded.\nset -euo pipefail\n\
          cd \"$(dirname \"$0\")\"\n# Build once on the login node so the tasks do not compile concurrently.\n\
-         (cd {cwd} && cargo build --quiet --bin ugl)\njid=$(sbatch --parsable array.sh)\n\
+         (cd {cwd_q} && cargo build --quiet --bin ugl)\njid=$(sbatch --parsable array.sh)\n\
          sbatch --dependency=afterok:${{jid}} report.sh\necho \"submitted array job ${{jid}} ({shards} tasks) and its report step\"\n",
-        cwd = cwd.display(),
     );
     for (file, text) in [
         ("array.sh", array),
@@ -1075,6 +1117,11 @@ fn slurm(
     Ok(())
 }
 
+/// A path as one POSIX shell word (single-quoted; a `'` becomes `'\''`).
+fn sh_quote(p: &Path) -> String {
+    format!("'{}'", p.to_string_lossy().replace('\'', "'\\''"))
+}
+
 fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
     check_out_dir(into)?;
     let (mut copied, mut same) = (0, 0);
@@ -1091,9 +1138,10 @@ fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
         for m in manifests {
             let manifest = ugl_bench::campaign::store::read_manifest(&m)?;
             let files = ugl_bench::campaign::store::run_paths(src, &manifest.run_id);
-            if !files.iter().all(|f| f.is_file()) {
+            if let Err(why) = ugl_bench::campaign::store::verify_files(src, &manifest) {
                 bail!(
-                    "{}: run {} is incomplete (a data file is missing)",
+                    "{}: run {} is incomplete or damaged ({why}); resume its campaign there to \
+                     recompute it, then merge again",
                     src.display(),
                     manifest.run_id
                 );

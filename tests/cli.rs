@@ -1106,3 +1106,310 @@ fn bad_arguments_touch_nothing() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// An error's cause is printed once (a library error that already shows its source is not
+/// followed by the source again), and sizes that cannot fit in memory are refused before
+/// anything is allocated.
+#[test]
+fn errors_are_one_line_each_cause_once_and_huge_sizes_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        "/nonexistent/profile.toml",
+        "--out",
+        p(&dir.path().join("out")),
+    ]);
+    assert_one_line_error(&o, "/nonexistent/profile.toml");
+    assert_eq!(stderr(&o).matches("os error 2").count(), 1, "{}", stderr(&o));
+    let out = dir.path().join("run");
+    for (args, needle) in [
+        (
+            vec!["--algo", "rpe", "--epochs", "9223372036854775808"],
+            "explore.epochs = 9223372036854775808 needs about",
+        ),
+        (
+            vec!["--algo", "rge-pca", "--latents", "2", "--images", "100000000000"],
+            "--images: ugl.images = 100000000000 needs about",
+        ),
+    ] {
+        let mut a = vec!["run", "--env", "armball", "--out", p(&out)];
+        a.extend(args);
+        let o = ugl(&a);
+        assert_one_line_error(&o, needle);
+    }
+    assert!(!out.exists(), "nothing was written");
+}
+
+/// `ugl report`: a missing `--paper` directory is an error, and the store's top level can be
+/// named as the listing names it, `(top level)`.
+#[test]
+fn report_paper_and_top_level_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("store");
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--out",
+        p(&store),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = dir.path().join("report");
+    let o = ugl(&[
+        "report",
+        "--results",
+        p(&store),
+        "--paper",
+        "/nonexistent/paper",
+        "--out",
+        p(&report),
+    ]);
+    assert_one_line_error(&o, "--paper /nonexistent/paper: not a directory");
+    let o = ugl(&["report", "--results", p(&store), "--out", p(&report)]);
+    assert_one_line_error(&o, "(top level)");
+    let o = ugl(&[
+        "report",
+        "--results",
+        p(&store),
+        "--main",
+        "(top level)",
+        "--out",
+        p(&report),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(report.join("REPORT.md").is_file());
+}
+
+/// The scripts of `ugl slurm` run end to end, with a fake `sbatch` (runs each array task, then
+/// the dependent step) and a fake `cargo` (runs this `ugl`), for a campaign that is not `paper`,
+/// with spaces in every path.
+#[cfg(unix)]
+#[test]
+fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path().join("has space");
+    let (bin, work, scripts) = (root.join("bin"), root.join("work dir"), root.join("slurm jobs"));
+    for d in [&bin, &work] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    // The checkout the scripts run in: its paper reference values.
+    std::fs::create_dir_all(work.join("data")).unwrap();
+    std::os::unix::fs::symlink(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/paper"),
+        work.join("data/paper"),
+    )
+    .unwrap();
+    let config = root.join("tiny camp.toml");
+    std::fs::write(
+        &config,
+        "[campaign]\nname = \"tiny-camp\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 60\neval_every = 20\n",
+    )
+    .unwrap();
+    let exe = |name: &str, text: &str| {
+        let f = bin.join(name);
+        std::fs::write(&f, text).unwrap();
+        std::fs::set_permissions(&f, std::fs::Permissions::from_mode(0o755)).unwrap();
+    };
+    exe(
+        "cargo",
+        "#!/usr/bin/env bash\n# fake cargo: `build` succeeds, `run ... -- ARGS` runs ugl ARGS\n\
+         [ \"$1\" = build ] && exit 0\nwhile [ \"$1\" != -- ]; do shift; done; shift\n\
+         exec \"$UGL_BIN\" \"$@\"\n",
+    );
+    exe(
+        "sbatch",
+        "#!/usr/bin/env bash\n# fake sbatch: runs the script now (every array task in turn)\n\
+         parsable=0; script=\"\"\nfor a in \"$@\"; do case \"$a\" in --parsable) parsable=1;; \
+         --*) ;; *) script=\"$a\";; esac; done\n\
+         last=$(sed -n 's/^#SBATCH --array=0-\\([0-9]*\\)$/\\1/p' \"$script\")\n\
+         if [ -n \"$last\" ]; then for i in $(seq 0 \"$last\"); do \
+         SLURM_ARRAY_TASK_ID=$i bash \"$script\" || exit 1; done; else bash \"$script\" || exit 1; fi\n\
+         [ $parsable = 1 ] && echo 42\nexit 0\n",
+    );
+    let results = root.join("my results");
+    let out = results.join("tiny-camp");
+    let o = Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args(["slurm", "--config", p(&config), "--shards", "2", "--scripts"])
+        .arg(&scripts)
+        .arg("--out")
+        .arg(&out)
+        .current_dir(&work)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+    let o = Command::new("bash")
+        .arg(scripts.join("submit.sh"))
+        .env("PATH", path)
+        .env("UGL_BIN", env!("CARGO_BIN_EXE_ugl"))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    let n = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "json"))
+        .count();
+    assert_eq!(n, 4, "every run of the campaign");
+    let report = std::fs::read_to_string(work.join("report/out/REPORT.md")).unwrap();
+    assert!(report.contains("tiny-camp"), "the report draws on the campaign");
+}
+
+/// An external learner whose fit fails is started once per cell, not once per run, and the
+/// campaign reports that one failure (one line).
+#[test]
+fn a_failing_external_fit_is_started_once_per_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let starts = dir.path().join("starts");
+    let cfg = dir.path().join("ext.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "[campaign]\nname = \"ext-fail\"\nreps = 3\n[matrix]\nenvs = [\"armball\"]\n\
+             algos = [\"rge-external\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [2]\n\
+             [ugl]\nimages = 50\n[explore]\nepochs = 20\n\
+             [learners.external]\nname = \"broken\"\ncommand = \"sh -c 'echo start >> {}; echo boom >&2; exit 3'\"\n",
+            starts.display()
+        ),
+    )
+    .unwrap();
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&dir.path().join("res")),
+        "--jobs",
+        "1",
+        "--quiet",
+    ]);
+    assert_one_line_error(&o, "armball.rge-external");
+    assert!(!stderr(&o).contains("not run:"), "the real error: {}", stderr(&o));
+    let n = std::fs::read_to_string(&starts).unwrap().lines().count();
+    assert_eq!(n, 1, "started once for 6 runs in 3 groups");
+}
+
+/// A run whose data file was truncated after its manifest was written is not complete: `ugl
+/// report` and `ugl merge` refuse it with one line naming the file, and a resumed campaign
+/// recomputes exactly that run, to the same bytes.
+#[test]
+fn a_truncated_run_file_is_detected_and_recomputed() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("store");
+    let campaign = |extra: &[&str]| {
+        let mut a = vec![
+            "campaign",
+            "--config",
+            "data/campaigns/baselines.toml",
+            "--out",
+            p(&store),
+            "--quiet",
+        ];
+        a.extend(extra);
+        ugl(&a)
+    };
+    assert!(campaign(&[]).status.success());
+    let victim = store.join("armball.rpe.s0.parquet");
+    let original = std::fs::read(&victim).unwrap();
+    std::fs::write(&victim, &original[..original.len() / 2]).unwrap();
+
+    let report = ugl(&[
+        "report",
+        "--results",
+        p(&store),
+        "--main",
+        ".",
+        "--out",
+        p(&dir.path().join("report")),
+    ]);
+    assert_one_line_error(&report, "armball.rpe.s0.parquet");
+    assert!(stderr(&report).contains("truncated or damaged"), "{}", stderr(&report));
+    let merge = ugl(&["merge", "--into", p(&dir.path().join("merged")), p(&store)]);
+    assert_one_line_error(&merge, "run armball.rpe.s0 is incomplete or damaged");
+
+    let o = campaign(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 runs executed"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&victim).unwrap(), original, "recomputed to the same bytes");
+    let m = manifest(&store.join("armball.rpe.s0.json"));
+    assert_eq!(m["files"][0]["name"], "armball.rpe.s0.parquet");
+    assert_eq!(m["files"][0]["bytes"], original.len());
+}
+
+/// An external learner cannot outlive `ugl`: after a `kill -9` of `ugl` mid-fit, the learner's
+/// whole process group (here a shell and its background `sleep`) is killed and its work
+/// directory removed by the watchdog; and a configured READY timeout is honoured.
+#[cfg(unix)]
+#[test]
+fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurable() {
+    let dir = tempfile::tempdir().unwrap();
+    let info = dir.path().join("learner-info");
+    let hang = format!(
+        "echo \"$$ $UGL_WORKDIR\" > {}; sleep 1000 & sleep 1000",
+        info.display()
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args([
+            "run", "--env", "armball", "--algo", "rge-external", "--latents", "2", "--images",
+            "60", "--command", &hang, "--out",
+        ])
+        .arg(dir.path().join("out"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    let text = loop {
+        if let Ok(t) = std::fs::read_to_string(&info)
+            && t.ends_with('\n')
+        {
+            break t;
+        }
+        assert!(t0.elapsed().as_secs() < 60, "the learner never started");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    let (pgid, workdir) = text.trim().split_once(' ').unwrap();
+    let group_alive = || {
+        Command::new("sh")
+            .args(["-c", &format!("kill -0 -{pgid} 2>/dev/null")])
+            .status()
+            .unwrap()
+            .success()
+    };
+    assert!(group_alive() && Path::new(workdir).is_dir());
+    child.kill().unwrap(); // SIGKILL: no handler, no destructor runs
+    child.wait().unwrap();
+    let t0 = std::time::Instant::now();
+    while group_alive() || Path::new(workdir).exists() {
+        assert!(
+            t0.elapsed().as_secs() < 15,
+            "the learner's group {pgid} or its work directory {workdir} outlived ugl"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+
+    let cfg = dir.path().join("timeout.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-external\"]\n\
+         [ugl]\nimages = 60\n[explore]\nepochs = 20\n\
+         [learners.external]\nname = \"slow\"\ncommand = \"sleep 1000\"\nready_timeout_s = 1.5\n",
+    )
+    .unwrap();
+    let t0 = std::time::Instant::now();
+    let o = ugl(&[
+        "run", "--env", "armball", "--algo", "rge-external", "--latents", "2", "--profile",
+        p(&cfg), "--out", p(&dir.path().join("out2")),
+    ]);
+    assert_one_line_error(&o, "no READY line within the ready timeout (1.5s)");
+    assert!(t0.elapsed().as_secs() < 30);
+}

@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod env;
 pub mod explore;
 pub mod goals;
+pub mod limits;
 pub mod metrics;
 pub mod repr;
 pub mod seed;

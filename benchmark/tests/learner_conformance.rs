@@ -40,6 +40,8 @@ fn learners_config() -> LearnersConfig {
                 "python3 {}/../scripts/external_learners/random_projection.py",
                 env!("CARGO_MANIFEST_DIR")
             ),
+            ready_timeout_s: None,
+            answer_timeout_s: None,
         }),
         ae: tiny(),
         vae: tiny(),

@@ -427,11 +427,60 @@ fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
     Ok(out)
 }
 
+/// Checks a run's data files against the lengths and BLAKE3 hashes its manifest records
+/// (`files`; manifests written before results version 3 have none and pass). A truncated or
+/// damaged file is an error naming it, before polars tries to parse it.
+fn verify_digests(manifest_path: &Path) -> Result<(), ReportError> {
+    let invalid = |path: &Path, problem: String| ReportError::Invalid {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let Ok(text) = std::fs::read_to_string(manifest_path) else {
+        return Ok(()); // reported with its context when the manifest is read
+    };
+    let Ok(raw) = serde_json::from_str::<Value>(&text) else {
+        return Ok(());
+    };
+    let Some(files) = raw.get("files").and_then(Value::as_array) else {
+        return Ok(());
+    };
+    let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    for f in files {
+        let (Some(name), Some(bytes), Some(hash)) = (
+            f.get("name").and_then(Value::as_str),
+            f.get("bytes").and_then(Value::as_u64),
+            f.get("blake3").and_then(Value::as_str),
+        ) else {
+            return Err(invalid(
+                manifest_path,
+                "`files`: an entry lacks its name, bytes or blake3".into(),
+            ));
+        };
+        let path = dir.join(name);
+        let data = std::fs::read(&path).map_err(|source| ReportError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        if data.len() as u64 != bytes || blake3::hash(&data).to_hex().as_str() != hash {
+            return Err(invalid(
+                &path,
+                format!(
+                    "does not match its manifest ({} bytes, {bytes} recorded, or another hash): \
+                     truncated or damaged; resume the campaign to recompute the run",
+                    data.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads one run from its three files.
 pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
     let curve_path = with_suffix(stem, CURVE_SUFFIX);
     let outcomes_path = with_suffix(stem, OUTCOMES_SUFFIX);
     let manifest_path = with_suffix(stem, MANIFEST_SUFFIX);
+    verify_digests(&manifest_path)?;
 
     let df = read_parquet(&curve_path)?;
     let c = Cols {

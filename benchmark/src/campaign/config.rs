@@ -168,7 +168,10 @@ impl LearnersConfig {
         let v = match learner {
             Learner::Pca | Learner::PcaCentred => serde_json::Value::Null,
             Learner::Isomap => serde_json::to_value(&self.isomap).expect("serialisable"),
-            Learner::External => serde_json::to_value(&self.external).expect("serialisable"),
+            Learner::External => {
+                serde_json::to_value(self.external.as_ref().map(ExternalConfig::identity))
+                    .expect("serialisable")
+            }
             Learner::Ae | Learner::Vae | Learner::Rfvae => {
                 let model = learner.model().expect("neural");
                 serde_json::to_value(self.neural_config(model, variant.unwrap_or_default()))
@@ -210,6 +213,25 @@ pub struct ExternalConfig {
     pub name: String,
     /// The command line (run with `sh -c`).
     pub command: String,
+    /// Seconds allowed from the program's start to its `READY` line, i.e. its whole fit
+    /// (default 3600). Not part of the runs' identity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ready_timeout_s: Option<f64>,
+    /// Seconds allowed for each encode answer (default 300). Not part of the runs' identity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub answer_timeout_s: Option<f64>,
+}
+
+impl ExternalConfig {
+    /// What the runs depend on: the name and the command (not the timeouts).
+    pub fn identity(&self) -> ExternalConfig {
+        ExternalConfig {
+            name: self.name.clone(),
+            command: self.command.clone(),
+            ready_timeout_s: None,
+            answer_timeout_s: None,
+        }
+    }
 }
 
 /// A whole campaign configuration.
@@ -300,6 +322,14 @@ impl CampaignConfig {
         if self.matrix.latents.is_empty() {
             return Err("matrix.latents must list at least one latent size".into());
         }
+        crate::limits::check_runs(&[
+            ("envs", self.matrix.envs.len()),
+            ("algos", self.matrix.algos.len()),
+            ("samplers", self.matrix.samplers.len()),
+            ("latent sizes", self.matrix.latents.len()),
+            ("variants", self.matrix.variants.len()),
+            ("reps", self.campaign.reps),
+        ])?;
         if self.matrix.variants.is_empty() {
             return Err(
                 "matrix.variants must list at least one variant (faithful, corrected)".into(),
@@ -327,6 +357,9 @@ impl CampaignConfig {
                 self.ugl.images
             ));
         }
+        if learned {
+            crate::limits::check_images(self.ugl.images)?;
+        }
         if let Some(LatentSize::N(n)) = self
             .matrix
             .latents
@@ -351,6 +384,18 @@ impl CampaignConfig {
                 return Err(
                     "learners.external.name and learners.external.command must not be empty".into(),
                 );
+            }
+            for (key, v) in [
+                ("ready_timeout_s", e.ready_timeout_s),
+                ("answer_timeout_s", e.answer_timeout_s),
+            ] {
+                if let Some(v) = v
+                    && !(v.is_finite() && v > 0.0 && v <= 1e7)
+                {
+                    return Err(format!(
+                        "learners.external.{key} must be a positive number of seconds (at most 1e7), got {v}"
+                    ));
+                }
             }
         }
         self.explore.validate()?;

@@ -1,5 +1,6 @@
 //! Executes runs: environment + explorer, then the results store.
 
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -48,6 +49,11 @@ pub enum RunError {
     Pool(String),
     #[error("run {run}: {source}")]
     Repr { run: String, source: ReprError },
+    /// A run whose representation was not fitted because the same fit failed before: in its
+    /// group (the runs sharing the representation), or, for an external learner, in another
+    /// seed of the same cell (a failing program is started once, not once per run).
+    #[error("run {run}: not run: the fit of its goal space failed for run {first} (error above)")]
+    FitFailedBefore { run: String, first: String },
     #[error(
         "interrupted: {done} of {total} runs finished and stored; rerun the same command to resume"
     )]
@@ -219,7 +225,14 @@ fn external_learner(cfg: &LearnersConfig) -> Result<ExternalLearner, ReprError> 
             "rge-external needs a [learners.external] section (name, command)".into(),
         )
     })?;
-    Ok(ExternalLearner::new(e.name.clone(), e.command.clone()))
+    let mut l = ExternalLearner::new(e.name.clone(), e.command.clone());
+    if let Some(t) = e.ready_timeout_s {
+        l.ready_timeout = std::time::Duration::from_secs_f64(t);
+    }
+    if let Some(t) = e.answer_timeout_s {
+        l.answer_timeout = std::time::Duration::from_secs_f64(t);
+    }
+    Ok(l)
 }
 
 /// The model-cache key of a neural representation: BLAKE3 of everything it depends on (the
@@ -278,6 +291,9 @@ fn fit_neural(
     let mut enc = match cached {
         Some(enc) => enc,
         None => {
+            if let Some(c) = ctx.cache {
+                c.check_writable()?;
+            }
             let mut l = NeuralLearner::new(model, cfg.clone());
             if let Some(sink) = &ctx.train_progress {
                 let sink = sink.clone();
@@ -618,6 +634,8 @@ pub fn execute(
         cpu: Some(cpu_info().clone()),
         latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
         summary: summary.clone(),
+        // Filled in by `write_run` from the bytes it writes.
+        files: None,
     };
     store::write_run(out, spec, &log, &manifest)?;
     Ok(summary)
@@ -715,18 +733,45 @@ pub fn run_campaign(
     let inner = (cores / jobs).max(1);
     let next = AtomicUsize::new(0);
     let slots: Vec<Mutex<GroupResult>> = groups.iter().map(|_| Mutex::new(Vec::new())).collect();
+    // External-learner cells whose fit failed: (env, learner, latents) -> the failed run.
+    let failed_external: Mutex<HashMap<String, String>> = Mutex::new(HashMap::new());
+    let external_cell = |spec: &RunSpec| {
+        (spec.algo.learner() == Some(Learner::External))
+            .then(|| format!("{}/{}", spec.env.name(), spec.latents))
+    };
     let run_group = |key: &Option<String>, specs: &[&RunSpec]| -> GroupResult {
         let mut out_v = Vec::with_capacity(specs.len());
         let mut repr = None;
+        let mut failed: Option<String> = None;
         for spec in specs {
             if opts.stop.load(Ordering::SeqCst) {
                 out_v.push(None);
                 continue;
             }
             if key.is_some() && repr.is_none() {
+                let cell = external_cell(spec);
+                let before = failed.clone().or_else(|| {
+                    let seen = failed_external.lock().unwrap_or_else(|e| e.into_inner());
+                    cell.as_ref().and_then(|c| seen.get(c).cloned())
+                });
+                if let Some(first) = before {
+                    out_v.push(Some(Err(RunError::FitFailedBefore {
+                        run: spec.run_id(),
+                        first,
+                    })));
+                    continue;
+                }
                 match fit_representation(spec, &ctx) {
                     Ok(r) => repr = Some(r),
                     Err(source) => {
+                        failed = Some(spec.run_id());
+                        if let Some(c) = cell {
+                            failed_external
+                                .lock()
+                                .unwrap_or_else(|e| e.into_inner())
+                                .entry(c)
+                                .or_insert_with(|| spec.run_id());
+                        }
                         out_v.push(Some(Err(RunError::Repr {
                             run: spec.run_id(),
                             source,
@@ -779,11 +824,23 @@ pub fn run_campaign(
         .collect();
     let mut done = Vec::new();
     let mut skipped_now = 0;
+    let mut first_err: Option<RunError> = None;
     for r in results.into_iter().flatten() {
         match r {
-            Some(r) => done.push(r?),
+            Some(Ok(r)) => done.push(r),
+            // The error to report: the first real one (a run skipped because of an earlier
+            // failed fit only points to it).
+            Some(Err(e)) => match (&first_err, &e) {
+                (None, _) | (Some(RunError::FitFailedBefore { .. }), RunError::Repr { .. }) => {
+                    first_err = Some(e)
+                }
+                _ => {}
+            },
             None => skipped_now += 1,
         }
+    }
+    if let Some(e) = first_err {
+        return Err(e);
     }
     if skipped_now > 0 {
         return Err(RunError::Interrupted {

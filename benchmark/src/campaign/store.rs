@@ -1,6 +1,8 @@
 //! The results store (`data/results/README.md` documents the schema): per run a curve parquet,
 //! an outcomes parquet and a JSON manifest, each written to a temporary file and renamed.
-//! A run is complete when its manifest exists (it is written last).
+//! A run is complete when its manifest exists (it is written last) and its two data files have
+//! the lengths and BLAKE3 hashes the manifest records ([`Manifest::files`]; manifests written
+//! before results version 3 do not record them, and their files are taken as they are).
 
 use std::fs::File;
 use std::io::Write;
@@ -106,6 +108,63 @@ pub struct Manifest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub latent_quality: Option<serde_json::Value>,
     pub summary: Summary,
+    /// The run's data files as written: name, length and BLAKE3 hash. A run is complete only
+    /// if its files still match (checked on resume, merge and report). Absent in manifests
+    /// written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<Vec<FileDigest>>,
+}
+
+/// A data file of a run as its manifest records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileDigest {
+    /// File name, in the run's directory.
+    pub name: String,
+    pub bytes: u64,
+    pub blake3: String,
+}
+
+impl FileDigest {
+    /// The digest of `bytes` written as `name`.
+    pub fn of(name: &str, bytes: &[u8]) -> FileDigest {
+        FileDigest {
+            name: name.to_string(),
+            bytes: bytes.len() as u64,
+            blake3: blake3::hash(bytes).to_hex().to_string(),
+        }
+    }
+}
+
+/// Check the data files of a run in `dir` against its manifest: each must exist with the
+/// recorded length and hash. The error says which file and how it differs. Manifests without
+/// digests (written before they were recorded) pass if the files exist.
+pub fn verify_files(dir: &Path, manifest: &Manifest) -> Result<(), String> {
+    let Some(files) = &manifest.files else {
+        let [c, o, _] = run_paths(dir, &manifest.run_id);
+        return match [&c, &o].into_iter().find(|p| !p.is_file()) {
+            Some(p) => Err(format!("{} is missing", p.display())),
+            None => Ok(()),
+        };
+    };
+    for f in files {
+        let path = dir.join(&f.name);
+        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        if bytes.len() as u64 != f.bytes {
+            return Err(format!(
+                "{} has {} bytes, its manifest records {} (truncated or replaced)",
+                path.display(),
+                bytes.len(),
+                f.bytes
+            ));
+        }
+        if blake3::hash(&bytes).to_hex().as_str() != f.blake3 {
+            return Err(format!(
+                "{} does not match the BLAKE3 hash its manifest records (damaged)",
+                path.display()
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn none_string() -> String {
@@ -244,9 +303,21 @@ pub fn write_run(
     };
     let mut curve = curve_frame(spec, log).map_err(|e| enc(&curve_p, e))?;
     let mut outcomes = outcomes_frame(spec, log).map_err(|e| enc(&outcomes_p, e))?;
-    write_atomic(&curve_p, &parquet_bytes(&mut curve, &curve_p)?)?;
-    write_atomic(&outcomes_p, &parquet_bytes(&mut outcomes, &outcomes_p)?)?;
-    let mut json = serde_json::to_vec_pretty(manifest).map_err(|e| StoreError::Encode {
+    let mut digests = Vec::new();
+    for (path, frame) in [(&curve_p, &mut curve), (&outcomes_p, &mut outcomes)] {
+        let bytes = parquet_bytes(frame, path)?;
+        write_atomic(path, &bytes)?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        digests.push(FileDigest::of(&name, &bytes));
+    }
+    let manifest = Manifest {
+        files: Some(digests),
+        ..manifest.clone()
+    };
+    let mut json = serde_json::to_vec_pretty(&manifest).map_err(|e| StoreError::Encode {
         path: manifest_p.clone(),
         message: e.to_string(),
     })?;
@@ -266,13 +337,19 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, StoreError> {
     })
 }
 
-/// Whether a run is complete in `dir` with the given config hash: manifest present, matching,
-/// and both data files present.
+/// Whether a run is complete in `dir` with the given config hash: manifest present and
+/// matching, and both data files as it records them ([`verify_files`]). A damaged run is not
+/// complete: a resumed campaign recomputes it (and says so in the log).
 pub fn is_complete(dir: &Path, run_id: &str, config_hash: &str) -> bool {
-    let [c, o, m] = run_paths(dir, run_id);
-    c.is_file()
-        && o.is_file()
-        && read_manifest(&m)
-            .map(|m| m.config_hash == config_hash)
-            .unwrap_or(false)
+    let [_, _, m] = run_paths(dir, run_id);
+    match read_manifest(&m) {
+        Ok(m) if m.config_hash == config_hash => match verify_files(dir, &m) {
+            Ok(()) => true,
+            Err(why) => {
+                tracing::warn!("run {run_id} is damaged and will be recomputed: {why}");
+                false
+            }
+        },
+        _ => false,
+    }
 }

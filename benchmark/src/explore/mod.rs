@@ -50,6 +50,7 @@ impl ExploreConfig {
         if self.epochs == 0 {
             return Err("explore.epochs must be at least 1".into());
         }
+        crate::limits::check_epochs(self.epochs)?;
         if self.eval_every == 0 {
             return Err("explore.eval_every must be at least 1".into());
         }

@@ -197,6 +197,27 @@ impl ModelCache {
         }
     }
 
+    /// Check, before a training, that the cache can be written: its directory exists or can be
+    /// created, and a file can be created in it (and is removed). A training whose model could
+    /// not be stored would be lost.
+    pub fn check_writable(&self) -> Result<(), ReprError> {
+        let fail = |what: &str, p: &Path, e: std::io::Error| {
+            ReprError::Cache(format!(
+                "model cache {}: cannot {what} {} ({e}); choose another with --cache DIR or \
+                 train without it (--no-cache)",
+                self.dir.display(),
+                p.display()
+            ))
+        };
+        std::fs::create_dir_all(&self.dir).map_err(|e| fail("create", &self.dir, e))?;
+        let probe = self
+            .dir
+            .join(format!(".write-probe-{}.tmp", std::process::id()));
+        std::fs::write(&probe, b"").map_err(|e| fail("write", &probe, e))?;
+        let _ = std::fs::remove_file(&probe);
+        Ok(())
+    }
+
     /// Store `enc` under `key` (atomically: temp file + rename).
     pub fn store(&self, key: &str, enc: &NeuralEncoder) -> Result<(), ReprError> {
         let io = |what: &str, p: &Path, e: std::io::Error| {

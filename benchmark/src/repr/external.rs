@@ -30,7 +30,7 @@ use std::fs::{self, File};
 use std::io::{self, BufRead, BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStderr, ChildStdin, ChildStdout, Command, ExitStatus, Stdio};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::thread;
@@ -380,10 +380,81 @@ struct WorkDir {
     path: PathBuf,
 }
 
+/// Set by the command line on an interrupt (the first Ctrl-C): a learner still fitting is
+/// stopped and killed instead of being waited for (its READY wait ends with an error).
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Stop waiting for external learners that are still fitting (see [`INTERRUPTED`]).
+pub fn interrupt() {
+    INTERRUPTED.store(true, Ordering::SeqCst);
+}
+
+/// Work directories are named `ugl-external-<harness pid>-...`: remove those whose harness is
+/// no longer running (left behind by a `kill -9` before the watchdog existed, or by a machine
+/// that went down). Once per process; Linux only (`/proc`).
+fn sweep_stale_work_dirs(base: &Path) {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if !Path::new("/proc/self").exists() {
+            return;
+        }
+        let Ok(entries) = fs::read_dir(base) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            let Some(pid) = name
+                .strip_prefix("ugl-external-")
+                .and_then(|r| r.split('-').next())
+                .and_then(|p| p.parse::<u32>().ok())
+            else {
+                continue;
+            };
+            if pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists() {
+                tracing::info!("removing the stale learner work directory {}", e.path().display());
+                let _ = fs::remove_dir_all(e.path());
+            }
+        }
+    });
+}
+
+/// A process that outlives `ugl` however it ends (Ctrl-C twice, SIGTERM, SIGKILL): every
+/// second it checks that the harness is alive; once the harness is gone it kills the learner's
+/// process group and removes its work directory. It exits by itself when the group is gone. It
+/// runs in its own process group, so neither the learner's end nor a terminal Ctrl-C stops it.
+#[cfg(unix)]
+fn spawn_watchdog(pgid: u32, workdir: &Path) -> Option<Child> {
+    use std::os::unix::process::CommandExt;
+    const SCRIPT: &str = "h=$1; g=$2; d=$3\n\
+        while kill -0 \"$h\" 2>/dev/null; do\n\
+          kill -0 -\"$g\" 2>/dev/null || exit 0\n\
+          sleep 1\n\
+        done\n\
+        kill -9 -\"$g\" 2>/dev/null\n\
+        rm -rf \"$d\"\n";
+    let mut cmd = Command::new("sh");
+    cmd.args(["-c", SCRIPT, "ugl-learner-watchdog"])
+        .arg(std::process::id().to_string())
+        .arg(pgid.to_string())
+        .arg(workdir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .process_group(0);
+    match cmd.spawn() {
+        Ok(c) => Some(c),
+        Err(e) => {
+            tracing::warn!("no watchdog for the learner's process group {pgid}: {e}");
+            None
+        }
+    }
+}
+
 impl WorkDir {
     fn create() -> Result<Self, ReprError> {
         static COUNTER: AtomicU64 = AtomicU64::new(0);
         let base = std::env::temp_dir();
+        sweep_stale_work_dirs(&base);
         let nanos = SystemTime::now()
             .duration_since(UNIX_EPOCH)
             .map(|d| d.subsec_nanos())
@@ -430,6 +501,8 @@ struct Session {
     broken: Option<String>,
     /// The fit time the program reported on its READY line.
     reported_fit_s: Option<f64>,
+    /// Kills the program's group if `ugl` dies first ([`spawn_watchdog`]).
+    watchdog: Option<Child>,
     // Dropped last, after the process is gone.
     _workdir: WorkDir,
 }
@@ -462,6 +535,10 @@ impl Session {
                 learner.name, learner.command
             ))
         })?;
+        #[cfg(unix)]
+        let watchdog = spawn_watchdog(child.id(), &workdir.path);
+        #[cfg(not(unix))]
+        let watchdog = None;
         let stdin = child.stdin.take().expect("piped stdin");
         let stdout = child.stdout.take().expect("piped stdout");
         let stderr = child.stderr.take().expect("piped stderr");
@@ -483,6 +560,7 @@ impl Session {
             status: None,
             broken: None,
             reported_fit_s: None,
+            watchdog,
             _workdir: workdir,
         };
         // On a thread-spawn failure the session drops here, which kills and reaps the child.
@@ -511,7 +589,26 @@ impl Session {
     }
 
     fn wait_ready(&mut self, timeout: Duration) -> Result<(), ReprError> {
-        match self.from_reader.recv_timeout(timeout) {
+        // In slices, so that an interrupt stops the wait.
+        let start = Instant::now();
+        let got = loop {
+            let left = timeout.saturating_sub(start.elapsed());
+            match self
+                .from_reader
+                .recv_timeout(left.min(Duration::from_millis(200)))
+            {
+                Err(RecvTimeoutError::Timeout) if !left.is_zero() => {
+                    if INTERRUPTED.load(Ordering::SeqCst) {
+                        return Err(self.fail(
+                            "interrupted while the program was fitting; it was stopped".into(),
+                            false,
+                        ));
+                    }
+                }
+                other => break other,
+            }
+        };
+        match got {
             Ok(FromReader::Ready(fit_s)) => {
                 self.reported_fit_s = fit_s;
                 Ok(())
@@ -694,6 +791,10 @@ impl Drop for Session {
     fn drop(&mut self) {
         if self.status.is_none() {
             self.terminate(SHUTDOWN_GRACE);
+        }
+        if let Some(mut w) = self.watchdog.take() {
+            let _ = w.kill();
+            let _ = w.wait();
         }
     }
 }

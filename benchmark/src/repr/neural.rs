@@ -224,6 +224,9 @@ impl NeuralConfig {
                 self.hidden
             ));
         }
+        if let Err(m) = crate::limits::check_hidden("hidden", self.hidden) {
+            return bad(m);
+        }
         if !(self.lr.is_finite() && self.lr > 0.0) {
             return bad(format!("lr must be positive and finite, got {}", self.lr));
         }

@@ -1,0 +1,96 @@
+//! Sizes checked before anything is allocated: a configuration whose data cannot fit in this
+//! machine's memory, or whose run matrix is absurdly large, is refused with one line naming the
+//! key, instead of an allocation failure (an abort with a backtrace) or minutes of silence.
+
+use crate::env::render::PIXELS;
+
+/// At most this many runs in one campaign (the `paper` matrix has 240).
+pub const MAX_RUNS: u128 = 1_000_000;
+
+/// Bytes held per exploration epoch, generously: the chosen parameters, the outcome, the
+/// latent goal and its encoding, and the neighbour index's share.
+pub const BYTES_PER_EPOCH: f64 = 1024.0;
+
+/// The machine's physical memory in bytes (`MemTotal` of `/proc/meminfo`); None where unknown.
+pub fn total_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The memory a configuration may plan for: the machine's, or 1 TiB where it is unknown.
+fn budget() -> f64 {
+    total_memory().unwrap_or(1024.0 * 1024.0 * 1024.0 * 1024.0)
+}
+
+fn gib(bytes: f64) -> String {
+    format!("{:.1} GiB", bytes / (1024.0 * 1024.0 * 1024.0))
+}
+
+/// Refuse `key = value` if it needs `bytes` (estimated) and that exceeds the machine's memory.
+pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Result<(), String> {
+    let have = budget();
+    if !bytes.is_finite() || bytes > have {
+        return Err(format!(
+            "{key} = {value} needs about {} of memory, more than this machine's {}",
+            gib(bytes),
+            gib(have)
+        ));
+    }
+    Ok(())
+}
+
+/// `ugl.images` (the UGL data set: `n` images of 70x70 f32, plus a sparse copy).
+pub fn check_images(n: usize) -> Result<(), String> {
+    check_fits("ugl.images", n, n as f64 * PIXELS as f64 * 4.0 * 2.0)
+}
+
+/// `explore.epochs` (the exploration's per-epoch records).
+pub fn check_epochs(n: usize) -> Result<(), String> {
+    check_fits("explore.epochs", n, n as f64 * BYTES_PER_EPOCH)
+}
+
+/// A network's `hidden` sizes: the weights of the 4900-H1-H2 MLP and its mirror, with their
+/// gradients and optimiser state (x5).
+pub fn check_hidden(key: &str, hidden: [usize; 2]) -> Result<(), String> {
+    let [h1, h2] = hidden.map(|h| h as f64);
+    let params = 2.0 * (PIXELS as f64 * h1 + h1 * h2) + 200.0 * h2;
+    check_fits(key, format!("{hidden:?}"), params * 4.0 * 5.0)
+}
+
+/// The number of runs of a matrix (the product of its dimensions, without overflow).
+pub fn check_runs(dims: &[(&str, usize)]) -> Result<(), String> {
+    let total = dims
+        .iter()
+        .fold(1u128, |acc, (_, n)| acc.saturating_mul(*n as u128));
+    if total > MAX_RUNS {
+        let what: Vec<String> = dims.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        return Err(format!(
+            "the run matrix ({}) holds up to {total} runs; a campaign holds at most {MAX_RUNS}",
+            what.join(" x ")
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn absurd_sizes_are_refused_and_real_ones_pass() {
+        assert!(check_images(10_000).is_ok());
+        assert!(check_epochs(5000).is_ok());
+        assert!(check_hidden("learners.vae.hidden", [1200, 1200]).is_ok());
+        let e = check_images(100_000_000_000).unwrap_err();
+        assert!(e.starts_with("ugl.images = 100000000000 needs about"), "{e}");
+        assert!(check_epochs(1 << 63).is_err());
+        assert!(check_epochs(usize::MAX).is_err());
+        assert!(check_hidden("learners.ae.hidden", [100_000_000, 10]).is_err());
+        assert!(check_runs(&[("envs", 2), ("algos", 7), ("reps", 5)]).is_ok());
+        let e = check_runs(&[("envs", 2), ("reps", 100_000_000_000)]).unwrap_err();
+        assert!(e.contains("at most 1000000"), "{e}");
+        assert!(check_runs(&[("a", usize::MAX), ("b", usize::MAX), ("c", usize::MAX)]).is_err());
+    }
+}
