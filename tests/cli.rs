@@ -553,17 +553,20 @@ fn shards_merge_into_the_whole_campaign() {
         common::parquet_files(&merged),
         "the union of the shards equals the whole campaign"
     );
-    // Merging again is a no-op; a conflicting run is refused.
+    // Merging again is a no-op; a conflicting run is refused; a damaged source run too.
     assert!(ugl(&args).status.success());
-    let f = parts[0].join(
-        std::fs::read_dir(&parts[0])
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .find(|p| p.to_str().unwrap().ends_with(".outcomes.parquet"))
-            .unwrap(),
-    );
-    std::fs::write(&f, b"corrupt").unwrap();
+    let name = std::fs::read_dir(&parts[0])
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .find(|n| n.ends_with(".outcomes.parquet"))
+        .unwrap();
+    let (source, dest) = (parts[0].join(&name), merged.join(&name));
+    let good = std::fs::read(&dest).unwrap();
+    std::fs::write(&dest, b"another run's data").unwrap();
     assert_one_line_error(&ugl(&args), "refusing to overwrite");
+    std::fs::write(&dest, &good).unwrap();
+    std::fs::write(&source, b"corrupt").unwrap();
+    assert_one_line_error(&ugl(&args), "is incomplete or damaged");
     assert_one_line_error(
         &ugl(&[
             "campaign",
