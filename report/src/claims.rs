@@ -336,6 +336,82 @@ pub struct ClaimResult {
     pub margin: f64,
     pub comparisons: Vec<Comparison>,
     pub verdict: Verdict,
+    /// The same claim on the paper's own reference values ([`check_on_paper`]); set by
+    /// [`attach_paper_checks`].
+    pub paper: Option<PaperCheck>,
+}
+
+/// One comparison of a claim on the paper's own values (single runs, so no interval).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperComparison {
+    pub subject: ConditionKey,
+    pub reference: ConditionKey,
+    /// `subject - reference` of the paper's final KLC values.
+    pub diff: f64,
+    /// Whether `diff` lies in the claim's set.
+    pub holds: bool,
+}
+
+/// A claim evaluated on the paper's reference values (`data/paper/klc_final.csv`, read from
+/// its figures): do the paper's own numbers satisfy the statement we test?
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperCheck {
+    /// The comparisons of the claim whose two conditions the paper reports.
+    pub comparisons: Vec<PaperComparison>,
+    /// `Some(true)`: every such comparison holds; `Some(false)`: at least one does not (the
+    /// paper's own figure contradicts the statement); `None`: the paper gives no value for any
+    /// comparison (another statistic, or conditions it did not run, e.g. corrected variants).
+    pub holds: Option<bool>,
+}
+
+/// Evaluates `claim` on the paper's values over the conditions `keys` (each subject condition
+/// against each reference condition, as [`evaluate`] pairs them). Only final-KLC claims can be
+/// checked (the table holds final KLC values); corrected variants are not the paper's and are
+/// skipped; a condition the paper does not report is skipped.
+pub fn check_on_paper(
+    claim: &Claim,
+    margin: f64,
+    keys: &[ConditionKey],
+    paper: &crate::paper::PaperTable,
+) -> PaperCheck {
+    let (a, b) = claim.relation.interval(margin);
+    let mut comparisons = Vec::new();
+    if claim.statistic == Statistic::FinalKlc {
+        let paper_value = |k: &ConditionKey| {
+            (k.variant != "corrected")
+                .then(|| paper.lookup(k).map(|v| v.klc))
+                .flatten()
+        };
+        for s in keys.iter().filter(|k| claim.subject.matches(k)) {
+            for r in keys
+                .iter()
+                .filter(|k| *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k))
+            {
+                if let (Some(x), Some(y)) = (paper_value(s), paper_value(r)) {
+                    let diff = x - y;
+                    comparisons.push(PaperComparison {
+                        subject: s.clone(),
+                        reference: r.clone(),
+                        diff,
+                        holds: diff > a && diff < b,
+                    });
+                }
+            }
+        }
+    }
+    let holds = (!comparisons.is_empty()).then(|| comparisons.iter().all(|c| c.holds));
+    PaperCheck { comparisons, holds }
+}
+
+/// Sets [`ClaimResult::paper`] of every result, over the conditions `keys`.
+pub fn attach_paper_checks(
+    results: &mut [ClaimResult],
+    keys: &[ConditionKey],
+    paper: &crate::paper::PaperTable,
+) {
+    for r in results {
+        r.paper = Some(check_on_paper(&r.claim, r.margin, keys, paper));
+    }
 }
 
 /// The per-seed values of `statistic` for a condition (seed order). Runs whose curve has no area
@@ -410,6 +486,7 @@ pub fn evaluate(
                 claim: claim.clone(),
                 margin,
                 comparisons,
+                paper: None,
             }
         })
         .collect()
@@ -418,6 +495,75 @@ pub fn evaluate(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    /// Every claim of `data/paper/claims.toml` on the paper's own values
+    /// (`data/paper/klc_final.csv`), over the paper's matrix: exactly these are contradicted by
+    /// the paper's own figures (each checked by hand against the CSV).
+    #[test]
+    fn every_claim_on_the_papers_own_numbers() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper");
+        let file = load_claims(&dir.join(FILE)).unwrap();
+        let paper = crate::paper::load_paper(&dir).unwrap();
+        assert!(!paper.values.is_empty());
+        let k = |env: &str, algo: &str, sampler: &str, latents: i64, variant: &str| ConditionKey {
+            env: env.into(),
+            algo: algo.into(),
+            sampler: sampler.into(),
+            latents,
+            variant: variant.into(),
+        };
+        let mut keys = Vec::new();
+        for (env, true_dim) in [("armball", 2), ("armarrow", 3)] {
+            keys.push(k(env, "rpe", "none", 0, "none"));
+            keys.push(k(env, "rge-efr", "uniform", 0, "none"));
+            for l in [true_dim, 10] {
+                for algo in ["rge-pca", "rge-isomap", "rge-ae"] {
+                    keys.push(k(env, algo, "kde", l, "none"));
+                }
+                for algo in ["rge-vae", "rge-rfvae"] {
+                    for sampler in ["kde", "gaussian"] {
+                        for variant in ["faithful", "corrected"] {
+                            keys.push(k(env, algo, sampler, l, variant));
+                        }
+                    }
+                }
+            }
+        }
+        let mut contradicted = Vec::new();
+        let mut unchecked = Vec::new();
+        for c in &file.claims {
+            let check = check_on_paper(c, c.margin.unwrap_or(file.settings.margin), &keys, &paper);
+            match check.holds {
+                Some(false) => contradicted.push(c.id.as_str()),
+                None => unchecked.push(c.id.as_str()),
+                Some(true) => {}
+            }
+        }
+        assert_eq!(
+            contradicted,
+            [
+                "armball-ae-true-dim",      // AE 4.39 at 2 latents vs 4.77 at 10: |Δ| > 0.2
+                "armball-pca-vae-true-dim", // PCA 4.09 at 2 < 4.28 at 10 (claimed higher)
+                "armarrow-10-beats-efr",    // AE-10 7.54 > EFR 7.46
+                "armarrow-true-others-not-better", // AE-3 6.82, Isomap-3 6.85 beat EFR 7.46 by > 0.2
+                "latents-10-not-worse",            // e.g. ArmArrow AE 7.54 at 10 vs 6.82 at 3
+                "vae-gaussian-vs-kde",             // ArmBall-10 Gaussian 3.84 vs KDE 4.25
+            ],
+            "claims the paper's own numbers contradict"
+        );
+        // Claims on other statistics, or only on our corrected variants, cannot be checked.
+        for id in &unchecked {
+            let c = file.claims.iter().find(|c| c.id == *id).unwrap();
+            assert!(
+                c.statistic != Statistic::FinalKlc
+                    || c.subject
+                        .variant
+                        .as_ref()
+                        .is_some_and(|v| v == &["corrected".to_string()]),
+                "{id} should be checkable on the paper's values"
+            );
+        }
+    }
 
     #[test]
     fn verdict_of_interval_against_open_sets() {

@@ -101,10 +101,12 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     } else {
         None
     };
-    let claim_results = claims_file
+    let mut claim_results = claims_file
         .as_ref()
         .map(|f| claims::evaluate(f, &conditions, store, opts.bootstrap_seed))
         .unwrap_or_default();
+    let keys: Vec<_> = conditions.iter().map(|c| c.key.clone()).collect();
+    claims::attach_paper_checks(&mut claim_results, &keys, &paper);
     let claims_input = match &claims_file {
         Some(f) => markdown::claims::ClaimsInput::Evaluated {
             path: &claims_path,

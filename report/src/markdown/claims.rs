@@ -165,11 +165,34 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
         );
     }
     let _ = writeln!(w);
+    let contradicted: Vec<&str> = results
+        .iter()
+        .filter(|r| r.paper.as_ref().and_then(|p| p.holds) == Some(false))
+        .map(|r| r.claim.id.as_str())
+        .collect();
     let _ = writeln!(
         w,
-        "| claim | the paper says | testable statement | requires | evidence | verdict |"
+        "*The paper's own numbers*: each claim is also evaluated on the paper's reference values \
+         (`data/paper/klc_final.csv`, read from its figures; single runs, so Δ without an \
+         interval). ✅: they satisfy the statement; ❌: **contradicted by the paper's own \
+         figure** (a verdict against it says little about our reproduction); —: the paper \
+         gives no value for these comparisons. Contradicted: {}.",
+        if contradicted.is_empty() {
+            "none".to_string()
+        } else {
+            contradicted
+                .iter()
+                .map(|c| format!("`{c}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|");
+    let _ = writeln!(w);
+    let _ = writeln!(
+        w,
+        "| claim | the paper says | testable statement | requires | evidence | verdict | the paper's own numbers |"
+    );
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|");
     for r in results {
         let evidence = if r.comparisons.is_empty() {
             "no condition of the main campaign matches".to_string()
@@ -182,7 +205,7 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
         };
         let _ = writeln!(
             w,
-            "| `{}` | *“{}”* ({}) | {} | {}, Δ of the {} | {} | **{}** |",
+            "| `{}` | *“{}”* ({}) | {} | {}, Δ of the {} | {} | **{}** | {} |",
             r.claim.id,
             cell(&r.claim.quote),
             cell(&r.claim.source),
@@ -190,10 +213,42 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
             r.claim.relation.describe(r.margin),
             r.claim.statistic.label(),
             evidence,
-            verdict_mark(r.verdict)
+            verdict_mark(r.verdict),
+            paper_cell(r.paper.as_ref(), r.claim.statistic)
         );
     }
     let _ = writeln!(w);
+}
+
+/// The paper's-own-numbers cell: the verdict, then the comparisons that fail (or all, if they
+/// all hold and are few).
+fn paper_cell(check: Option<&crate::claims::PaperCheck>, statistic: Statistic) -> String {
+    let Some(check) = check else {
+        return "—".into();
+    };
+    let line = |c: &crate::claims::PaperComparison| {
+        format!(
+            "{} {}: {} vs {}: Δ = {}",
+            if c.holds { "✅" } else { "❌" },
+            env_name(&c.subject.env),
+            describe_key(&c.subject),
+            describe_key(&c.reference),
+            signed(statistic, c.diff)
+        )
+    };
+    match check.holds {
+        None => "— not reported".into(),
+        Some(true) => format!("✅ satisfy ({} comparisons)", check.comparisons.len()),
+        Some(false) => {
+            let failing: Vec<String> = check
+                .comparisons
+                .iter()
+                .filter(|c| !c.holds)
+                .map(line)
+                .collect();
+            format!("**❌ contradicted**<br>{}", failing.join("<br>"))
+        }
+    }
 }
 
 /// Text safe inside a table cell.
