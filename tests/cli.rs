@@ -1124,7 +1124,12 @@ fn errors_are_one_line_each_cause_once_and_huge_sizes_are_refused() {
         p(&dir.path().join("out")),
     ]);
     assert_one_line_error(&o, "/nonexistent/profile.toml");
-    assert_eq!(stderr(&o).matches("os error 2").count(), 1, "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o).matches("os error 2").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
     let out = dir.path().join("run");
     for (args, needle) in [
         (
@@ -1132,7 +1137,14 @@ fn errors_are_one_line_each_cause_once_and_huge_sizes_are_refused() {
             "explore.epochs = 9223372036854775808 needs about",
         ),
         (
-            vec!["--algo", "rge-pca", "--latents", "2", "--images", "100000000000"],
+            vec![
+                "--algo",
+                "rge-pca",
+                "--latents",
+                "2",
+                "--images",
+                "100000000000",
+            ],
             "--images: ugl.images = 100000000000 needs about",
         ),
     ] {
@@ -1194,7 +1206,11 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
     use std::os::unix::fs::PermissionsExt;
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path().join("has space");
-    let (bin, work, scripts) = (root.join("bin"), root.join("work dir"), root.join("slurm jobs"));
+    let (bin, work, scripts) = (
+        root.join("bin"),
+        root.join("work dir"),
+        root.join("slurm jobs"),
+    );
     for d in [&bin, &work] {
         std::fs::create_dir_all(d).unwrap();
     }
@@ -1236,7 +1252,14 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
     let results = root.join("my results");
     let out = results.join("tiny-camp");
     let o = Command::new(env!("CARGO_BIN_EXE_ugl"))
-        .args(["slurm", "--config", p(&config), "--shards", "2", "--scripts"])
+        .args([
+            "slurm",
+            "--config",
+            p(&config),
+            "--shards",
+            "2",
+            "--scripts",
+        ])
         .arg(&scripts)
         .arg("--out")
         .arg(&out)
@@ -1251,19 +1274,23 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
         .env("UGL_BIN", env!("CARGO_BIN_EXE_ugl"))
         .output()
         .unwrap();
-    assert!(
-        o.status.success(),
-        "{}\n{}",
-        stdout(&o),
-        stderr(&o)
-    );
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     let n = std::fs::read_dir(&out)
         .unwrap()
-        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "json"))
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "json")
+        })
         .count();
     assert_eq!(n, 4, "every run of the campaign");
     let report = std::fs::read_to_string(work.join("report/out/REPORT.md")).unwrap();
-    assert!(report.contains("tiny-camp"), "the report draws on the campaign");
+    assert!(
+        report.contains("tiny-camp"),
+        "the report draws on the campaign"
+    );
 }
 
 /// An external learner whose fit fails is started once per cell, not once per run, and the
@@ -1295,7 +1322,11 @@ fn a_failing_external_fit_is_started_once_per_cell() {
         "--quiet",
     ]);
     assert_one_line_error(&o, "armball.rge-external");
-    assert!(!stderr(&o).contains("not run:"), "the real error: {}", stderr(&o));
+    assert!(
+        !stderr(&o).contains("not run:"),
+        "the real error: {}",
+        stderr(&o)
+    );
     let n = std::fs::read_to_string(&starts).unwrap().lines().count();
     assert_eq!(n, 1, "started once for 6 runs in 3 groups");
 }
@@ -1334,14 +1365,22 @@ fn a_truncated_run_file_is_detected_and_recomputed() {
         p(&dir.path().join("report")),
     ]);
     assert_one_line_error(&report, "armball.rpe.s0.parquet");
-    assert!(stderr(&report).contains("truncated or damaged"), "{}", stderr(&report));
+    assert!(
+        stderr(&report).contains("truncated or damaged"),
+        "{}",
+        stderr(&report)
+    );
     let merge = ugl(&["merge", "--into", p(&dir.path().join("merged")), p(&store)]);
     assert_one_line_error(&merge, "run armball.rpe.s0 is incomplete or damaged");
 
     let o = campaign(&[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("1 runs executed"), "{}", stderr(&o));
-    assert_eq!(std::fs::read(&victim).unwrap(), original, "recomputed to the same bytes");
+    assert_eq!(
+        std::fs::read(&victim).unwrap(),
+        original,
+        "recomputed to the same bytes"
+    );
     let m = manifest(&store.join("armball.rpe.s0.json"));
     assert_eq!(m["files"][0]["name"], "armball.rpe.s0.parquet");
     assert_eq!(m["files"][0]["bytes"], original.len());
@@ -1361,8 +1400,18 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
     );
     let mut child = Command::new(env!("CARGO_BIN_EXE_ugl"))
         .args([
-            "run", "--env", "armball", "--algo", "rge-external", "--latents", "2", "--images",
-            "60", "--command", &hang, "--out",
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-external",
+            "--latents",
+            "2",
+            "--images",
+            "60",
+            "--command",
+            &hang,
+            "--out",
         ])
         .arg(dir.path().join("out"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -1410,8 +1459,17 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
     .unwrap();
     let t0 = std::time::Instant::now();
     let o = ugl(&[
-        "run", "--env", "armball", "--algo", "rge-external", "--latents", "2", "--profile",
-        p(&cfg), "--out", p(&dir.path().join("out2")),
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-external",
+        "--latents",
+        "2",
+        "--profile",
+        p(&cfg),
+        "--out",
+        p(&dir.path().join("out2")),
     ]);
     assert_one_line_error(&o, "no READY line within the ready timeout (1.5s)");
     assert!(t0.elapsed().as_secs() < 30);

@@ -84,7 +84,10 @@ mod tests {
         assert!(check_epochs(5000).is_ok());
         assert!(check_hidden("learners.vae.hidden", [1200, 1200]).is_ok());
         let e = check_images(100_000_000_000).unwrap_err();
-        assert!(e.starts_with("ugl.images = 100000000000 needs about"), "{e}");
+        assert!(
+            e.starts_with("ugl.images = 100000000000 needs about"),
+            "{e}"
+        );
         assert!(check_epochs(1 << 63).is_err());
         assert!(check_epochs(usize::MAX).is_err());
         assert!(check_hidden("learners.ae.hidden", [100_000_000, 10]).is_err());

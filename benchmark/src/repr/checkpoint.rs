@@ -17,7 +17,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::neural::{CheckpointSpec, Engine, Model, NeuralConfig, NeuralEncoder, ResumeState, Trainer};
+use super::neural::{
+    CheckpointSpec, Engine, Model, NeuralConfig, NeuralEncoder, ResumeState, Trainer,
+};
 use super::{ImageSet, ReprError, cache};
 use crate::seed::Stream;
 

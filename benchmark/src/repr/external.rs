@@ -411,7 +411,10 @@ fn sweep_stale_work_dirs(base: &Path) {
                 continue;
             };
             if pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists() {
-                tracing::info!("removing the stale learner work directory {}", e.path().display());
+                tracing::info!(
+                    "removing the stale learner work directory {}",
+                    e.path().display()
+                );
                 let _ = fs::remove_dir_all(e.path());
             }
         }

@@ -293,11 +293,7 @@ fn sparse_weight_grad(xs: &SparseBatch, dy: &[f32], cols: usize, dw: &mut [f32])
     let lit_rows: Vec<(usize, &[usize], &[f32])> = (0..xs.pixels.len())
         .map(|k| {
             let range = xs.ptr[k]..xs.ptr[k + 1];
-            (
-                xs.pixels[k],
-                &xs.rows[range.clone()],
-                &xs.vals[range],
-            )
+            (xs.pixels[k], &xs.rows[range.clone()], &xs.vals[range])
         })
         .collect();
     // Disjoint rows of dW: split the matrix at the lit pixels.
@@ -336,7 +332,11 @@ fn bce_and_grad(logits: &[f32], x: &[f32], dim: usize, scale: f32, grad: &mut [f
             let mut sum = 0.0f64;
             for ((&l, &t), g) in l.iter().zip(t).zip(g.iter_mut()) {
                 let e = (-l.abs()).exp();
-                let sig = if l >= 0.0 { 1.0 / (1.0 + e) } else { e / (1.0 + e) };
+                let sig = if l >= 0.0 {
+                    1.0 / (1.0 + e)
+                } else {
+                    e / (1.0 + e)
+                };
                 sum += f64::from(l.max(0.0) - t * l + e.ln_1p());
                 *g = scale * (sig - t);
             }
@@ -465,13 +465,19 @@ impl HostOptimizer {
                             adam_update(p, g, m, v, &k)
                         });
                     } else {
-                        par_chunks(p, g, (m, v), |p, g, (m, v)| adam_update(p, Some(g), m, v, &k));
+                        par_chunks(p, g, (m, v), |p, g, (m, v)| {
+                            adam_update(p, Some(g), m, v, &k)
+                        });
                     }
                 }
             }
             HostOptimizer::Adagrad { rule, acc } => {
                 let (lr, clip) = (lr as f32, rule.clip);
-                for (i, ((p, g), acc)) in params.into_iter().zip(grads).zip(acc.iter_mut()).enumerate()
+                for (i, ((p, g), acc)) in params
+                    .into_iter()
+                    .zip(grads)
+                    .zip(acc.iter_mut())
+                    .enumerate()
                 {
                     if i == 0 {
                         // A zero gradient leaves Adagrad's accumulator and parameter unchanged:
@@ -671,7 +677,12 @@ impl HostTrainer {
         relu_in_place(&mut ws.g1);
         dense_forward(&net.dec2, &ws.g1, rows, sized(&mut ws.g2, rows * h1));
         relu_in_place(&mut ws.g2);
-        dense_forward(&net.dec_out, &ws.g2, rows, sized(&mut ws.logits, rows * dim));
+        dense_forward(
+            &net.dec_out,
+            &ws.g2,
+            rows,
+            sized(&mut ws.logits, rows * dim),
+        );
         let scale = latent.rec_scale / rows as f64;
         let per_row = bce_and_grad(
             &ws.logits,
@@ -683,8 +694,20 @@ impl HostTrainer {
         let rec: f64 = per_row.iter().sum();
 
         // Decoder backward.
-        let [gw_e1, gb_e1, gw_e2, gb_e2, gw_h, gb_h, gw_d1, gb_d1, gw_d2, gb_d2, gw_o, gb_o] =
-            &mut ws.grads[..]
+        let [
+            gw_e1,
+            gb_e1,
+            gw_e2,
+            gb_e2,
+            gw_h,
+            gb_h,
+            gw_d1,
+            gb_d1,
+            gw_d2,
+            gb_d2,
+            gw_o,
+            gb_o,
+        ] = &mut ws.grads[..]
         else {
             unreachable!("twelve parameters")
         };
@@ -808,7 +831,12 @@ mod tests {
         // Through transposed storage.
         let at = transpose(&a, m, k);
         let bt = transpose(&b, k, n);
-        matmul(&mut out, View::of(&at, k, m).t(), View::of(&bt, n, k).t(), false);
+        matmul(
+            &mut out,
+            View::of(&at, k, m).t(),
+            View::of(&bt, n, k).t(),
+            false,
+        );
         close(&out, &want);
         // Accumulate.
         let mut acc = vec![1.0; m * n];
@@ -871,7 +899,8 @@ mod tests {
             let bytes = opt.to_bytes();
             assert_eq!(HostOptimizer::from_bytes(model, &net, &bytes).unwrap(), opt);
             assert!(HostOptimizer::from_bytes(model, &net, &bytes[..bytes.len() - 1]).is_err());
-            let other = super::super::neural::init_net(model, &cfg, 13, 2, &mut stream_named(1, "o"));
+            let other =
+                super::super::neural::init_net(model, &cfg, 13, 2, &mut stream_named(1, "o"));
             assert!(HostOptimizer::from_bytes(model, &other, &bytes).is_err());
         }
     }

@@ -410,7 +410,6 @@ fn f32_slice_mut(data: &mut TensorData) -> &mut [f32] {
     data.as_mut_slice::<f32>().expect("the networks are f32")
 }
 
-
 /// Chunk length of the parallel optimiser loops (element-wise, so any split gives the same
 /// bits).
 const OPT_CHUNK: usize = 1 << 16;

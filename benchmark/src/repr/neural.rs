@@ -782,7 +782,8 @@ impl<'a> Trainer<'a> {
 
     /// Save the optimiser's state (burn's record format, or [`HostOptimizer::to_bytes`]).
     pub fn save_optimizer(&self, path: &Path) -> Result<(), ReprError> {
-        let fail = |e: String| ReprError::Io(format!("saving optimiser state {}: {e}", path.display()));
+        let fail =
+            |e: String| ReprError::Io(format!("saving optimiser state {}: {e}", path.display()));
         match &self.state {
             EngineState::Burn { opt, .. } => opt.save(path).map_err(|e| fail(format!("{e:?}"))),
             EngineState::Host(host) => {
