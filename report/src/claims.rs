@@ -67,6 +67,10 @@ pub struct Claim {
     /// Overrides `settings.margin` for this claim.
     #[serde(default)]
     pub margin: Option<f64>,
+    /// A finding of ours, not a claim of the paper (e.g. a claim re-tested on the corrected
+    /// variants): listed apart, and not counted in the headline.
+    #[serde(default)]
+    pub ours: bool,
 }
 
 /// What is compared between conditions (one value per seed).

@@ -70,15 +70,22 @@ fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
 /// The one-line count of verdicts for the top of the report, if claims were evaluated.
 pub fn summary_line(w: &mut String, inp: &Inputs<'_>) {
     if let ClaimsInput::Evaluated { results, .. } = inp.claims {
-        let count = |v: Verdict| results.iter().filter(|r| r.verdict == v).count();
+        let papers: Vec<_> = results.iter().filter(|r| !r.claim.ours).collect();
+        let count = |v: Verdict| papers.iter().filter(|r| r.verdict == v).count();
+        let ours = results.len() - papers.len();
         let _ = writeln!(
             w,
             "**The paper's claims** ([details](#the-papers-claims)): {} reproduced, {} not \
-             reproduced, {} inconclusive, of {} claims evaluated on these results.\n",
+             reproduced, {} inconclusive, of {} claims of the paper evaluated on these results{}.\n",
             count(Verdict::Reproduced),
             count(Verdict::NotReproduced),
             count(Verdict::Inconclusive),
-            results.len()
+            papers.len(),
+            if ours > 0 {
+                format!(" ({ours} finding(s) of ours are listed apart)")
+            } else {
+                String::new()
+            }
         );
     }
 }
@@ -188,6 +195,21 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
         }
     );
     let _ = writeln!(w);
+    let (papers, ours): (Vec<&ClaimResult>, Vec<&ClaimResult>) =
+        results.iter().partition(|r| !r.claim.ours);
+    claims_table(w, &papers);
+    if !ours.is_empty() {
+        let _ = writeln!(
+            w,
+            "### Our findings (not claims of the paper)\n\nStatements of ours, tested the same \
+             way (e.g. a claim of the paper re-tested on the corrected variants); not counted \
+             in the headline.\n"
+        );
+        claims_table(w, &ours);
+    }
+}
+
+fn claims_table(w: &mut String, results: &[&ClaimResult]) {
     let _ = writeln!(
         w,
         "| claim | the paper says | testable statement | requires | evidence | verdict | the paper's own numbers |"
