@@ -41,7 +41,15 @@ pub struct ConditionSummary {
     pub final_outcomes_mean: f64,
     pub final_coverage_mean: f64,
     pub paper: Option<PaperValue>,
+    /// Runs that ended at RPE level: fewer object moves than [`RPE_LEVEL_FACTOR`] x RPE's mean
+    /// in the same environment (a failed exploration; the IQM trims such runs, so they are
+    /// counted apart). None for RPE itself, or without RPE runs.
+    pub at_rpe_level: Option<usize>,
 }
+
+/// A run "ends at RPE level" when it moved the object fewer than this many times RPE's mean
+/// number of moves (same environment).
+pub const RPE_LEVEL_FACTOR: f64 = 2.0;
 
 impl ConditionSummary {
     pub fn last_epoch(&self) -> i64 {
@@ -65,7 +73,28 @@ pub fn aggregate(
         .map(|(key, runs)| summarize_condition(store, paper, key, runs, bootstrap_seed, n_boot))
         .collect();
     out.sort_by_key(|c| c.key.order_key());
+    mark_rpe_level(store, &mut out);
     out
+}
+
+/// Sets [`ConditionSummary::at_rpe_level`] from each environment's RPE condition.
+fn mark_rpe_level(store: &Store, conditions: &mut [ConditionSummary]) {
+    let thresholds: Vec<(String, f64)> = conditions
+        .iter()
+        .filter(|c| c.key.algo == "rpe")
+        .map(|c| (c.key.env.clone(), RPE_LEVEL_FACTOR * c.final_moved_mean))
+        .collect();
+    for c in conditions.iter_mut().filter(|c| c.key.algo != "rpe") {
+        c.at_rpe_level = thresholds
+            .iter()
+            .find(|(env, _)| *env == c.key.env)
+            .map(|&(_, t)| {
+                c.runs
+                    .iter()
+                    .filter(|&&i| (store.runs[i].final_point().n_moved as f64) < t)
+                    .count()
+            });
+    }
 }
 
 fn summarize_condition(
@@ -139,6 +168,7 @@ fn summarize_condition(
         final_moved_mean,
         final_outcomes_mean,
         final_coverage_mean,
+        at_rpe_level: None,
     }
 }
 

@@ -57,6 +57,12 @@ pub struct Entry {
     /// Runs whose neural representation did not leave the mean-image plateau; None when no
     /// run records it (other learners, older results).
     pub untrained: Option<usize>,
+    /// Mean of the normalised final KLC over all its runs (the IQM trims a quarter at each
+    /// end, silently dropping failed explorations; the mean does not).
+    pub final_mean: f64,
+    /// Runs that ended at RPE level ([`crate::aggregate::ConditionSummary::at_rpe_level`]),
+    /// each run counted once; None for RPE.
+    pub at_rpe_level: Option<usize>,
 }
 
 impl Entry {
@@ -97,11 +103,22 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>)>;
     let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
     let mut untrained: BTreeMap<EntryKey, usize> = BTreeMap::new();
+    let mut at_rpe: BTreeMap<EntryKey, usize> = BTreeMap::new();
     for src in sources {
         for c in src.conditions {
             let Some(max) = klc_max(&c.key.env) else {
                 continue;
             };
+            if let Some(k) = c.at_rpe_level {
+                *at_rpe
+                    .entry((
+                        src.campaign.to_string(),
+                        c.key.algo.clone(),
+                        c.key.sampler.clone(),
+                        c.key.variant.clone(),
+                    ))
+                    .or_default() += k;
+            }
             let flags: Vec<bool> = c
                 .runs
                 .iter()
@@ -187,6 +204,9 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 )
             };
             let untrained = untrained.get(&key).copied();
+            let at_rpe_level = at_rpe.get(&key).copied();
+            let all: Vec<f64> = finals.iter().flatten().copied().collect();
+            let final_mean = stats::mean(&all);
             let papers: Vec<f64> = per.values().filter_map(|v| v.2).collect();
             let paper = (papers.len() == per.len()).then(|| stats::mean(&papers));
             Some(Entry {
@@ -201,6 +221,8 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 poi_vs_efr,
                 paper,
                 untrained,
+                final_mean,
+                at_rpe_level,
             })
         })
         .collect();

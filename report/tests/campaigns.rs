@@ -598,9 +598,20 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     );
     // Claims: the committed claims file is evaluated, and the verdicts are counted.
     assert!(md.contains("## The paper's claims"));
-    let summary = line(&md, "**The paper's claims**", "of 15 claims");
+    // 14 of the paper's claims in the headline; our one finding apart.
+    let summary = line(&md, "**The paper's claims**", "of 14 claims of the paper");
     assert!(summary.contains("reproduced"), "{summary}");
+    assert!(
+        summary.contains("(1 finding(s) of ours are listed apart)"),
+        "{summary}"
+    );
     assert!(md.contains("| `rfvae-worse` |"));
+    let ours = md
+        .find("### Our findings (not claims of the paper)")
+        .unwrap();
+    assert!(md[ours..].contains("| `rfvae-worse-corrected` |"));
+    // Each claim is checked on the paper's own values.
+    assert!(md.contains("*The paper's own numbers*") && md.contains("| the paper's own numbers |"));
 }
 
 #[test]

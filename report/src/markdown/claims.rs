@@ -323,8 +323,10 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          environment. *Paper*: the mean of the paper's normalised single-run final values on the \
          same tasks, where it gives all of them. *Untrained*: runs whose network did not leave \
          the mean-image plateau (\"Did the goal spaces learn?\"); their scores are those of an \
-         untrained random projection and are counted in, not hidden. Ranked by *final*; entries \
-         missing a task come last.\n",
+         untrained random projection and are counted in, not hidden. *At RPE level*: runs that \
+         moved the object fewer than twice as often as RPE (failed explorations, which the IQM \
+         trims); *mean*: the untrimmed mean of the normalised final KLC, which they do weigh \
+         on. Ranked by *final*; entries missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
         lb.confidence * 100.0,
@@ -332,16 +334,19 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
     );
     let _ = writeln!(
         w,
-        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | final (IQM) | speed (IQM) | P(better than EFR) | paper |"
+        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | at RPE level | final (IQM) | final (mean) | speed (IQM) | P(better than EFR) | paper |"
     );
-    let _ = writeln!(w, "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        w,
+        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     let n = lb.tasks.len();
     for (i, e) in lb.entries.iter().enumerate() {
         let new = e.campaign != inp.campaigns.main.name;
         let name = condition_name(&e.algo, &e.variant);
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} |",
             if e.is_complete(n) {
                 (i + 1).to_string()
             } else {
@@ -361,7 +366,13 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
                 Some(k) => format!("**{k}**"),
                 None => "—".into(),
             },
+            match e.at_rpe_level {
+                Some(0) => "0".to_string(),
+                Some(k) => format!("**{k}**"),
+                None => "—".into(),
+            },
             ci3(e.final_iqm),
+            e.final_mean,
             e.auc_iqm.map(ci3).unwrap_or_else(|| "—".into()),
             e.poi_vs_efr.map(ci3).unwrap_or_else(|| "—".into()),
             e.paper
