@@ -104,6 +104,8 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
     let mut untrained: BTreeMap<EntryKey, usize> = BTreeMap::new();
     let mut at_rpe: BTreeMap<EntryKey, usize> = BTreeMap::new();
+    // Entries whose runs serve every task of their environment (baselines, latents 0).
+    let mut shared: std::collections::BTreeSet<EntryKey> = Default::default();
     for src in sources {
         for c in src.conditions {
             let Some(max) = klc_max(&c.key.env) else {
@@ -148,6 +150,9 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 .iter()
                 .map(|v| v / max)
                 .collect();
+            if c.key.latents == 0 {
+                shared.insert(key.clone());
+            }
             let paper_value = c.paper.as_ref().map(|p| p.klc / max);
             for (ti, (env, l)) in tasks.iter().enumerate() {
                 // A baseline (latents 0) serves every task of its environment.
@@ -174,8 +179,26 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
         .into_iter()
         .filter_map(|(key, per)| {
             let (campaign, algo, sampler, variant) = key.clone();
-            let finals: Vec<Vec<f64>> = per.values().map(|v| v.0.clone()).collect();
-            let aucs: Vec<Vec<f64>> = per.values().map(|v| v.1.clone()).collect();
+            // A baseline's runs are the same in both tasks of an environment: in the pooled
+            // statistics (IQM, mean, run count) they count once, one stratum per environment.
+            let mut seen_envs: Vec<&str> = Vec::new();
+            let strata: Vec<&(Vec<f64>, Vec<f64>, Option<f64>)> = per
+                .iter()
+                .filter(|(t, _)| {
+                    let env = tasks[**t].0.as_str();
+                    if !shared.contains(&key) || !seen_envs.contains(&env) {
+                        seen_envs.push(env);
+                        true
+                    } else {
+                        false
+                    }
+                })
+                .map(|(_, v)| v)
+                .collect();
+            let finals: Vec<Vec<f64>> = strata.iter().map(|v| v.0.clone()).collect();
+            let aucs: Vec<Vec<f64>> = strata.iter().map(|v| v.1.clone()).collect();
+            // Probability of improvement: task by task (a baseline against EFR on each task).
+            let finals_by_task: Vec<Vec<f64>> = per.values().map(|v| v.0.clone()).collect();
             let label = format!("leaderboard|{campaign}|{algo}|{sampler}|{variant}");
             let final_iqm = stratified_bootstrap_ci(
                 &finals,
@@ -196,7 +219,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             } else {
                 let ys: Vec<Vec<f64>> = per.keys().map(|t| efr[t].clone()).collect();
                 probability_of_improvement_ci(
-                    &finals,
+                    &finals_by_task,
                     &ys,
                     n_boot,
                     alpha,
@@ -290,8 +313,9 @@ mod tests {
         assert_eq!(pca.poi_vs_efr, Some((1.0, 1.0, 1.0)));
         assert_eq!(lb.entries[2].poi_vs_efr, Some((0.0, 0.0, 0.0)));
         assert_eq!(lb.entries[1].poi_vs_efr, None);
-        // EFR's runs serve both tasks.
-        assert_eq!(lb.entries[1].n_runs, 8);
+        // EFR's runs serve both tasks, and count once in its pooled statistics.
+        assert_eq!(lb.entries[1].n_runs, 4);
+        assert_eq!(lb.entries[1].tasks.len(), 2);
         assert!(!lb.entries[3].is_complete(2));
     }
 }

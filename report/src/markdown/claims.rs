@@ -320,7 +320,8 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          RGE-EFR on the same task, averaged over tasks (0.5: no difference). Brackets: {:.0}% \
          stratified bootstrap intervals ({} resamples, runs resampled within each task, seeded). \
          Baselines do not depend on the latent size: their runs serve both tasks of an \
-         environment. *Paper*: the mean of the paper's normalised single-run final values on the \
+         environment for the probability of improvement, and count once in their own IQM, mean \
+         and run count (one stratum per environment). *Paper*: the mean of the paper's normalised single-run final values on the \
          same tasks, where it gives all of them. *Untrained*: runs whose network did not leave \
          the mean-image plateau (\"Did the goal spaces learn?\"); their scores are those of an \
          untrained random projection and are counted in, not hidden. *At RPE level*: runs that \
