@@ -316,6 +316,15 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     let efr = lb.lines().find(|l| l.contains("| RGE-EFR |")).expect("EFR");
     assert!(efr.contains("| — |"), "{efr}");
     assert!(md.contains("AE, VAE and RFVAE runs** did not leave the mean-image plateau"));
+    // Three seeds per condition: the final tables and the budget tables warn.
+    let budget = &md[md.find("## Training-budget sensitivity").unwrap()..];
+    assert!(
+        budget.contains("⚠ **Small samples**: as few as 3 seeds"),
+        "{budget}"
+    );
+    let finals =
+        &md[md.find("## Final KL-coverage").unwrap()..md.find("## The paper's claims").unwrap()];
+    assert!(finals.contains("⚠ **Small samples**"));
     // A non-paper init is a listed deviation.
     assert!(
         md.contains("weight init AE he instead of the paper's truncated normal"),

@@ -465,6 +465,16 @@ pub fn render(inp: &Inputs<'_>) -> String {
                 delta
             );
         }
+        let min_n = inp
+            .conditions
+            .iter()
+            .filter(|c| c.key.env == *env)
+            .map(|c| c.final_klc.n)
+            .min()
+            .unwrap_or(0);
+        if min_n <= neural::SMALL_N {
+            let _ = writeln!(w, "\n{}", neural::small_n_warning(min_n));
+        }
         let _ = writeln!(w);
     }
 

@@ -429,6 +429,19 @@ fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>
 const BUDGET_N_BOOT: usize = 10_000;
 
 /// Training-budget sensitivity: the `budget-*` campaigns.
+/// At or below this many seeds a statistic gets [`small_n_warning`].
+pub const SMALL_N: usize = 5;
+
+/// The warning under a table whose smallest sample has `n` seeds.
+pub fn small_n_warning(n: usize) -> String {
+    format!(
+        "⚠ **Small samples**: as few as {n} seed{} per value. Percentile-bootstrap intervals over \
+         so few seeds are too narrow (they under-cover), and one outlying run moves a mean a \
+         lot: read the intervals as rough, and a difference as real only when it is large.",
+        if n == 1 { "" } else { "s" }
+    )
+}
+
 pub fn budget(w: &mut String, inp: &Inputs<'_>) {
     let _ = writeln!(w, "## Training-budget sensitivity\n");
     let camps = &inp.campaigns.budget;
@@ -494,6 +507,16 @@ pub fn budget(w: &mut String, inp: &Inputs<'_>) {
                 efr,
                 seed,
             );
+        }
+        let min_n = s
+            .points
+            .iter()
+            .chain(&s.main)
+            .map(|p| p.values.len())
+            .min()
+            .unwrap_or(0);
+        if min_n <= SMALL_N {
+            let _ = writeln!(w, "\n{}", small_n_warning(min_n));
         }
         if !s.references.is_empty() {
             let refs: Vec<String> = s
