@@ -63,6 +63,8 @@ pub struct Entry {
     /// Runs that ended at RPE level ([`crate::aggregate::ConditionSummary::at_rpe_level`]),
     /// each run counted once; None for RPE.
     pub at_rpe_level: Option<usize>,
+    /// Whether any of its runs ran below the paper's budget (manifest `reduced_budget`).
+    pub reduced_budget: bool,
 }
 
 impl Entry {
@@ -106,6 +108,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     let mut at_rpe: BTreeMap<EntryKey, usize> = BTreeMap::new();
     // Entries whose runs serve every task of their environment (baselines, latents 0).
     let mut shared: std::collections::BTreeSet<EntryKey> = Default::default();
+    let mut reduced: std::collections::BTreeSet<EntryKey> = Default::default();
     for src in sources {
         for c in src.conditions {
             let Some(max) = klc_max(&c.key.env) else {
@@ -152,6 +155,12 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 .collect();
             if c.key.latents == 0 {
                 shared.insert(key.clone());
+            }
+            if c.runs
+                .iter()
+                .any(|&i| src.store.runs[i].manifest.reduced_budget())
+            {
+                reduced.insert(key.clone());
             }
             let paper_value = c.paper.as_ref().map(|p| p.klc / max);
             for (ti, (env, l)) in tasks.iter().enumerate() {
@@ -246,6 +255,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 untrained,
                 final_mean,
                 at_rpe_level,
+                reduced_budget: reduced.contains(&key),
             })
         })
         .collect();

@@ -327,7 +327,7 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          untrained random projection and are counted in, not hidden. *At RPE level*: runs that \
          moved the object fewer than twice as often as RPE (failed explorations, which the IQM \
          trims); *mean*: the untrimmed mean of the normalised final KLC, which they do weigh \
-         on. Ranked by *final*; entries missing a task come last.\n",
+         on. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *final*; entries missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
         lb.confidence * 100.0,
@@ -353,10 +353,17 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
             } else {
                 "—".into()
             },
-            if new {
-                format!("**{name}** (new)")
-            } else {
-                name
+            {
+                let name = if e.reduced_budget {
+                    format!("{name} †")
+                } else {
+                    name
+                };
+                if new {
+                    format!("**{name}** (new)")
+                } else {
+                    name
+                }
             },
             sampler_name(&e.sampler),
             super::campaign_name(&e.campaign),
