@@ -9,6 +9,7 @@
 pub mod aggregate;
 pub mod campaigns;
 pub mod claims;
+pub mod data;
 pub mod error;
 pub mod figures;
 pub mod leaderboard;
@@ -199,10 +200,12 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     });
     let report_path = opts.out.join("REPORT.md");
     write_file(&report_path, md.as_bytes())?;
+    let data_files = data::write(&opts.out.join(data::DIR), &camps)?;
 
     figure_files.sort();
     let mut files = vec![report_path];
     files.extend(figure_files);
+    files.extend(data_files);
     Ok(ReportSummary {
         n_runs: camps.n_used_runs(),
         n_main_runs: store.runs.len(),

@@ -316,6 +316,18 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     let efr = lb.lines().find(|l| l.contains("| RGE-EFR |")).expect("EFR");
     assert!(efr.contains("| — |"), "{efr}");
     assert!(md.contains("AE, VAE and RFVAE runs** did not leave the mean-image plateau"));
+    // The numbers behind the report, as CSV: one row per main-campaign run; every curve point.
+    let finals = std::fs::read_to_string(out.join("data/final_by_seed.csv")).unwrap();
+    let mut lines = finals.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("campaign,env,algo,sampler,latents,variant,seed,epoch,final_klc")
+    );
+    assert_eq!(lines.count(), n_main);
+    let curves = std::fs::read_to_string(out.join("data/curves.csv")).unwrap();
+    assert!(curves.lines().count() > 2 * n_main, "whole curves");
     // Three seeds per condition: the final tables and the budget tables warn.
     let budget = &md[md.find("## Training-budget sensitivity").unwrap()..];
     assert!(
@@ -458,10 +470,9 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             })
             .map(|(p, b)| (p.rsplit('/').next().unwrap().to_string(), b))
             .collect();
-        v.push((
-            "REPORT.md".into(),
-            std::fs::read(dir.join("REPORT.md")).unwrap(),
-        ));
+        for f in ["REPORT.md", "data/final_by_seed.csv", "data/curves.csv"] {
+            v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));
+        }
         v.sort();
         v
     };

@@ -204,7 +204,8 @@ fn renders_report_and_figures_with_the_right_numbers() {
             assert!(out.join("figures").join(&name).is_file(), "{name}");
         }
     }
-    assert_eq!(summary.files.len(), 1 + 2 + 4);
+    // REPORT.md, 2 KLC figures, 4 outcome scatters, 2 CSV files.
+    assert_eq!(summary.files.len(), 1 + 2 + 4 + 2);
     for f in &summary.files {
         assert!(f.is_file(), "{}", f.display());
     }

@@ -1,0 +1,115 @@
+//! The numbers behind the report as CSV, beside it (`out/data/`), for people who compare a new
+//! learner or redo a statistic: one row per run (its final values, with its training evidence and
+//! latent quality where recorded) and one row per run and evaluated epoch (the whole curves). The
+//! main campaign and every `compare-*` campaign; rows in the report's condition order, then seed.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::ReportError;
+use crate::campaigns::{Campaign, Campaigns};
+use crate::load::Run;
+
+/// The directory under the report's output.
+pub const DIR: &str = "data";
+/// One row per run.
+pub const FINAL_FILE: &str = "final_by_seed.csv";
+/// One row per run and evaluated epoch.
+pub const CURVES_FILE: &str = "curves.csv";
+
+const KEY_HEADER: &str = "campaign,env,algo,sampler,latents,variant,seed";
+
+fn key_fields(camp: &Campaign, r: &Run) -> String {
+    format!(
+        "{},{},{},{},{},{},{}",
+        if camp.name.is_empty() {
+            "."
+        } else {
+            &camp.name
+        },
+        r.key.env,
+        r.key.algo,
+        r.key.sampler,
+        r.key.latents,
+        r.key.variant,
+        r.seed
+    )
+}
+
+/// A float as CSV: shortest round-trip form; `inf`; empty when absent.
+fn num(v: Option<f64>) -> String {
+    v.map(|v| format!("{v}")).unwrap_or_default()
+}
+
+fn runs_in_order(camp: &Campaign) -> Vec<&Run> {
+    let mut runs: Vec<&Run> = camp.store.runs.iter().collect();
+    runs.sort_by(|a, b| {
+        (a.key.order_key(), a.seed, &a.run_id).cmp(&(b.key.order_key(), b.seed, &b.run_id))
+    });
+    runs
+}
+
+/// Write both files into `dir`; returns their paths.
+pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let sources: Vec<&Campaign> = std::iter::once(&camps.main)
+        .chain(camps.compare.iter())
+        .collect();
+    let mut finals = format!(
+        "{KEY_HEADER},epoch,final_klc,n_moved,n_outcomes,coverage,trained,loss_fraction,\
+         linear_r2_mean,knn_r2_mean\n"
+    );
+    let mut curves = format!("{KEY_HEADER},epoch,n_outcomes,klc,n_moved,coverage\n");
+    for camp in sources {
+        for r in runs_in_order(camp) {
+            let key = key_fields(camp, r);
+            let f = r.final_point();
+            let raw = &r.manifest.raw;
+            let evidence = raw.get("train").and_then(|t| t.get("evidence"));
+            let quality = raw.get("latent_quality");
+            let _ = writeln!(
+                finals,
+                "{key},{},{},{},{},{},{},{},{},{}",
+                f.epoch,
+                num(Some(f.klc)),
+                f.n_moved,
+                f.n_outcomes,
+                num(Some(f.coverage)),
+                r.manifest
+                    .trained()
+                    .map(|t| t.to_string())
+                    .unwrap_or_default(),
+                num(evidence
+                    .and_then(|e| e.get("loss_fraction"))
+                    .and_then(|v| v.as_f64())),
+                num(quality
+                    .and_then(|q| q.get("linear_r2_mean"))
+                    .and_then(|v| v.as_f64())),
+                num(quality
+                    .and_then(|q| q.get("knn_r2_mean"))
+                    .and_then(|v| v.as_f64())),
+            );
+            for p in &r.curve {
+                let _ = writeln!(
+                    curves,
+                    "{key},{},{},{},{},{}",
+                    p.epoch,
+                    p.n_outcomes,
+                    num(Some(p.klc)),
+                    p.n_moved,
+                    num(Some(p.coverage))
+                );
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (name, text) in [(CURVES_FILE, curves), (FINAL_FILE, finals)] {
+        let path = dir.join(name);
+        crate::write_file(&path, text.as_bytes())?;
+        out.push(path);
+    }
+    Ok(out)
+}
