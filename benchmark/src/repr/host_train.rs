@@ -32,7 +32,9 @@ use gemm::Parallelism;
 use rayon::prelude::*;
 
 use super::ReprError;
-use super::nets::{HostLayer, HostNet, TfAdagrad, TfAdam, adagrad_update, adam_update};
+use super::nets::{
+    HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update,
+};
 use super::neural::{LatentInput, Model, NeuralConfig, tensor2};
 use super::{ae, rfvae, vae};
 use crate::seed::Stream;
@@ -448,8 +450,8 @@ impl HostOptimizer {
     /// rows of the first weight matrix whose pixel is not `lit` have a zero gradient (not
     /// read).
     fn step(&mut self, lr: f64, net: &mut HostNet, grads: &[Vec<f32>], lit: &[bool]) {
+        let first_cols = net.enc1.out;
         let params = params_mut(net);
-        let first_cols = net_first_cols(grads, lit);
         match self {
             HostOptimizer::Adam { rule, time, m, v } => {
                 *time += 1;
@@ -498,13 +500,6 @@ impl HostOptimizer {
             }
         }
     }
-}
-
-/// Chunk length of the parallel optimiser loops (element-wise: any split gives the same bits).
-const OPT_CHUNK: usize = 1 << 16;
-
-fn net_first_cols(grads: &[Vec<f32>], lit: &[bool]) -> usize {
-    grads[0].len() / lit.len().max(1)
 }
 
 fn par_chunks(

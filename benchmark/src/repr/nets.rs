@@ -412,7 +412,7 @@ fn f32_slice_mut(data: &mut TensorData) -> &mut [f32] {
 
 /// Chunk length of the parallel optimiser loops (element-wise, so any split gives the same
 /// bits).
-const OPT_CHUNK: usize = 1 << 16;
+pub(crate) const OPT_CHUNK: usize = 1 << 16;
 
 fn state_tensor(values: &[f32], shape: &[usize]) -> TensorData {
     TensorData::new(values.to_vec(), shape.to_vec())
