@@ -568,7 +568,7 @@ fn host_engine_gradients_match_burn_autodiff() {
     use burn::module::ParamId;
     use burn::optim::GradientsParams;
     use ugl_bench::repr::host_train::{HostOptimizer, HostTrainer};
-    use ugl_bench::repr::neural::{Init, StepInput, tensor2, training_device};
+    use ugl_bench::repr::neural::{Init, LatentInput, StepInput, tensor2, training_device};
     use ugl_bench::repr::{ae, rfvae, vae};
     let set = images(EnvKind::ArmBall, 60);
     let (rows, d, step) = (40, 3, 3);
@@ -591,12 +591,14 @@ fn host_engine_gradients_match_burn_autodiff() {
             let module = net.to_module(&device);
             let input = StepInput {
                 x: tensor2(x.clone(), rows, set.dim, &device),
-                batch: rows,
-                latents: d,
-                step,
-                warmup: cfg.warmup,
-                variant,
-                device: &device,
+                latent: LatentInput {
+                    batch: rows,
+                    latents: d,
+                    step,
+                    warmup: cfg.warmup,
+                    variant,
+                    device: &device,
+                },
             };
             let mut rng = stream_named(5, "noise");
             let loss = match model {

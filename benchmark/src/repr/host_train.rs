@@ -32,9 +32,7 @@ use gemm::Parallelism;
 use rayon::prelude::*;
 
 use super::ReprError;
-use super::nets::{
-    HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update,
-};
+use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
 use super::neural::{LatentInput, Model, NeuralConfig, tensor2};
 use super::{ae, rfvae, vae};
 use crate::seed::Stream;

@@ -560,20 +560,14 @@ impl Encoder for NeuralEncoder {
     }
 }
 
-/// What one training iteration's loss needs besides the network and the batch.
+/// What one training iteration's loss needs besides the network (burn engine): the batch and
+/// what the model's code needs.
 pub struct StepInput<'a> {
     pub x: Tensor<2>,
-    pub batch: usize,
-    pub latents: usize,
-    /// 0-based iteration.
-    pub step: usize,
-    /// RFVAE warm-up length.
-    pub warmup: usize,
-    pub variant: Variant,
-    pub device: &'a Device,
+    pub latent: LatentInput<'a>,
 }
 
-/// What a model's latent code needs besides the head outputs (host engine).
+/// What a model's latent code needs besides the head outputs (both engines).
 pub struct LatentInput<'a> {
     pub batch: usize,
     pub latents: usize,
@@ -733,12 +727,14 @@ impl<'a> Trainer<'a> {
                 let module = net.take().expect("the module is present between steps");
                 let input = StepInput {
                     x,
-                    batch: k,
-                    latents: self.latents,
-                    step: self.step,
-                    warmup: self.cfg.warmup,
-                    variant: self.cfg.variant,
-                    device,
+                    latent: LatentInput {
+                        batch: k,
+                        latents: self.latents,
+                        step: self.step,
+                        warmup: self.cfg.warmup,
+                        variant: self.cfg.variant,
+                        device,
+                    },
                 };
                 let loss = match self.model {
                     Model::Ae => ae::loss(&module, input),

@@ -129,19 +129,29 @@ pub fn flows(z0: Tensor<2>, p: &FlowParams, d: usize, variant: Variant) -> (Tens
     (z, total.expect("at least one flow"))
 }
 
-/// The training loss of one mini-batch (see the module doc for the two variants).
-pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
+/// The code of the heads `[B, P]` through the flows (draws the noise): `(z_K, KL of z0 [B, 1],
+/// summed log-det, warm-up factor)`.
+fn code(
+    heads: Tensor<2>,
+    input: &LatentInput<'_>,
+    rng: &mut Stream,
+) -> (Tensor<2>, Tensor<2>, Tensor<2>, f64) {
     let d = input.latents;
-    let heads = net.heads(input.x.clone());
     let mu = heads.clone().narrow(1, 0, d);
     let logvar = heads.clone().narrow(1, d, d);
     let p = FlowParams::from_heads(&heads, d);
     let e = eps(input.variant, input.batch, d, rng, input.device);
     let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
     let (zk, logdet) = flows(z0, &p, d, input.variant);
-    let rec = bce_with_logits_sum(net.decode(zk), input.x) + kl_std_normal(mu, logvar);
     let ann = annealing(input.step, input.warmup);
-    match input.variant {
+    (zk, kl_std_normal(mu, logvar), logdet, ann)
+}
+
+/// The training loss of one mini-batch (see the module doc for the two variants).
+pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
+    let (zk, kl, logdet, ann) = code(net.heads(input.x.clone()), &input.latent, rng);
+    let rec = bce_with_logits_sum(net.decode(zk), input.x) + kl;
+    match input.latent.variant {
         Variant::Corrected => (rec.mul_scalar(ann) - logdet).mean(),
         Variant::Faithful => rec.mul_scalar(ann).mean() - logdet.mean(),
     }
@@ -151,17 +161,10 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
 /// `ann` x (batch-mean reconstruction + batch-mean KL) - the mean log-det (the diagonal `[B]`
 /// corrected, the original's broadcast `[B, B]` faithful; see the module doc).
 pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
-    let d = input.latents;
-    let mu = heads.clone().narrow(1, 0, d);
-    let logvar = heads.clone().narrow(1, d, d);
-    let p = FlowParams::from_heads(&heads, d);
-    let e = eps(input.variant, input.batch, d, rng, input.device);
-    let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
-    let (zk, logdet) = flows(z0, &p, d, input.variant);
-    let ann = annealing(input.step, input.warmup);
+    let (zk, kl, logdet, ann) = code(heads, input, rng);
     Latent {
         z: zk,
-        extra: Some(kl_std_normal(mu, logvar).mean().mul_scalar(ann) - logdet.mean()),
+        extra: Some(kl.mean().mul_scalar(ann) - logdet.mean()),
         rec_scale: ann,
     }
 }
