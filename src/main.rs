@@ -143,6 +143,12 @@ enum Command {
         /// shards is the whole campaign, and runs sharing a trained representation stay together.
         #[arg(long)]
         shard: Option<String>,
+        /// Run nothing: bring the goal-space diagnostics of the finished runs up to date: the
+        /// latent quality where a manifest holds an older measure, and the missing goal-space
+        /// figure data of seed 0 (each representation concerned is fitted again, or loaded from
+        /// the model cache, once; the runs' data files are not touched).
+        #[arg(long)]
+        refresh_diagnostics: bool,
         #[command(flatten)]
         cache: CacheArgs,
     },
@@ -477,8 +483,15 @@ fn dispatch(cmd: Command) -> Result<()> {
             jobs,
             quiet,
             shard,
+            refresh_diagnostics,
             cache,
-        } => campaign(&config, out, jobs, quiet, shard.as_deref(), &cache),
+        } => {
+            if refresh_diagnostics {
+                remeasure(&config, out, jobs, shard.as_deref(), &cache)
+            } else {
+                campaign(&config, out, jobs, quiet, shard.as_deref(), &cache)
+            }
+        }
         Command::Slurm {
             config,
             shards,
@@ -789,6 +802,81 @@ fn campaign(
         .unwrap_or("custom")
         .to_string();
     run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
+}
+
+/// `ugl campaign --refresh-diagnostics`.
+fn remeasure(
+    config: &Path,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    cache: &CacheArgs,
+) -> Result<()> {
+    let cfg = CampaignConfig::load(config)?;
+    let profile = config
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("custom")
+        .to_string();
+    let shard = shard
+        .map(parse_shard)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!(e))?;
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    if !out.is_dir() {
+        bail!("--out {}: no results directory to refresh", out.display());
+    }
+    let jobs = jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    check_out_dir(&out)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || {
+            if stop.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!(
+                "\ninterrupt: finishing the representations in flight (Ctrl-C again to abort now)"
+            );
+        })
+        .context("cannot install the Ctrl-C handler")?;
+    }
+    let t0 = std::time::Instant::now();
+    let model_cache = cache.resolve(&out);
+    let opts = CampaignOptions {
+        jobs,
+        profile: &profile,
+        stop: &stop,
+        shard,
+        cache: model_cache.as_ref(),
+        train_progress: None,
+        learner_messages: None,
+        checkpoint_every: cache.checkpoint_every,
+    };
+    let r = ugl_bench::campaign::remeasure::refresh_diagnostics(&cfg, &out, &opts, &|label| {
+        eprintln!("refreshed {label} ({:.0} s)", t0.elapsed().as_secs_f64())
+    })?;
+    eprintln!(
+        "goal-space diagnostics: {} representations refreshed: {} manifests given the latent \
+         quality measure version {} ({} already had it), {} figure samples written; {} \
+         learned-space runs not finished; in {:.1} s -> {}",
+        r.representations,
+        r.runs,
+        ugl_bench::repr::quality::MEASURE_VERSION,
+        r.current,
+        r.samples,
+        r.unfinished,
+        t0.elapsed().as_secs_f64(),
+        out.display()
+    );
+    Ok(())
 }
 
 /// `ugl embed`: the latents of one fitted goal space.

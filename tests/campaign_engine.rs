@@ -303,3 +303,112 @@ fn a_full_disk_gives_a_clear_error_and_touches_nothing() {
         "an existing result"
     );
 }
+
+/// `--refresh-diagnostics` brings an older store up to date (latent-quality measure, goal-space
+/// figure data) to exactly what a fresh campaign writes, without touching a run's data files;
+/// a second refresh has nothing to do.
+#[test]
+fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("diag.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"diag\"\nreps = 2\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
+         algos = [\"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
+         variants = [\"corrected\"]\n[ugl]\nimages = 300\n[explore]\nepochs = 100\n\
+         eval_every = 50\n[learners.vae]\niterations = 20\nhidden = [16, 8]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("res");
+    let campaign = |extra: &[&str]| {
+        let mut args = vec!["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    campaign(&[]);
+    // Seed 0 of each learned cell has figure data; the VAE has a reconstruction grid.
+    let gs = out.join("goal_spaces");
+    let mut names: Vec<String> = std::fs::read_dir(&gs)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "armarrow.rge-pca.l3.s0.json",
+            "armarrow.rge-vae.corrected.l3.s0.json",
+            "armarrow.rge-vae.corrected.l3.s0.reconstructions.png",
+            "armball.rge-pca.l2.s0.json",
+            "armball.rge-vae.corrected.l2.s0.json",
+            "armball.rge-vae.corrected.l2.s0.reconstructions.png",
+        ]
+    );
+    let sample: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(gs.join("armarrow.rge-vae.corrected.l3.s0.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(sample["grid_latents"].as_array().unwrap().len(), 21 * 21);
+    assert_eq!(sample["grid_latents"][0].as_array().unwrap().len(), 3);
+    let manifests = |dir: &Path| -> Vec<(PathBuf, serde_json::Value)> {
+        let mut v: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .map(|p| {
+                let m = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+                (p, m)
+            })
+            .collect();
+        v.sort_by(|a, b| a.0.cmp(&b.0));
+        v
+    };
+    let fresh = manifests(&out);
+    assert_eq!(fresh.len(), 8);
+    for (_, m) in &fresh {
+        assert_eq!(m["latent_quality"]["version"], 2, "{m}");
+        let groups = m["latent_quality"]["groups"].as_array().unwrap().len();
+        assert_eq!(groups, if m["env"] == "armarrow" { 3 } else { 1 });
+    }
+    let samples: Vec<(String, Vec<u8>)> = names
+        .iter()
+        .map(|n| (n.clone(), std::fs::read(gs.join(n)).unwrap()))
+        .collect();
+    let data = common::parquet_files(&out);
+
+    // An older store: measure version 1 (no version, no groups), no figure data.
+    for (path, m) in &fresh {
+        let mut old = m.clone();
+        let q = old["latent_quality"].as_object_mut().unwrap();
+        q.remove("version");
+        q.remove("groups");
+        std::fs::write(path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
+    }
+    std::fs::remove_dir_all(&gs).unwrap();
+    let log = campaign(&["--refresh-diagnostics", "--jobs", "2"]);
+    assert!(
+        log.contains("8 representations refreshed: 8 manifests")
+            && log.contains("4 figure samples written"),
+        "{log}"
+    );
+    let refreshed = manifests(&out);
+    assert!(
+        fresh == refreshed,
+        "refreshed manifests differ from fresh ones"
+    );
+    for (name, bytes) in &samples {
+        assert!(
+            std::fs::read(gs.join(name)).unwrap() == *bytes,
+            "{name} differs from the fresh campaign's"
+        );
+    }
+    assert!(common::parquet_files(&out) == data, "run data touched");
+    let log = campaign(&["--refresh-diagnostics"]);
+    assert!(
+        log.contains("0 representations refreshed: 0 manifests")
+            && log.contains("(8 already had it), 0 figure samples"),
+        "{log}"
+    );
+}

@@ -884,7 +884,7 @@ fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
     assert_eq!(s["representation"], "armarrow.rge-pca.l3.s0");
-    assert_eq!(s["latent_quality"]["targets"].as_array().unwrap().len(), 4);
+    assert_eq!(s["latent_quality"]["targets"].as_array().unwrap().len(), 6);
     // npy v1 headers: (n, d) of the training set, (grid^2, d) of the grid, and their states.
     let header = |name: &str| {
         let b = std::fs::read(dir.path().join("emb").join(name)).unwrap();

@@ -416,3 +416,43 @@ fn measure_fit_10k_balls() {
         t.elapsed().as_secs_f64() * 1e6 / probe.n as f64
     );
 }
+
+/// Measurement (not a check): fit on 10,000 arrow images (states uniform on [-1,1]^3, all
+/// distinct, so no zero-edge merging) with 3 latents; prints the phases and a fingerprint of
+/// the embedding's bits (a speed change must leave it unchanged).
+/// Run: `cargo test -p ugl-bench --test isomap measure_fit_10k_arrows -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_fit_10k_arrows() {
+    use std::hash::{Hash, Hasher};
+    use ugl_bench::env::render::render_arrow_into;
+    let mut rng = stream_named(12, "bench-arrows");
+    let n = 10_000;
+    let mut data = vec![0.0f32; n * PIXELS];
+    for img in data.chunks_exact_mut(PIXELS) {
+        let s: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        render_arrow_into(s[0], s[1], s[2], img);
+    }
+    let set = ImageSet::new(n, PIXELS, data).unwrap();
+    // The same images for another implementation (`scripts/isomap_side_by_side.sh`).
+    if let Ok(path) = std::env::var("UGL_ISOMAP_DUMP") {
+        let wide: Vec<f64> = set.data.iter().map(|&v| f64::from(v)).collect();
+        ugl_bench::campaign::embed::write_npy_f64(std::path::Path::new(&path), n, PIXELS, &wide)
+            .unwrap();
+        println!("wrote the images to {path}");
+        return;
+    }
+    let joined = Isomap {
+        disconnected: Disconnected::ConnectClosestPairs,
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let (enc, z) = joined
+        .fit_isomap(&set, 3, &mut stream_named(10, "learner"))
+        .unwrap();
+    println!("fit 10000 arrows, 3 latents: {:.2?}", t.elapsed());
+    println!("phases: {:?}", enc.fit_timings());
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    z.data.iter().for_each(|v| v.to_bits().hash(&mut h));
+    println!("embedding fingerprint: {:016x}", h.finish());
+}

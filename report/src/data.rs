@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
 use crate::load::Run;
+use crate::markdown::quality::group_r2;
 
 /// The directory under the report's output.
 pub const DIR: &str = "data";
@@ -60,7 +61,8 @@ pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError>
         .collect();
     let mut finals = format!(
         "{KEY_HEADER},epoch,final_klc,n_moved,n_outcomes,coverage,trained,loss_fraction,\
-         linear_r2_mean,knn_r2_mean\n"
+         linear_r2_mean,knn_r2_mean,quality_version,position_knn_r2,angle_knn_r2,\
+         angle_mod_120_knn_r2\n"
     );
     let mut curves = format!("{KEY_HEADER},epoch,n_outcomes,klc,n_moved,coverage\n");
     for camp in sources {
@@ -72,7 +74,7 @@ pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError>
             let quality = raw.get("latent_quality");
             let _ = writeln!(
                 finals,
-                "{key},{},{},{},{},{},{},{},{},{}",
+                "{key},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 f.epoch,
                 num(Some(f.klc)),
                 f.n_moved,
@@ -91,6 +93,16 @@ pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError>
                 num(quality
                     .and_then(|q| q.get("knn_r2_mean"))
                     .and_then(|v| v.as_f64())),
+                quality
+                    .map(|q| q
+                        .get("version")
+                        .and_then(|v| v.as_u64())
+                        .unwrap_or(1)
+                        .to_string())
+                    .unwrap_or_default(),
+                num(group_r2(&r.manifest, "position").map(|g| g.1)),
+                num(group_r2(&r.manifest, "angle").map(|g| g.1)),
+                num(group_r2(&r.manifest, "angle_mod_120").map(|g| g.1)),
             );
             for p in &r.curve {
                 let _ = writeln!(

@@ -169,6 +169,9 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     let variants_fig = figures::variants::draw(&pairs, &fig_dir)?;
     let budget_figs = figures::budget::draw_all(&budget.series, &opts.main_campaign, &fig_dir)?;
     let loss_fig = figures::training_loss::draw(&losses, &fig_dir)?;
+    let samples = figures::goal_space::load(&camps.main.path)?;
+    let (mesh_figs, recon_figs) =
+        figures::goal_space::draw_all(&samples, &camps.main.path, &fig_dir)?;
 
     let mut figure_files: Vec<PathBuf> = klc_figs
         .iter()
@@ -177,6 +180,8 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         .chain(&variants_fig)
         .chain(&budget_figs)
         .chain(&loss_fig)
+        .chain(&mesh_figs)
+        .chain(&recon_figs)
         .map(|f| f.path.clone())
         .collect();
     remove_stale_figures(&fig_dir, &figure_files)?;
@@ -195,6 +200,8 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         budget: &budget,
         budget_figures: &budget_figs,
         loss_figure: loss_fig.as_ref(),
+        goal_space_figures: &mesh_figs,
+        reconstruction_figures: &recon_figs,
         claims: &claims_input,
         leaderboard: &board,
     });
@@ -262,11 +269,13 @@ fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), Repor
         let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
             continue;
         };
-        let ours = name.ends_with(".svg")
+        let ours = (name.ends_with(".svg")
             && (name.starts_with("klc_")
                 || name.starts_with("outcomes_")
                 || name.starts_with("budget_")
-                || OWN_FIGURES.contains(&name));
+                || name.starts_with("goal_space_")
+                || OWN_FIGURES.contains(&name)))
+            || (name.ends_with(".png") && name.starts_with("recon_"));
         if ours && !written.contains(&path) {
             stale.push(path);
         }

@@ -186,7 +186,11 @@ fn write_run(dir: &Path, s: &Spec) {
     if s.latents > 0 {
         manifest.as_object_mut().unwrap().insert(
             "latent_quality".into(),
-            serde_json::json!({"linear_r2_mean": 0.5 + 0.1 * s.seed as f64, "knn_r2_mean": 0.9}),
+            serde_json::json!({"version": 2, "linear_r2_mean": 0.5 + 0.1 * s.seed as f64,
+                               "knn_r2_mean": 0.9,
+                               "groups": [{"group": "position",
+                                           "linear_r2": 0.5 + 0.1 * s.seed as f64,
+                                           "knn_r2": 0.9}]}),
         );
     }
     std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
@@ -213,6 +217,33 @@ fn vae_drop(seed: i64) -> f64 {
 /// unused one.
 fn neural_store(root: &Path) {
     let main = root.join("paper");
+    // Goal-space figure data of one cell: a 3 x 3 lattice of positions and its 2 latents (the
+    // middle column folded onto the first), and a reconstruction image (copied as it is).
+    let gs = main.join("goal_spaces");
+    std::fs::create_dir_all(&gs).unwrap();
+    let positions: Vec<[f64; 2]> = (0..9)
+        .map(|k| [-1.0 + (k / 3) as f64, -1.0 + (k % 3) as f64])
+        .collect();
+    let latents: Vec<[f32; 2]> = positions
+        .iter()
+        .map(|p| [p[0].abs() as f32, p[1] as f32])
+        .collect();
+    std::fs::write(
+        gs.join("armball.rge-vae.faithful.l2.s0.json"),
+        serde_json::json!({
+            "representation": "armball.rge-vae.faithful.l2.s0", "env": "armball",
+            "algo": "rge-vae", "variant": "faithful", "latents": 2, "seed": 0, "grid": 3,
+            "positions": positions, "grid_latents": latents,
+            "reconstructions": "armball.rge-vae.faithful.l2.s0.reconstructions.png"
+        })
+        .to_string(),
+    )
+    .unwrap();
+    std::fs::write(
+        gs.join("armball.rge-vae.faithful.l2.s0.reconstructions.png"),
+        b"not decoded by the report",
+    )
+    .unwrap();
     for seed in 0..3 {
         write_run(&main, &spec("armball", "rpe", seed, 0.2));
         write_run(
@@ -352,7 +383,7 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         .find(|l| l.starts_with("| ArmBall | RGE-VAE | faithful |"))
         .expect("a VAE row");
     assert!(
-        row.contains("**1 of 3**") && row.contains("| 0.600 | 0.900 |"),
+        row.contains("**1 of 3**") && row.contains("| 0.600 | 0.900 | — | — |"),
         "{row}"
     );
     assert!(q.contains("did not leave the plateau"), "{q}");
@@ -367,10 +398,21 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         "outcomes_armball_rge-vae_kde_10_faithful.svg",
         "outcomes_armball_rge-vae_kde_10_corrected.svg",
         "outcomes_armball_rge-vae_gaussian_2_corrected.svg",
+        "goal_space_armball_l2.svg",
+        "recon_armball.rge-vae.faithful.l2.s0.png",
     ] {
         assert!(fig(name).is_file(), "{name}");
         assert!(s.files.contains(&fig(name)), "{name}");
     }
+    assert_eq!(
+        std::fs::read(fig("recon_armball.rge-vae.faithful.l2.s0.png")).unwrap(),
+        b"not decoded by the report"
+    );
+    // The lattice: 3 lines of constant x and 3 of constant y.
+    let mesh = std::fs::read_to_string(fig("goal_space_armball_l2.svg")).unwrap();
+    assert_eq!(mesh.matches("<polyline").count(), 6, "{mesh}");
+    assert!(md.contains("![ArmBall, 2 latents: the lattice of object positions in each goal space](figures/goal_space_armball_l2.svg)"));
+    assert!(md.contains("| ArmBall, RGE-VAE (faithful), 2 latents (seed 0) | ![ArmBall, RGE-VAE (faithful), 2 latents (seed 0): held-out images (top) and their reconstructions (bottom)](figures/recon_armball.rge-vae.faithful.l2.s0.png) |"), "{}", &md[md.find("### What the goal spaces").unwrap()..]);
 
     let md = read(&out);
     assert!(

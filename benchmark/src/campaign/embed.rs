@@ -13,8 +13,8 @@ use std::path::Path;
 
 use super::plan::RunSpec;
 use super::runner::{RunContext, fit_with_data};
-use crate::env::make_env;
 use crate::env::render::PIXELS;
+use crate::env::{Environment, make_env};
 use crate::repr::quality::LatentQuality;
 use crate::repr::{ImageSet, Latents, ReprError};
 use crate::seed::{Component, stream};
@@ -46,19 +46,8 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
     let d = env.state_dim();
     repr.encoder.begin_run(stream(ds_seed, Component::Encoding));
     let train = repr.encoder.encode(&data.images)?;
-    let mut grid_states = Vec::with_capacity(grid * grid * d);
-    let mut pixels = vec![0f32; grid * grid * PIXELS];
-    for (k, img) in pixels.chunks_exact_mut(PIXELS).enumerate() {
-        let (i, j) = (k / grid, k % grid);
-        let at = |t: usize| -1.0 + 2.0 * t as f64 / (grid - 1) as f64;
-        let mut s = vec![at(i), at(j)];
-        s.resize(d, 0.0);
-        env.render_into(&s, img);
-        grid_states.extend_from_slice(&s);
-    }
-    let grid_latents = repr
-        .encoder
-        .encode(&ImageSet::new(grid * grid, PIXELS, pixels)?)?;
+    let (grid_states, grid_images) = grid_images(env.as_ref(), grid)?;
+    let grid_latents = repr.encoder.encode(&grid_images)?;
     Ok(Embedding {
         state_dim: d,
         train,
@@ -67,6 +56,23 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
         grid_states,
         quality: repr.quality,
     })
+}
+
+/// The `grid x grid` lattice of object positions over [-1, 1]^2 (other state coordinates 0: the
+/// arrow's angle), x-major: its states (row-major `grid^2 x state_dim`) and rendered images.
+pub fn grid_images(env: &dyn Environment, grid: usize) -> Result<(Vec<f64>, ImageSet), ReprError> {
+    let d = env.state_dim();
+    let mut states = Vec::with_capacity(grid * grid * d);
+    let mut pixels = vec![0f32; grid * grid * PIXELS];
+    for (k, img) in pixels.chunks_exact_mut(PIXELS).enumerate() {
+        let (i, j) = (k / grid, k % grid);
+        let at = |t: usize| -1.0 + 2.0 * t as f64 / (grid - 1) as f64;
+        let mut s = vec![at(i), at(j)];
+        s.resize(d, 0.0);
+        env.render_into(&s, img);
+        states.extend_from_slice(&s);
+    }
+    Ok((states, ImageSet::new(grid * grid, PIXELS, pixels)?))
 }
 
 /// Write a float64 `rows x cols` array as .npy (C order).

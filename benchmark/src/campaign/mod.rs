@@ -3,8 +3,10 @@
 
 pub mod config;
 pub mod embed;
+pub mod goal_space;
 pub mod machine;
 pub mod plan;
+pub mod remeasure;
 pub mod runner;
 pub mod store;
 

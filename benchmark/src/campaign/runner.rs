@@ -11,6 +11,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::config::{CampaignConfig, LearnersConfig, UglConfig};
+use super::goal_space;
 use super::machine::{cpu_info, host_name};
 use super::plan::{RunSpec, plan};
 use super::store::{self, Manifest, StoreError, Summary};
@@ -149,15 +150,15 @@ pub struct Representation {
     pub quality: Option<LatentQuality>,
 }
 
-/// Held-out images of the latent-quality measure, and training images it encodes.
+/// Held-out images of the latent-quality measure.
 pub const QUALITY_HELDOUT: usize = 1000;
-pub const QUALITY_TRAIN: usize = 2000;
 
-/// Measure the latent quality of a fitted encoder: regressions fitted on the encodings of the
-/// first [`QUALITY_TRAIN`] training images, scored on [`QUALITY_HELDOUT`] fresh images from the
-/// data set's held-out stream. A stochastic encoder draws its noise from that stream too, and
-/// every run resets it ([`Encoder::begin_run`]), so this changes no run's results.
-fn measure_quality(
+/// Measure the latent quality of a fitted encoder (measure version
+/// [`quality::MEASURE_VERSION`]): regressions fitted on the encodings of every training image,
+/// scored on [`QUALITY_HELDOUT`] fresh images from the data set's held-out stream. A stochastic
+/// encoder draws its noise from that stream too, and every run resets it
+/// ([`Encoder::begin_run`]), so this changes no run's results.
+pub fn measure_quality(
     encoder: &mut dyn Encoder,
     env: &dyn Environment,
     data: &crate::repr::dataset::UglDataset,
@@ -167,11 +168,9 @@ fn measure_quality(
     let mut rng = stream(ds_seed, Component::HeldOut);
     let heldout = generate(env, QUALITY_HELDOUT, &mut rng)?;
     encoder.begin_run(rng);
-    let train_images = data.images.head(QUALITY_TRAIN);
-    let n = train_images.n;
-    let z_train = encoder.encode(&train_images)?;
+    let z_train = encoder.encode(&data.images)?;
     let z_heldout = encoder.encode(&heldout.images)?;
-    let (y_train, names) = quality::targets(&data.states[..n * d], d);
+    let (y_train, names) = quality::targets(&data.states, d);
     let (y_heldout, _) = quality::targets(&heldout.states, d);
     quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)
 }
@@ -673,15 +672,13 @@ pub struct CampaignOptions<'a> {
     pub checkpoint_every: usize,
 }
 
-/// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
-/// matching config hash are skipped). Returns the summaries of the runs executed now.
-pub fn run_campaign(
-    cfg: &CampaignConfig,
-    out: &Path,
-    opts: &CampaignOptions,
-    on_progress: &(dyn Fn(Progress) + Sync),
-) -> Result<Vec<Summary>, RunError> {
-    let ctx = RunContext {
+/// The run context of a campaign's runs.
+pub(crate) fn campaign_context<'a>(
+    cfg: &'a CampaignConfig,
+    out: &'a Path,
+    opts: &CampaignOptions<'a>,
+) -> RunContext<'a> {
+    RunContext {
         campaign: &cfg.campaign.name,
         campaign_seed: cfg.campaign.seed,
         profile: opts.profile,
@@ -692,12 +689,80 @@ pub fn run_campaign(
         threads: opts.jobs,
         cache: opts.cache,
         train_progress: opts.train_progress.clone(),
-        // Each worker's own pool is the training's (see below).
+        // Each worker's own pool is the training's ([`for_each_group`]).
         train_threads: 0,
         log_dir: Some(out),
         learner_messages: opts.learner_messages.clone(),
         checkpoint_every: opts.checkpoint_every,
-    };
+    }
+}
+
+/// Run `work(g)` for every group index `g < n`: `jobs` plain worker threads pull indexes from a
+/// shared counter, and each worker owns a rayon pool of `cores / jobs` threads for the parallel
+/// parts of a fit (Isomap's searches, the training kernels). Not a rayon `par_iter` over
+/// groups: a rayon worker waiting inside a fit steals other groups and starts their fits too,
+/// so dozens of fits (and their memory) pile up. Returns the results in index order.
+pub(crate) fn for_each_group<T: Send>(
+    jobs: usize,
+    n: usize,
+    work: &(dyn Fn(usize) -> T + Sync),
+) -> Result<Vec<T>, RunError> {
+    let jobs = jobs.max(1);
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let inner = (cores / jobs).max(1);
+    let next = AtomicUsize::new(0);
+    let slots: Vec<Mutex<Option<T>>> = (0..n).map(|_| Mutex::new(None)).collect();
+    let pools = (0..jobs.min(n))
+        .map(|_| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(inner)
+                .build()
+                .map_err(|e| RunError::Pool(e.to_string()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = pools
+            .iter()
+            .map(|pool| {
+                scope.spawn(|| {
+                    loop {
+                        let g = next.fetch_add(1, Ordering::SeqCst);
+                        if g >= n {
+                            break;
+                        }
+                        let r = pool.install(|| work(g));
+                        *slots[g].lock().expect("result slot") = Some(r);
+                    }
+                })
+            })
+            .collect();
+        for h in handles {
+            if let Err(panic) = h.join() {
+                std::panic::resume_unwind(panic);
+            }
+        }
+    });
+    Ok(slots
+        .into_iter()
+        .map(|m| {
+            m.into_inner()
+                .expect("result slot")
+                .expect("every group ran")
+        })
+        .collect())
+}
+
+/// Run every run of the campaign that is not complete in `out` (resumable: complete runs with a
+/// matching config hash are skipped). Returns the summaries of the runs executed now.
+pub fn run_campaign(
+    cfg: &CampaignConfig,
+    out: &Path,
+    opts: &CampaignOptions,
+    on_progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Vec<Summary>, RunError> {
+    let ctx = campaign_context(cfg, out, opts);
     let all = match opts.shard {
         None => plan(cfg),
         Some((i, n)) => super::plan::shard(&plan(cfg), cfg.ugl.images, i, n),
@@ -722,17 +787,6 @@ pub fn run_campaign(
     }
     // Expensive groups (learned representations) first, for a better load balance.
     groups.sort_by_key(|(k, _)| k.is_none());
-    // `jobs` plain worker threads pull groups from a shared counter. Each worker owns a rayon
-    // pool of `cores / jobs` threads for the parallel parts of a fit (Isomap's searches, burn's
-    // kernels). Not a rayon `par_iter` over groups: a rayon worker waiting inside a fit steals
-    // other groups and starts their fits too, so dozens of fits (and their memory) pile up.
-    let jobs = opts.jobs.max(1);
-    let cores = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let inner = (cores / jobs).max(1);
-    let next = AtomicUsize::new(0);
-    let slots: Vec<Mutex<GroupResult>> = groups.iter().map(|_| Mutex::new(Vec::new())).collect();
     // External-learner cells whose fit failed: (env, learner, latents) -> the failed run.
     let failed_external: Mutex<HashMap<String, String>> = Mutex::new(HashMap::new());
     let external_cell = |spec: &RunSpec| {
@@ -762,7 +816,17 @@ pub fn run_campaign(
                     continue;
                 }
                 match fit_representation(spec, &ctx) {
-                    Ok(r) => repr = Some(r),
+                    Ok(mut r) => {
+                        if goal_space::wanted(spec)
+                            && let Err(e) = goal_space::write(out, spec, &ctx, &mut r)
+                        {
+                            tracing::warn!(
+                                "{}: goal-space figure data not written: {e}",
+                                spec.run_id()
+                            );
+                        }
+                        repr = Some(r)
+                    }
                     Err(source) => {
                         failed = Some(spec.run_id());
                         if let Some(c) = cell {
@@ -788,40 +852,10 @@ pub fn run_campaign(
         }
         out_v
     };
-    let pools = (0..jobs.min(groups.len()))
-        .map(|_| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(inner)
-                .build()
-                .map_err(|e| RunError::Pool(e.to_string()))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = pools
-            .iter()
-            .map(|pool| {
-                scope.spawn(|| {
-                    loop {
-                        let g = next.fetch_add(1, Ordering::SeqCst);
-                        let Some((key, specs)) = groups.get(g) else {
-                            break;
-                        };
-                        let r = pool.install(|| run_group(key, specs));
-                        *slots[g].lock().expect("result slot") = r;
-                    }
-                })
-            })
-            .collect();
-        for h in handles {
-            if let Err(panic) = h.join() {
-                std::panic::resume_unwind(panic);
-            }
-        }
-    });
-    let results: Vec<GroupResult> = slots
-        .into_iter()
-        .map(|m| m.into_inner().expect("result slot"))
-        .collect();
+    let results: Vec<GroupResult> = for_each_group(opts.jobs, groups.len(), &|g| {
+        let (key, specs) = &groups[g];
+        run_group(key, specs)
+    })?;
     let mut done = Vec::new();
     let mut skipped_now = 0;
     let mut first_err: Option<RunError> = None;

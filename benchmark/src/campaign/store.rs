@@ -296,7 +296,7 @@ pub fn write_run(
         path: dir.to_path_buf(),
         source,
     })?;
-    let [curve_p, outcomes_p, manifest_p] = run_paths(dir, &spec.run_id());
+    let [curve_p, outcomes_p, _] = run_paths(dir, &spec.run_id());
     let enc = |p: &Path, e: PolarsError| StoreError::Encode {
         path: p.to_path_buf(),
         message: e.to_string(),
@@ -317,7 +317,13 @@ pub fn write_run(
         files: Some(digests),
         ..manifest.clone()
     };
-    let mut json = serde_json::to_vec_pretty(&manifest).map_err(|e| StoreError::Encode {
+    write_manifest(dir, &manifest)
+}
+
+/// Write (or replace, atomically) a run's manifest.
+pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<(), StoreError> {
+    let [_, _, manifest_p] = run_paths(dir, &manifest.run_id);
+    let mut json = serde_json::to_vec_pretty(manifest).map_err(|e| StoreError::Encode {
         path: manifest_p.clone(),
         message: e.to_string(),
     })?;

@@ -792,20 +792,52 @@ const PNG_SCALE: usize = 4;
 /// as a matrix).
 pub fn write_png(img: &Image70, path: &Path) -> Result<(), RenderError> {
     check_len(img, path)?;
-    let side = SIDE * PNG_SCALE;
-    let mut data = vec![0u8; side * side];
-    for (row, line) in data.chunks_exact_mut(side).enumerate() {
-        let y = SIDE - 1 - row / PNG_SCALE;
-        for (col, p) in line.iter_mut().enumerate() {
-            let x = col / PNG_SCALE;
-            let v = img.0[x * SIDE + y];
-            *p = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-        }
-    }
+    write_png_grid(&[&img.0[..]], 1, PNG_SCALE, path)
+}
+
+/// Gap between the cells of [`write_png_grid`], in output pixels (mid gray).
+const GRID_GAP: usize = 2;
+
+/// Write 70x70 images (`PIXELS` values in [0, 1] each, indexed `[x][y]`) as one grayscale PNG:
+/// `cols` per row, each upscaled `scale` times and oriented like [`write_png`], separated by a
+/// gray gap. For figures (reconstructions: inputs above outputs).
+pub fn write_png_grid(
+    images: &[&[f32]],
+    cols: usize,
+    scale: usize,
+    path: &Path,
+) -> Result<(), RenderError> {
     let io_err = |source| RenderError::Io {
         path: path.to_path_buf(),
         source,
     };
+    if images.is_empty() || cols == 0 || scale == 0 || images.iter().any(|i| i.len() != PIXELS) {
+        return Err(io_err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("a PNG grid needs images of {PIXELS} pixels, columns and a scale"),
+        )));
+    }
+    let rows = images.len().div_ceil(cols);
+    let cell = SIDE * scale;
+    let (width, height) = (
+        cols * cell + (cols - 1) * GRID_GAP,
+        rows * cell + (rows - 1) * GRID_GAP,
+    );
+    let mut data = vec![128u8; width * height];
+    for (k, img) in images.iter().enumerate() {
+        let (r0, c0) = (
+            (k / cols) * (cell + GRID_GAP),
+            (k % cols) * (cell + GRID_GAP),
+        );
+        for row in 0..cell {
+            let y = SIDE - 1 - row / scale;
+            let line = &mut data[(r0 + row) * width + c0..(r0 + row) * width + c0 + cell];
+            for (col, p) in line.iter_mut().enumerate() {
+                let v = img[(col / scale) * SIDE + y];
+                *p = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            }
+        }
+    }
     let png_err = |source| RenderError::Png {
         path: path.to_path_buf(),
         source,
@@ -813,7 +845,7 @@ pub fn write_png(img: &Image70, path: &Path) -> Result<(), RenderError> {
     let file = File::create(path).map_err(io_err)?;
     let mut buf = BufWriter::new(file);
     {
-        let mut encoder = png::Encoder::new(&mut buf, side as u32, side as u32);
+        let mut encoder = png::Encoder::new(&mut buf, width as u32, height as u32);
         encoder.set_color(png::ColorType::Grayscale);
         encoder.set_depth(png::BitDepth::Eight);
         let mut writer = encoder.write_header().map_err(png_err)?;
@@ -999,6 +1031,40 @@ mod tests {
         for i in 0..PIXELS {
             assert_eq!(out[i], f32::from(g[i]) / max);
         }
+    }
+
+    #[test]
+    fn png_grid_places_the_cells_with_gaps() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b, c) = (
+            render_ball(-0.9, -0.9),
+            render_ball(0.0, 0.0),
+            render_ball(0.9, 0.9),
+        );
+        let p = dir.path().join("grid.png");
+        write_png_grid(&[&a.0, &b.0, &c.0], 2, 1, &p).unwrap();
+        let dec = png::Decoder::new(std::io::BufReader::new(File::open(&p).unwrap()));
+        let mut reader = dec.read_info().unwrap();
+        let mut buf = vec![0u8; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let w = 2 * 70 + GRID_GAP;
+        assert_eq!((info.width as usize, info.height as usize), (w, w));
+        // The gap column is gray; the empty fourth cell too.
+        assert_eq!(buf[10 * w + 70], 128);
+        assert_eq!(buf[(72 + 10) * w + 72 + 10], 128);
+        // Each cell is its image, y flipped: pixel (x, y) at row 69 - y.
+        let at = |r0: usize, c0: usize, img: &Image70, x: usize, y: usize| {
+            assert_eq!(
+                buf[(r0 + 69 - y) * w + c0 + x],
+                (img.0[x * 70 + y] * 255.0).round() as u8
+            )
+        };
+        for (x, y) in [(3, 3), (35, 35), (66, 66), (10, 50)] {
+            at(0, 0, &a, x, y);
+            at(0, 72, &b, x, y);
+            at(72, 0, &c, x, y);
+        }
+        assert!(write_png_grid(&[&a.0[..10]], 1, 1, &p).is_err());
     }
 
     #[test]

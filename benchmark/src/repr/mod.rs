@@ -119,6 +119,12 @@ pub trait Encoder: Send {
         out.copy_from_slice(&z.data);
         Ok(())
     }
+    /// The reconstruction of an image (pixel values in [0, 1]) by a model with a decoder, from
+    /// the image's noise-free code; None for learners without one (PCA, Isomap, external).
+    fn reconstruct(&mut self, image: &[f32]) -> Option<Result<Vec<f32>, ReprError>> {
+        let _ = image;
+        None
+    }
     /// The model's prior over latents, where it has one (VAE-type models).
     fn prior(&self) -> Option<GaussianPrior> {
         None

@@ -492,6 +492,13 @@ impl Encoder for NeuralEncoder {
         self.net.latents
     }
 
+    fn reconstruct(&mut self, image: &[f32]) -> Option<Result<Vec<f32>, ReprError>> {
+        Some(
+            self.check_dim(image.len())
+                .map(|_| reconstruct(self.model, &self.net, image)),
+        )
+    }
+
     fn begin_run(&mut self, rng: Stream) {
         self.rng = rng;
     }
@@ -968,20 +975,11 @@ pub fn train_with_checkpoints(
 /// ([`super::evidence::mean_image_loss`]) for every model.
 pub fn reconstruction_loss(model: Model, net: &HostNet, images: &ImageSet, max: usize) -> f64 {
     let n = images.n.min(max);
-    let d = net.latents;
     let per_image: Vec<f64> = (0..n)
         .into_par_iter()
         .map_init(Scratch::default, |scratch, i| {
             let x = images.row(i);
-            let head = net.encode_head(x, scratch);
-            let mut code = vec![0.0f64; d];
-            match model {
-                Model::Ae => ae::encoding(&head, d, &mut code),
-                Model::Vae => vae::encoding(&head, d, &mut code),
-                Model::Rfvae => rfvae::mean_code(&head, d, &mut code),
-            }
-            let z: Vec<f32> = code.iter().map(|&v| v as f32).collect();
-            let logits = net.decode_logits(&z, scratch);
+            let logits = noise_free_logits(model, net, x, scratch);
             // softplus(l) - x l, stably.
             logits
                 .iter()
@@ -994,6 +992,30 @@ pub fn reconstruction_loss(model: Model, net: &HostNet, images: &ImageSet, max: 
         })
         .collect();
     per_image.iter().sum::<f64>() / n as f64
+}
+
+/// The decoder's logits for an image's noise-free code (AE: its sigmoid latents; VAE: mu;
+/// RFVAE: the flows applied to mu).
+fn noise_free_logits(model: Model, net: &HostNet, x: &[f32], scratch: &mut Scratch) -> Vec<f32> {
+    let d = net.latents;
+    let head = net.encode_head(x, scratch);
+    let mut code = vec![0.0f64; d];
+    match model {
+        Model::Ae => ae::encoding(&head, d, &mut code),
+        Model::Vae => vae::encoding(&head, d, &mut code),
+        Model::Rfvae => rfvae::mean_code(&head, d, &mut code),
+    }
+    let z: Vec<f32> = code.iter().map(|&v| v as f32).collect();
+    net.decode_logits(&z, scratch)
+}
+
+/// The reconstruction of an image (pixel probabilities, the sigmoid of the decoder's logits for
+/// its noise-free code), as in [`reconstruction_loss`]: for figures.
+pub fn reconstruct(model: Model, net: &HostNet, x: &[f32]) -> Vec<f32> {
+    noise_free_logits(model, net, x, &mut Scratch::default())
+        .into_iter()
+        .map(|l| 1.0 / (1.0 + (-l).exp()))
+        .collect()
 }
 
 /// Floating-point operations of one training iteration, counted as `3 x` the forward pass's

@@ -29,6 +29,9 @@ pub struct Inputs<'a> {
     pub conditions: &'a [ConditionSummary],
     pub klc_figures: &'a [FigureFile],
     pub outcome_figures: &'a [FigureFile],
+    /// Goal-space lattices and reconstruction grids (seed 0 of each learned cell).
+    pub goal_space_figures: &'a [FigureFile],
+    pub reconstruction_figures: &'a [FigureFile],
     /// KDE-vs-Gaussian figures (the paper's Figure 4 for RGE-VAE first).
     pub sampler_figures: &'a [FigureFile],
     pub variant_pairs: &'a [VariantPair<'a>],
