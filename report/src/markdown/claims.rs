@@ -232,7 +232,10 @@ fn claims_table(w: &mut String, results: &[&ClaimResult]) {
             cell(&r.claim.quote),
             cell(&r.claim.source),
             cell(&r.claim.statement),
-            r.claim.relation.describe(r.margin),
+            match r.claim.quantifier.label() {
+                "" => r.claim.relation.describe(r.margin),
+                q => format!("{} in {q}", r.claim.relation.describe(r.margin)),
+            },
             r.claim.statistic.label(),
             evidence,
             verdict_mark(r.verdict),
