@@ -79,11 +79,25 @@ pub fn aggregate(
 
 /// Sets [`ConditionSummary::at_rpe_level`] from each environment's RPE condition.
 fn mark_rpe_level(store: &Store, conditions: &mut [ConditionSummary]) {
-    let thresholds: Vec<(String, f64)> = conditions
+    let thresholds = rpe_thresholds(conditions);
+    apply_rpe_level(store, conditions, &thresholds);
+}
+
+/// Per environment: the object moves below which a run is "at RPE level" (RPE's mean times
+/// [`RPE_LEVEL_FACTOR`]).
+fn rpe_thresholds(conditions: &[ConditionSummary]) -> Vec<(String, f64)> {
+    conditions
         .iter()
         .filter(|c| c.key.algo == "rpe")
         .map(|c| (c.key.env.clone(), RPE_LEVEL_FACTOR * c.final_moved_mean))
-        .collect();
+        .collect()
+}
+
+fn apply_rpe_level(
+    store: &Store,
+    conditions: &mut [ConditionSummary],
+    thresholds: &[(String, f64)],
+) {
     for c in conditions.iter_mut().filter(|c| c.key.algo != "rpe") {
         c.at_rpe_level = thresholds
             .iter()
@@ -95,6 +109,21 @@ fn mark_rpe_level(store: &Store, conditions: &mut [ConditionSummary]) {
                     .count()
             });
     }
+}
+
+/// For a campaign without RPE runs of its own (a `compare-*` campaign): "at RPE level" against
+/// the main campaign's RPE (`main`), environment by environment. A campaign's own RPE runs,
+/// where it has them, take precedence.
+pub fn mark_rpe_level_against(
+    store: &Store,
+    conditions: &mut [ConditionSummary],
+    main: &[ConditionSummary],
+) {
+    let own = rpe_thresholds(conditions);
+    let mut thresholds = rpe_thresholds(main);
+    thresholds.retain(|(env, _)| !own.iter().any(|(e, _)| e == env));
+    thresholds.extend(own);
+    apply_rpe_level(store, conditions, &thresholds);
 }
 
 fn summarize_condition(

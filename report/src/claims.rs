@@ -140,6 +140,9 @@ pub enum Statistic {
     Auc,
     /// Episodes in which the object moved, at the last epoch.
     Moved,
+    /// Fraction of the achievable histogram cells the outcomes reached, at the last epoch: how
+    /// diverse the outcomes are (KLC also rewards moving the object often).
+    Coverage,
     /// Mean distance from the origin (the centre of the disk of reachable positions) of the
     /// object's final positions in the episodes that moved it: larger is nearer the boundary.
     Boundary,
@@ -152,6 +155,7 @@ impl Statistic {
             Statistic::Auc => "area under the KLC curve",
             Statistic::Moved => "episodes that moved the object",
             Statistic::Boundary => "mean distance of the moved object from the centre",
+            Statistic::Coverage => "fraction of the achievable cells reached",
         }
     }
 }
@@ -490,6 +494,7 @@ pub fn values(store: &Store, cond: &ConditionSummary, statistic: Statistic) -> V
             match statistic {
                 Statistic::FinalKlc => Some(run.final_point().klc),
                 Statistic::Moved => Some(run.final_point().n_moved as f64),
+                Statistic::Coverage => Some(run.final_point().coverage),
                 Statistic::Boundary => {
                     let r: Vec<f64> = run
                         .outcomes
@@ -632,14 +637,15 @@ pub(crate) mod tests {
         assert_eq!(
             unchecked,
             [
-                "ugl-vs-efr-speed",        // area under the curve
-                "rfvae-worse-corrected",   // our corrected variant
-                "vae-moves-more",          // episodes moved
-                "more-latents-more-moves", // episodes moved
-                "more-latents-boundary",   // distance from the centre
-                "rpe-few-moves",           // episodes moved
-                "rfvae-few-moves",         // episodes moved
-                "rfvae-gp-worse",          // no RFVAE-GP value in the paper
+                "ugl-vs-efr-speed",         // area under the curve
+                "rfvae-worse-corrected",    // our corrected variant
+                "vae-moves-more",           // episodes moved
+                "more-latents-more-moves",  // episodes moved
+                "more-latents-boundary",    // distance from the centre
+                "rpe-few-moves",            // episodes moved
+                "rfvae-few-moves",          // episodes moved
+                "rpe-rfvae-small-coverage", // cell coverage
+                "rfvae-gp-worse",           // no RFVAE-GP value in the paper
             ]
         );
         for id in &unchecked {

@@ -65,6 +65,10 @@ pub struct Entry {
     pub at_rpe_level: Option<usize>,
     /// Whether any of its runs ran below the paper's budget (manifest `reduced_budget`).
     pub reduced_budget: bool,
+    /// Mean final cell coverage over its runs (each run once): how diverse its outcomes are.
+    /// KLC also rewards moving the object often; an entry can rank high on KLC with little
+    /// coverage.
+    pub coverage_mean: f64,
 }
 
 impl Entry {
@@ -101,8 +105,8 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     tasks.sort_by_key(|(env, l)| (rank(env, &["armball", "armarrow"]), env.clone(), -*l));
     let alpha = 1.0 - confidence;
 
-    // entry -> task -> (final values, auc values, paper value)
-    type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>)>;
+    // entry -> task -> (final values, auc values, paper value, final coverages)
+    type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>)>;
     let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
     let mut untrained: BTreeMap<EntryKey, usize> = BTreeMap::new();
     let mut at_rpe: BTreeMap<EntryKey, usize> = BTreeMap::new();
@@ -153,6 +157,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 .iter()
                 .map(|v| v / max)
                 .collect();
+            let coverages = claims::values(src.store, c, Statistic::Coverage);
             if c.key.latents == 0 {
                 shared.insert(key.clone());
             }
@@ -166,10 +171,10 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             for (ti, (env, l)) in tasks.iter().enumerate() {
                 // A baseline (latents 0) serves every task of its environment.
                 if *env == c.key.env && (c.key.latents == *l || c.key.latents == 0) {
-                    groups
-                        .entry(key.clone())
-                        .or_default()
-                        .insert(ti, (finals.clone(), aucs.clone(), paper_value));
+                    groups.entry(key.clone()).or_default().insert(
+                        ti,
+                        (finals.clone(), aucs.clone(), paper_value, coverages.clone()),
+                    );
                 }
             }
         }
@@ -191,7 +196,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             // A baseline's runs are the same in both tasks of an environment: in the pooled
             // statistics (IQM, mean, run count) they count once, one stratum per environment.
             let mut seen_envs: Vec<&str> = Vec::new();
-            let strata: Vec<&(Vec<f64>, Vec<f64>, Option<f64>)> = per
+            let strata: Vec<&(Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>)> = per
                 .iter()
                 .filter(|(t, _)| {
                     let env = tasks[**t].0.as_str();
@@ -239,6 +244,8 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             let at_rpe_level = at_rpe.get(&key).copied();
             let all: Vec<f64> = finals.iter().flatten().copied().collect();
             let final_mean = stats::mean(&all);
+            let coverages: Vec<f64> = strata.iter().flat_map(|v| v.3.iter().copied()).collect();
+            let coverage_mean = stats::mean(&coverages);
             let papers: Vec<f64> = per.values().filter_map(|v| v.2).collect();
             let paper = (papers.len() == per.len()).then(|| stats::mean(&papers));
             Some(Entry {
@@ -256,6 +263,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 final_mean,
                 at_rpe_level,
                 reduced_budget: reduced.contains(&key),
+                coverage_mean,
             })
         })
         .collect();

@@ -124,7 +124,12 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     let compare_conditions: Vec<Vec<aggregate::ConditionSummary>> = camps
         .compare
         .iter()
-        .map(|c| aggregate::aggregate(&c.store, &paper, opts.bootstrap_seed, opts.n_boot))
+        .map(|c| {
+            let mut conds =
+                aggregate::aggregate(&c.store, &paper, opts.bootstrap_seed, opts.n_boot);
+            aggregate::mark_rpe_level_against(&c.store, &mut conds, &conditions);
+            conds
+        })
         .collect();
     let mut sources = vec![leaderboard::Source {
         campaign: &camps.main.name,

@@ -652,6 +652,10 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
         row.contains("(new)") && row.contains("compare-random-projection"),
         "{row}"
     );
+    // A compare campaign has no RPE of its own: "at RPE level" uses the main campaign's.
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    assert_eq!(cells[8], "**6**", "at RPE level: {row}");
+    assert!(cells[11].ends_with('%'), "coverage: {row}");
     assert!(md.contains("1 `compare-*` campaign in the store"));
     let svg = std::fs::read_to_string(out.join("figures/klc_armball.svg")).unwrap();
     assert!(
@@ -660,8 +664,8 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     );
     // Claims: the committed claims file is evaluated, and the verdicts are counted.
     assert!(md.contains("## The paper's claims"));
-    // 14 of the paper's claims in the headline; our one finding apart.
-    let summary = line(&md, "**The paper's claims**", "of 14 claims of the paper");
+    // 22 of the paper's claims in the headline; our one finding apart.
+    let summary = line(&md, "**The paper's claims**", "of 22 claims of the paper");
     assert!(summary.contains("reproduced"), "{summary}");
     assert!(
         summary.contains("(1 finding(s) of ours are listed apart)"),

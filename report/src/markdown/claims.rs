@@ -39,6 +39,7 @@ fn verdict_mark(v: Verdict) -> String {
 fn value(statistic: Statistic, v: f64) -> String {
     match statistic {
         Statistic::Moved if v.is_finite() => format!("{v:.0}"),
+        Statistic::Coverage if v.is_finite() => format!("{:.1}%", 100.0 * v),
         _ => fmt_klc(v),
     }
 }
@@ -330,7 +331,10 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          untrained random projection and are counted in, not hidden. *At RPE level*: runs that \
          moved the object fewer than twice as often as RPE (failed explorations, which the IQM \
          trims); *mean*: the untrimmed mean of the normalised final KLC, which they do weigh \
-         on. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *final*; entries missing a task come last.\n",
+         on. *Coverage*: the mean fraction of the achievable histogram cells its outcomes \
+         reached (each run once). KL-coverage also rewards moving the object often (every \
+         episode that leaves it in place adds to one cell), so an entry can rank high here \
+         with little coverage: read the two together. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *final*; entries missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
         lb.confidence * 100.0,
@@ -338,11 +342,11 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
     );
     let _ = writeln!(
         w,
-        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | at RPE level | final (IQM) | final (mean) | speed (IQM) | P(better than EFR) | paper |"
+        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | at RPE level | final (IQM) | final (mean) | coverage | speed (IQM) | P(better than EFR) | paper |"
     );
     let _ = writeln!(
         w,
-        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     let n = lb.tasks.len();
     for (i, e) in lb.entries.iter().enumerate() {
@@ -350,7 +354,7 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
         let name = condition_name(&e.algo, &e.variant);
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.1}% | {} | {} | {} |",
             if e.is_complete(n) {
                 (i + 1).to_string()
             } else {
@@ -384,6 +388,7 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
             },
             ci3(e.final_iqm),
             e.final_mean,
+            100.0 * e.coverage_mean,
             e.auc_iqm.map(ci3).unwrap_or_else(|| "—".into()),
             e.poi_vs_efr.map(ci3).unwrap_or_else(|| "—".into()),
             e.paper
