@@ -493,10 +493,12 @@ pub fn render(inp: &Inputs<'_>) -> String {
     let _ = writeln!(w, "## Object positions reached\n");
     let _ = writeln!(
         w,
-        "For each condition, the outcomes of one run (seed 0 where present) at three epochs: every \
-         episode that moved the object is a dot at the object's final (x, y); the circle is the \
-         reachable unit disk and the red mark the initial position (0.6, 0.6), where every other \
-         episode ends. Panel titles count the episodes that moved the object.\n"
+        "For each condition, the outcomes of its median run (by final KL-coverage; the title \
+         names its seed) at three epochs: every episode that moved the object is a dot at the \
+         object's final (x, y), for ArmArrow a short stroke from the arrow's position toward its \
+         tip (angles grouped in 30° sectors); the circle is the reachable unit disk and the red \
+         mark the initial position (0.6, 0.6), where every other episode ends. Panel titles \
+         count the episodes that moved the object.\n"
     );
     for env in &envs {
         let _ = writeln!(w, "### {}\n", env_name(env));
