@@ -73,26 +73,6 @@ pub fn exists(out: &Path, spec: &RunSpec) -> bool {
         .is_some()
 }
 
-/// Read every sample of a results directory (none if it has no `goal_spaces/`), by label.
-pub fn read_all(out: &Path) -> Result<Vec<GoalSpaceSample>, String> {
-    let dir = out.join(DIR_NAME);
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        return Ok(Vec::new());
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    paths.sort();
-    paths
-        .iter()
-        .map(|p| {
-            let bytes = std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", p.display()))
-        })
-        .collect()
-}
-
 /// Encode the lattice (and reconstruct held-out images) with a fitted representation and write
 /// the sample of `spec` into `out`.
 pub fn write(
