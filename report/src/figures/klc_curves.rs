@@ -191,13 +191,32 @@ fn draw_panel(
         if m > 0.0 { m * 1.05 } else { 1.0 }
     });
     let x_range = -0.01 * x_last..x_last * 1.04;
+    // The y axis spans the data (bands and the paper's values), down to the next 0.5 below
+    // their smallest value, not from 0: the differences between conditions are a few tenths.
+    let y_min = panel
+        .members
+        .iter()
+        .flat_map(|c| {
+            c.curve
+                .iter()
+                .map(|p| p.lo.min(p.mean))
+                .chain(c.paper.iter().map(|p| p.klc))
+        })
+        .filter(|v| v.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let y_min = if y_min.is_finite() {
+        ((y_min - 0.1) * 2.0).floor().max(0.0) / 2.0
+    } else {
+        0.0
+    };
+    let y_min = y_min.min(y_max - 0.5).max(0.0);
 
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, (FONT, 17))
         .margin(12)
         .x_label_area_size(42)
         .y_label_area_size(56)
-        .build_cartesian_2d(x_range, 0.0..y_max)?;
+        .build_cartesian_2d(x_range, y_min..y_max)?;
     chart
         .configure_mesh()
         .x_desc("exploration epochs")
@@ -214,7 +233,7 @@ fn draw_panel(
         .draw()?;
 
     let clamp = |v: f64| {
-        if v.is_nan() { v } else { v.clamp(0.0, y_max) }
+        if v.is_nan() { v } else { v.clamp(y_min, y_max) }
     };
     let styles = styles(&panel.members);
 

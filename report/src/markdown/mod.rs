@@ -387,8 +387,9 @@ pub fn render(inp: &Inputs<'_>) -> String {
         w,
         "Mean over seeds (line) with the 90% percentile-bootstrap confidence interval of the mean \
          (shaded; {} resamples of the runs, seed {}), as the paper's `seaborn.tsplot(ci=90)`. \
-         Lower is better; the y axis spans 0 to the KL-coverage of outcomes all in one cell \
-         (ln 756 = 6.63 for ArmBall, ln 22680 = 10.03 for ArmArrow). The baselines appear in every \
+         Lower is better; the y axis spans the data: from just below the lowest value drawn to \
+         the KL-coverage of outcomes all in one cell (ln 756 = 6.63 for ArmBall, ln 22680 = \
+         10.03 for ArmArrow), not from 0. The baselines appear in every \
          panel of their environment, as in the paper. Hollow stars: the paper's final values \
          (single runs, read off its plots at the point labelled 4900), drawn at our last epoch. \
          As in the paper's figure, only KDE goals for the learned spaces: the Gaussian-goal runs \
