@@ -443,12 +443,16 @@ pub struct LossCurve {
     pub trainings: usize,
     /// (iteration, mean loss over the trainings that recorded it).
     pub points: Vec<(i64, f64)>,
+    /// The mean-image loss of the training images (the plateau), mean over the trainings that
+    /// record it (`train.evidence.plateau_loss`).
+    pub plateau: Option<f64>,
 }
 
 /// Mean training-loss curves of `store`'s neural runs, one training counted once.
 pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
     type Group = (String, String, String, i64);
-    let mut groups: BTreeMap<Group, BTreeMap<String, Vec<(i64, f64)>>> = BTreeMap::new();
+    type Recorded = (Vec<(i64, f64)>, Option<f64>);
+    let mut groups: BTreeMap<Group, BTreeMap<String, Recorded>> = BTreeMap::new();
     for r in &store.runs {
         let (Some(l), Some(t)) = (learner(r), training(&r.manifest)) else {
             continue;
@@ -457,21 +461,29 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
             continue;
         }
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
+        let plateau = r
+            .manifest
+            .raw
+            .get("train")
+            .and_then(|t| t.get("evidence"))
+            .and_then(|e| e.get("plateau_loss"))
+            .and_then(|v| v.as_f64());
         groups
             .entry((r.key.env.clone(), l, r.key.variant.clone(), r.key.latents))
             .or_default()
             .entry(key)
-            .or_insert(t.losses);
+            .or_insert((t.losses, plateau));
     }
     let mut out: Vec<LossCurve> = groups
         .into_iter()
         .map(|((env, learner, variant, latents), trainings)| {
             let mut by_it: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
-            for losses in trainings.values() {
+            for (losses, _) in trainings.values() {
                 for &(i, v) in losses {
                     by_it.entry(i).or_default().push(v);
                 }
             }
+            let plateaus: Vec<f64> = trainings.values().filter_map(|t| t.1).collect();
             LossCurve {
                 env,
                 learner,
@@ -482,6 +494,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
                     .into_iter()
                     .map(|(i, vs)| (i, stats::mean(&vs)))
                     .collect(),
+                plateau: (!plateaus.is_empty()).then(|| stats::mean(&plateaus)),
             }
         })
         .collect();

@@ -408,6 +408,12 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         std::fs::read(fig("recon_armball.rge-vae.faithful.l2.s0.png")).unwrap(),
         b"not decoded by the report"
     );
+    // The training-loss panels mark the plateau (the fixture's mean-image loss, 440).
+    let loss = std::fs::read_to_string(fig("training_loss.svg")).unwrap();
+    assert!(
+        loss.contains("mean-image loss (plateau) 440"),
+        "no plateau line"
+    );
     // The lattice: 3 lines of constant x and 3 of constant y.
     let mesh = std::fs::read_to_string(fig("goal_space_armball_l2.svg")).unwrap();
     assert_eq!(mesh.matches("<polyline").count(), 6, "{mesh}");

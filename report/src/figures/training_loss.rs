@@ -4,9 +4,14 @@
 //! learner minimises (PAPER-NOTES section 5: pixel-summed Bernoulli cross-entropy, plus the KL
 //! for the VAE, minus the flows' log-determinant for the RFVAE), so levels differ between
 //! learners; the y axis starts after the first recorded point, which can be far above the rest.
+//! A dotted grey line marks the mean-image loss of the training images (the *plateau*, the loss of
+//! the best constant prediction): a network whose loss stays on it learned nothing. (The RFVAE's
+//! loss subtracts the flows' log-determinant, so it can sit below the plateau without having
+//! learned; its evidence of training is the reconstruction loss, "Did the goal spaces learn?".)
 
 use std::path::Path;
 
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
@@ -108,15 +113,21 @@ fn draw_panel(
         .flat_map(|c| c.points.iter().skip(skip).map(|p| p.1))
         .filter(|v| v.is_finite())
         .collect();
+    let plateaus: Vec<f64> = curves.iter().filter_map(|c| c.plateau).collect();
+    let plateau = (!plateaus.is_empty())
+        .then(|| plateaus.iter().sum::<f64>() / plateaus.len() as f64)
+        .filter(|v| v.is_finite());
     let all: Vec<f64> = curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.1))
+        .chain(plateau)
         .filter(|v| v.is_finite())
         .collect();
     let lo = all.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = if body.is_empty() { &all } else { &body }
         .iter()
         .copied()
+        .chain(plateau)
         .fold(f64::NEG_INFINITY, f64::max);
     let (lo, hi) = if lo.is_finite() && hi.is_finite() && hi > lo {
         (lo, hi)
@@ -149,6 +160,24 @@ fn draw_panel(
         .light_line_style(RGBColor(0xF0, 0xF0, 0xF0))
         .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
         .draw()?;
+    if let Some(p) = plateau {
+        chart
+            .draw_series(std::iter::once(DashedPathElement::new(
+                vec![(0.0, p), (x_hi, p)],
+                3,
+                4,
+                RGBColor(0x77, 0x77, 0x77).stroke_width(1),
+            )))?
+            .label(format!("mean-image loss (plateau) {p:.0}"))
+            .legend(|(x, y)| {
+                DashedPathElement::new(
+                    vec![(x, y), (x + 20, y)],
+                    3,
+                    4,
+                    RGBColor(0x77, 0x77, 0x77).stroke_width(1),
+                )
+            });
+    }
     let n = curves.len().max(1);
     for (i, c) in curves.iter().enumerate() {
         let slot = if Some(c.latents) == super::true_latents(env) {
