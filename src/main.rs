@@ -268,6 +268,10 @@ struct CompareArgs {
     /// No progress bars.
     #[arg(long)]
     quiet: bool,
+    /// Run nothing: bring the goal-space diagnostics of the finished runs up to date (as
+    /// `ugl campaign --refresh-diagnostics`).
+    #[arg(long)]
+    refresh_diagnostics: bool,
     #[command(flatten)]
     cache: CacheArgs,
 }
@@ -818,6 +822,18 @@ fn remeasure(
         .and_then(|s| s.to_str())
         .unwrap_or("custom")
         .to_string();
+    refresh_config(&cfg, &profile, out, jobs, shard, cache)
+}
+
+/// `--refresh-diagnostics` of a loaded campaign (`ugl campaign`, `ugl compare`).
+fn refresh_config(
+    cfg: &CampaignConfig,
+    profile: &str,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    cache: &CacheArgs,
+) -> Result<()> {
     let shard = shard
         .map(parse_shard)
         .transpose()
@@ -852,7 +868,7 @@ fn remeasure(
     let model_cache = cache.resolve(&out);
     let opts = CampaignOptions {
         jobs,
-        profile: &profile,
+        profile,
         stop: &stop,
         shard,
         cache: model_cache.as_ref(),
@@ -860,7 +876,7 @@ fn remeasure(
         learner_messages: None,
         checkpoint_every: cache.checkpoint_every,
     };
-    let r = ugl_bench::campaign::remeasure::refresh_diagnostics(&cfg, &out, &opts, &|label| {
+    let r = ugl_bench::campaign::remeasure::refresh_diagnostics(cfg, &out, &opts, &|label| {
         eprintln!("refreshed {label} ({:.0} s)", t0.elapsed().as_secs_f64())
     })?;
     eprintln!(
@@ -1018,6 +1034,10 @@ fn compare(a: CompareArgs) -> Result<()> {
     let out = a
         .out
         .unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    if a.refresh_diagnostics {
+        let profile = cfg.campaign.name.clone();
+        return refresh_config(&cfg, &profile, Some(out), a.jobs, None, &a.cache);
+    }
     run_config(
         &cfg,
         &cfg.campaign.name.clone(),
