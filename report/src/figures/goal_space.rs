@@ -79,6 +79,11 @@ pub fn load(campaign_dir: &Path) -> Result<Vec<Sample>, ReportError> {
     Ok(out)
 }
 
+/// The report's order of environments.
+fn env_order(env: &str) -> usize {
+    crate::load::rank(env, &["armball", "armarrow"])
+}
+
 /// The report's order of learners in a figure.
 fn order(s: &Sample) -> (usize, String) {
     let algo = ["rge-pca", "rge-isomap", "rge-ae", "rge-vae", "rge-rfvae"]
@@ -173,7 +178,7 @@ pub fn draw_all(
 ) -> Result<(Vec<FigureFile>, Vec<FigureFile>), ReportError> {
     let mut cells: Vec<(String, usize)> =
         samples.iter().map(|s| (s.env.clone(), s.latents)).collect();
-    cells.sort();
+    cells.sort_by_key(|(env, d)| (env_order(env), env.clone(), *d));
     cells.dedup();
     let mut meshes = Vec::new();
     for (env, d) in &cells {
@@ -222,7 +227,7 @@ pub fn draw_all(
         .iter()
         .filter(|s| s.reconstructions.is_some())
         .collect();
-    with_recon.sort_by_key(|s| (s.env.clone(), s.latents, order(s)));
+    with_recon.sort_by_key(|s| (env_order(&s.env), s.env.clone(), s.latents, order(s)));
     for s in with_recon {
         let file = s.reconstructions.as_ref().expect("filtered");
         let src = campaign_dir.join(DIR_NAME).join(file);
