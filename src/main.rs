@@ -1041,12 +1041,41 @@ fn compare(a: CompareArgs) -> Result<()> {
     run_config(
         &cfg,
         &cfg.campaign.name.clone(),
-        Some(out),
+        Some(out.clone()),
         a.jobs,
         a.quiet,
         None,
         &a.cache,
-    )
+    )?;
+    print_compare_page(&out, &cfg.campaign.name, &base);
+    Ok(())
+}
+
+/// After `ugl compare`: the new learner's one-page summary (what `ugl report` writes as
+/// `compare_<campaign>.md`), from a report rendered into a temporary directory.
+fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) {
+    let results = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = std::env::temp_dir().join(format!("ugl-compare-{}", std::process::id()));
+    let mut opts = ugl_report::ReportOptions::new(results.to_path_buf(), tmp.clone());
+    opts.main_campaign = main_campaign.to_string();
+    let page = ugl_report::render_report(&opts)
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            let p = tmp.join(ugl_report::markdown::compare::file_name(campaign));
+            std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))
+        });
+    let _ = std::fs::remove_dir_all(&tmp);
+    match page {
+        Ok(text) => println!("{text}"),
+        Err(e) => eprintln!(
+            "no summary page ({e}); `ugl report` ranks the learner once the main campaign \
+             `{main_campaign}` is in {}",
+            results.display()
+        ),
+    }
 }
 
 fn run_config(

@@ -807,6 +807,8 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
         "--quiet",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // No main campaign `base` in the results directory yet: no ranking page, said so.
+    assert!(stderr(&o).contains("no summary page"), "{}", stderr(&o));
     let mut names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())

@@ -69,6 +69,9 @@ pub struct Entry {
     /// KLC also rewards moving the object often; an entry can rank high on KLC with little
     /// coverage.
     pub coverage_mean: f64,
+    /// Its normalised final KLC values per task, aligned with `tasks` (a baseline's runs in
+    /// each task of their environment): for pairwise probabilities of improvement.
+    pub finals_by_task: Vec<Vec<f64>>,
 }
 
 impl Entry {
@@ -264,6 +267,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 at_rpe_level,
                 reduced_budget: reduced.contains(&key),
                 coverage_mean,
+                finals_by_task,
             })
         })
         .collect();

@@ -212,10 +212,27 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     });
     let report_path = opts.out.join("REPORT.md");
     write_file(&report_path, md.as_bytes())?;
+    // One page per new learner.
+    let mut compare_pages = Vec::new();
+    for c in &camps.compare {
+        if let Some(page) = markdown::compare::page(
+            &c.name,
+            &c.store,
+            &board,
+            &camps.main.name,
+            opts.bootstrap_seed,
+        ) {
+            let path = opts.out.join(markdown::compare::file_name(&c.name));
+            write_file(&path, page.as_bytes())?;
+            compare_pages.push(path);
+        }
+    }
+    remove_stale_pages(&opts.out, &compare_pages)?;
     let data_files = data::write(&opts.out.join(data::DIR), &camps)?;
 
     figure_files.sort();
     let mut files = vec![report_path];
+    files.extend(compare_pages);
     files.extend(figure_files);
     files.extend(data_files);
     Ok(ReportSummary {
@@ -245,6 +262,21 @@ const OWN_FIGURES: [&str; 4] = [
     "fig4_vae_kde_vs_gaussian.svg",
     "rfvae_kde_vs_gaussian.svg",
 ];
+
+/// `compare_*.md` pages of campaigns no longer in the store.
+fn remove_stale_pages(out: &Path, written: &[PathBuf]) -> Result<(), ReportError> {
+    let entries = std::fs::read_dir(out).map_err(|source| ReportError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    for path in entries.flatten().map(|e| e.path()) {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with("compare_") && name.ends_with(".md") && !written.contains(&path) {
+            std::fs::remove_file(&path).map_err(|source| ReportError::Io { path, source })?;
+        }
+    }
+    Ok(())
+}
 
 fn create_dir(dir: &Path) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {

@@ -663,6 +663,28 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     assert_eq!(cells[8], "**6**", "at RPE level: {row}");
     assert!(cells[11].ends_with('%'), "coverage: {row}");
     assert!(md.contains("1 `compare-*` campaign in the store"));
+    // Its one-page summary: rank, failures, coverage, latent R², PoI against each algorithm.
+    let page_path = out.join("compare_compare-random-projection.md");
+    assert!(s.files.contains(&page_path));
+    let page = std::fs::read_to_string(&page_path).unwrap();
+    assert!(page.contains("**rank 1 of "), "{page}");
+    assert!(
+        page.contains("failed explorations (fewer than twice RPE's object moves): 6 of 6"),
+        "{page}"
+    );
+    assert!(
+        page.contains("  - ArmBall, 10 latents: position 0.900"),
+        "{page}"
+    );
+    let efr = page
+        .lines()
+        .find(|l| l.starts_with("| RGE-EFR |"))
+        .expect("PoI vs EFR");
+    assert!(efr.ends_with("| 2 |"), "{efr}");
+    assert!(page.lines().any(|l| l.starts_with("| RPE |")), "{page}");
+    assert!(md.contains(
+        "[`compare_compare-random-projection.md`](compare_compare-random-projection.md)"
+    ));
     let svg = std::fs::read_to_string(out.join("figures/klc_armball.svg")).unwrap();
     assert!(
         svg.contains("RGE-RANDOM-PROJECTION"),

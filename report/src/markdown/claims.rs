@@ -406,8 +406,19 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
                 .to_string()
         } else {
             format!(
-                "{new} `compare-*` campaign{} in the store; new learners are in **bold**.",
-                plural(new)
+                "{new} `compare-*` campaign{} in the store; new learners are in **bold**. One \
+                 page each (rank, probability of improvement over every algorithm, failures, \
+                 coverage, latent R²): {}.",
+                plural(new),
+                inp.campaigns
+                    .compare
+                    .iter()
+                    .map(|c| {
+                        let f = super::compare::file_name(&c.name);
+                        format!("[`{f}`]({f})")
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )
         }
     );

@@ -15,6 +15,7 @@ use crate::neural::{BudgetAnalysis, VariantPair};
 use crate::paper::PaperTable;
 
 pub mod claims;
+pub mod compare;
 pub mod neural;
 pub mod quality;
 
