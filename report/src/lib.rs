@@ -174,6 +174,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     let variants_fig = figures::variants::draw(&pairs, &fig_dir)?;
     let budget_figs = figures::budget::draw_all(&budget.series, &opts.main_campaign, &fig_dir)?;
     let loss_fig = figures::training_loss::draw(&losses, &fig_dir)?;
+    let appendix_figs = vec![figures::radial_flow::draw(&fig_dir)?];
     let samples = figures::goal_space::load(&camps.main.path)?;
     let (mesh_figs, recon_figs) =
         figures::goal_space::draw_all(&samples, &camps.main.path, &fig_dir)?;
@@ -187,6 +188,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         .chain(&loss_fig)
         .chain(&mesh_figs)
         .chain(&recon_figs)
+        .chain(&appendix_figs)
         .map(|f| f.path.clone())
         .collect();
     remove_stale_figures(&fig_dir, &figure_files)?;
@@ -207,6 +209,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         loss_figure: loss_fig.as_ref(),
         goal_space_figures: &mesh_figs,
         reconstruction_figures: &recon_figs,
+        appendix_figures: &appendix_figs,
         claims: &claims_input,
         leaderboard: &board,
     });
@@ -256,9 +259,10 @@ pub const SAMPLER_FIGURES: [(&str, &str); 2] = [
 
 /// File names of figures this crate writes besides the per-condition ones: a stale copy of any
 /// of them is removed when a render no longer writes it.
-const OWN_FIGURES: [&str; 4] = [
+const OWN_FIGURES: [&str; 5] = [
     figures::variants::FILE,
     figures::training_loss::FILE,
+    figures::radial_flow::FILE,
     "fig4_vae_kde_vs_gaussian.svg",
     "rfvae_kde_vs_gaussian.svg",
 ];

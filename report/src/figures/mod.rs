@@ -7,6 +7,7 @@ pub mod budget;
 pub mod goal_space;
 pub mod klc_curves;
 pub mod outcomes;
+pub mod radial_flow;
 pub mod sampler_compare;
 pub mod training_loss;
 pub mod variants;

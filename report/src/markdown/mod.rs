@@ -33,6 +33,8 @@ pub struct Inputs<'a> {
     /// Goal-space lattices and reconstruction grids (seed 0 of each learned cell).
     pub goal_space_figures: &'a [FigureFile],
     pub reconstruction_figures: &'a [FigureFile],
+    /// The paper's appendix figures that need no results (Figure 5: a radial flow).
+    pub appendix_figures: &'a [FigureFile],
     /// KDE-vs-Gaussian figures (the paper's Figure 4 for RGE-VAE first).
     pub sampler_figures: &'a [FigureFile],
     pub variant_pairs: &'a [VariantPair<'a>],
@@ -505,6 +507,21 @@ pub fn render(inp: &Inputs<'_>) -> String {
     for env in &envs {
         let _ = writeln!(w, "### {}\n", env_name(env));
         for f in inp.outcome_figures.iter().filter(|f| f.env == *env) {
+            let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+        }
+    }
+
+    // --- The paper's appendix figures that need no results.
+    if !inp.appendix_figures.is_empty() {
+        let _ = writeln!(w, "## Appendix figures\n");
+        let _ = writeln!(
+            w,
+            "The paper's Figure 5: one radial flow (Rezende & Mohamed 2015), the transformation \
+             the RFVAE stacks ten of, `z' = z + beta h(a, r) (z - c)` with `h = 1 / (a + r)` and \
+             `r = |z - c|` (invertible for `beta >= -a`), applied to 1000 seeded samples of an \
+             isotropic Gaussian.\n"
+        );
+        for f in inp.appendix_figures {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
         }
     }
