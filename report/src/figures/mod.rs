@@ -4,6 +4,7 @@
 //! pattern, so the curves stay apart on a greyscale print as well.
 
 pub mod budget;
+pub mod environment;
 pub mod goal_space;
 pub mod klc_curves;
 pub mod outcomes;

@@ -513,13 +513,18 @@ pub fn render(inp: &Inputs<'_>) -> String {
 
     // --- The paper's appendix figures that need no results.
     if !inp.appendix_figures.is_empty() {
-        let _ = writeln!(w, "## Appendix figures\n");
+        let _ = writeln!(w, "## The paper's illustrations\n");
         let _ = writeln!(
             w,
-            "The paper's Figure 5: one radial flow (Rezende & Mohamed 2015), the transformation \
-             the RFVAE stacks ten of, `z' = z + beta h(a, r) (z - c)` with `h = 1 / (a + r)` and \
-             `r = |z - c|` (invertible for `beta >= -a`), applied to 1000 seeded samples of an \
-             isotropic Gaussian.\n"
+            "Drawn from the benchmark's own code, not from results. Figure 1: the arm at rest \
+             (7 links summing to 1: the reachable set is the unit disk) with the ball at its \
+             initial position, and the 70 x 70 images the learners see. Figure 5: one radial \
+             flow (Rezende & Mohamed 2015), the transformation the RFVAE stacks ten of, \
+             `z' = z + beta h(a, r) (z - c)` with `h = 1 / (a + r)` and `r = |z - c|` \
+             (invertible for `beta >= -a`), on 1000 seeded samples of an isotropic Gaussian. \
+             Figure 6: one DMP episode on ArmBall, the first seeded uniform parameter vector (as \
+             RPE samples them) that catches the ball: the arm every 7 steps (light to dark), the \
+             hand's path (blue), the ball's start (pale) and end, and the joint commands.\n"
         );
         for f in inp.appendix_figures {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
