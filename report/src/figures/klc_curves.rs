@@ -161,6 +161,9 @@ fn label(c: &ConditionSummary) -> String {
         s.push_str(&format!(", {} goals", sampler_name(&c.key.sampler)));
     }
     s.push_str(&format!(", n={}", c.seeds.len()));
+    if !super::ALGOS.contains(&c.key.algo.as_str()) {
+        s.push_str(" (not in the paper)");
+    }
     s
 }
 

@@ -401,6 +401,21 @@ pub fn render(inp: &Inputs<'_>) -> String {
          markers. *n* in the legend: seeds.\n",
         inp.opts.n_boot, inp.opts.bootstrap_seed
     );
+    if !inp.campaigns.compare.is_empty() {
+        let names: Vec<String> = inp
+            .campaigns
+            .compare
+            .iter()
+            .map(|c| format!("`{}`", c.name))
+            .collect();
+        let _ = writeln!(
+            w,
+            "**Not in the paper:** these figures also draw the learners of the `compare-*` \
+             campaigns ({}), marked \"not in the paper\" in the legends; the paper's text \
+             says nothing about them (the leaderboard and their one-page summaries do).\n",
+            names.join(", ")
+        );
+    }
     for f in inp.klc_figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
     }
