@@ -204,8 +204,16 @@ fn renders_report_and_figures_with_the_right_numbers() {
             assert!(out.join("figures").join(&name).is_file(), "{name}");
         }
     }
-    // REPORT.md, 2 KLC figures, 4 outcome scatters, 2 CSV files.
-    assert_eq!(summary.files.len(), 1 + 2 + 4 + 2);
+    // REPORT.md, 2 KLC figures, 4 outcome scatters, the paper's 3 illustrations (Figures 1, 5,
+    // 6), 2 CSV files.
+    assert_eq!(summary.files.len(), 1 + 2 + 4 + 3 + 2);
+    for name in [
+        "fig1_environments.svg",
+        "fig5_radial_flow.svg",
+        "fig6_dmp_episode.svg",
+    ] {
+        assert!(out.join("figures").join(name).is_file(), "{name}");
+    }
     for f in &summary.files {
         assert!(f.is_file(), "{}", f.display());
     }
