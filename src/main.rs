@@ -834,36 +834,12 @@ fn refresh_config(
     shard: Option<&str>,
     cache: &CacheArgs,
 ) -> Result<()> {
-    let shard = shard
-        .map(parse_shard)
-        .transpose()
-        .map_err(|e| anyhow::anyhow!(e))?;
-    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
     if !out.is_dir() {
         bail!("--out {}: no results directory to refresh", out.display());
     }
-    let jobs = jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    if jobs == 0 {
-        bail!("--jobs must be at least 1");
-    }
     check_out_dir(&out)?;
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || {
-            if stop.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-            eprintln!(
-                "\ninterrupt: finishing the representations in flight (Ctrl-C again to abort now)"
-            );
-        })
-        .context("cannot install the Ctrl-C handler")?;
-    }
+    let stop = stop_on_ctrl_c("the representations in flight")?;
     let t0 = std::time::Instant::now();
     let model_cache = cache.resolve(&out);
     let opts = CampaignOptions {
@@ -1078,6 +1054,47 @@ fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) {
     }
 }
 
+/// The checked `--shard`, `--out` (default `data/results/<campaign>`) and `--jobs` (default: the
+/// number of cores) of a campaign command.
+fn campaign_args(
+    cfg: &CampaignConfig,
+    shard: Option<&str>,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+) -> Result<(Option<(usize, usize)>, PathBuf, usize)> {
+    let shard = shard
+        .map(parse_shard)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!(e))?;
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let jobs = jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    Ok((shard, out, jobs))
+}
+
+/// The stop flag of a campaign command: the first Ctrl-C sets it (and stops external learners
+/// still fitting), so the work in flight (`what`) finishes and is stored; a second one exits.
+fn stop_on_ctrl_c(what: &'static str) -> Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        // External learners still fitting are stopped now, not waited for.
+        ugl_bench::repr::external::interrupt();
+        eprintln!("\ninterrupt: finishing {what} (Ctrl-C again to abort now)");
+    })
+    .context("cannot install the Ctrl-C handler")?;
+    Ok(stop)
+}
+
 fn run_config(
     cfg: &CampaignConfig,
     profile: &str,
@@ -1087,34 +1104,10 @@ fn run_config(
     shard: Option<&str>,
     cache: &CacheArgs,
 ) -> Result<()> {
-    let shard = shard
-        .map(parse_shard)
-        .transpose()
-        .map_err(|e| anyhow::anyhow!(e))?;
-    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
     // Every argument is checked before anything touches the disk.
-    let jobs = jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    if jobs == 0 {
-        bail!("--jobs must be at least 1");
-    }
+    let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
     check_out_dir(&out)?;
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || {
-            if stop.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-            // External learners still fitting are stopped now, not waited for.
-            ugl_bench::repr::external::interrupt();
-            eprintln!("\ninterrupt: finishing the runs in flight (Ctrl-C again to abort now)");
-        })
-        .context("cannot install the Ctrl-C handler")?;
-    }
+    let stop = stop_on_ctrl_c("the runs in flight")?;
     let mp = MultiProgress::new();
     if quiet || !std::io::stderr().is_terminal() {
         mp.set_draw_target(ProgressDrawTarget::hidden());

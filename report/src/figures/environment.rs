@@ -60,14 +60,8 @@ where
         .y_labels(5)
         .label_style((FONT, 11))
         .draw()?;
-    let disk: Vec<(f64, f64)> = (0..=180)
-        .map(|i| {
-            let a = i as f64 * std::f64::consts::PI / 90.0;
-            (a.cos(), a.sin())
-        })
-        .collect();
     chart.draw_series(std::iter::once(PathElement::new(
-        disk,
+        super::unit_circle(),
         RGBColor(0x99, 0x99, 0x99),
     )))?;
     Ok(chart)

@@ -15,32 +15,16 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use serde::Deserialize;
 
 use super::{FONT, FigureFile, condition_name, env_name, file_safe, write_svg};
 use crate::ReportError;
 
-/// The directory of the samples in a campaign's results.
-pub const DIR_NAME: &str = "goal_spaces";
+/// One representation's figure data, as the campaign writes it.
+pub use ugl_bench::campaign::goal_space::{DIR_NAME, GoalSpaceSample as Sample};
 
 const PANEL: u32 = 240;
 const TITLE_H: u32 = 36;
 const COLS: usize = 4;
-
-/// One representation's figure data (the benchmark's `GoalSpaceSample`).
-#[derive(Clone, Debug, Deserialize)]
-pub struct Sample {
-    pub representation: String,
-    pub env: String,
-    pub algo: String,
-    pub variant: String,
-    pub latents: usize,
-    pub seed: u64,
-    pub grid: usize,
-    pub positions: Vec<[f64; 2]>,
-    pub grid_latents: Vec<Vec<f32>>,
-    pub reconstructions: Option<String>,
-}
 
 /// The samples of a campaign directory (none without `goal_spaces/`), sorted by label.
 pub fn load(campaign_dir: &Path) -> Result<Vec<Sample>, ReportError> {

@@ -390,6 +390,16 @@ pub fn dash_pattern(k: usize) -> Option<(i32, i32)> {
     }
 }
 
+/// The unit circle (the boundary of the reachable disk), as a closed path of 181 points.
+pub fn unit_circle() -> Vec<(f64, f64)> {
+    (0..=180)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::PI / 90.0;
+            (a.cos(), a.sin())
+        })
+        .collect()
+}
+
 /// Renders into a string with the SVG backend, then writes the file. `draw` gets the root area.
 pub fn write_svg(
     path: &Path,

@@ -182,14 +182,8 @@ fn draw_panel(
         .draw()?;
 
     // The reachable set: the unit disk.
-    let circle: Vec<(f64, f64)> = (0..=180)
-        .map(|i| {
-            let a = i as f64 * std::f64::consts::PI / 90.0;
-            (a.cos(), a.sin())
-        })
-        .collect();
     chart.draw_series(std::iter::once(PathElement::new(
-        circle,
+        super::unit_circle(),
         RGBColor(0x60, 0x60, 0x60).stroke_width(1),
     )))?;
 
