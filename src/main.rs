@@ -489,13 +489,15 @@ fn dispatch(cmd: Command) -> Result<()> {
             shard,
             refresh_diagnostics,
             cache,
-        } => {
-            if refresh_diagnostics {
-                remeasure(&config, out, jobs, shard.as_deref(), &cache)
-            } else {
-                campaign(&config, out, jobs, quiet, shard.as_deref(), &cache)
-            }
-        }
+        } => campaign(
+            &config,
+            out,
+            jobs,
+            quiet,
+            shard.as_deref(),
+            refresh_diagnostics,
+            &cache,
+        ),
         Command::Slurm {
             config,
             shards,
@@ -791,12 +793,14 @@ fn check_out_dir(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
 }
 
+/// `ugl campaign`: run the campaign, or with `--refresh-diagnostics` refresh its diagnostics.
 fn campaign(
     config: &Path,
     out: Option<PathBuf>,
     jobs: Option<usize>,
     quiet: bool,
     shard: Option<&str>,
+    refresh_diagnostics: bool,
     cache: &CacheArgs,
 ) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
@@ -805,24 +809,11 @@ fn campaign(
         .and_then(|s| s.to_str())
         .unwrap_or("custom")
         .to_string();
-    run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
-}
-
-/// `ugl campaign --refresh-diagnostics`.
-fn remeasure(
-    config: &Path,
-    out: Option<PathBuf>,
-    jobs: Option<usize>,
-    shard: Option<&str>,
-    cache: &CacheArgs,
-) -> Result<()> {
-    let cfg = CampaignConfig::load(config)?;
-    let profile = config
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("custom")
-        .to_string();
-    refresh_config(&cfg, &profile, out, jobs, shard, cache)
+    if refresh_diagnostics {
+        refresh_config(&cfg, &profile, out, jobs, shard, cache)
+    } else {
+        run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
+    }
 }
 
 /// `--refresh-diagnostics` of a loaded campaign (`ugl campaign`, `ugl compare`).

@@ -11,7 +11,7 @@ use rand_chacha::ChaCha8Rng;
 use ugl_bench::env::render::{PIXELS, SIDE, render_arrow_into, render_ball_into};
 use ugl_bench::env::{EnvConfig, EnvKind, JOINTS, PARAMS, dmp, make_env};
 
-use super::{FONT, FigureFile, write_svg};
+use super::{FONT, FigureFile, PanelChart, plain_panel, write_svg};
 use crate::ReportError;
 
 pub const FIG1: &str = "fig1_environments.svg";
@@ -34,32 +34,15 @@ pub fn joints(cfg: &EnvConfig, q: &[f64; JOINTS]) -> Vec<(f64, f64)> {
     pts
 }
 
-type WorldChart<'a, DB> = ChartContext<
-    'a,
-    DB,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
-
+/// The world square with the reachable disk.
 fn world<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
-) -> Result<WorldChart<'a, DB>, Box<dyn std::error::Error>>
+) -> Result<PanelChart<'a, DB>, Box<dyn std::error::Error>>
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 14))
-        .margin(8)
-        .x_label_area_size(26)
-        .y_label_area_size(30)
-        .build_cartesian_2d(-1.1..1.1, -1.1..1.1)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(5)
-        .y_labels(5)
-        .label_style((FONT, 11))
-        .draw()?;
+    let mut chart = plain_panel(area, title, (-1.1, 1.1), 5)?;
     chart.draw_series(std::iter::once(PathElement::new(
         super::unit_circle(),
         RGBColor(0x99, 0x99, 0x99),
@@ -76,19 +59,7 @@ fn draw_image<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 14))
-        .margin(8)
-        .x_label_area_size(26)
-        .y_label_area_size(30)
-        .build_cartesian_2d(0.0..SIDE as f64, 0.0..SIDE as f64)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(3)
-        .y_labels(3)
-        .label_style((FONT, 11))
-        .draw()?;
+    let mut chart = plain_panel(area, title, (0.0, SIDE as f64), 3)?;
     chart.draw_series(std::iter::once(Rectangle::new(
         [(0.0, 0.0), (SIDE as f64, SIDE as f64)],
         BLACK.filled(),

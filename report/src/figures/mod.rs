@@ -390,6 +390,40 @@ pub fn dash_pattern(k: usize) -> Option<(i32, i32)> {
     }
 }
 
+/// A chart with f64 axes on any backend.
+pub type PanelChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// A square panel without grid lines over `[lo, hi]^2`, with `labels` ticks per axis: the
+/// illustrations' (Figures 1, 5, 6) common frame.
+pub fn plain_panel<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    (lo, hi): (f64, f64),
+    labels: usize,
+) -> Result<PanelChart<'a, DB>, Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 14))
+        .margin(8)
+        .x_label_area_size(26)
+        .y_label_area_size(30)
+        .build_cartesian_2d(lo..hi, lo..hi)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(labels)
+        .y_labels(labels)
+        .label_style((FONT, 11))
+        .draw()?;
+    Ok(chart)
+}
+
 /// The unit circle (the boundary of the reachable disk), as a closed path of 181 points.
 pub fn unit_circle() -> Vec<(f64, f64)> {
     (0..=180)

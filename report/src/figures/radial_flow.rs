@@ -10,7 +10,7 @@ use plotters::prelude::*;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{FONT, FigureFile, write_svg};
+use super::{FONT, FigureFile, plain_panel, write_svg};
 use crate::ReportError;
 
 pub const FILE: &str = "fig5_radial_flow.svg";
@@ -63,19 +63,7 @@ pub fn draw(fig_dir: &Path) -> Result<FigureFile, ReportError> {
         )?;
         let areas = area.split_evenly((1, 3));
         for ((title, pts), a) in panels.iter().zip(areas.iter()) {
-            let mut chart = ChartBuilder::on(a)
-                .caption(title, (FONT, 14))
-                .margin(8)
-                .x_label_area_size(26)
-                .y_label_area_size(30)
-                .build_cartesian_2d(-4.0..4.0, -4.0..4.0)?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(5)
-                .y_labels(5)
-                .label_style((FONT, 11))
-                .draw()?;
+            let mut chart = plain_panel(a, title, (-4.0, 4.0), 5)?;
             chart.draw_series(
                 pts.iter()
                     .filter(|p| p.0.abs() < 4.0 && p.1.abs() < 4.0)
