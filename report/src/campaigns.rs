@@ -14,6 +14,10 @@
 //!   on the main campaign's cells and seeds: the leaderboard ranks it against the paper's
 //!   algorithms and the KL-coverage figures draw it. Their runs of the external learner are
 //!   labelled `rge-<NAME>` (the learner's name from the manifest), not `rge-external`.
+//! - Campaigns named `<main>-*` (e.g. `paper-init`, `paper-long`) rerun cells of the main
+//!   campaign with another training recipe for the neural learners, on the main campaign's run
+//!   seeds: the training-recipes section pairs each of their runs with the main run of the same
+//!   cell and seed.
 //! - Any other campaign is listed as present but not used (its runs are not even read).
 
 use std::path::{Path, PathBuf};
@@ -54,6 +58,8 @@ pub struct Campaigns {
     pub budget: Vec<Campaign>,
     /// `compare-*` campaigns, sorted by name, external learners relabelled `rge-<name>`.
     pub compare: Vec<Campaign>,
+    /// `<main>-*` campaigns (training-recipe variants of the main campaign), sorted by name.
+    pub recipe: Vec<Campaign>,
     /// Everything else, sorted by name.
     pub unused: Vec<Unused>,
 }
@@ -66,6 +72,7 @@ impl Campaigns {
                 .budget
                 .iter()
                 .chain(&self.compare)
+                .chain(&self.recipe)
                 .map(|c| c.store.runs.len())
                 .sum::<usize>()
     }
@@ -113,6 +120,16 @@ pub fn relabel_external(store: &mut Store) {
     }
 }
 
+/// Whether a campaign is a training-recipe variant of the main campaign `main`: named
+/// `<main>-<something>`.
+pub fn is_recipe_campaign(name: &str, main: &str) -> bool {
+    !main.is_empty()
+        && name
+            .strip_prefix(main)
+            .and_then(|rest| rest.strip_prefix('-'))
+            .is_some_and(|rest| !rest.is_empty())
+}
+
 /// Whether a campaign feeds the budget-sensitivity section.
 pub fn is_budget_campaign(name: &str) -> bool {
     name.starts_with(BUDGET_PREFIX)
@@ -149,6 +166,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
     };
     let mut budget = Vec::new();
     let mut compare = Vec::new();
+    let mut recipe = Vec::new();
     let mut unused = Vec::new();
     for d in &dirs {
         if d.name == main {
@@ -168,6 +186,12 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
                 path: d.path.clone(),
                 store,
             });
+        } else if is_recipe_campaign(&d.name, main) {
+            recipe.push(Campaign {
+                name: d.name.clone(),
+                path: d.path.clone(),
+                store: d.load()?,
+            });
         } else {
             unused.push(Unused {
                 name: d.name.clone(),
@@ -181,6 +205,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
         main: main_campaign,
         budget,
         compare,
+        recipe,
         unused,
     })
 }
@@ -210,5 +235,10 @@ mod tests {
             ]
         );
         assert!(is_budget_campaign("budget-vae-300") && !is_budget_campaign("paper"));
+        assert!(is_recipe_campaign("paper-init", "paper"));
+        assert!(!is_recipe_campaign("paper", "paper"));
+        assert!(!is_recipe_campaign("paper-", "paper"));
+        assert!(!is_recipe_campaign("paperback", "paper"));
+        assert!(!is_recipe_campaign("quick-init", "paper"));
     }
 }

@@ -65,7 +65,7 @@ impl ReportOptions {
 /// What `render_report` did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReportSummary {
-    /// Complete runs the report used (main, budget and compare campaigns).
+    /// Complete runs the report used (main, budget, compare and training-recipe campaigns).
     pub n_runs: usize,
     /// Complete runs of the main campaign.
     pub n_main_runs: usize,
@@ -73,6 +73,8 @@ pub struct ReportSummary {
     pub budget_campaigns: Vec<String>,
     /// Campaigns present in the store but not used, sorted.
     pub unused_campaigns: Vec<String>,
+    /// Training-recipe campaigns (`<main>-*`), sorted by name.
+    pub recipe_campaigns: Vec<String>,
     /// Files written (`REPORT.md` first, then the figures), sorted, under `opts.out`.
     pub files: Vec<PathBuf>,
 }
@@ -245,6 +247,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         n_main_runs: store.runs.len(),
         budget_campaigns: camps.budget.iter().map(|c| c.name.clone()).collect(),
         unused_campaigns: camps.unused.iter().map(|c| c.name.clone()).collect(),
+        recipe_campaigns: camps.recipe.iter().map(|c| c.name.clone()).collect(),
         files,
     })
 }

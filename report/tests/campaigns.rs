@@ -303,6 +303,23 @@ fn neural_store(root: &Path) {
     }
     // An old campaign holding a run with the same id as one of the main campaign's.
     write_run(&root.join("baselines"), &spec("armball", "rpe", 0, 0.9));
+    // A training-recipe campaign: three runs that pair with the main campaign's (0.3 lower final
+    // KLC each) and one (seed 7) that does not.
+    for seed in [0, 1, 2, 7] {
+        write_run(
+            &root.join("paper-long"),
+            &neural(
+                "armball",
+                "rge-vae",
+                "kde",
+                10,
+                "faithful",
+                seed,
+                vae_drop(seed.min(2)) + 0.3,
+                4000,
+            ),
+        );
+    }
 }
 
 fn read(out: &Path) -> String {
@@ -324,9 +341,10 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     let s = render_report(&opts(&results, &out)).unwrap();
     let n_main = 3 * (3 + 2 * 2 * 2 * 2);
     assert_eq!(s.n_main_runs, n_main);
-    assert_eq!(s.n_runs, n_main + 6);
+    assert_eq!(s.n_runs, n_main + 6 + 4);
     assert_eq!(s.budget_campaigns, ["budget-vae-300", "budget-vae-3000"]);
     assert_eq!(s.unused_campaigns, ["baselines"]);
+    assert_eq!(s.recipe_campaigns, ["paper-long"]);
     // 27 distinct trainings of 60 s (the KDE and Gaussian runs of a cell share one) and 57 runs
     // of 10 s exploration.
     let md = read(&out);
@@ -410,9 +428,10 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     );
     // The training-loss panels mark the plateau (the fixture's mean-image loss, 440).
     let loss = std::fs::read_to_string(fig("training_loss.svg")).unwrap();
+    assert!(loss.contains("(plateau 440)"), "no plateau value");
     assert!(
-        loss.contains("mean-image loss (plateau) 440"),
-        "no plateau line"
+        loss.contains("mean-image loss (the plateau"),
+        "no plateau line in the legend"
     );
     // The lattice: 3 lines of constant x and 3 of constant y.
     let mesh = std::fs::read_to_string(fig("goal_space_armball_l2.svg")).unwrap();
@@ -425,10 +444,34 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         md.contains(
             "- **Campaigns:** main `paper` (57 runs: the paper's figures and table); \
              training-budget sensitivity `budget-vae-300` (3 runs), `budget-vae-3000` (3 runs); \
-             present but not used: `baselines` (1 run)."
+             training recipes `paper-long` (4 runs); present but not used: `baselines` (1 run)."
         ),
         "{md}"
     );
+    // The training-recipe section: the recipe against the main campaign's, and the paired cell
+    // (seed 0 untrained on both sides; every training loss above 0.8 x 440 after the warm-up;
+    // each recipe run 0.3 lower, i.e. better).
+    let recipe = &md[md.find("## Training recipes").expect("recipe section")..];
+    assert!(
+        recipe.contains("4 complete runs; 1 without a `paper` run to pair with."),
+        "{recipe}"
+    );
+    assert!(
+        recipe.contains(
+            "- **RGE-VAE**: 4900-512-256, init `paper`, 4000 iterations, learning rate 0.001, \
+             warm-up 100 (`paper`: 4900-512-256, init `paper`, 1000 iterations, learning rate \
+             0.001, warm-up 100)."
+        ),
+        "{recipe}"
+    );
+    let row = line(recipe, "| ArmBall | RGE-VAE | kde | faithful | 10 |", "");
+    assert_eq!(
+        row,
+        "| ArmBall | RGE-VAE | kde | faithful | 10 | 3 | 1/3 / 1/3 | 0.20 / 0.20 | never (3) / \
+         never (3) | 0.90 / 0.90 | 4.578 / 4.878 | -0.300 [-0.300, -0.300] | 3/3 |",
+        "final KLC: ln 756 minus the mean over seeds 0-2 of vae_drop (+ 0.3)"
+    );
+    assert!(recipe.contains("Over all 3 pairs: untrained 1 of 3 `paper-long` runs against 1 of 3 `paper` runs; mean paired Δ final KLC -0.300; the `paper-long` run ends with the lower (better) KL-coverage in 3 of 3."), "{recipe}");
     // Display names with variants; 3 seeds on every row.
     assert!(
         md.contains("| RGE-VAE (corrected), Gaussian goals, 2 latents † | 3 |"),

@@ -12,8 +12,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    ALGOS, FONT, FigureFile, Icon, colour, condition_name, env_name, legend_strip, marker,
-    marker_points, sampler_name, star_points, write_svg,
+    ALGOS, FONT, FigureFile, Icon, colour, condition_name, env_name, legend_height, legend_strip,
+    marker, marker_points, sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
 use crate::load::campaign_display;
@@ -22,7 +22,6 @@ use crate::neural::{BudgetPoint, BudgetSeries};
 const PANEL_W: u32 = 760;
 const PANEL_H: u32 = 440;
 const TITLE_H: u32 = 36;
-const LEGEND_H: u32 = 60;
 
 fn slot(algo: &str) -> usize {
     ALGOS.iter().position(|a| *a == algo).unwrap_or(ALGOS.len())
@@ -50,9 +49,14 @@ pub fn draw_all(
         let name = file_name(algo);
         let path = fig_dir.join(&name);
         let rows = of.len() as u32;
+        let legend_h = of
+            .iter()
+            .map(|s| legend_height(PANEL_W, &legend(s, main_campaign), 13))
+            .max()
+            .unwrap_or(0);
         write_svg(
             &path,
-            (PANEL_W, rows * (PANEL_H + LEGEND_H) + TITLE_H),
+            (PANEL_W, rows * (PANEL_H + legend_h) + TITLE_H),
             |root| {
                 let area = root.titled(
                     &format!(
@@ -109,11 +113,11 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
         (
             Icon::Marker {
                 colour: col,
-                points: circle,
+                points: circle.clone(),
                 filled: false,
                 stroke: 1,
             },
-            "one seed (grey: main campaign)".to_string(),
+            "budget campaigns: one seed".to_string(),
         ),
         (
             Icon::Line {
@@ -122,27 +126,39 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
                 width: 2,
                 marker: Some((diamond, true)),
             },
-            "mean over seeds".to_string(),
+            "budget campaigns: mean over seeds".to_string(),
         ),
         (
             Icon::Whisker { colour: col },
-            "90% bootstrap CI".to_string(),
+            "budget campaigns: 90% bootstrap CI".to_string(),
         ),
     ];
     if let Some(m) = s.main.first() {
-        items.push((
-            Icon::Marker {
-                colour: BLACK,
-                points: star_points(8.0, 3.5),
-                filled: false,
-                stroke: 2,
-            },
-            format!(
-                "main campaign {} (n={}): mean, 90% CI",
-                campaign_display(main_campaign),
-                m.summary.n
+        let main = campaign_display(main_campaign);
+        items.extend([
+            (
+                Icon::Marker {
+                    colour: MAIN_GREY,
+                    points: circle,
+                    filled: false,
+                    stroke: 1,
+                },
+                format!("main campaign {main}: one seed"),
             ),
-        ));
+            (
+                Icon::Marker {
+                    colour: BLACK,
+                    points: star_points(8.0, 3.5),
+                    filled: false,
+                    stroke: 2,
+                },
+                format!("main campaign {main}: mean over seeds (n={})", m.summary.n),
+            ),
+            (
+                Icon::Whisker { colour: BLACK },
+                format!("main campaign {main}: 90% bootstrap CI"),
+            ),
+        ]);
     }
     for r in &s.references {
         items.push((
@@ -161,6 +177,9 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
     }
     items
 }
+
+/// The main campaign's seeds.
+const MAIN_GREY: RGBColor = RGBColor(0x55, 0x55, 0x55);
 
 fn reference_dash(algo: &str) -> (i32, i32) {
     if algo == "rpe" { (3, 4) } else { (10, 6) }
@@ -238,7 +257,7 @@ fn draw_panel(
     let (diamond, _) = marker_points(3, 5.0);
     let star = star_points(8.0, 3.5);
     // Seeds: the budget campaigns' in the condition's colour, the main campaign's in grey.
-    let main_grey = RGBColor(0x55, 0x55, 0x55);
+    let main_grey = MAIN_GREY;
     for (p, col) in s
         .points
         .iter()

@@ -16,8 +16,9 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, SOLID, algo_slot, colour, condition_name, dash_pattern, env_name, file_safe,
-    fmt_epoch, icon_parts, klc_max, marker, marker_points, sampler_name, star_points, write_svg,
+    FONT, FigureFile, Icon, SOLID, algo_slot, colour, condition_name, dash_pattern, dedup_legend,
+    env_name, file_safe, fmt_epoch, klc_max, legend_height, legend_strip, marker, marker_points,
+    sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
@@ -61,16 +62,21 @@ pub fn draw_all(
         let name = format!("klc_{}.svg", file_safe(env));
         let path = fig_dir.join(&name);
         let width = PANEL_W * panels.len() as u32;
-        write_svg(&path, (width, PANEL_H + TITLE_H), |root| {
+        // One legend for all panels, in a strip under them (no legend hides a curve).
+        let legend = dedup_legend(panels.iter().flat_map(panel_legend).collect());
+        let legend_h = legend_height(width, &legend, 13);
+        write_svg(&path, (width, PANEL_H + TITLE_H + legend_h), |root| {
             let title = format!(
                 "{}: KL-coverage, mean over seeds with 90% bootstrap CI",
                 env_name(env)
             );
             let area = root.titled(&title, (FONT, 18))?;
-            let areas = area.split_evenly((1, panels.len()));
+            let (plots, strip) = area.split_vertically(PANEL_H);
+            let areas = plots.split_evenly((1, panels.len()));
             for (panel, a) in panels.iter().zip(areas.iter()) {
                 draw_panel(a, env, panel)?;
             }
+            legend_strip(&strip, &legend, 13)?;
             Ok(())
         })?;
         let panel_list: Vec<&str> = panels.iter().map(|p| p.title.as_str()).collect();
@@ -165,6 +171,42 @@ fn label(c: &ConditionSummary) -> String {
         s.push_str(" (not in the paper)");
     }
     s
+}
+
+/// The legend entries of a panel: one per condition with a finite mean somewhere, and the
+/// paper's star when the panel shows a paper value.
+fn panel_legend(panel: &Panel<'_>) -> Vec<(Icon, String)> {
+    let styles = styles(&panel.members);
+    let mut items: Vec<(Icon, String)> = panel
+        .members
+        .iter()
+        .zip(&styles)
+        .filter(|(c, _)| c.curve.iter().any(|p| p.mean.is_finite()))
+        .map(|(c, &(slot, dash, filled))| {
+            let (mpts, _) = marker_points(slot, 4.0);
+            (
+                Icon::Line {
+                    colour: colour(slot),
+                    dash,
+                    width: 2,
+                    marker: Some((mpts, filled)),
+                },
+                label(c),
+            )
+        })
+        .collect();
+    if panel.members.iter().any(|c| c.paper.is_some()) {
+        items.push((
+            Icon::Marker {
+                colour: BLACK,
+                points: star_points(8.0, 3.5),
+                filled: false,
+                stroke: 2,
+            },
+            "paper: final value (1 run, read off plot)".into(),
+        ));
+    }
+    items
 }
 
 fn draw_panel(
@@ -277,23 +319,13 @@ fn draw_panel(
             }
         }
         segments.retain(|s| !s.is_empty());
-        for (k, seg) in segments.iter().enumerate() {
-            let series = chart.draw_series(std::iter::once(DashedPathElement::new(
+        for seg in &segments {
+            chart.draw_series(std::iter::once(DashedPathElement::new(
                 seg.clone(),
                 dash_len,
                 gap,
                 line_style,
             )))?;
-            if k == 0 {
-                let lpts = mpts.clone();
-                series.label(label(c)).legend(move |(x, y)| {
-                    let (fill, outline) = icon_parts(&lpts, 13, filled, col, 1);
-                    EmptyElement::at((x, y))
-                        + DashedPathElement::new(vec![(0, 0), (26, 0)], dash_len, gap, line_style)
-                        + fill
-                        + outline
-                });
-            }
         }
 
         // Markers on about 8 points per curve, staggered between curves.
@@ -315,33 +347,11 @@ fn draw_panel(
 
     // The paper's single-run values, at the last epoch of each condition.
     let star = star_points(8.0, 3.5);
-    let mut any_paper = false;
     for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
         if let Some(p) = &c.paper {
-            any_paper = true;
             let at = (c.last_epoch() as f64, clamp(p.klc));
             chart.draw_series(std::iter::once(marker(at, &star, false, colour(slot), 2)))?;
         }
     }
-    if any_paper {
-        let star = star.clone();
-        chart
-            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
-            .label("paper: final value (1 run, read off plot)")
-            .legend(move |(x, y)| {
-                let (fill, outline) = icon_parts(&star, 13, false, BLACK, 2);
-                EmptyElement::at((x, y)) + fill + outline
-            });
-    }
-
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .legend_area_size(32)
-        .margin(8)
-        .label_font((FONT, 13))
-        .background_style(WHITE.mix(0.9))
-        .border_style(RGBColor(0x99, 0x99, 0x99))
-        .draw()?;
     Ok(())
 }

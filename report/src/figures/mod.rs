@@ -534,7 +534,7 @@ pub enum Icon {
         filled: bool,
         stroke: u32,
     },
-    /// A vertical whisker (a confidence interval) with a horizontal bar (the mean).
+    /// A vertical whisker with caps (a confidence interval).
     Whisker { colour: RGBColor },
     /// A shaded box (a band).
     Band { colour: RGBColor },
@@ -553,15 +553,8 @@ pub fn legend_strip(
 ) -> Result<i32, Box<dyn std::error::Error>> {
     use plotters::element::DashedPathElement;
     let (w, _) = area.dim_in_pixel();
-    let row_h = font_size as i32 + 10;
-    let (mut x, mut y) = (16, row_h / 2 + 2);
-    for (icon, label) in items {
-        let text_w = (label.chars().count() as f64 * font_size as f64 * 0.56).ceil() as i32;
-        let item_w = ICON_W + 8 + text_w + 22;
-        if x > 16 && x + item_w > w as i32 {
-            x = 16;
-            y += row_h;
-        }
+    let (places, height) = legend_layout(w, items, font_size);
+    for ((icon, label), &(x, y)) in items.iter().zip(&places) {
         match icon {
             Icon::Line {
                 colour,
@@ -595,15 +588,15 @@ pub fn legend_strip(
                 ))?;
             }
             Icon::Whisker { colour } => {
+                // As the plots draw an interval: a vertical bar with caps, in one colour.
                 let c = x + ICON_W / 2;
-                area.draw(&PathElement::new(
+                for path in [
                     vec![(c, y - 8), (c, y + 8)],
-                    colour.stroke_width(2),
-                ))?;
-                area.draw(&PathElement::new(
-                    vec![(c - 7, y), (c + 7, y)],
-                    BLACK.stroke_width(3),
-                ))?;
+                    vec![(c - 5, y - 8), (c + 5, y - 8)],
+                    vec![(c - 5, y + 8), (c + 5, y + 8)],
+                ] {
+                    area.draw(&PathElement::new(path, colour.stroke_width(2)))?;
+                }
             }
             Icon::Band { colour } => {
                 area.draw(&Rectangle::new(
@@ -617,7 +610,43 @@ pub fn legend_strip(
             (x + ICON_W + 8, y - font_size as i32 / 2 - 1),
             (FONT, font_size),
         ))?;
+    }
+    Ok(height)
+}
+
+/// Where [`legend_strip`] puts each item (the icon's left end and the row's centre line) in a
+/// strip `width` pixels wide, and the height it needs.
+fn legend_layout(width: u32, items: &[(Icon, String)], font_size: u32) -> (Vec<(i32, i32)>, i32) {
+    let row_h = font_size as i32 + 10;
+    let (mut x, mut y) = (16, row_h / 2 + 2);
+    let mut places = Vec::with_capacity(items.len());
+    for (_, label) in items {
+        let text_w = (label.chars().count() as f64 * font_size as f64 * 0.56).ceil() as i32;
+        let item_w = ICON_W + 8 + text_w + 22;
+        if x > 16 && x + item_w > width as i32 {
+            x = 16;
+            y += row_h;
+        }
+        places.push((x, y));
         x += item_w;
     }
-    Ok(y + row_h / 2)
+    (places, y + row_h / 2 + 2)
+}
+
+/// The height (pixels) that [`legend_strip`] needs for `items` in a strip `width` pixels wide.
+pub fn legend_height(width: u32, items: &[(Icon, String)], font_size: u32) -> u32 {
+    if items.is_empty() {
+        return 0;
+    }
+    legend_layout(width, items, font_size).1.max(0) as u32
+}
+
+/// `items` without repeated labels (the first of each kept): the legend of a figure whose
+/// panels share their entries.
+pub fn dedup_legend(items: Vec<(Icon, String)>) -> Vec<(Icon, String)> {
+    let mut seen = std::collections::BTreeSet::new();
+    items
+        .into_iter()
+        .filter(|(_, l)| seen.insert(l.clone()))
+        .collect()
 }

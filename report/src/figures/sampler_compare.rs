@@ -13,9 +13,9 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, LineStyle, draw_curve, env_name, fmt_epoch, icon_parts, klc_max, marker,
-    marker_points, panel_order, sampler_colour, sampler_marker_slot, sampler_name, star_points,
-    variant_dash, variant_filled, write_svg,
+    FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, fmt_epoch, klc_max,
+    legend_height, legend_strip, marker, marker_points, panel_order, sampler_colour,
+    sampler_marker_slot, sampler_name, star_points, variant_dash, variant_filled, write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
@@ -112,15 +112,21 @@ pub fn draw(
         "{}: KDE vs Gaussian goals, mean over seeds ± 1 sd",
         algo_name(algo)
     );
+    let width = PANEL_W * cols as u32;
+    // One legend for all panels, under them (no legend hides a curve).
+    let legend = dedup_legend(panels.iter().flat_map(panel_legend).collect());
+    let legend_h = legend_height(width, &legend, 13);
     write_svg(
         &path,
-        (PANEL_W * cols as u32, PANEL_H * rows as u32 + TITLE_H),
+        (width, PANEL_H * rows as u32 + TITLE_H + legend_h),
         |root| {
             let area = root.titled(&title, (FONT, 18))?;
-            let areas = area.split_evenly((rows, cols));
+            let (plots, strip) = area.split_vertically(PANEL_H * rows as u32);
+            let areas = plots.split_evenly((rows, cols));
             for (p, a) in panels.iter().zip(areas.iter()) {
                 draw_panel(a, p)?;
             }
+            legend_strip(&strip, &legend, 13)?;
             Ok(())
         },
     )?;
@@ -135,6 +141,38 @@ pub fn draw(
         ),
         env: String::new(),
     }))
+}
+
+/// The legend entries of a panel: one per curve, and the paper's star when the panel has one.
+fn panel_legend(panel: &SamplerPanel<'_>) -> Vec<(Icon, String)> {
+    let mut items: Vec<(Icon, String)> = panel
+        .members
+        .iter()
+        .map(|&(sampler, variant, c)| {
+            let (mpts, _) = marker_points(sampler_marker_slot(sampler), 4.5);
+            (
+                Icon::Line {
+                    colour: sampler_colour(sampler),
+                    dash: variant_dash(variant),
+                    width: 2,
+                    marker: Some((mpts, variant_filled(variant))),
+                },
+                label(sampler, variant, c),
+            )
+        })
+        .collect();
+    if panel.members.iter().any(|(_, _, c)| c.paper.is_some()) {
+        items.push((
+            Icon::Marker {
+                colour: BLACK,
+                points: star_points(8.0, 3.5),
+                filled: false,
+                stroke: 2,
+            },
+            "paper: final value (1 run)".into(),
+        ));
+    }
+    items
 }
 
 /// Legend label: `KDE goals, faithful, n=5`.
@@ -244,25 +282,17 @@ fn draw_panel(
                 (p.epoch as f64, y)
             })
             .collect();
-        draw_curve(
-            &mut chart,
-            &pts,
-            &style,
-            i as f64 / n as f64,
-            Some(label(sampler, variant, c)),
-        )?;
+        draw_curve(&mut chart, &pts, &style, i as f64 / n as f64, None)?;
     }
 
     // The paper's single-run values (its Figure 4 has ArmBall 10 latents only in our table).
     let star = star_points(8.0, 3.5);
-    let mut any_paper = false;
     let mut drawn: Vec<&str> = Vec::new();
     for &(sampler, _, c) in &panel.members {
         if let Some(p) = &c.paper
             && !drawn.contains(&sampler)
         {
             drawn.push(sampler);
-            any_paper = true;
             let at = (c.last_epoch() as f64, clamp(p.klc));
             chart.draw_series(std::iter::once(marker(
                 at,
@@ -273,24 +303,5 @@ fn draw_panel(
             )))?;
         }
     }
-    if any_paper {
-        let star = star.clone();
-        chart
-            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
-            .label("paper: final value (1 run)")
-            .legend(move |(x, y)| {
-                let (fill, outline) = icon_parts(&star, 13, false, BLACK, 2);
-                EmptyElement::at((x, y)) + fill + outline
-            });
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .legend_area_size(32)
-        .margin(8)
-        .label_font((FONT, 13))
-        .background_style(WHITE.mix(0.9))
-        .border_style(RGBColor(0x99, 0x99, 0x99))
-        .draw()?;
     Ok(())
 }

@@ -15,8 +15,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, LineStyle, draw_curve, env_name, learner_name, marker_points, variant_dash,
-    variant_filled, write_svg,
+    FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, learner_name,
+    legend_height, legend_strip, marker_points, variant_dash, variant_filled, write_svg,
 };
 use crate::ReportError;
 use crate::load::rank;
@@ -34,6 +34,43 @@ fn latents_colour(env: &str, latents: i64) -> RGBColor {
     } else {
         RGBColor(0x00, 0x72, 0xB2)
     }
+}
+
+/// The plateau's reference line.
+const PLATEAU_GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
+
+/// (colour, marker points, dash, filled marker) of a curve: colour and marker by latent size,
+/// dash and fill by variant.
+fn curve_style(
+    env: &str,
+    latents: i64,
+    variant: &str,
+) -> (RGBColor, Vec<(i32, i32)>, Option<(i32, i32)>, bool) {
+    let slot = if Some(latents) == super::true_latents(env) {
+        2
+    } else {
+        0
+    };
+    let (mpts, _) = marker_points(slot, 4.0);
+    (
+        latents_colour(env, latents),
+        mpts,
+        variant_dash(variant),
+        variant_filled(variant),
+    )
+}
+
+/// The legend label of a curve's style: `10 latents, corrected`, `true dimension, faithful`.
+fn curve_label(env: &str, latents: i64, variant: &str) -> String {
+    let mut label = if Some(latents) == super::true_latents(env) {
+        "true dimension".to_string()
+    } else {
+        format!("{latents} latents")
+    };
+    if variant != "none" {
+        label.push_str(&format!(", {variant}"));
+    }
+    label
 }
 
 /// Draws the figure; `None` when no run recorded a loss.
@@ -54,15 +91,46 @@ pub fn draw(curves: &[LossCurve], fig_dir: &Path) -> Result<Option<FigureFile>, 
     learners.sort_by_key(|l| (rank(l, &LEARNERS), l.to_string()));
     let path = fig_dir.join(FILE);
     let (rows, cols) = (envs.len(), learners.len());
+    let width = PANEL_W * cols as u32;
+    // One legend for all panels, under them (no legend hides a curve).
+    let mut legend: Vec<(Icon, String)> = curves
+        .iter()
+        .map(|c| {
+            let (colour, mpts, dash, filled) = curve_style(&c.env, c.latents, &c.variant);
+            (
+                Icon::Line {
+                    colour,
+                    dash,
+                    width: 2,
+                    marker: Some((mpts, filled)),
+                },
+                curve_label(&c.env, c.latents, &c.variant),
+            )
+        })
+        .collect();
+    legend.sort_by(|a, b| a.1.cmp(&b.1));
+    let mut legend = dedup_legend(legend);
+    legend.push((
+        Icon::Line {
+            colour: PLATEAU_GREY,
+            dash: Some((3, 4)),
+            width: 1,
+            marker: None,
+        },
+        "mean-image loss (the plateau; its value in each panel's title)".into(),
+    ));
+    let legend_h = legend_height(width, &legend, 13);
     write_svg(
         &path,
-        (PANEL_W * cols as u32, PANEL_H * rows as u32 + TITLE_H),
+        (width, PANEL_H * rows as u32 + TITLE_H + legend_h),
         |root| {
             let area = root.titled(
                 "Training loss of the neural learners, mean over trainings",
                 (FONT, 18),
             )?;
-            let areas = area.split_evenly((rows, cols));
+            let (plots, strip) = area.split_vertically(PANEL_H * rows as u32);
+            legend_strip(&strip, &legend, 13)?;
+            let areas = plots.split_evenly((rows, cols));
             for (i, env) in envs.iter().enumerate() {
                 for (j, l) in learners.iter().enumerate() {
                     let of: Vec<&LossCurve> = curves
@@ -75,12 +143,21 @@ pub fn draw(curves: &[LossCurve], fig_dir: &Path) -> Result<Option<FigureFile>, 
             Ok(())
         },
     )?;
+    let mut trainings: Vec<usize> = curves.iter().map(|c| c.trainings).collect();
+    trainings.sort_unstable();
+    trainings.dedup();
+    let per_curve = match (trainings.first(), trainings.last()) {
+        (Some(a), Some(b)) if a == b => format!("{a}"),
+        (Some(a), Some(b)) => format!("{a}-{b}"),
+        _ => "0".into(),
+    };
     Ok(Some(FigureFile {
         path,
         link: format!("figures/{FILE}"),
-        caption: "Training loss of the AE, VAE and RFVAE against the iteration (mean over the \
-                  main campaign's trainings)"
-            .into(),
+        caption: format!(
+            "Training loss of the AE, VAE and RFVAE against the iteration (mean over the main \
+             campaign's trainings, {per_curve} per curve)"
+        ),
         env: String::new(),
     }))
 }
@@ -91,7 +168,7 @@ fn draw_panel(
     learner: &str,
     curves: &[&LossCurve],
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let title = format!("{}, {}", env_name(env), learner_name(learner));
+    let mut title = format!("{}, {}", env_name(env), learner_name(learner));
     if curves.is_empty() {
         area.draw(&Text::new(
             format!("{title}: no recorded loss"),
@@ -129,6 +206,9 @@ fn draw_panel(
         .copied()
         .chain(plateau)
         .fold(f64::NEG_INFINITY, f64::max);
+    if let Some(p) = plateau {
+        title.push_str(&format!(" (plateau {p:.0})"));
+    }
     let (lo, hi) = if lo.is_finite() && hi.is_finite() && hi > lo {
         (lo, hi)
     } else if lo.is_finite() {
@@ -161,35 +241,20 @@ fn draw_panel(
         .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
         .draw()?;
     if let Some(p) = plateau {
-        chart
-            .draw_series(std::iter::once(DashedPathElement::new(
-                vec![(0.0, p), (x_hi, p)],
-                3,
-                4,
-                RGBColor(0x77, 0x77, 0x77).stroke_width(1),
-            )))?
-            .label(format!("mean-image loss (plateau) {p:.0}"))
-            .legend(|(x, y)| {
-                DashedPathElement::new(
-                    vec![(x, y), (x + 20, y)],
-                    3,
-                    4,
-                    RGBColor(0x77, 0x77, 0x77).stroke_width(1),
-                )
-            });
+        chart.draw_series(std::iter::once(DashedPathElement::new(
+            vec![(0.0, p), (x_hi, p)],
+            3,
+            4,
+            PLATEAU_GREY.stroke_width(1),
+        )))?;
     }
     let n = curves.len().max(1);
     for (i, c) in curves.iter().enumerate() {
-        let slot = if Some(c.latents) == super::true_latents(env) {
-            2
-        } else {
-            0
-        };
-        let (mpts, _) = marker_points(slot, 4.0);
+        let (colour, mpts, dash, filled) = curve_style(env, c.latents, &c.variant);
         let style = LineStyle {
-            colour: latents_colour(env, c.latents),
-            dash: variant_dash(&c.variant),
-            marker: (mpts, variant_filled(&c.variant)),
+            colour,
+            dash,
+            marker: (mpts, filled),
             width: 2,
         };
         let pts: Vec<(f64, f64)> = c
@@ -206,25 +271,7 @@ fn draw_panel(
                 )
             })
             .collect();
-        let mut label = format!("{} latents", c.latents);
-        if c.variant != "none" {
-            label.push_str(&format!(", {}", c.variant));
-        }
-        label.push_str(&format!(
-            " ({} training{})",
-            c.trainings,
-            if c.trainings == 1 { "" } else { "s" }
-        ));
-        draw_curve(&mut chart, &pts, &style, i as f64 / n as f64, Some(label))?;
+        draw_curve(&mut chart, &pts, &style, i as f64 / n as f64, None)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .legend_area_size(30)
-        .margin(6)
-        .label_font((FONT, 12))
-        .background_style(WHITE.mix(0.9))
-        .border_style(RGBColor(0x99, 0x99, 0x99))
-        .draw()?;
     Ok(())
 }

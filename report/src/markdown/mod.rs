@@ -18,6 +18,7 @@ pub mod claims;
 pub mod compare;
 pub mod neural;
 pub mod quality;
+pub mod recipe;
 
 /// Everything the markdown is made of.
 pub struct Inputs<'a> {
@@ -507,6 +508,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
     neural::budget(w, inp);
     neural::training_loss(w, inp);
     quality::section(w, inp);
+    recipe::section(w, inp);
 
     // --- Outcome scatters.
     let _ = writeln!(w, "## Object positions reached\n");

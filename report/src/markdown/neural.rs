@@ -48,6 +48,17 @@ pub fn campaigns_line(w: &mut String, inp: &Inputs<'_>) {
             .collect();
         parts.push(format!("training-budget sensitivity {}", b.join(", ")));
     }
+    if !c.recipe.is_empty() {
+        let r: Vec<String> = c
+            .recipe
+            .iter()
+            .map(|r| {
+                let n = r.store.runs.len();
+                format!("{} ({n} run{})", campaign(&r.name), plural(n))
+            })
+            .collect();
+        parts.push(format!("training recipes {}", r.join(", ")));
+    }
     if !c.unused.is_empty() {
         let u: Vec<String> = c
             .unused
@@ -469,7 +480,9 @@ pub fn budget(w: &mut String, inp: &Inputs<'_>) {
         w,
         "The same condition trained for different numbers of iterations (read from each run's \
          `train.config.iterations`), from the campaigns {}. The seeds are the main campaign's: a \
-         seed starts from the same weights and draws the same batches at every budget. Each dot \
+         seed starts from the same weights and draws the same batches at every budget of these \
+         campaigns (the main campaign's network may have another recipe: see the list under the \
+         figure). Each dot \
          is a seed's final KL-coverage; diamonds the mean with its 90% bootstrap CI; the star the \
          main campaign {} at its own budget; horizontal lines the mean final KL-coverage of \
          RGE-EFR and RPE in the main campaign. The paper trained the VAE for 100,000 iterations. \
@@ -482,6 +495,24 @@ pub fn budget(w: &mut String, inp: &Inputs<'_>) {
     for f in inp.budget_figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
     }
+    let budget_runs: Vec<crate::load::Run> = inp
+        .campaigns
+        .budget
+        .iter()
+        .flat_map(|c| c.store.runs.iter().cloned())
+        .collect();
+    let _ = writeln!(
+        w,
+        "The budget campaigns' recipe besides the iterations, read from the manifests:\n"
+    );
+    super::recipe::recipe_lines(
+        w,
+        &budget_runs,
+        &inp.campaigns.main.store.runs,
+        &inp.campaigns.main.name,
+        false,
+    );
+    let _ = writeln!(w);
     for s in &inp.budget.series {
         let _ = writeln!(w, "### {}\n", series_title(s));
         let _ = writeln!(

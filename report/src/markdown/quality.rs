@@ -28,7 +28,7 @@ struct Row {
     old_measure: usize,
 }
 
-fn evidence(m: &Manifest) -> Option<(f64, bool)> {
+pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
     let e = m.raw.get("train")?.get("evidence")?;
     Some((e.get("loss_fraction")?.as_f64()?, m.trained()?))
 }
@@ -43,7 +43,7 @@ pub fn group_r2(m: &Manifest, group: &str) -> Option<(f64, f64)> {
     Some((g.get("linear_r2")?.as_f64()?, g.get("knn_r2")?.as_f64()?))
 }
 
-fn median(v: &[f64]) -> Option<f64> {
+pub(crate) fn median(v: &[f64]) -> Option<f64> {
     if v.is_empty() {
         return None;
     }
