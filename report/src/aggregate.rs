@@ -31,6 +31,8 @@ pub struct ConditionSummary {
     pub campaigns: Vec<String>,
     /// Sorted by epoch: every epoch any run of the condition evaluated.
     pub curve: Vec<CurveStat>,
+    /// The fraction of the achievable cells reached, per epoch, with the same statistics.
+    pub coverage_curve: Vec<CurveStat>,
     /// Distinct last epochs of the runs, sorted (one value unless budgets differ).
     pub final_epochs: Vec<i64>,
     /// KL-coverage at each run's last epoch.
@@ -137,26 +139,34 @@ fn summarize_condition(
     let slug = key.slug();
     let rs: Vec<&crate::load::Run> = runs.iter().map(|&i| &store.runs[i]).collect();
 
-    let mut by_epoch: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
-    for r in &rs {
-        for p in &r.curve {
-            by_epoch.entry(p.epoch).or_default().push(p.klc);
-        }
-    }
-    let curve = by_epoch
-        .iter()
-        .map(|(&epoch, xs)| {
-            let s = stats::summarize(xs, n_boot, epoch_seed(bootstrap_seed, &slug, epoch));
-            CurveStat {
-                epoch,
-                n: s.n,
-                mean: s.mean,
-                std: s.std,
-                lo: s.ci_lo,
-                hi: s.ci_hi,
+    // Per epoch over the runs: a value of each run's curve, summarised with the bootstrap
+    // stream `seed(epoch)`.
+    let curve_of = |value: fn(&crate::load::CurvePoint) -> f64, seed: &dyn Fn(i64) -> u64| {
+        let mut by_epoch: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
+        for r in &rs {
+            for p in &r.curve {
+                by_epoch.entry(p.epoch).or_default().push(value(p));
             }
-        })
-        .collect();
+        }
+        by_epoch
+            .iter()
+            .map(|(&epoch, xs)| {
+                let s = stats::summarize(xs, n_boot, seed(epoch));
+                CurveStat {
+                    epoch,
+                    n: s.n,
+                    mean: s.mean,
+                    std: s.std,
+                    lo: s.ci_lo,
+                    hi: s.ci_hi,
+                }
+            })
+            .collect::<Vec<_>>()
+    };
+    let curve = curve_of(|p| p.klc, &|e| epoch_seed(bootstrap_seed, &slug, e));
+    let coverage_curve = curve_of(|p| p.coverage, &|e| {
+        stats::derive_seed(bootstrap_seed, &format!("{slug}|coverage|epoch={e}"))
+    });
 
     let finals: Vec<_> = rs.iter().map(|r| r.final_point()).collect();
     let final_by_seed = rs
@@ -191,6 +201,7 @@ fn summarize_condition(
         runs,
         campaigns,
         curve,
+        coverage_curve,
         final_epochs,
         final_klc,
         final_by_seed,

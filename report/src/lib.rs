@@ -166,6 +166,11 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     create_dir(&fig_dir)?;
 
     let klc_figs = figures::klc_curves::draw_all(&curve_conditions, &fig_dir)?;
+    let coverage_figs = figures::klc_curves::draw_metric(
+        &curve_conditions,
+        &fig_dir,
+        figures::klc_curves::Metric::Coverage,
+    )?;
     let outcome_figs = figures::outcomes::draw_all(store, &conditions, &fig_dir)?;
     let mut sampler_figs = Vec::new();
     for (algo, name) in SAMPLER_FIGURES {
@@ -185,6 +190,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
 
     let mut figure_files: Vec<PathBuf> = klc_figs
         .iter()
+        .chain(&coverage_figs)
         .chain(&outcome_figs)
         .chain(&sampler_figs)
         .chain(&variants_fig)
@@ -204,6 +210,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         paper: &paper,
         conditions: &conditions,
         klc_figures: &klc_figs,
+        coverage_figures: &coverage_figs,
         outcome_figures: &outcome_figs,
         sampler_figures: &sampler_figs,
         variant_pairs: &pairs,

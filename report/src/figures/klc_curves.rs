@@ -21,7 +21,7 @@ use super::{
     sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
-use crate::aggregate::ConditionSummary;
+use crate::aggregate::{ConditionSummary, CurveStat};
 
 const PANEL_W: u32 = 620;
 const PANEL_H: u32 = 520;
@@ -38,10 +38,66 @@ struct Panel<'a> {
     members: Vec<&'a ConditionSummary>,
 }
 
+/// What a figure of curves shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Metric {
+    /// KL-coverage (the paper's Figure 2), with the paper's final values.
+    Klc,
+    /// The fraction of the achievable histogram cells reached (not in the paper).
+    Coverage,
+}
+
+impl Metric {
+    fn curve(self, c: &ConditionSummary) -> &[CurveStat] {
+        match self {
+            Metric::Klc => &c.curve,
+            Metric::Coverage => &c.coverage_curve,
+        }
+    }
+
+    /// The paper's final value of a condition, where it gives one for this metric.
+    fn paper(self, c: &ConditionSummary) -> Option<f64> {
+        match self {
+            Metric::Klc => c.paper.as_ref().map(|p| p.klc),
+            Metric::Coverage => None,
+        }
+    }
+
+    fn file(self, env: &str) -> String {
+        match self {
+            Metric::Klc => format!("klc_{}.svg", file_safe(env)),
+            Metric::Coverage => format!("coverage_{}.svg", file_safe(env)),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Metric::Klc => "KL-coverage",
+            Metric::Coverage => "cell coverage",
+        }
+    }
+
+    fn y_desc(self) -> &'static str {
+        match self {
+            Metric::Klc => "KL-coverage (nats, lower is better)",
+            Metric::Coverage => "achievable cells reached (higher is better)",
+        }
+    }
+}
+
 /// Draws `klc_<env>.svg` for every environment, in the report's order.
 pub fn draw_all(
     conditions: &[ConditionSummary],
     fig_dir: &Path,
+) -> Result<Vec<FigureFile>, ReportError> {
+    draw_metric(conditions, fig_dir, Metric::Klc)
+}
+
+/// Draws `<metric>_<env>.svg` for every environment, in the report's order.
+pub fn draw_metric(
+    conditions: &[ConditionSummary],
+    fig_dir: &Path,
+    metric: Metric,
 ) -> Result<Vec<FigureFile>, ReportError> {
     let mut envs: Vec<&str> = Vec::new();
     for c in conditions {
@@ -59,22 +115,28 @@ pub fn draw_all(
             continue;
         }
         let panels = panels_of(env, &of_env);
-        let name = format!("klc_{}.svg", file_safe(env));
+        let name = metric.file(env);
         let path = fig_dir.join(&name);
         let width = PANEL_W * panels.len() as u32;
         // One legend for all panels, in a strip under them (no legend hides a curve).
-        let legend = dedup_legend(panels.iter().flat_map(panel_legend).collect());
+        let legend = dedup_legend(
+            panels
+                .iter()
+                .flat_map(|p| panel_legend(p, metric))
+                .collect(),
+        );
         let legend_h = legend_height(width, &legend, 13);
         write_svg(&path, (width, PANEL_H + TITLE_H + legend_h), |root| {
             let title = format!(
-                "{}: KL-coverage, mean over seeds with 90% bootstrap CI",
-                env_name(env)
+                "{}: {}, mean over seeds with 90% bootstrap CI",
+                env_name(env),
+                metric.name()
             );
             let area = root.titled(&title, (FONT, 18))?;
             let (plots, strip) = area.split_vertically(PANEL_H);
             let areas = plots.split_evenly((1, panels.len()));
             for (panel, a) in panels.iter().zip(areas.iter()) {
-                draw_panel(a, env, panel)?;
+                draw_panel(a, env, panel, metric)?;
             }
             legend_strip(&strip, &legend, 13)?;
             Ok(())
@@ -84,8 +146,9 @@ pub fn draw_all(
             path,
             link: format!("figures/{name}"),
             caption: format!(
-                "{}: KL-coverage vs exploration epochs ({})",
+                "{}: {} vs exploration epochs ({})",
                 env_name(env),
+                metric.name(),
                 panel_list.join("; ")
             ),
             env: env.to_string(),
@@ -175,13 +238,13 @@ fn label(c: &ConditionSummary) -> String {
 
 /// The legend entries of a panel: one per condition with a finite mean somewhere, and the
 /// paper's star when the panel shows a paper value.
-fn panel_legend(panel: &Panel<'_>) -> Vec<(Icon, String)> {
+fn panel_legend(panel: &Panel<'_>, metric: Metric) -> Vec<(Icon, String)> {
     let styles = styles(&panel.members);
     let mut items: Vec<(Icon, String)> = panel
         .members
         .iter()
         .zip(&styles)
-        .filter(|(c, _)| c.curve.iter().any(|p| p.mean.is_finite()))
+        .filter(|(c, _)| metric.curve(c).iter().any(|p| p.mean.is_finite()))
         .map(|(c, &(slot, dash, filled))| {
             let (mpts, _) = marker_points(slot, 4.0);
             (
@@ -195,7 +258,7 @@ fn panel_legend(panel: &Panel<'_>) -> Vec<(Icon, String)> {
             )
         })
         .collect();
-    if panel.members.iter().any(|c| c.paper.is_some()) {
+    if panel.members.iter().any(|c| metric.paper(c).is_some()) {
         items.push((
             Icon::Marker {
                 colour: BLACK,
@@ -213,6 +276,7 @@ fn draw_panel(
     area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
     env: &str,
     panel: &Panel<'_>,
+    metric: Metric,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let x_last = panel
         .members
@@ -221,20 +285,19 @@ fn draw_panel(
         .max()
         .unwrap_or(1)
         .max(1) as f64;
-    let y_max = klc_max(env).unwrap_or_else(|| {
+    let data_max = || {
         let m = panel
             .members
             .iter()
-            .flat_map(|c| {
-                c.curve
-                    .iter()
-                    .map(|p| p.hi)
-                    .chain(c.paper.iter().map(|p| p.klc))
-            })
+            .flat_map(|c| metric.curve(c).iter().map(|p| p.hi).chain(metric.paper(c)))
             .filter(|v| v.is_finite())
             .fold(0.0f64, f64::max);
         if m > 0.0 { m * 1.05 } else { 1.0 }
-    });
+    };
+    let y_max = match metric {
+        Metric::Klc => klc_max(env).unwrap_or_else(data_max),
+        Metric::Coverage => data_max(),
+    };
     let x_range = -0.01 * x_last..x_last * 1.04;
     // The y axis spans the data (bands and the paper's values), down to the next 0.5 below
     // their smallest value, not from 0: the differences between conditions are a few tenths.
@@ -242,10 +305,11 @@ fn draw_panel(
         .members
         .iter()
         .flat_map(|c| {
-            c.curve
+            metric
+                .curve(c)
                 .iter()
                 .map(|p| p.lo.min(p.mean))
-                .chain(c.paper.iter().map(|p| p.klc))
+                .chain(metric.paper(c))
         })
         .filter(|v| v.is_finite())
         .fold(f64::INFINITY, f64::min);
@@ -254,7 +318,11 @@ fn draw_panel(
     } else {
         0.0
     };
-    let y_min = y_min.min(y_max - 0.5).max(0.0);
+    let y_min = match metric {
+        Metric::Klc => y_min.min(y_max - 0.5).max(0.0),
+        // Coverage is a fraction: from 0.
+        Metric::Coverage => 0.0,
+    };
 
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, (FONT, 17))
@@ -265,9 +333,12 @@ fn draw_panel(
     chart
         .configure_mesh()
         .x_desc("exploration epochs")
-        .y_desc("KL-coverage (nats, lower is better)")
+        .y_desc(metric.y_desc())
         .x_label_formatter(&fmt_epoch)
-        .y_label_formatter(&|v| format!("{v:.1}"))
+        .y_label_formatter(&|v| match metric {
+            Metric::Klc => format!("{v:.1}"),
+            Metric::Coverage => format!("{:.0}%", v * 100.0),
+        })
         .x_labels(8)
         .y_labels(8)
         .label_style((FONT, 13))
@@ -284,8 +355,8 @@ fn draw_panel(
 
     // Bands first, so that every line is drawn over every band.
     for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
-        let pts: Vec<_> = c
-            .curve
+        let pts: Vec<_> = metric
+            .curve(c)
             .iter()
             .filter(|p| !p.lo.is_nan() && !p.hi.is_nan())
             .collect();
@@ -308,7 +379,7 @@ fn draw_panel(
 
         // Finite means only; an infinite mean breaks the line.
         let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-        for p in &c.curve {
+        for p in metric.curve(c) {
             if p.mean.is_finite() {
                 segments
                     .last_mut()
@@ -348,8 +419,8 @@ fn draw_panel(
     // The paper's single-run values, at the last epoch of each condition.
     let star = star_points(8.0, 3.5);
     for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
-        if let Some(p) = &c.paper {
-            let at = (c.last_epoch() as f64, clamp(p.klc));
+        if let Some(p) = metric.paper(c) {
+            let at = (c.last_epoch() as f64, clamp(p));
             chart.draw_series(std::iter::once(marker(at, &star, false, colour(slot), 2)))?;
         }
     }

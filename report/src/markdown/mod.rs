@@ -30,6 +30,8 @@ pub struct Inputs<'a> {
     /// The main campaign's conditions.
     pub conditions: &'a [ConditionSummary],
     pub klc_figures: &'a [FigureFile],
+    /// Cell coverage against the epochs, as the KL-coverage figures.
+    pub coverage_figures: &'a [FigureFile],
     pub outcome_figures: &'a [FigureFile],
     /// Goal-space lattices and reconstruction grids (seed 0 of each learned cell).
     pub goal_space_figures: &'a [FigureFile],
@@ -419,6 +421,25 @@ pub fn render(inp: &Inputs<'_>) -> String {
     }
     for f in inp.klc_figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+    }
+    if !inp.coverage_figures.is_empty() {
+        let _ = writeln!(
+            w,
+            "### Cell coverage during exploration (not in the paper)
+"
+        );
+        let _ = writeln!(
+            w,
+            "The same runs and styles, with the fraction of the achievable histogram cells \
+             (PAPER-NOTES section 4; the arrow's angle is a dimension of ArmArrow's cells) that \
+             the outcomes have reached, higher is better. KL-coverage also rewards moving the \
+             object often (every episode that leaves it in place adds to one cell), so a \
+             condition can lower its KL-coverage without reaching new cells; this figure shows \
+             the diversity alone.\n"
+        );
+        for f in inp.coverage_figures {
+            let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+        }
     }
 
     // --- Final table.
