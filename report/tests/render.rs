@@ -195,7 +195,12 @@ fn renders_report_and_figures_with_the_right_numbers() {
 
     let report = out.join("REPORT.md");
     assert_eq!(summary.files[0], report);
-    for name in ["klc_armball.svg", "klc_armarrow.svg"] {
+    for name in [
+        "klc_armball.svg",
+        "klc_armarrow.svg",
+        "coverage_armball.svg",
+        "coverage_armarrow.svg",
+    ] {
         assert!(out.join("figures").join(name).is_file(), "{name}");
     }
     for env in ENVS {
@@ -204,9 +209,9 @@ fn renders_report_and_figures_with_the_right_numbers() {
             assert!(out.join("figures").join(&name).is_file(), "{name}");
         }
     }
-    // REPORT.md, 2 KLC figures, 4 outcome scatters, the paper's 3 illustrations (Figures 1, 5,
-    // 6), 2 CSV files.
-    assert_eq!(summary.files.len(), 1 + 2 + 4 + 3 + 2);
+    // REPORT.md, 2 KLC and 2 coverage figures, 4 outcome scatters, the paper's 3 illustrations
+    // (Figures 1, 5, 6), 2 CSV files.
+    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + 3 + 2);
     for name in [
         "fig1_environments.svg",
         "fig5_radial_flow.svg",
