@@ -184,14 +184,22 @@ fn write_run(dir: &Path, s: &Spec) {
         );
     }
     if s.latents > 0 {
-        manifest.as_object_mut().unwrap().insert(
-            "latent_quality".into(),
-            serde_json::json!({"version": 2, "linear_r2_mean": 0.5 + 0.1 * s.seed as f64,
+        let mut q = serde_json::json!({"version": 2, "linear_r2_mean": 0.5 + 0.1 * s.seed as f64,
                                "knn_r2_mean": 0.9,
                                "groups": [{"group": "position",
                                            "linear_r2": 0.5 + 0.1 * s.seed as f64,
-                                           "knn_r2": 0.9}]}),
-        );
+                                           "knn_r2": 0.9}]});
+        // Seed 0 holds measure version 2, the others version 3 (trustworthiness 0.8 + 0.05 x
+        // seed, continuity 0.95, against the position).
+        if s.seed > 0 {
+            q["version"] = 3.into();
+            q["neighbourhoods"] = serde_json::json!([{"space": "position",
+                "trustworthiness": 0.8 + 0.05 * s.seed as f64, "continuity": 0.95}]);
+        }
+        manifest
+            .as_object_mut()
+            .unwrap()
+            .insert("latent_quality".into(), q);
     }
     std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
 }
@@ -400,9 +408,15 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         .lines()
         .find(|l| l.starts_with("| ArmBall | RGE-VAE | faithful |"))
         .expect("a VAE row");
+    // T / C: the mean over seeds 1 and 2 (seed 0 has no neighbourhoods).
     assert!(
-        row.contains("**1 of 3**") && row.contains("| 0.600 | 0.900 | — | — |"),
+        row.contains("**1 of 3**") && row.contains("| 0.600 | 0.900 | — | — | 0.875 / 0.950 |"),
         "{row}"
+    );
+    // Nine learned cells (AE-10; VAE and RFVAE, two variants, two sizes), seed 0 of each.
+    assert!(
+        q.contains("9 runs hold version 2 of the latent-quality measure"),
+        "{q}"
     );
     assert!(q.contains("did not leave the plateau"), "{q}");
     let fig = |n: &str| out.join("figures").join(n);

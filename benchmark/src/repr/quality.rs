@@ -24,6 +24,22 @@
 //! Each reports R² = 1 - SSE / SST per target and their mean. An untrained random projection
 //! scores well on the linear map only when it keeps the object's position; a collapsed encoder
 //! scores about 0.
+//!
+//! **Neighbourhoods** (measure version 3): the R² says whether the state can be read off the
+//! latents, not whether the goal space keeps the state's neighbourhoods (a goal space folded
+//! onto itself can score a high k-NN R² and still put far-apart states side by side). So the
+//! measure also gives the co-ranking measures of the original code's `src/measures.py`,
+//! trustworthiness and continuity (Venna & Kaski 2001), between the object's state and the
+//! latents of the held-out images, with `k` = [`KNN_K`] neighbours and Euclidean distances:
+//! - **trustworthiness** `T(k) = 1 - 2 / (n k (2n - 3k - 1)) * sum_i sum_{j in U_k(i)} (r(i, j) - k)`,
+//!   `U_k(i)` the latent neighbours of `i` that are not among its state neighbours and `r(i, j)`
+//!   the rank of `j` among `i`'s neighbours in the state space: 1 when every latent neighbour
+//!   is a true neighbour;
+//! - **continuity** `C(k)`: the same with the spaces swapped (state neighbours missing from the
+//!   latent neighbourhood, ranked in the latent space).
+//!
+//! Ranks break ties by index (a collapsed encoder gets chance-level values, about 0.5). Spaces:
+//! `position` (x, y) and, for the arrow, `state` (x, y, cos a, sin a).
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -35,8 +51,9 @@ use super::{Latents, ReprError};
 pub const KNN_K: usize = 10;
 
 /// Version of the measure recorded with it (1: maps fitted on 2000 training latents, no
-/// modulo-120° targets; 2: on the whole training set, with them).
-pub const MEASURE_VERSION: u32 = 2;
+/// modulo-120° targets; 2: on the whole training set, with them; 3: with trustworthiness and
+/// continuity).
+pub const MEASURE_VERSION: u32 = 3;
 
 /// R² of the two regressions, per target and on average.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,6 +72,9 @@ pub struct LatentQuality {
     /// Means per target group ([`TargetGroup`]): linear and k-NN R² of the position, and (arrow)
     /// of the angle and of the angle modulo 120°.
     pub groups: Vec<GroupR2>,
+    /// Trustworthiness and continuity per state space (version 3 and later; empty before).
+    #[serde(default)]
+    pub neighbourhoods: Vec<Neighbourhoods>,
     /// Training and held-out set sizes, and `k`.
     pub n_train: usize,
     pub n_heldout: usize,
@@ -69,6 +89,21 @@ pub struct GroupR2 {
     pub linear_r2: f64,
     pub knn_r2: f64,
 }
+
+/// Neighbourhood preservation between one state space and the latents, on the held-out images.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Neighbourhoods {
+    /// `position` (x, y) or `state` (arrow: x, y, cos a, sin a).
+    pub space: String,
+    pub trustworthiness: f64,
+    pub continuity: f64,
+}
+
+/// The state spaces of the neighbourhood measures: name and target columns.
+const NEIGHBOURHOOD_SPACES: [(&str, &[&str]); 2] = [
+    ("position", &["x", "y"]),
+    ("state", &["x", "y", "cos_angle", "sin_angle"]),
+];
 
 /// The groups of targets, by name prefix: what a reader asks of a goal space.
 const GROUPS: [(&str, &[&str]); 3] = [
@@ -137,8 +172,28 @@ pub fn latent_quality(
             })
         })
         .collect();
+    let neighbourhoods = NEIGHBOURHOOD_SPACES
+        .iter()
+        .filter_map(|(space, members)| {
+            let idx: Vec<usize> = members
+                .iter()
+                .map(|m| names.iter().position(|n| n == m))
+                .collect::<Option<_>>()?;
+            let points: Vec<f64> = (0..heldout.n)
+                .flat_map(|i| idx.iter().map(move |&j| heldout_targets[i * t + j]))
+                .collect();
+            let (trustworthiness, continuity) =
+                trustworthiness_continuity(&points, idx.len(), heldout, KNN_K);
+            Some(Neighbourhoods {
+                space: space.to_string(),
+                trustworthiness,
+                continuity,
+            })
+        })
+        .collect();
     Ok(LatentQuality {
         version: MEASURE_VERSION,
+        neighbourhoods,
         targets: names,
         linear_r2_mean: mean(&linear_r2),
         knn_r2_mean: mean(&knn_r2),
@@ -149,6 +204,70 @@ pub fn latent_quality(
         n_heldout: heldout.n,
         k: KNN_K.min(train.n),
     })
+}
+
+/// For each point, the ranks of all points by distance from it (itself rank 0, its nearest
+/// neighbour 1; ties broken by index), row-major `n x n`, from row-major `n x dim` coordinates.
+fn ranks(points: &[f64], dim: usize) -> Vec<u32> {
+    use rayon::prelude::*;
+    let n = points.len() / dim;
+    let row = |i: usize| &points[i * dim..(i + 1) * dim];
+    let mut out = vec![0u32; n * n];
+    out.par_chunks_mut(n).enumerate().for_each(|(i, r)| {
+        let d: Vec<f64> = (0..n)
+            .map(|j| {
+                row(i)
+                    .iter()
+                    .zip(row(j))
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum()
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..n).filter(|&j| j != i).collect();
+        order.sort_by(|&a, &b| d[a].total_cmp(&d[b]).then(a.cmp(&b)));
+        r[i] = 0;
+        for (rank, &j) in order.iter().enumerate() {
+            r[j] = rank as u32 + 1;
+        }
+    });
+    out
+}
+
+/// Trustworthiness and continuity (module docs) of `latents` against the row-major
+/// `n x dim` state coordinates `state`, with `k` neighbours (clamped to keep the normaliser
+/// positive).
+pub fn trustworthiness_continuity(
+    state: &[f64],
+    dim: usize,
+    latents: &Latents,
+    k: usize,
+) -> (f64, f64) {
+    let n = latents.n;
+    let k = k.min((2 * n).saturating_sub(2) / 3).max(1);
+    if n < 3 || state.len() != n * dim {
+        return (f64::NAN, f64::NAN);
+    }
+    let high = ranks(state, dim);
+    let low = ranks(&latents.data, latents.latents);
+    let k32 = k as u32;
+    // Sum over i of (rank in `a` - k) for the points within k of i in `b` but not in `a`.
+    let penalty = |a: &[u32], b: &[u32]| -> f64 {
+        (0..n)
+            .map(|i| {
+                let (ra, rb) = (&a[i * n..(i + 1) * n], &b[i * n..(i + 1) * n]);
+                (0..n)
+                    .filter(|&j| j != i && rb[j] <= k32 && ra[j] > k32)
+                    .map(|j| f64::from(ra[j] - k32))
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    let (nf, kf) = (n as f64, k as f64);
+    let norm = 2.0 / (nf * kf * (2.0 * nf - 3.0 * kf - 1.0));
+    (
+        1.0 - norm * penalty(&high, &low),
+        1.0 - norm * penalty(&low, &high),
+    )
 }
 
 /// Per-column mean and standard deviation (1 where the column is constant).
@@ -319,6 +438,40 @@ mod tests {
         assert!(
             q.linear_r2_mean.abs() < 0.02 && q.knn_r2_mean.abs() < 0.05,
             "{q:?}"
+        );
+    }
+
+    /// Trustworthiness and continuity on known answers: an isometry keeps every neighbourhood
+    /// (1, 1); a fold (x -> |x|) puts mirrored states side by side (trustworthiness falls) but
+    /// keeps true neighbours close (continuity stays high); constant latents are at chance
+    /// (about 0.5); and a hand-checked tiny case.
+    #[test]
+    fn neighbourhood_measures_know_isometries_folds_and_collapse() {
+        let mut rng = stream_named(7, "quality-neighbourhoods");
+        let n = 600;
+        let s: Vec<f64> = (0..2 * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let map = |f: &dyn Fn(f64, f64) -> Vec<f64>, d: usize| {
+            latents(n, d, s.chunks(2).flat_map(|p| f(p[0], p[1])).collect())
+        };
+        let (t, c) = trustworthiness_continuity(&s, 2, &map(&|x, y| vec![3.0 - y, x], 2), 10);
+        assert!(
+            (t - 1.0).abs() < 1e-12 && (c - 1.0).abs() < 1e-12,
+            "{t} {c}"
+        );
+        let (t, c) = trustworthiness_continuity(&s, 2, &map(&|x, y| vec![x.abs(), y], 2), 10);
+        assert!(t < 0.97 && c > 0.99 && c > t, "{t} {c}");
+        let (t, c) = trustworthiness_continuity(&s, 2, &map(&|_, _| vec![1.0], 1), 10);
+        assert!((t - 0.5).abs() < 0.1 && (c - 0.5).abs() < 0.1, "{t} {c}");
+        // 4 states on a line at 0, 1, 3, 7 (no tied distances); latents 0, 3, 1, 7 swap the
+        // middle two. With k = 1 every point's latent neighbour is its state rank-2 point
+        // (penalty 1 each: 0 -> 2, 1 -> 2, 2 -> 0, 3 -> 1), and every state neighbour is its
+        // latent rank-2 point: T = C = 1 - 2 / (4 (8 - 3 - 1)) * 4 = 0.5.
+        let line = [0.0, 1.0, 3.0, 7.0];
+        let swapped = latents(4, 1, vec![0.0, 3.0, 1.0, 7.0]);
+        let (t, c) = trustworthiness_continuity(&line, 1, &swapped, 1);
+        assert!(
+            (t - 0.5).abs() < 1e-12 && (c - 0.5).abs() < 1e-12,
+            "{t} {c}"
         );
     }
 

@@ -52,6 +52,17 @@ fn poi(
 /// Mean k-NN R² of a target group over the runs of `store` in a task (one value per seed: the
 /// KDE and Gaussian runs of a cell share a representation).
 fn group_r2(store: &Store, task: &Task, group: &str) -> Option<f64> {
+    per_representation(store, task, |m| {
+        super::quality::group_r2(m, group).map(|(_, knn)| knn)
+    })
+}
+
+/// The mean over the representations of a task (one per seed and variant) of a manifest value.
+fn per_representation(
+    store: &Store,
+    task: &Task,
+    value: impl Fn(&crate::load::Manifest) -> Option<f64>,
+) -> Option<f64> {
     let mut seen = Vec::new();
     let mut vals = Vec::new();
     for r in store
@@ -62,9 +73,9 @@ fn group_r2(store: &Store, task: &Task, group: &str) -> Option<f64> {
         if seen.contains(&(r.seed, r.key.variant.clone())) {
             continue;
         }
-        if let Some((_, knn)) = super::quality::group_r2(&r.manifest, group) {
+        if let Some(v) = value(&r.manifest) {
             seen.push((r.seed, r.key.variant.clone()));
-            vals.push(knn);
+            vals.push(v);
         }
     }
     (!vals.is_empty()).then(|| stats::mean(&vals))
@@ -144,7 +155,9 @@ pub fn page(
         );
         let _ = writeln!(
             w,
-            "- what its goal spaces encode (held-out k-NN R², mean over seeds):"
+            "- what its goal spaces encode (held-out k-NN R², mean over seeds; T / C: \
+             trustworthiness and continuity of the latents against the position, as in the \
+             main report's quality section):"
         );
         for t in &e.tasks {
             let pos = group_r2(store, t, "position");
@@ -163,6 +176,15 @@ pub fn page(
                     f(angle),
                     f(mod120)
                 ));
+            }
+            let t_pos = per_representation(store, t, |m| {
+                super::quality::neighbourhoods(m, "position").map(|(t, _)| t)
+            });
+            let c_pos = per_representation(store, t, |m| {
+                super::quality::neighbourhoods(m, "position").map(|(_, c)| c)
+            });
+            if let (Some(tp), Some(cp)) = (t_pos, c_pos) {
+                line.push_str(&format!("; position T / C {tp:.3} / {cp:.3}"));
             }
             let _ = writeln!(w, "{line}");
         }

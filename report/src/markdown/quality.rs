@@ -24,8 +24,31 @@ struct Row {
     position_knn: Vec<f64>,
     angle_knn: Vec<f64>,
     angle_mod_120_knn: Vec<f64>,
+    /// Trustworthiness and continuity of the latents against the object's position (measure
+    /// version 3 and later).
+    trustworthiness: Vec<f64>,
+    continuity: Vec<f64>,
     /// Runs whose manifest holds the first version of the measure (no groups).
     old_measure: usize,
+    /// Runs whose measure has groups but no neighbourhoods (version 2).
+    no_neighbourhoods: usize,
+}
+
+/// (trustworthiness, continuity) of a manifest's latents against a state space (`position`,
+/// `state`), measure version 3 and later.
+pub fn neighbourhoods(m: &Manifest, space: &str) -> Option<(f64, f64)> {
+    let all = m
+        .raw
+        .get("latent_quality")?
+        .get("neighbourhoods")?
+        .as_array()?;
+    let n = all
+        .iter()
+        .find(|g| g.get("space").and_then(|v| v.as_str()) == Some(space))?;
+    Some((
+        n.get("trustworthiness")?.as_f64()?,
+        n.get("continuity")?.as_f64()?,
+    ))
 }
 
 pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
@@ -87,7 +110,10 @@ fn rows(inp: &Inputs<'_>) -> Vec<Row> {
             position_knn: Vec::new(),
             angle_knn: Vec::new(),
             angle_mod_120_knn: Vec::new(),
+            trustworthiness: Vec::new(),
+            continuity: Vec::new(),
             old_measure: 0,
+            no_neighbourhoods: 0,
         };
         for &i in &c.runs {
             let m = &inp.store.runs[i].manifest;
@@ -108,6 +134,15 @@ fn rows(inp: &Inputs<'_>) -> Vec<Row> {
                     }
                 }
                 None => r.old_measure += usize::from(m.raw.get("latent_quality").is_some()),
+            }
+            match neighbourhoods(m, "position") {
+                Some((t, c)) => {
+                    r.trustworthiness.push(t);
+                    r.continuity.push(c);
+                }
+                None => {
+                    r.no_neighbourhoods += usize::from(group_r2(m, "position").is_some());
+                }
             }
         }
         out.push(r);
@@ -138,7 +173,16 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
          held-out images, by a linear map and by 10-nearest-neighbour regression, both fitted on \
          the whole training set (mean over seeds). **position**: ball or arrow x, y; **angle**: \
          the arrow's angle a as cos a, sin a; **angle mod 120°**: cos 3a, sin 3a. 1 is \
-         perfect, 0 is no better than the mean.\n\n\
+         perfect, 0 is no better than the mean;\n\
+         - **T / C**: trustworthiness and continuity (Venna & Kaski 2001; the co-ranking \
+         measures of the original code's `measures.py`) between the object's position and the \
+         latents of the same held-out images, with 10 neighbours (mean over seeds). \
+         *Trustworthiness* is 1 when every latent neighbour of an image is one of its nearest \
+         positions (a goal space folded onto itself brings far-apart positions together and \
+         loses it), *continuity* when every near position stays a latent neighbour (a goal \
+         space torn apart loses it); chance level is about 0.5. R² says whether the position \
+         can be read off the latents, T and C whether the latents keep its neighbourhoods, \
+         which is what a goal sampled near another asks for.\n\n\
          Why the angle modulo 120°: the rendered arrow is a dart whose three outer corners lie \
          120° apart, and only the notch at its centre tells the tip from the other two. In \
          pixel distance the shape is nearly three-fold symmetric. From raw pixels (no learner), \
@@ -163,9 +207,13 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
     let _ = writeln!(
         w,
         "| env | algorithm | variant | latents | runs | untrained | loss / plateau | \
-         position R² linear | position R² k-NN | angle R² k-NN | angle mod 120° R² k-NN |"
+         position R² linear | position R² k-NN | angle R² k-NN | angle mod 120° R² k-NN | \
+         position T / C |"
     );
-    let _ = writeln!(w, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        w,
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for r in &rows {
         let untrained = if r.with_evidence == 0 {
             "—".to_string()
@@ -176,7 +224,7 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
         };
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             env_name(&r.env),
             crate::figures::algo_name(&r.algo),
             r.variant,
@@ -187,7 +235,11 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
             fmt(mean(&r.position_linear), 3),
             fmt(mean(&r.position_knn), 3),
             fmt(mean(&r.angle_knn), 3),
-            fmt(mean(&r.angle_mod_120_knn), 3)
+            fmt(mean(&r.angle_mod_120_knn), 3),
+            match (mean(&r.trustworthiness), mean(&r.continuity)) {
+                (Some(t), Some(c)) => format!("{t:.3} / {c:.3}"),
+                _ => "—".into(),
+            }
         );
     }
     let old: usize = rows.iter().map(|r| r.old_measure).sum();
@@ -195,9 +247,19 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
         let _ = writeln!(
             w,
             "\n{old} run{} hold the first version of the latent-quality measure (fitted on 2000 \
-             images, no groups) and show \"—\": `ugl campaign --config ... --remeasure-quality` \
+             images, no groups) and show \"—\": `ugl campaign --config ... --refresh-diagnostics` \
              brings them up to date without rerunning them.",
             plural(old)
+        );
+    }
+    let v2: usize = rows.iter().map(|r| r.no_neighbourhoods).sum();
+    if v2 > 0 {
+        let _ = writeln!(
+            w,
+            "\n{v2} run{} hold version 2 of the latent-quality measure (no trustworthiness or \
+             continuity) and show \"—\" under T / C: `ugl campaign --config ... \
+             --refresh-diagnostics` brings them up to date without rerunning them.",
+            plural(v2)
         );
     }
     let n_untrained: usize = rows.iter().map(|r| r.untrained).sum();
