@@ -8,6 +8,7 @@
 pub mod campaign;
 pub mod env;
 pub mod explore;
+pub mod fsio;
 pub mod goals;
 pub mod limits;
 pub mod metrics;

@@ -5,9 +5,11 @@ pub mod config;
 pub mod embed;
 pub mod goal_space;
 pub mod machine;
+pub mod merge;
 pub mod plan;
 pub mod remeasure;
 pub mod runner;
+pub mod slurm;
 pub mod store;
 
 pub use config::{CampaignConfig, ConfigError};

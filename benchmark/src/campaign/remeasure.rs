@@ -68,8 +68,7 @@ pub fn refresh_diagnostics(
             done.unfinished += 1;
             continue;
         }
-        let [_, _, path] = store::run_paths(out, &spec.run_id());
-        let manifest = store::read_manifest(&path)?;
+        let manifest = store::read_manifest(&store::run_paths(out, &spec.run_id()).manifest)?;
         let stale = measure_version(&manifest) < u64::from(MEASURE_VERSION);
         done.current += usize::from(!stale);
         let key = spec

@@ -4,8 +4,6 @@
 //! the lengths and BLAKE3 hashes the manifest records ([`Manifest::files`]; manifests written
 //! before results version 3 do not record them, and their files are taken as they are).
 
-use std::fs::File;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
@@ -140,8 +138,8 @@ impl FileDigest {
 /// digests (written before they were recorded) pass if the files exist.
 pub fn verify_files(dir: &Path, manifest: &Manifest) -> Result<(), String> {
     let Some(files) = &manifest.files else {
-        let [c, o, _] = run_paths(dir, &manifest.run_id);
-        return match [&c, &o].into_iter().find(|p| !p.is_file()) {
+        let paths = run_paths(dir, &manifest.run_id);
+        return match paths.data().into_iter().find(|p| !p.is_file()) {
             Some(p) => Err(format!("{} is missing", p.display())),
             None => Ok(()),
         };
@@ -197,13 +195,31 @@ mod inf_as_string {
     }
 }
 
+/// The files of a run in a results directory.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunPaths {
+    /// `<run_id>.parquet`: the exploration curve.
+    pub curve: PathBuf,
+    /// `<run_id>.outcomes.parquet`: every outcome.
+    pub outcomes: PathBuf,
+    /// `<run_id>.json`: the manifest, written last (a run is complete when it exists).
+    pub manifest: PathBuf,
+}
+
+impl RunPaths {
+    /// The data files, in the order they are written (the manifest comes after them).
+    pub fn data(&self) -> [&Path; 2] {
+        [&self.curve, &self.outcomes]
+    }
+}
+
 /// Paths of a run's files in a results directory.
-pub fn run_paths(dir: &Path, run_id: &str) -> [PathBuf; 3] {
-    [
-        dir.join(format!("{run_id}.parquet")),
-        dir.join(format!("{run_id}.outcomes.parquet")),
-        dir.join(format!("{run_id}.json")),
-    ]
+pub fn run_paths(dir: &Path, run_id: &str) -> RunPaths {
+    RunPaths {
+        curve: dir.join(format!("{run_id}.parquet")),
+        outcomes: dir.join(format!("{run_id}.outcomes.parquet")),
+        manifest: dir.join(format!("{run_id}.json")),
+    }
 }
 
 /// The curve table of a run.
@@ -245,32 +261,12 @@ pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Data
     )
 }
 
-/// Write `bytes` to `path` atomically (temporary file in the same directory, then rename).
+/// Write `bytes` to `path` atomically ([`crate::fsio::write_atomic`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
-    let tmp = tmp_path(path);
-    let io = |source| StoreError::Io {
+    crate::fsio::write_atomic(path, bytes).map_err(|source| StoreError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let mut f = File::create(&tmp).map_err(io)?;
-    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
-    })?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
     })
-}
-
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut name = path
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
-    name.push(format!(".{}.tmp", std::process::id()));
-    path.with_file_name(name)
 }
 
 /// Encode a frame as parquet bytes (deterministic for the same frame).
@@ -296,7 +292,11 @@ pub fn write_run(
         path: dir.to_path_buf(),
         source,
     })?;
-    let [curve_p, outcomes_p, _] = run_paths(dir, &spec.run_id());
+    let RunPaths {
+        curve: curve_p,
+        outcomes: outcomes_p,
+        ..
+    } = run_paths(dir, &spec.run_id());
     let enc = |p: &Path, e: PolarsError| StoreError::Encode {
         path: p.to_path_buf(),
         message: e.to_string(),
@@ -322,7 +322,7 @@ pub fn write_run(
 
 /// Write (or replace, atomically) a run's manifest.
 pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<(), StoreError> {
-    let [_, _, manifest_p] = run_paths(dir, &manifest.run_id);
+    let manifest_p = run_paths(dir, &manifest.run_id).manifest;
     let mut json = serde_json::to_vec_pretty(manifest).map_err(|e| StoreError::Encode {
         path: manifest_p.clone(),
         message: e.to_string(),
@@ -347,8 +347,7 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, StoreError> {
 /// matching, and both data files as it records them ([`verify_files`]). A damaged run is not
 /// complete: a resumed campaign recomputes it (and says so in the log).
 pub fn is_complete(dir: &Path, run_id: &str, config_hash: &str) -> bool {
-    let [_, _, m] = run_paths(dir, run_id);
-    match read_manifest(&m) {
+    match read_manifest(&run_paths(dir, run_id).manifest) {
         Ok(m) if m.config_hash == config_hash => match verify_files(dir, &m) {
             Ok(()) => true,
             Err(why) => {

@@ -225,8 +225,7 @@ impl ModelCache {
         };
         std::fs::create_dir_all(&self.dir).map_err(|e| io("create", &self.dir, e))?;
         let path = self.path(key);
-        crate::campaign::store::write_atomic(&path, &to_bytes(key, enc))
-            .map_err(|e| ReprError::Cache(e.to_string()))
+        crate::fsio::write_atomic(&path, &to_bytes(key, enc)).map_err(|e| io("write", &path, e))
     }
 }
 

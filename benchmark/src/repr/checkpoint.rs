@@ -93,8 +93,7 @@ pub fn save(
     );
     let net_bytes = cache::to_bytes(&c.key, &enc);
     let net_path = dir.join("net.model");
-    crate::campaign::store::write_atomic(&net_path, &net_bytes)
-        .map_err(|e| io("write", &net_path, e))?;
+    crate::fsio::write_atomic(&net_path, &net_bytes).map_err(|e| io("write", &net_path, e))?;
     let optim_path = dir.join(optim_file(&trainer.cfg));
     trainer.save_optimizer(&optim_path)?;
     let optim_bytes = std::fs::read(&optim_path).map_err(|e| io("read", &optim_path, e))?;
@@ -112,8 +111,7 @@ pub fn save(
     };
     let json = serde_json::to_vec(&state).expect("state serialises");
     let state_path = dir.join("state.json");
-    crate::campaign::store::write_atomic(&state_path, &json)
-        .map_err(|e| io("write", &state_path, e))?;
+    crate::fsio::write_atomic(&state_path, &json).map_err(|e| io("write", &state_path, e))?;
     for (step, old) in existing(c) {
         if step < trainer.step {
             let _ = std::fs::remove_dir_all(old);

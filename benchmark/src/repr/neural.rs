@@ -789,10 +789,8 @@ impl<'a> Trainer<'a> {
             |e: String| ReprError::Io(format!("saving optimiser state {}: {e}", path.display()));
         match &self.state {
             EngineState::Burn { opt, .. } => opt.save(path).map_err(|e| fail(format!("{e:?}"))),
-            EngineState::Host(host) => {
-                crate::campaign::store::write_atomic(path, &host.opt.to_bytes())
-                    .map_err(|e| fail(e.to_string()))
-            }
+            EngineState::Host(host) => crate::fsio::write_atomic(path, &host.opt.to_bytes())
+                .map_err(|e| fail(e.to_string())),
         }
     }
 

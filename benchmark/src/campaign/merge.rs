@@ -1,0 +1,120 @@
+//! Merging results stores (`ugl merge`): the shards of a campaign run on several machines
+//! (`--shard i/n`, or `ugl slurm`) come back as separate directories and are merged into one.
+//!
+//! A run is copied data files first, manifest last (a run is complete when its manifest exists),
+//! each file written atomically. A run already in the destination is left as it is when it is
+//! the same run (same config hash, byte-identical data); anything else is refused, never
+//! overwritten. A damaged or incomplete run in a source is refused with what is wrong with it.
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use super::store::{self, StoreError};
+
+/// Why a merge stopped.
+#[derive(Debug, Error)]
+pub enum MergeError {
+    #[error("{0}: not a directory")]
+    NotADirectory(PathBuf),
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{source_dir}: run {run_id} is incomplete or damaged ({why}); resume its campaign there to \
+         recompute it, then merge again"
+    )]
+    Damaged {
+        source_dir: PathBuf,
+        run_id: String,
+        why: String,
+    },
+    #[error("run {run_id} exists in {into} with different {what}: refusing to overwrite")]
+    Conflict {
+        run_id: String,
+        into: PathBuf,
+        /// `config hash` or `data`.
+        what: &'static str,
+    },
+    #[error(transparent)]
+    Store(#[from] StoreError),
+}
+
+/// What a merge did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MergeSummary {
+    /// Runs copied into the destination.
+    pub copied: usize,
+    /// Runs already there, identical.
+    pub already_present: usize,
+}
+
+/// Merge the runs of every store in `sources` into `into` (created if needed).
+pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, MergeError> {
+    let mut done = MergeSummary::default();
+    for src in sources {
+        if !src.is_dir() {
+            return Err(MergeError::NotADirectory(src.clone()));
+        }
+        let read = |source| MergeError::Read {
+            path: src.clone(),
+            source,
+        };
+        let mut manifests: Vec<PathBuf> = std::fs::read_dir(src)
+            .map_err(read)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        manifests.sort();
+        for m in manifests {
+            let manifest = store::read_manifest(&m)?;
+            let from = store::run_paths(src, &manifest.run_id);
+            if let Err(why) = store::verify_files(src, &manifest) {
+                return Err(MergeError::Damaged {
+                    source_dir: src.clone(),
+                    run_id: manifest.run_id,
+                    why,
+                });
+            }
+            let to = store::run_paths(into, &manifest.run_id);
+            if to.manifest.exists() {
+                let theirs = store::read_manifest(&to.manifest)?;
+                let identical_data = from
+                    .data()
+                    .iter()
+                    .zip(to.data())
+                    .all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
+                if theirs.config_hash != manifest.config_hash || !identical_data {
+                    return Err(MergeError::Conflict {
+                        run_id: manifest.run_id,
+                        into: into.to_path_buf(),
+                        what: if theirs.config_hash != manifest.config_hash {
+                            "config hash"
+                        } else {
+                            "data"
+                        },
+                    });
+                }
+                done.already_present += 1;
+                continue;
+            }
+            // Data files first, manifest last.
+            for (a, b) in from
+                .data()
+                .into_iter()
+                .chain([from.manifest.as_path()])
+                .zip(to.data().into_iter().chain([to.manifest.as_path()]))
+            {
+                let bytes = std::fs::read(a).map_err(|source| MergeError::Read {
+                    path: a.to_path_buf(),
+                    source,
+                })?;
+                store::write_atomic(b, &bytes)?;
+            }
+            done.copied += 1;
+        }
+    }
+    Ok(done)
+}
