@@ -368,9 +368,15 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
     let fresh = manifests(&out);
     assert_eq!(fresh.len(), 8);
     for (_, m) in &fresh {
-        assert_eq!(m["latent_quality"]["version"], 2, "{m}");
+        assert_eq!(m["latent_quality"]["version"], 3, "{m}");
         let groups = m["latent_quality"]["groups"].as_array().unwrap().len();
         assert_eq!(groups, if m["env"] == "armarrow" { 3 } else { 1 });
+        // Trustworthiness and continuity against the position (and the arrow's whole state).
+        let spaces = m["latent_quality"]["neighbourhoods"]
+            .as_array()
+            .unwrap()
+            .len();
+        assert_eq!(spaces, if m["env"] == "armarrow" { 2 } else { 1 });
     }
     let samples: Vec<(String, Vec<u8>)> = names
         .iter()
@@ -384,6 +390,7 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
         let q = old["latent_quality"].as_object_mut().unwrap();
         q.remove("version");
         q.remove("groups");
+        q.remove("neighbourhoods");
         std::fs::write(path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
     }
     std::fs::remove_dir_all(&gs).unwrap();

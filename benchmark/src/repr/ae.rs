@@ -4,14 +4,15 @@
 //! cross-entropy, TF Adagrad (lr 1e-3, initial accumulator 0.1), 200,000 iterations.
 //! Encoding = the sigmoid latent.
 //!
-//! The original AE has no documented defect: [`Variant::Faithful`](super::neural::Variant) and
+//! The original AE has no documented defect: [`Variant::Faithful`] and
 //! `Corrected` train and encode identically (same stream, same weights, same latents).
 
 use burn::tensor::Tensor;
 use burn::tensor::activation::sigmoid;
 
 use super::nets::{DenseNet, bce_with_logits_sum};
-use super::neural::{Latent, LatentInput, StepInput};
+use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant};
+use crate::seed::Stream;
 
 /// The training loss of one mini-batch: `mean_b sum_pixels BCE(decode(sigmoid(head(x))), x)`.
 pub fn loss(net: &DenseNet, input: StepInput<'_>) -> Tensor<1> {
@@ -32,5 +33,41 @@ pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>) -> Latent {
 pub fn encoding(head: &[f32], d: usize, out: &mut [f64]) {
     for (o, &h) in out.iter_mut().zip(&head[..d]) {
         *o = 1.0 / (1.0 + (-f64::from(h)).exp());
+    }
+}
+
+/// The AE as a [`NeuralModel`]: TF Adagrad, no prior, 200,000 iterations in the paper.
+pub struct Ae;
+
+impl NeuralModel for Ae {
+    fn name(&self) -> &'static str {
+        "ae"
+    }
+    fn head_blocks(&self, latents: usize) -> Vec<usize> {
+        vec![latents]
+    }
+    fn paper_iterations(&self) -> usize {
+        200_000
+    }
+    fn optimiser(&self) -> Optimiser {
+        Optimiser::Adagrad
+    }
+    fn has_prior(&self) -> bool {
+        false
+    }
+    fn loss(&self, net: &DenseNet, input: StepInput<'_>, _rng: &mut Stream) -> Tensor<1> {
+        loss(net, input)
+    }
+    fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, _rng: &mut Stream) -> Latent {
+        latent(heads, input)
+    }
+    fn encoding(&self, head: &[f32], d: usize, _: Variant, _: &mut Stream, out: &mut [f64]) {
+        encoding(head, d, out)
+    }
+    fn encoding_deterministic(&self, head: &[f32], d: usize, _: Variant, out: &mut [f64]) {
+        encoding(head, d, out)
+    }
+    fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
+        encoding(head, d, out)
     }
 }

@@ -33,8 +33,7 @@ use rayon::prelude::*;
 
 use super::ReprError;
 use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
-use super::neural::{LatentInput, Model, NeuralConfig, tensor2};
-use super::{ae, rfvae, vae};
+use super::neural::{LatentInput, Model, NeuralConfig, Optimiser, tensor2};
 use crate::seed::Stream;
 
 /// A `rows x cols` matrix view on a slice, with strides (a transpose is a view with swapped
@@ -368,8 +367,8 @@ impl HostOptimizer {
     /// The original's optimiser of `model`, fresh, for the parameters of `net`.
     pub fn new(model: Model, net: &HostNet) -> HostOptimizer {
         let sizes = param_sizes(net);
-        match model {
-            Model::Ae => {
+        match model.spec().optimiser() {
+            Optimiser::Adagrad => {
                 let rule = TfAdagrad::default();
                 let a0 = rule.initial_accumulator as f32;
                 HostOptimizer::Adagrad {
@@ -377,7 +376,7 @@ impl HostOptimizer {
                     rule,
                 }
             }
-            Model::Vae | Model::Rfvae => HostOptimizer::Adam {
+            Optimiser::Adam => HostOptimizer::Adam {
                 rule: TfAdam::default(),
                 time: 0,
                 m: sizes.iter().map(|&n| vec![0.0; n]).collect(),
@@ -653,11 +652,7 @@ impl HostTrainer {
             variant: cfg.variant,
             device: &self.device,
         };
-        let latent = match model {
-            Model::Ae => ae::latent(heads.clone(), &input),
-            Model::Vae => vae::latent(heads.clone(), &input, rng),
-            Model::Rfvae => rfvae::latent(heads.clone(), &input, rng),
-        };
+        let latent = model.spec().latent(heads.clone(), &input, rng);
         ws.z = latent
             .z
             .clone()

@@ -16,6 +16,7 @@ pub mod host_train;
 pub mod isomap;
 pub mod nets;
 pub mod neural;
+pub mod neural_model;
 pub mod pca;
 pub mod quality;
 pub mod rfvae;

@@ -22,15 +22,17 @@ use std::sync::Arc;
 
 use burn::module::Module as _;
 use burn::optim::{GradientsParams, ModuleOptimizer};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::Device;
 use rand::{Rng, RngExt, SeedableRng};
-use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::host_train::{HostOptimizer, HostTrainer};
 pub use super::nets::Init;
 use super::nets::{DenseNet, HostNet, Scratch, TfAdagrad, TfAdam};
+pub use super::neural_model::{
+    Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, normals, tensor2,
+};
 use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_input, check_latents};
 use crate::repr::{ae, rfvae, vae};
 use crate::seed::Stream;
@@ -105,57 +107,28 @@ impl Model {
     /// All three.
     pub const ALL: [Model; 3] = [Model::Ae, Model::Vae, Model::Rfvae];
 
+    /// What the model is: the one place a model's identity maps to its code.
+    pub fn spec(self) -> &'static dyn NeuralModel {
+        match self {
+            Model::Ae => &ae::Ae,
+            Model::Vae => &vae::Vae,
+            Model::Rfvae => &rfvae::Rfvae,
+        }
+    }
+
     /// `ae`, `vae`, `rfvae`.
     pub fn name(self) -> &'static str {
-        match self {
-            Model::Ae => "ae",
-            Model::Vae => "vae",
-            Model::Rfvae => "rfvae",
-        }
+        self.spec().name()
     }
 
     /// The widths of the encoder's head blocks for `latents` dimensions.
     pub fn head_blocks(self, latents: usize) -> Vec<usize> {
-        match self {
-            Model::Ae => vec![latents],
-            Model::Vae => vec![latents, latents],
-            Model::Rfvae => rfvae::head_blocks(latents),
-        }
+        self.spec().head_blocks(latents)
     }
 
     /// The paper's training length (the original's `fit`: AE 2e5, VAE 1e5, RFVAE 5e4).
     pub fn paper_iterations(self) -> usize {
-        match self {
-            Model::Ae => 200_000,
-            Model::Vae => 100_000,
-            Model::Rfvae => 50_000,
-        }
-    }
-}
-
-/// Paper-faithful or corrected behaviour where the original code has a defect.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Variant {
-    /// What the original code did, defects included (see `vae.rs`, `rfvae.rs`).
-    #[default]
-    Faithful,
-    /// The defects fixed. The AE has none: both variants are identical.
-    Corrected,
-}
-
-impl Variant {
-    /// Both.
-    pub const ALL: [Variant; 2] = [Variant::Faithful, Variant::Corrected];
-
-    /// `faithful` / `corrected`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Variant::Faithful => "faithful",
-            Variant::Corrected => "corrected",
-        }
+        self.spec().paper_iterations()
     }
 }
 
@@ -200,10 +173,7 @@ impl NeuralConfig {
             lr: 1e-3,
             variant: Variant::Faithful,
             log_every: 100,
-            warmup: match model {
-                Model::Rfvae => rfvae::ANNEAL_STEPS,
-                Model::Ae | Model::Vae => 0,
-            },
+            warmup: model.spec().paper_warmup(),
             init: Init::Paper,
             engine: Engine::Host,
         }
@@ -233,7 +203,7 @@ impl NeuralConfig {
         if self.log_every == 0 {
             return bad("log_every must be at least 1".into());
         }
-        if model == Model::Rfvae && self.warmup == 0 {
+        if model.spec().paper_warmup() > 0 && self.warmup == 0 {
             return bad("warmup must be at least 1".into());
         }
         Ok(())
@@ -437,17 +407,15 @@ impl NeuralEncoder {
 
     /// Whether encoding draws random numbers (the faithful RFVAE).
     pub fn is_stochastic(&self) -> bool {
-        self.model == Model::Rfvae && self.variant == Variant::Faithful
+        self.model.spec().is_stochastic(self.variant)
     }
 
     fn encode_row(&mut self, image: &[f32], out: &mut [f64]) {
         let head = self.net.encode_head(image, &mut self.scratch);
         let d = self.net.latents;
-        match self.model {
-            Model::Ae => ae::encoding(&head, d, out),
-            Model::Vae => vae::encoding(&head, d, out),
-            Model::Rfvae => rfvae::encoding(&head, d, self.variant, &mut self.rng, out),
-        }
+        self.model
+            .spec()
+            .encoding(&head, d, self.variant, &mut self.rng, out);
     }
 
     fn check_dim(&self, dim: usize) -> Result<(), ReprError> {
@@ -475,7 +443,7 @@ impl NeuralEncoder {
         let mut rng = Stream::from_seed(self.encode_seed);
         for (i, out) in data.chunks_exact_mut(d).enumerate() {
             let head = self.net.encode_head(images.row(i), &mut self.scratch);
-            rfvae::z0_sample(&head, d, &mut rng, out);
+            self.model.spec().training_sample(&head, d, &mut rng, out);
         }
         let z = Latents {
             n: images.n,
@@ -519,11 +487,7 @@ impl Encoder for NeuralEncoder {
                 Scratch::default,
                 |scratch, (i, out)| {
                     let head = net.encode_head(images.row(i), scratch);
-                    match model {
-                        Model::Ae => ae::encoding(&head, d, out),
-                        Model::Vae => vae::encoding(&head, d, out),
-                        Model::Rfvae => rfvae::encoding_deterministic(&head, d, variant, out),
-                    }
+                    model.spec().encoding_deterministic(&head, d, variant, out);
                 },
             );
         }
@@ -557,43 +521,11 @@ impl Encoder for NeuralEncoder {
     }
 
     fn prior(&self) -> Option<GaussianPrior> {
-        match self.model {
-            Model::Ae => None,
-            Model::Vae | Model::Rfvae => Some(GaussianPrior {
-                mean: vec![0.0; self.net.latents],
-                std: vec![1.0; self.net.latents],
-            }),
-        }
+        self.model.spec().has_prior().then(|| GaussianPrior {
+            mean: vec![0.0; self.net.latents],
+            std: vec![1.0; self.net.latents],
+        })
     }
-}
-
-/// What one training iteration's loss needs besides the network (burn engine): the batch and
-/// what the model's code needs.
-pub struct StepInput<'a> {
-    pub x: Tensor<2>,
-    pub latent: LatentInput<'a>,
-}
-
-/// What a model's latent code needs besides the head outputs (both engines).
-pub struct LatentInput<'a> {
-    pub batch: usize,
-    pub latents: usize,
-    /// 0-based iteration.
-    pub step: usize,
-    /// RFVAE warm-up length.
-    pub warmup: usize,
-    pub variant: Variant,
-    pub device: &'a Device,
-}
-
-/// A model's middle, from the head outputs (host engine): the latent code fed to the decoder,
-/// and the loss as `rec_scale * mean_b(sum_pixels BCE_b) + extra` (`extra`: the KL and flow
-/// terms, None for the AE).
-pub struct Latent {
-    /// `[B, d]`.
-    pub z: Tensor<2>,
-    pub extra: Option<Tensor<1>>,
-    pub rec_scale: f64,
 }
 
 /// The initial weights of `model` (a function of the stream only; the variant plays no part).
@@ -623,14 +555,6 @@ pub fn draw_batch(perm: &mut [usize], k: usize, rng: &mut Stream) {
         let j = rng.random_range(i..n);
         perm.swap(i, j);
     }
-}
-
-/// `n` standard normals from `rng`.
-pub fn normals(rng: &mut Stream, n: usize) -> Vec<f32> {
-    (0..n)
-        .map(|_| StandardNormal.sample(rng))
-        .map(|v: f64| v as f32)
-        .collect()
 }
 
 /// The engine-specific part of a [`Trainer`]: the weights and the optimiser state.
@@ -743,11 +667,7 @@ impl<'a> Trainer<'a> {
                         device,
                     },
                 };
-                let loss = match self.model {
-                    Model::Ae => ae::loss(&module, input),
-                    Model::Vae => vae::loss(&module, input, rng),
-                    Model::Rfvae => rfvae::loss(&module, input, rng),
-                };
+                let loss = self.model.spec().loss(&module, input, rng);
                 let value = f64::from(loss.clone().into_scalar::<f32>());
                 if value.is_finite() {
                     let grads = GradientsParams::from_grads(loss.backward(), &module);
@@ -868,9 +788,9 @@ impl<'a> Trainer<'a> {
 
 /// The original's optimiser of `model`: Adagrad for the AE, Adam for the VAE and RFVAE.
 fn optimizer(model: Model) -> ModuleOptimizer {
-    match model {
-        Model::Ae => TfAdagrad::default().into(),
-        Model::Vae | Model::Rfvae => TfAdam::default().into(),
+    match model.spec().optimiser() {
+        Optimiser::Adagrad => TfAdagrad::default().into(),
+        Optimiser::Adam => TfAdam::default().into(),
     }
 }
 
@@ -998,11 +918,7 @@ fn noise_free_logits(model: Model, net: &HostNet, x: &[f32], scratch: &mut Scrat
     let d = net.latents;
     let head = net.encode_head(x, scratch);
     let mut code = vec![0.0f64; d];
-    match model {
-        Model::Ae => ae::encoding(&head, d, &mut code),
-        Model::Vae => vae::encoding(&head, d, &mut code),
-        Model::Rfvae => rfvae::mean_code(&head, d, &mut code),
-    }
+    model.spec().mean_code(&head, d, &mut code);
     let z: Vec<f32> = code.iter().map(|&v| v as f32).collect();
     net.decode_logits(&z, scratch)
 }
@@ -1043,11 +959,6 @@ pub fn fit(
     let mut enc = train(model, cfg, images, latents, rng, progress)?;
     let z = enc.training_latents(images)?;
     Ok((enc, z))
-}
-
-/// Helper for the model files: a `[rows, cols]` tensor from host values.
-pub fn tensor2(values: Vec<f32>, rows: usize, cols: usize, device: &Device) -> Tensor<2> {
-    Tensor::from_data(TensorData::new(values, [rows, cols]), device)
 }
 
 #[cfg(test)]

@@ -40,7 +40,9 @@ use burn::tensor::{Device, Tensor};
 use rand_distr::{Distribution, StandardNormal};
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{self, Latent, LatentInput, StepInput, Variant};
+use super::neural_model::{
+    Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, tensor2,
+};
 use super::vae::eps;
 use crate::seed::Stream;
 
@@ -228,7 +230,6 @@ pub fn encoding(head: &[f32], d: usize, variant: Variant, rng: &mut Stream, out:
     }
 }
 
-/// The deterministic (corrected) encoding: the flows applied to mu.
 /// The noise-free code: `z_K` of `z0 = mu` (both variants; the corrected variant's encoding).
 pub fn mean_code(head: &[f32], d: usize, out: &mut [f64]) {
     for (o, &m) in out.iter_mut().zip(&head[..d]) {
@@ -237,6 +238,7 @@ pub fn mean_code(head: &[f32], d: usize, out: &mut [f64]) {
     flows_host(head, d, out);
 }
 
+/// The deterministic (corrected) encoding: the flows applied to mu.
 pub fn encoding_deterministic(head: &[f32], d: usize, variant: Variant, out: &mut [f64]) {
     debug_assert_eq!(
         variant,
@@ -263,7 +265,7 @@ pub fn flow_logdet_tensor(
     let n = a.len();
     let device = Device::flex();
     let f = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    let zt = neural::tensor2(f(z), n, d, &device);
+    let zt = tensor2(f(z), n, d, &device);
     // Build a head-shaped parameter set with only flow 0 used.
     let mut cfull = vec![0.0f32; n * FLOWS * d];
     let mut afull = vec![0.0f32; n * FLOWS];
@@ -276,9 +278,9 @@ pub fn flow_logdet_tensor(
         bfull[i * FLOWS] = b[i] as f32;
     }
     let p = FlowParams {
-        c: neural::tensor2(cfull, n, FLOWS * d, &device),
-        a: neural::tensor2(afull, n, FLOWS, &device),
-        b: neural::tensor2(bfull, n, FLOWS, &device),
+        c: tensor2(cfull, n, FLOWS * d, &device),
+        a: tensor2(afull, n, FLOWS, &device),
+        b: tensor2(bfull, n, FLOWS, &device),
     };
     let (zn, ld) = flow_step(zt, &p, 0, d, variant);
     let read = |t: Tensor<2>| -> Vec<f64> {
@@ -290,4 +292,49 @@ pub fn flow_logdet_tensor(
             .collect()
     };
     (read(zn), read(ld))
+}
+/// The RFVAE as a [`NeuralModel`]: TF Adam, KL warm-up, prior N(0, I), 50,000 iterations in
+/// the paper; the faithful variant encodes stochastically.
+pub struct Rfvae;
+
+impl NeuralModel for Rfvae {
+    fn name(&self) -> &'static str {
+        "rfvae"
+    }
+    fn head_blocks(&self, latents: usize) -> Vec<usize> {
+        head_blocks(latents)
+    }
+    fn paper_iterations(&self) -> usize {
+        50_000
+    }
+    fn paper_warmup(&self) -> usize {
+        ANNEAL_STEPS
+    }
+    fn optimiser(&self) -> Optimiser {
+        Optimiser::Adam
+    }
+    fn has_prior(&self) -> bool {
+        true
+    }
+    fn loss(&self, net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
+        loss(net, input, rng)
+    }
+    fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
+        latent(heads, input, rng)
+    }
+    fn is_stochastic(&self, variant: Variant) -> bool {
+        variant == Variant::Faithful
+    }
+    fn encoding(&self, head: &[f32], d: usize, v: Variant, rng: &mut Stream, out: &mut [f64]) {
+        encoding(head, d, v, rng, out)
+    }
+    fn encoding_deterministic(&self, head: &[f32], d: usize, v: Variant, out: &mut [f64]) {
+        encoding_deterministic(head, d, v, out)
+    }
+    fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
+        mean_code(head, d, out)
+    }
+    fn training_sample(&self, head: &[f32], d: usize, rng: &mut Stream, out: &mut [f64]) {
+        z0_sample(head, d, rng, out)
+    }
 }

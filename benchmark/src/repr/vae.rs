@@ -13,7 +13,9 @@
 use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural::{Latent, LatentInput, StepInput, Variant, normals, tensor2};
+use super::neural_model::{
+    Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, normals, tensor2,
+};
 use crate::seed::Stream;
 
 /// The reparameterisation noise of one iteration: `[1, d]` (faithful: shared by the batch,
@@ -68,5 +70,41 @@ pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> La
 pub fn encoding(head: &[f32], d: usize, out: &mut [f64]) {
     for (o, &h) in out.iter_mut().zip(&head[..d]) {
         *o = f64::from(h);
+    }
+}
+
+/// The VAE as a [`NeuralModel`]: TF Adam, prior N(0, I), 100,000 iterations in the paper.
+pub struct Vae;
+
+impl NeuralModel for Vae {
+    fn name(&self) -> &'static str {
+        "vae"
+    }
+    fn head_blocks(&self, latents: usize) -> Vec<usize> {
+        vec![latents, latents]
+    }
+    fn paper_iterations(&self) -> usize {
+        100_000
+    }
+    fn optimiser(&self) -> Optimiser {
+        Optimiser::Adam
+    }
+    fn has_prior(&self) -> bool {
+        true
+    }
+    fn loss(&self, net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
+        loss(net, input, rng)
+    }
+    fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
+        latent(heads, input, rng)
+    }
+    fn encoding(&self, head: &[f32], d: usize, _: Variant, _: &mut Stream, out: &mut [f64]) {
+        encoding(head, d, out)
+    }
+    fn encoding_deterministic(&self, head: &[f32], d: usize, _: Variant, out: &mut [f64]) {
+        encoding(head, d, out)
+    }
+    fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
+        encoding(head, d, out)
     }
 }

@@ -1,0 +1,128 @@
+//! The model-specific part of the dense neural learners (PAPER-NOTES.md section 5): one
+//! [`NeuralModel`] trait that the AE (`ae.rs`), the VAE (`vae.rs`) and the RFVAE (`rfvae.rs`)
+//! implement, with the types their code shares. `neural.rs` is the generic part (training loop,
+//! encoder, cache keys) and reaches a model only through [`super::neural::Model::spec`]; the
+//! model files depend on this module and on `nets.rs`, never on `neural.rs`.
+
+use burn::tensor::{Device, Tensor, TensorData};
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::nets::DenseNet;
+use crate::seed::Stream;
+
+/// The original optimiser of a model (both engines).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Optimiser {
+    /// TF Adagrad (the AE).
+    Adagrad,
+    /// TF Adam (the VAE and RFVAE).
+    Adam,
+}
+
+/// What distinguishes one dense neural learner from another: its encoder's head, its latent
+/// code and loss, its encoding of an image, its optimiser and the paper's budget.
+pub trait NeuralModel: Sync {
+    /// `ae`, `vae`, `rfvae`.
+    fn name(&self) -> &'static str;
+    /// The widths of the encoder's head blocks for `latents` dimensions.
+    fn head_blocks(&self, latents: usize) -> Vec<usize>;
+    /// The paper's training length (the original's `fit`).
+    fn paper_iterations(&self) -> usize;
+    /// The paper's KL warm-up (0: the model has none).
+    fn paper_warmup(&self) -> usize {
+        0
+    }
+    /// The original's optimiser.
+    fn optimiser(&self) -> Optimiser;
+    /// Whether goals may be drawn from the prior N(0, I) (a VAE's).
+    fn has_prior(&self) -> bool;
+    /// The loss of one training iteration (burn engine).
+    fn loss(&self, net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>;
+    /// The middle of one iteration from the head outputs (host engine).
+    fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent;
+    /// Whether encoding an image draws random numbers (`rng` of [`NeuralModel::encoding`]).
+    fn is_stochastic(&self, _variant: Variant) -> bool {
+        false
+    }
+    /// The goal-space latents of one image from its head outputs.
+    fn encoding(&self, head: &[f32], d: usize, variant: Variant, rng: &mut Stream, out: &mut [f64]);
+    /// [`NeuralModel::encoding`] for a model that is not stochastic in `variant` (in parallel).
+    fn encoding_deterministic(&self, head: &[f32], d: usize, variant: Variant, out: &mut [f64]);
+    /// The noise-free code the decoder reconstructs from (the evidence of training).
+    fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]);
+    /// The training latent of one image of a model that is stochastic in its variant (the
+    /// faithful RFVAE's z0 sample, what the original fitted its KDE on); the others' training
+    /// latents are their encodings, and this is not called for them.
+    fn training_sample(&self, head: &[f32], d: usize, _rng: &mut Stream, out: &mut [f64]) {
+        self.mean_code(head, d, out);
+    }
+}
+
+/// Paper-faithful or corrected behaviour where the original code has a defect.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Variant {
+    /// What the original code did, defects included (see `vae.rs`, `rfvae.rs`).
+    #[default]
+    Faithful,
+    /// The defects fixed. The AE has none: both variants are identical.
+    Corrected,
+}
+
+impl Variant {
+    /// Both.
+    pub const ALL: [Variant; 2] = [Variant::Faithful, Variant::Corrected];
+
+    /// `faithful` / `corrected`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Faithful => "faithful",
+            Variant::Corrected => "corrected",
+        }
+    }
+}
+
+/// What one training iteration's loss needs besides the network (burn engine): the batch and
+/// what the model's code needs.
+pub struct StepInput<'a> {
+    pub x: Tensor<2>,
+    pub latent: LatentInput<'a>,
+}
+
+/// What a model's latent code needs besides the head outputs (both engines).
+pub struct LatentInput<'a> {
+    pub batch: usize,
+    pub latents: usize,
+    /// 0-based iteration.
+    pub step: usize,
+    /// RFVAE warm-up length.
+    pub warmup: usize,
+    pub variant: Variant,
+    pub device: &'a Device,
+}
+
+/// A model's middle, from the head outputs (host engine): the latent code fed to the decoder,
+/// and the loss as `rec_scale * mean_b(sum_pixels BCE_b) + extra` (`extra`: the KL and flow
+/// terms, None for the AE).
+pub struct Latent {
+    /// `[B, d]`.
+    pub z: Tensor<2>,
+    pub extra: Option<Tensor<1>>,
+    pub rec_scale: f64,
+}
+
+/// `n` standard normals from `rng`.
+pub fn normals(rng: &mut Stream, n: usize) -> Vec<f32> {
+    (0..n)
+        .map(|_| StandardNormal.sample(rng))
+        .map(|v: f64| v as f32)
+        .collect()
+}
+
+/// Helper for the model files: a `[rows, cols]` tensor from host values.
+pub fn tensor2(values: Vec<f32>, rows: usize, cols: usize, device: &Device) -> Tensor<2> {
+    Tensor::from_data(TensorData::new(values, [rows, cols]), device)
+}
