@@ -1,5 +1,6 @@
 //! The top eigenpairs of a symmetric matrix (the MDS step of Isomap): a full dense
-//! decomposition for small matrices, else a blocked Krylov-Schur-like Rayleigh-Ritz iteration.
+//! decomposition up to 256 rows, else a restarted block Krylov iteration with Rayleigh-Ritz
+//! extraction (random start from the fit's stream).
 
 use super::*;
 
