@@ -4,14 +4,14 @@
 //! cross-entropy, TF Adagrad (lr 1e-3, initial accumulator 0.1), 200,000 iterations.
 //! Encoding = the sigmoid latent.
 //!
-//! The original AE has no documented defect: [`Variant::Faithful`] and
+//! The original AE has no documented defect: [`Variant::Faithful`](super::neural_model::Variant) and
 //! `Corrected` train and encode identically (same stream, same weights, same latents).
 
 use burn::tensor::Tensor;
 use burn::tensor::activation::sigmoid;
 
 use super::nets::{DenseNet, bce_with_logits_sum};
-use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant};
+use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput};
 use crate::seed::Stream;
 
 /// The training loss of one mini-batch: `mean_b sum_pixels BCE(decode(sigmoid(head(x))), x)`.
@@ -60,12 +60,6 @@ impl NeuralModel for Ae {
     }
     fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, _rng: &mut Stream) -> Latent {
         latent(heads, input)
-    }
-    fn encoding(&self, head: &[f32], d: usize, _: Variant, _: &mut Stream, out: &mut [f64]) {
-        encoding(head, d, out)
-    }
-    fn encoding_deterministic(&self, head: &[f32], d: usize, _: Variant, out: &mut [f64]) {
-        encoding(head, d, out)
     }
     fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
         encoding(head, d, out)

@@ -482,12 +482,12 @@ impl Encoder for NeuralEncoder {
             }
         } else {
             let (net, model) = (&self.net, self.model);
-            let variant = self.variant;
             data.par_chunks_mut(d).enumerate().for_each_init(
                 Scratch::default,
                 |scratch, (i, out)| {
                     let head = net.encode_head(images.row(i), scratch);
-                    model.spec().encoding_deterministic(&head, d, variant, out);
+                    // Not stochastic: the encoding is the noise-free code.
+                    model.spec().mean_code(&head, d, out);
                 },
             );
         }

@@ -45,12 +45,22 @@ pub trait NeuralModel: Sync {
     fn is_stochastic(&self, _variant: Variant) -> bool {
         false
     }
-    /// The goal-space latents of one image from its head outputs.
-    fn encoding(&self, head: &[f32], d: usize, variant: Variant, rng: &mut Stream, out: &mut [f64]);
-    /// [`NeuralModel::encoding`] for a model that is not stochastic in `variant` (in parallel).
-    fn encoding_deterministic(&self, head: &[f32], d: usize, variant: Variant, out: &mut [f64]);
-    /// The noise-free code the decoder reconstructs from (the evidence of training).
+    /// The noise-free code of one image from its head outputs (AE: the sigmoid latent; VAE: mu;
+    /// RFVAE: the flows applied to mu): the encoding of every model that is not stochastic, and
+    /// what the decoder reconstructs from (the evidence of training).
     fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]);
+    /// The goal-space latents of one image from its head outputs; [`NeuralModel::mean_code`]
+    /// unless the model is stochastic in `variant`.
+    fn encoding(
+        &self,
+        head: &[f32],
+        d: usize,
+        _variant: Variant,
+        _rng: &mut Stream,
+        out: &mut [f64],
+    ) {
+        self.mean_code(head, d, out);
+    }
     /// The training latent of one image of a model that is stochastic in its variant (the
     /// faithful RFVAE's z0 sample, what the original fitted its KDE on); the others' training
     /// latents are their encodings, and this is not called for them.

@@ -226,25 +226,12 @@ pub fn encoding(head: &[f32], d: usize, variant: Variant, rng: &mut Stream, out:
             z0_sample(head, d, rng, out);
             flows_host(head, d, out);
         }
-        Variant::Corrected => encoding_deterministic(head, d, variant, out),
+        Variant::Corrected => mean_code(head, d, out),
     }
 }
 
 /// The noise-free code: `z_K` of `z0 = mu` (both variants; the corrected variant's encoding).
 pub fn mean_code(head: &[f32], d: usize, out: &mut [f64]) {
-    for (o, &m) in out.iter_mut().zip(&head[..d]) {
-        *o = f64::from(m);
-    }
-    flows_host(head, d, out);
-}
-
-/// The deterministic (corrected) encoding: the flows applied to mu.
-pub fn encoding_deterministic(head: &[f32], d: usize, variant: Variant, out: &mut [f64]) {
-    debug_assert_eq!(
-        variant,
-        Variant::Corrected,
-        "the faithful RFVAE encoding is stochastic"
-    );
     for (o, &m) in out.iter_mut().zip(&head[..d]) {
         *o = f64::from(m);
     }
@@ -327,9 +314,6 @@ impl NeuralModel for Rfvae {
     }
     fn encoding(&self, head: &[f32], d: usize, v: Variant, rng: &mut Stream, out: &mut [f64]) {
         encoding(head, d, v, rng, out)
-    }
-    fn encoding_deterministic(&self, head: &[f32], d: usize, v: Variant, out: &mut [f64]) {
-        encoding_deterministic(head, d, v, out)
     }
     fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
         mean_code(head, d, out)

@@ -98,12 +98,6 @@ impl NeuralModel for Vae {
     fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
         latent(heads, input, rng)
     }
-    fn encoding(&self, head: &[f32], d: usize, _: Variant, _: &mut Stream, out: &mut [f64]) {
-        encoding(head, d, out)
-    }
-    fn encoding_deterministic(&self, head: &[f32], d: usize, _: Variant, out: &mut [f64]) {
-        encoding(head, d, out)
-    }
     fn mean_code(&self, head: &[f32], d: usize, out: &mut [f64]) {
         encoding(head, d, out)
     }

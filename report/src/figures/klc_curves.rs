@@ -18,7 +18,7 @@ use plotters::prelude::*;
 use super::{
     FONT, FigureFile, Icon, SOLID, algo_slot, colour, condition_name, dash_pattern, dedup_legend,
     env_name, file_safe, fmt_epoch, klc_max, legend_height, legend_strip, marker, marker_points,
-    sampler_name, star_points, write_svg,
+    paper_star_item, sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::{ConditionSummary, CurveStat};
@@ -259,15 +259,7 @@ fn panel_legend(panel: &Panel<'_>, metric: Metric) -> Vec<(Icon, String)> {
         })
         .collect();
     if panel.members.iter().any(|c| metric.paper(c).is_some()) {
-        items.push((
-            Icon::Marker {
-                colour: BLACK,
-                points: star_points(8.0, 3.5),
-                filled: false,
-                stroke: 2,
-            },
-            "paper: final value (1 run, read off plot)".into(),
-        ));
+        items.push(paper_star_item("paper: final value (1 run, read off plot)"));
     }
     items
 }

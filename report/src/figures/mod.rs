@@ -540,6 +540,19 @@ pub enum Icon {
     Band { colour: RGBColor },
 }
 
+/// The legend entry of the paper's final values: a hollow black star, as the plots draw them.
+pub fn paper_star_item(label: &str) -> (Icon, String) {
+    (
+        Icon::Marker {
+            colour: BLACK,
+            points: star_points(8.0, 3.5),
+            filled: false,
+            stroke: 2,
+        },
+        label.to_string(),
+    )
+}
+
 /// Width of the icon column of a legend entry, in pixels.
 const ICON_W: i32 = 30;
 

@@ -14,8 +14,9 @@ use plotters::prelude::*;
 
 use super::{
     FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, fmt_epoch, klc_max,
-    legend_height, legend_strip, marker, marker_points, panel_order, sampler_colour,
-    sampler_marker_slot, sampler_name, star_points, variant_dash, variant_filled, write_svg,
+    legend_height, legend_strip, marker, marker_points, panel_order, paper_star_item,
+    sampler_colour, sampler_marker_slot, sampler_name, star_points, variant_dash, variant_filled,
+    write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
@@ -162,15 +163,7 @@ fn panel_legend(panel: &SamplerPanel<'_>) -> Vec<(Icon, String)> {
         })
         .collect();
     if panel.members.iter().any(|(_, _, c)| c.paper.is_some()) {
-        items.push((
-            Icon::Marker {
-                colour: BLACK,
-                points: star_points(8.0, 3.5),
-                filled: false,
-                stroke: 2,
-            },
-            "paper: final value (1 run)".into(),
-        ));
+        items.push(paper_star_item("paper: final value (1 run)"));
     }
     items
 }
