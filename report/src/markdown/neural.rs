@@ -28,7 +28,8 @@ fn campaign(name: &str) -> String {
     format!("`{}`", campaign_display(name))
 }
 
-/// `- **Campaigns:** ...`: the main one, the budget ones, and those present but not used.
+/// `- **Campaigns:** ...`: the main one, the budget and training-recipe ones, and those present
+/// but not used.
 pub fn campaigns_line(w: &mut String, inp: &Inputs<'_>) {
     let c = inp.campaigns;
     let n = c.main.store.runs.len();
@@ -37,27 +38,22 @@ pub fn campaigns_line(w: &mut String, inp: &Inputs<'_>) {
         campaign(&c.main.name),
         plural(n)
     )];
-    if !c.budget.is_empty() {
-        let b: Vec<String> = c
-            .budget
+    // `name (n runs), ...` of a group of campaigns that were read.
+    let listed = |group: &[crate::campaigns::Campaign]| -> String {
+        group
             .iter()
-            .map(|b| {
-                let n = b.store.runs.len();
-                format!("{} ({n} run{})", campaign(&b.name), plural(n))
+            .map(|g| {
+                let n = g.store.runs.len();
+                format!("{} ({n} run{})", campaign(&g.name), plural(n))
             })
-            .collect();
-        parts.push(format!("training-budget sensitivity {}", b.join(", ")));
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if !c.budget.is_empty() {
+        parts.push(format!("training-budget sensitivity {}", listed(&c.budget)));
     }
     if !c.recipe.is_empty() {
-        let r: Vec<String> = c
-            .recipe
-            .iter()
-            .map(|r| {
-                let n = r.store.runs.len();
-                format!("{} ({n} run{})", campaign(&r.name), plural(n))
-            })
-            .collect();
-        parts.push(format!("training recipes {}", r.join(", ")));
+        parts.push(format!("training recipes {}", listed(&c.recipe)));
     }
     if !c.unused.is_empty() {
         let u: Vec<String> = c
