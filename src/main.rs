@@ -73,10 +73,7 @@ enum Command {
         /// armball or armarrow.
         #[arg(long)]
         env: EnvKind,
-        /// rpe, rge-efr, or a learned goal space: rge-pca (the paper's non-centred PCA),
-        /// rge-pca-centred, rge-isomap, rge-ae, rge-vae, rge-rfvae (neural; budgets in the
-        /// profile's [learners.ae|vae|rfvae]), rge-external (needs [learners.external]).
-        #[arg(long)]
+        #[arg(long, help = algo_help())]
         algo: Algo,
         /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (the
         /// prior N(0, I); VAE, RFVAE, or an external learner that writes a prior).
@@ -152,6 +149,9 @@ enum Command {
         #[command(flatten)]
         cache: CacheArgs,
     },
+    /// List the registered representation learners: name, algorithm, what its goal space
+    /// offers (variants, a prior), whether the paper evaluated it, and a description.
+    Learners,
     /// Run one more representation learner on the cells and seeds of a campaign (default: the
     /// paper's), into data/results/compare-NAME; the report ranks it against the paper's
     /// algorithms with the same statistics.
@@ -210,9 +210,7 @@ struct EmbedArgs {
     /// armball or armarrow.
     #[arg(long)]
     env: EnvKind,
-    /// A registered learner (pca, pca-centred, isomap, ae, vae, rfvae), or with --command the
-    /// name of an external program.
-    #[arg(long)]
+    #[arg(long, help = learner_help())]
     learner: String,
     /// External learners: the command line of the program (docs/external-learners.md).
     #[arg(long)]
@@ -245,9 +243,7 @@ struct EmbedArgs {
 
 #[derive(clap::Args, Debug)]
 struct CompareArgs {
-    /// A registered learner (pca, pca-centred, isomap, ae, vae, rfvae), or with --command the
-    /// name of an external program.
-    #[arg(long)]
+    #[arg(long, help = learner_help())]
     learner: String,
     /// Command line of a program speaking the external-learner protocol
     /// (docs/external-learners.md), run with `sh -c`.
@@ -507,6 +503,10 @@ fn dispatch(cmd: Command) -> Result<()> {
             time,
         } => slurm(&config, shards, out, &scripts, cpus, &time),
         Command::Merge { into, sources } => merge(&into, &sources),
+        Command::Learners => {
+            learners();
+            Ok(())
+        }
         Command::Compare(a) => compare(a),
         Command::Embed(a) => embed(a),
         Command::Report {
@@ -692,18 +692,28 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
         }
     };
     if a.variant.is_some() && !a.algo.learner().is_some_and(|l| l.has_variants()) {
+        let with_variants: Vec<&str> = Learner::all()
+            .filter(|l| l.has_variants())
+            .map(|l| l.entry().algo)
+            .collect();
         bail!(
-            "--variant applies to rge-vae and rge-rfvae only (the other algorithms have one behaviour), not {}",
+            "--variant applies to {} only (the other algorithms have one behaviour), not {}",
+            with_variants.join(" and "),
             a.algo
         );
     }
     if a.sampler == SamplerKind::Gaussian && !a.algo.learner().is_some_and(|l| l.may_have_prior()) {
+        let with_prior: Vec<&str> = Learner::all()
+            .filter(|l| l.may_have_prior())
+            .map(|l| l.entry().algo)
+            .collect();
         bail!(
-            "--sampler gaussian needs a goal-space prior: rge-vae, rge-rfvae or rge-external, not {} (use kde)",
+            "--sampler gaussian needs a goal-space prior: {}, not {} (use kde)",
+            with_prior.join(", "),
             a.algo
         );
     }
-    let external = a.algo.learner() == Some(Learner::External);
+    let external = a.algo.learner().is_some_and(Learner::is_external);
     if !external && (a.command.is_some() || a.name.is_some()) {
         bail!(
             "--command and --name apply to --algo rge-external only, not {}",
@@ -715,22 +725,24 @@ fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
             if cmd.trim().is_empty() {
                 bail!("--command must not be empty");
             }
+            let configured = cfg.learners.external();
             let name = a
                 .name
                 .clone()
-                .or_else(|| cfg.learners.external.as_ref().map(|e| e.name.clone()))
+                .or_else(|| configured.as_ref().map(|e| e.name.clone()))
                 .unwrap_or_else(|| "external".into());
-            let timeouts = cfg.learners.external.as_ref();
-            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
-                name,
-                command: cmd.clone(),
-                ready_timeout_s: timeouts.and_then(|e| e.ready_timeout_s),
-                answer_timeout_s: timeouts.and_then(|e| e.answer_timeout_s),
-            });
-        } else if let (Some(name), Some(e)) = (&a.name, cfg.learners.external.as_mut()) {
+            cfg.learners
+                .set_external(&ugl_bench::campaign::config::ExternalConfig {
+                    name,
+                    command: cmd.clone(),
+                    ready_timeout_s: configured.as_ref().and_then(|e| e.ready_timeout_s),
+                    answer_timeout_s: configured.as_ref().and_then(|e| e.answer_timeout_s),
+                });
+        } else if let (Some(name), Some(mut e)) = (&a.name, cfg.learners.external()) {
             e.name = name.clone();
+            cfg.learners.set_external(&e);
         }
-        if cfg.learners.external.is_none() {
+        if cfg.learners.external().is_none() {
             bail!(
                 "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
                 path.display()
@@ -937,13 +949,57 @@ fn embed(a: EmbedArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--algo`'s help, from the registry.
+fn algo_help() -> String {
+    let algos: Vec<&str> = Learner::all().map(|l| l.entry().algo).collect();
+    format!(
+        "rpe, rge-efr, or a learned goal space rge-NAME: {} (parameters in the profile's \
+         [learners.NAME]; `ugl learners` describes them)",
+        algos.join(", ")
+    )
+}
+
+/// `--learner`'s help, from the registry.
+fn learner_help() -> String {
+    let names: Vec<&str> = Learner::all()
+        .filter(|l| !l.is_external())
+        .map(Learner::name)
+        .collect();
+    format!(
+        "A registered learner ({}), or with --command the name of an external program",
+        names.join(", ")
+    )
+}
+
+/// `ugl learners`: the registry as a table.
+fn learners() {
+    println!(
+        "{:<22} {:<26} {:<9} {:<9} {:<6} description",
+        "name", "algorithm", "variants", "prior", "paper"
+    );
+    for l in Learner::all() {
+        let e = l.entry();
+        let prior = match e.prior {
+            ugl_bench::repr::registry::Prior::None => "no",
+            ugl_bench::repr::registry::Prior::Always => "yes",
+            ugl_bench::repr::registry::Prior::Declared => "declared",
+        };
+        println!(
+            "{:<22} {:<26} {:<9} {:<9} {:<6} {}",
+            e.name,
+            e.algo,
+            if e.has_variants { "yes" } else { "no" },
+            prior,
+            if e.in_paper { "yes" } else { "no" },
+            e.description
+        );
+    }
+}
+
 /// The learner named `name`: a registered one, or with `command` an external program (set in
 /// `cfg.learners.external`).
 fn resolve_learner(name: &str, command: Option<&str>, cfg: &mut CampaignConfig) -> Result<Learner> {
-    let registered: Vec<Learner> = Learner::ALL
-        .into_iter()
-        .filter(|l| *l != Learner::External)
-        .collect();
+    let registered: Vec<Learner> = Learner::all().filter(|l| !l.is_external()).collect();
     match (registered.iter().find(|l| l.name() == name), command) {
         (Some(l), None) => Ok(*l),
         (Some(_), Some(_)) => bail!(
@@ -953,13 +1009,16 @@ fn resolve_learner(name: &str, command: Option<&str>, cfg: &mut CampaignConfig) 
             if cmd.trim().is_empty() {
                 bail!("--command must not be empty");
             }
-            cfg.learners.external = Some(ugl_bench::campaign::config::ExternalConfig {
-                name: name.to_string(),
-                command: cmd.to_string(),
-                ready_timeout_s: None,
-                answer_timeout_s: None,
-            });
-            Ok(Learner::External)
+            cfg.learners
+                .set_external(&ugl_bench::campaign::config::ExternalConfig {
+                    name: name.to_string(),
+                    command: cmd.to_string(),
+                    ready_timeout_s: None,
+                    answer_timeout_s: None,
+                });
+            Learner::all()
+                .find(|l| l.is_external())
+                .ok_or_else(|| anyhow::anyhow!("this build has no external learner"))
         }
         (None, None) => {
             let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
@@ -990,7 +1049,7 @@ fn compare(a: CompareArgs) -> Result<()> {
     let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
     cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
     cfg.matrix.algos = vec![algo];
-    if algo == Algo::Rge(Learner::External) && !a.gaussian {
+    if algo.learner().is_some_and(Learner::is_external) && !a.gaussian {
         cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);
         if cfg.matrix.samplers.is_empty() {
             cfg.matrix.samplers = vec![SamplerKind::Kde];

@@ -862,6 +862,114 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
     assert_one_line_error(&args(&["--learner", "Bad Name"]), "--learner");
 }
 
+/// The registry's promise: a learner added in one file and one registry entry
+/// (`repr/gaussian_projection.rs`, no other code names it) runs with `ugl run`, is ranked by
+/// `ugl compare`, and appears in the report's leaderboard.
+#[test]
+fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base.toml");
+    std::fs::write(
+        &base,
+        "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
+         [ugl]\nimages = 200\n[explore]\nepochs = 150\n\
+         [learners.gaussian-projection]\nstd = 0.5\n",
+    )
+    .unwrap();
+    let o = ugl(&["learners"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("rge-gaussian-projection"),
+        "{}",
+        stdout(&o)
+    );
+    let single = dir.path().join("single");
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rge-gaussian-projection",
+        "--latents",
+        "2",
+        "--profile",
+        p(&base),
+        "--out",
+        p(&single),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = manifest(&single.join("armball.rge-gaussian-projection.kde.l2.s0.json"));
+    assert_eq!(m["learner"], "gaussian-projection");
+    // Its [learners.NAME] table is checked: a bad value is a one-line error naming the key.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        std::fs::read_to_string(&base)
+            .unwrap()
+            .replace("std = 0.5", "std = -1.0"),
+    )
+    .unwrap();
+    assert_one_line_error(
+        &ugl(&["plan", "--config", p(&bad)]),
+        "learners.gaussian-projection: std must be a positive number",
+    );
+    let results = dir.path().join("results");
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&base),
+        "--out",
+        p(&results.join("base")),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = ugl(&[
+        "compare",
+        "--learner",
+        "gaussian-projection",
+        "--config",
+        p(&base),
+        "--out",
+        p(&results.join("compare-gaussian-projection")),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The same run as `ugl run`, and a ranking page against the base campaign.
+    assert_eq!(
+        std::fs::read(
+            results
+                .join("compare-gaussian-projection")
+                .join("armball.rge-gaussian-projection.kde.l2.s0.parquet")
+        )
+        .unwrap(),
+        std::fs::read(single.join("armball.rge-gaussian-projection.kde.l2.s0.parquet")).unwrap()
+    );
+    let page = stdout(&o);
+    assert!(
+        page.contains("## RGE-Gaussian projection, KDE goals"),
+        "{page}"
+    );
+    assert!(page.contains("rank "), "{page}");
+    let report = dir.path().join("report");
+    let o = ugl(&[
+        "report",
+        "--results",
+        p(&results),
+        "--out",
+        p(&report),
+        "--main",
+        "base",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
+    let row = md
+        .lines()
+        .find(|l| l.contains("| compare-gaussian-projection |"))
+        .unwrap_or_else(|| panic!("no leaderboard row for the new learner:\n{md}"));
+    assert!(row.contains("RGE-Gaussian projection"), "{row}");
+}
+
 #[test]
 fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
     let dir = tempfile::tempdir().unwrap();

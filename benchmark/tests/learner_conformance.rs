@@ -2,19 +2,19 @@
 //! deterministically for a seed, return (n, latents) finite encodings, and encode its training
 //! images stably (batch and single-image paths agree with the fitted encodings).
 //!
-//! A new learner is covered by adding it to `Learner::ALL` (and `make_learner`); the external
+//! A new learner is covered by its entry in the registry (`repr/registry.rs`); the external
 //! learner runs with the example program when python3 + numpy are present. The neural learners
 //! run with tiny networks and budgets, in their corrected variant: the faithful RFVAE encodes
 //! outcomes stochastically in another space than its training latents (the original code's
 //! defect, which it reproduces on purpose; `neural.rs` tests it).
 
-use ugl_bench::campaign::config::{ExternalConfig, LearnersConfig};
+use ugl_bench::campaign::config::LearnersConfig;
 use ugl_bench::campaign::runner::make_learner;
 use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::Learner;
 use ugl_bench::repr::ImageSet;
 use ugl_bench::repr::dataset::generate;
-use ugl_bench::repr::neural::{NeuralSection, Variant};
+use ugl_bench::repr::neural::Variant;
 use ugl_bench::seed::{Component, stream, stream_named};
 
 fn images(kind: EnvKind, n: usize) -> ImageSet {
@@ -33,39 +33,25 @@ fn python_numpy() -> bool {
 }
 
 fn learners_config() -> LearnersConfig {
-    LearnersConfig {
-        external: Some(ExternalConfig {
-            name: "random-projection".into(),
-            command: format!(
-                "python3 {}/../scripts/external_learners/random_projection.py",
-                env!("CARGO_MANIFEST_DIR")
-            ),
-            ready_timeout_s: None,
-            answer_timeout_s: None,
-        }),
-        ae: tiny(),
-        vae: tiny(),
-        rfvae: NeuralSection {
-            warmup: Some(10),
-            ..tiny()
-        },
-        ..Default::default()
-    }
+    let text = format!(
+        "[external]\nname = \"random-projection\"\n\
+         command = \"python3 {}/../scripts/external_learners/random_projection.py\"\n\
+         [ae]\n{TINY}[vae]\n{TINY}[rfvae]\n{TINY}warmup = 10\n",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let cfg: LearnersConfig = toml::from_str(&text).unwrap();
+    cfg.validate().unwrap();
+    cfg
 }
 
-fn tiny() -> NeuralSection {
-    NeuralSection {
-        iterations: Some(20),
-        hidden: Some([32, 16]),
-        ..Default::default()
-    }
-}
+/// Tiny networks and budgets.
+const TINY: &str = "iterations = 20\nhidden = [32, 16]\n";
 
 #[test]
 fn every_registered_learner_conforms() {
     let cfg = learners_config();
-    for learner in Learner::ALL {
-        if learner == Learner::External && !python_numpy() {
+    for learner in Learner::all() {
+        if learner.is_external() && !python_numpy() {
             eprintln!("SKIPPED: external learner conformance (python3 with numpy not found)");
             continue;
         }

@@ -17,12 +17,23 @@ use crate::aggregate::ConditionSummary;
 use crate::campaigns::Campaign;
 use crate::load::{ConditionKey, Manifest, Run, Store, rank};
 use crate::stats::{self, Summary};
+use ugl_bench::repr::registry::Learner;
 
-/// The neural learners, in the paper's order.
-pub const LEARNERS: [&str; 3] = ["ae", "vae", "rfvae"];
+/// The neural learners, in the registry's order (`ae`, `vae`, `rfvae`).
+pub fn learners() -> Vec<&'static str> {
+    Learner::all()
+        .filter(|l| l.model().is_some())
+        .map(Learner::name)
+        .collect()
+}
 
-/// The algorithms compared faithful vs corrected.
-pub const VARIANT_ALGOS: [&str; 2] = ["rge-vae", "rge-rfvae"];
+/// The algorithms compared faithful vs corrected: the learners with variants.
+pub fn variant_algos() -> Vec<&'static str> {
+    Learner::all()
+        .filter(|l| l.has_variants())
+        .map(|l| l.entry().algo)
+        .collect()
+}
 
 /// The paper's training of one learner (PAPER-NOTES section 5; the original `src/network.py`).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,45 +43,27 @@ pub struct PaperTraining {
     pub hidden: [i64; 2],
     pub batch: i64,
     pub lr: f64,
-    pub optimiser: &'static str,
+    pub optimiser: String,
     /// RFVAE: iterations of the warm-up `min(1, 0.01 + step / 10⁴)` on KL and reconstruction.
     pub warmup: Option<i64>,
 }
 
-/// AE 200,000 iterations (Adagrad), VAE 100,000 (Adam), RFVAE 50,000 (Adam, 10,000 warm-up);
-/// all 4900-1200-1200 dense networks, batch 100, learning rate 1e-3.
-pub const PAPER_TRAINING: [PaperTraining; 3] = [
-    PaperTraining {
-        learner: "ae",
-        iterations: 200_000,
-        hidden: [1200, 1200],
-        batch: 100,
-        lr: 1e-3,
-        optimiser: "Adagrad",
-        warmup: None,
-    },
-    PaperTraining {
-        learner: "vae",
-        iterations: 100_000,
-        hidden: [1200, 1200],
-        batch: 100,
-        lr: 1e-3,
-        optimiser: "Adam",
-        warmup: None,
-    },
-    PaperTraining {
-        learner: "rfvae",
-        iterations: 50_000,
-        hidden: [1200, 1200],
-        batch: 100,
-        lr: 1e-3,
-        optimiser: "Adam",
-        warmup: Some(10_000),
-    },
-];
-
-pub fn paper_training(learner: &str) -> Option<&'static PaperTraining> {
-    PAPER_TRAINING.iter().find(|p| p.learner == learner)
+/// The paper's training of a neural learner, from the registry: AE 200,000 iterations
+/// (Adagrad), VAE 100,000 (Adam), RFVAE 50,000 (Adam, 10,000 warm-up); all 4900-1200-1200
+/// dense networks, batch 100, learning rate 1e-3.
+pub fn paper_training(learner: &str) -> Option<PaperTraining> {
+    let l = Learner::by_name(learner)?;
+    let model = l.model()?;
+    let c = l.entry().paper_training()?;
+    Some(PaperTraining {
+        learner: l.name(),
+        iterations: c.iterations as i64,
+        hidden: [c.hidden[0] as i64, c.hidden[1] as i64],
+        batch: c.batch as i64,
+        lr: c.lr,
+        optimiser: format!("{:?}", model.spec().optimiser()),
+        warmup: (c.warmup > 0 && model.spec().paper_warmup() > 0).then_some(c.warmup as i64),
+    })
 }
 
 /// What a manifest's `train` object records (every field optional: the schema belongs to the
@@ -139,12 +132,12 @@ pub fn training(m: &Manifest) -> Option<Training> {
 /// (`rge-vae` → `vae`); `None` for runs without a neural representation.
 pub fn learner(run: &Run) -> Option<String> {
     if let Some(l) = run.manifest.raw.get("learner").and_then(Value::as_str)
-        && LEARNERS.contains(&l)
+        && learners().contains(&l)
     {
         return Some(l.to_string());
     }
     let l = run.key.algo.strip_prefix("rge-")?;
-    LEARNERS.contains(&l).then(|| l.to_string())
+    learners().contains(&l).then(|| l.to_string())
 }
 
 /// Training iterations of a run, from `train.config.iterations`.
@@ -217,7 +210,7 @@ pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
         b.mean_fit_s = (!fits.is_empty()).then(|| fits.iter().sum::<f64>() / fits.len() as f64);
     }
     let mut out: Vec<BudgetUsed> = by.into_values().collect();
-    out.sort_by_key(|b| (rank(&b.learner, &LEARNERS), b.learner.clone()));
+    out.sort_by_key(|b| (rank(&b.learner, &learners()), b.learner.clone()));
     out
 }
 
@@ -236,7 +229,7 @@ pub struct VariantPair<'a> {
     pub diff: Option<Summary>,
 }
 
-/// Every cell of [`VARIANT_ALGOS`] with a faithful or corrected condition, in the report's order.
+/// Every cell of [`variant_algos`] with a faithful or corrected condition, in the report's order.
 pub fn variant_pairs<'a>(
     conditions: &'a [ConditionSummary],
     bootstrap_seed: u64,
@@ -247,7 +240,7 @@ pub fn variant_pairs<'a>(
         BTreeMap::new();
     for c in conditions {
         let k = &c.key;
-        if !VARIANT_ALGOS.contains(&k.algo.as_str()) {
+        if !variant_algos().contains(&k.algo.as_str()) {
             continue;
         }
         let cell = (k.env.clone(), k.algo.clone(), k.sampler.clone(), k.latents);
@@ -289,7 +282,7 @@ pub fn variant_pairs<'a>(
     out.sort_by_key(|p| {
         (
             crate::figures::panel_order(&p.env, p.latents),
-            rank(&p.algo, &VARIANT_ALGOS),
+            rank(&p.algo, &variant_algos()),
             rank(&p.sampler, &["kde", "gaussian"]),
             p.sampler.clone(),
         )
@@ -502,7 +495,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
         (
             rank(&c.env, &["armball", "armarrow"]),
             c.env.clone(),
-            rank(&c.learner, &LEARNERS),
+            rank(&c.learner, &learners()),
             c.learner.clone(),
             std::cmp::Reverse(c.latents),
             rank(&c.variant, &["none", "faithful", "corrected"]),

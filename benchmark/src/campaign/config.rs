@@ -1,15 +1,19 @@
 //! Campaign configuration (TOML; `data/campaigns/NAME.toml`). Every budget lives here, never in
 //! code; the defaults of the `explore` and `env` sections are the paper's values.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::env::{EnvConfig, EnvKind};
-use crate::explore::{Algo, ExploreConfig, Learner, SamplerKind};
-use crate::repr::isomap::Disconnected;
-use crate::repr::neural::{Model, NeuralConfig, NeuralSection, Variant};
+use crate::explore::{Algo, ExploreConfig, SamplerKind};
+pub use crate::repr::external::ExternalConfig;
+use crate::repr::external::ExternalParams;
+pub use crate::repr::isomap::IsomapConfig;
+use crate::repr::neural::{Model, NeuralConfig, NeuralParams, Variant};
+use crate::repr::registry::{self, Learner, LearnerParams};
 
 /// Errors reading or validating a configuration.
 #[derive(Debug, Error)]
@@ -133,104 +137,81 @@ impl Default for UglConfig {
     }
 }
 
-/// The `[learners]` section: hyperparameters of each learner.
+/// The `[learners]` section: one free-form `[learners.NAME]` table per learner of the registry
+/// ([`crate::repr::registry`]), parsed and checked by the learner's own entry. Missing tables take
+/// the learner's defaults (the paper's values).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
+#[serde(transparent)]
 pub struct LearnersConfig {
-    pub isomap: IsomapConfig,
-    pub external: Option<ExternalConfig>,
-    /// `[learners.ae]`: training budget and architecture; missing keys take the paper's values.
-    pub ae: NeuralSection,
-    /// `[learners.vae]`.
-    pub vae: NeuralSection,
-    /// `[learners.rfvae]`.
-    pub rfvae: NeuralSection,
+    tables: BTreeMap<String, toml::Value>,
 }
 
 impl LearnersConfig {
-    /// The configuration section of a neural model.
-    pub fn neural(&self, model: Model) -> &NeuralSection {
-        match model {
-            Model::Ae => &self.ae,
-            Model::Vae => &self.vae,
-            Model::Rfvae => &self.rfvae,
-        }
+    /// The checked parameters of `learner`; the message names the key (`learners.vae: ...`).
+    pub fn params(&self, learner: Learner) -> Result<Box<dyn LearnerParams>, String> {
+        (learner.entry().params)(self.tables.get(learner.name()))
+            .map_err(|m| prefix_key(learner.name(), &m))
+    }
+
+    /// Set the `[learners.NAME]` table (e.g. an external program given on the command line).
+    pub fn set_table(&mut self, name: &str, table: toml::Value) {
+        self.tables.insert(name.to_string(), table);
+    }
+
+    /// The `[learners.external]` program, if the section is there and valid.
+    pub fn external(&self) -> Option<ExternalConfig> {
+        let l = Learner::all().find(|l| l.is_external())?;
+        let p = self.params(l).ok()?;
+        let e = p.as_any().downcast_ref::<ExternalParams>()?;
+        Some(e.config().clone())
+    }
+
+    /// Set `[learners.external]`.
+    pub fn set_external(&mut self, e: &ExternalConfig) {
+        let l = Learner::all()
+            .find(|l| l.is_external())
+            .expect("registered");
+        self.set_table(
+            l.name(),
+            toml::Value::try_from(e).expect("an external config serialises"),
+        );
     }
 
     /// The complete training configuration of a neural model and variant.
-    pub fn neural_config(&self, model: Model, variant: Variant) -> NeuralConfig {
-        self.neural(model).resolve(model, variant)
+    pub fn neural_config(&self, model: Model, variant: Variant) -> Result<NeuralConfig, String> {
+        let l = Learner::all()
+            .find(|l| l.model() == Some(model))
+            .expect("every model is registered");
+        let p = self.params(l)?;
+        p.as_any()
+            .downcast_ref::<NeuralParams>()
+            .map(|p| p.config(Some(variant)))
+            .ok_or_else(|| format!("{l} is not a neural learner"))
     }
 
     /// The part of the configuration a learner depends on (hashed into its runs' config hash,
-    /// so changing the VAE budget reruns only the VAE's runs).
+    /// so changing the VAE budget reruns only the VAE's runs): `{name: identity}`, with a null
+    /// identity where the table does not parse (validation rejects such a campaign first).
     pub fn hash_value(&self, learner: Learner, variant: Option<Variant>) -> serde_json::Value {
-        let v = match learner {
-            Learner::Pca | Learner::PcaCentred => serde_json::Value::Null,
-            Learner::Isomap => serde_json::to_value(&self.isomap).expect("serialisable"),
-            Learner::External => {
-                serde_json::to_value(self.external.as_ref().map(ExternalConfig::identity))
-                    .expect("serialisable")
-            }
-            Learner::Ae | Learner::Vae | Learner::Rfvae => {
-                let model = learner.model().expect("neural");
-                serde_json::to_value(self.neural_config(model, variant.unwrap_or_default()))
-                    .expect("serialisable")
-            }
-        };
+        let v = self
+            .params(learner)
+            .map(|p| p.identity(variant))
+            .unwrap_or(serde_json::Value::Null);
         serde_json::json!({ learner.name(): v })
     }
-}
 
-/// `[learners.isomap]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct IsomapConfig {
-    /// Neighbours of the kNN graph (sklearn's default, used by the paper: 5).
-    pub n_neighbors: usize,
-    /// What to do when the kNN graph is disconnected: `connect-closest-pairs` (sklearn >= 1.0;
-    /// the default) or `error`. With 10,000 ArmBall images it always is: positions are
-    /// truncated to pixels, so groups of 6+ identical images are each other's only neighbours.
-    /// The paper's sklearn (< 1.0) silently set the distances between pieces to 0, a defect we
-    /// do not reproduce.
-    pub disconnected: Disconnected,
-}
-
-impl Default for IsomapConfig {
-    fn default() -> Self {
-        IsomapConfig {
-            n_neighbors: 5,
-            disconnected: Disconnected::ConnectClosestPairs,
+    /// Check every table present, and that each names a registered learner.
+    pub fn validate(&self) -> Result<(), String> {
+        for name in self.tables.keys() {
+            let l = Learner::by_name(name).ok_or_else(|| {
+                format!(
+                    "learners.{name}: no learner is called '{name}' (registered: {})",
+                    registry::names().join(", ")
+                )
+            })?;
+            self.params(l)?;
         }
-    }
-}
-
-/// `[learners.external]`: a learner program speaking the protocol of `docs/external-learners.md`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ExternalConfig {
-    /// A short name for results and the report.
-    pub name: String,
-    /// The command line (run with `sh -c`).
-    pub command: String,
-    /// Seconds allowed from the program's start to its `READY` line, i.e. its whole fit
-    /// (default 3600). Not part of the runs' identity.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ready_timeout_s: Option<f64>,
-    /// Seconds allowed for each encode answer (default 300). Not part of the runs' identity.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub answer_timeout_s: Option<f64>,
-}
-
-impl ExternalConfig {
-    /// What the runs depend on: the name and the command (not the timeouts).
-    pub fn identity(&self) -> ExternalConfig {
-        ExternalConfig {
-            name: self.name.clone(),
-            command: self.command.clone(),
-            ready_timeout_s: None,
-            answer_timeout_s: None,
-        }
+        Ok(())
     }
 }
 
@@ -335,20 +316,11 @@ impl CampaignConfig {
                 "matrix.variants must list at least one variant (faithful, corrected)".into(),
             );
         }
-        for model in Model::ALL {
-            if model != Model::Rfvae && self.learners.neural(model).warmup.is_some() {
-                return Err(format!(
-                    "learners.{}.warmup: only the rfvae has a KL warm-up",
-                    model.name()
-                ));
-            }
+        self.learners.validate()?;
+        for l in self.matrix.algos.iter().filter_map(|a| a.learner()) {
             self.learners
-                .neural_config(model, Variant::Faithful)
-                .validate(model, &format!("learners.{}", model.name()))
-                .map_err(|e| match e {
-                    crate::repr::ReprError::InvalidInput(m) => m,
-                    other => other.to_string(),
-                })?;
+                .params(l)
+                .map_err(|m| format!("matrix.algos has {}, but {m}", l.entry().algo))?;
         }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {
@@ -370,33 +342,6 @@ impl CampaignConfig {
                 "matrix.latents: {n} must be below ugl.images ({})",
                 self.ugl.images
             ));
-        }
-        if self.learners.isomap.n_neighbors == 0 {
-            return Err("learners.isomap.n_neighbors must be at least 1".into());
-        }
-        if self.matrix.algos.contains(&Algo::Rge(Learner::External))
-            && self.learners.external.is_none()
-        {
-            return Err("matrix.algos has rge-external but there is no [learners.external] section (name, command)".into());
-        }
-        if let Some(e) = &self.learners.external {
-            if e.command.trim().is_empty() || e.name.trim().is_empty() {
-                return Err(
-                    "learners.external.name and learners.external.command must not be empty".into(),
-                );
-            }
-            for (key, v) in [
-                ("ready_timeout_s", e.ready_timeout_s),
-                ("answer_timeout_s", e.answer_timeout_s),
-            ] {
-                if let Some(v) = v
-                    && !(v.is_finite() && v > 0.0 && v <= 1e7)
-                {
-                    return Err(format!(
-                        "learners.external.{key} must be a positive number of seconds (at most 1e7), got {v}"
-                    ));
-                }
-            }
         }
         self.explore.validate()?;
         validate_env(&self.env)
@@ -546,5 +491,22 @@ epochs = 50
             assert!(e.contains(key), "{e} should name {key}");
             assert!(!e.contains('\n'), "one line: {e}");
         }
+    }
+}
+
+/// A `[learners.NAME]` message with its table's path: a message that starts with the key
+/// (`warmup: ...`, as [`ParamGuard::check`](crate::repr::registry::ParamGuard) writes them)
+/// becomes `learners.NAME.warmup: ...`, any other `learners.NAME: ...`.
+fn prefix_key(name: &str, msg: &str) -> String {
+    match msg.split_once(": ") {
+        Some((key, rest))
+            if !key.is_empty()
+                && key.chars().all(|c| {
+                    c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '[' | ']')
+                }) =>
+        {
+            format!("learners.{name}.{key}: {rest}")
+        }
+        _ => format!("learners.{name}: {msg}"),
     }
 }

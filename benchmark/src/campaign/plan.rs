@@ -243,7 +243,7 @@ mod tests {
         assert_eq!(r.representation_identity(10), None);
         let r = RunSpec::learned(
             EnvKind::ArmBall,
-            Algo::Rge(Learner::Pca),
+            Algo::Rge(Learner::by_name("pca").unwrap()),
             SamplerKind::Kde,
             10,
             Variant::Corrected,
@@ -265,7 +265,7 @@ mod tests {
         );
         let v = RunSpec::learned(
             EnvKind::ArmBall,
-            Algo::Rge(Learner::Vae),
+            Algo::Rge(Learner::by_name("vae").unwrap()),
             SamplerKind::Gaussian,
             2,
             Variant::Corrected,
@@ -289,7 +289,7 @@ mod tests {
         assert_eq!(
             RunSpec::learned(
                 EnvKind::ArmBall,
-                Algo::Rge(Learner::Ae),
+                Algo::Rge(Learner::by_name("ae").unwrap()),
                 SamplerKind::Kde,
                 2,
                 Variant::Corrected,

@@ -24,10 +24,8 @@ use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::repr::evidence::{EVIDENCE_IMAGES, TrainingEvidence, mean_image_loss};
-use crate::repr::external::{ExternalLearner, LineSink};
-use crate::repr::isomap::Isomap;
+use crate::repr::external::{ExternalLearner, ExternalParams, LineSink};
 use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
-use crate::repr::pca::{CentredPca, TruncatedSvd};
 use crate::repr::quality::{self, LatentQuality};
 use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
@@ -192,46 +190,26 @@ pub struct TrainInfo {
     pub evidence: TrainingEvidence,
 }
 
-/// Build the learner of an algorithm from the configuration; `variant` is used by the
-/// learners that have variants.
+/// Build the learner of an algorithm from its checked `[learners.NAME]` parameters (the
+/// registry's entry parses them); `variant` is used by the learners that have variants.
 pub fn make_learner(
     learner: Learner,
     cfg: &LearnersConfig,
     variant: Option<Variant>,
 ) -> Result<Box<dyn RepresentationLearner>, ReprError> {
-    if let Some(model) = learner.model() {
-        return Ok(Box::new(NeuralLearner::new(
-            model,
-            cfg.neural_config(model, variant.unwrap_or_default()),
-        )));
-    }
-    Ok(match learner {
-        Learner::Pca => Box::new(TruncatedSvd::default()),
-        Learner::PcaCentred => Box::new(CentredPca),
-        Learner::Isomap => Box::new(Isomap {
-            n_neighbors: cfg.isomap.n_neighbors,
-            disconnected: cfg.isomap.disconnected,
-        }),
-        Learner::External => Box::new(external_learner(cfg)?),
-        Learner::Ae | Learner::Vae | Learner::Rfvae => unreachable!("handled above"),
-    })
+    Ok(cfg
+        .params(learner)
+        .map_err(ReprError::InvalidInput)?
+        .build(variant))
 }
 
 /// The configured external learner (`[learners.external]`).
-fn external_learner(cfg: &LearnersConfig) -> Result<ExternalLearner, ReprError> {
-    let e = cfg.external.as_ref().ok_or_else(|| {
-        ReprError::InvalidInput(
-            "rge-external needs a [learners.external] section (name, command)".into(),
-        )
-    })?;
-    let mut l = ExternalLearner::new(e.name.clone(), e.command.clone());
-    if let Some(t) = e.ready_timeout_s {
-        l.ready_timeout = std::time::Duration::from_secs_f64(t);
-    }
-    if let Some(t) = e.answer_timeout_s {
-        l.answer_timeout = std::time::Duration::from_secs_f64(t);
-    }
-    Ok(l)
+fn external_learner(learner: Learner, cfg: &LearnersConfig) -> Result<ExternalLearner, ReprError> {
+    let p = cfg.params(learner).map_err(ReprError::InvalidInput)?;
+    p.as_any()
+        .downcast_ref::<ExternalParams>()
+        .map(ExternalParams::learner)
+        .ok_or_else(|| ReprError::InvalidInput(format!("{learner} is not an external learner")))
 }
 
 /// The model-cache key of a neural representation: BLAKE3 of everything it depends on (the
@@ -268,7 +246,8 @@ fn fit_neural(
     let model = learner.model().expect("neural learner");
     let cfg = ctx
         .learners
-        .neural_config(model, spec.variant.unwrap_or_default());
+        .neural_config(model, spec.variant.unwrap_or_default())
+        .map_err(ReprError::InvalidInput)?;
     let key = model_key(spec, ctx, &cfg);
     let mut status = "off";
     let cached = match ctx.cache.map(|c| c.load(&key)) {
@@ -390,9 +369,9 @@ pub fn fit_with_data(
     let (mut encoder, train, info) = if learner.model().is_some() {
         let (e, z, info) = fit_neural(spec, ctx, &data.images, &mut rng)?;
         (e, z, Some(info))
-    } else if learner == Learner::External {
+    } else if learner.is_external() {
         // The program's stderr: a log file beside the runs, and the last line to the caller.
-        let mut l = external_learner(ctx.learners)?;
+        let mut l = external_learner(learner, ctx.learners)?;
         let label = representation_label(spec);
         l.log_file = ctx.log_dir.map(|d| d.join(format!("{label}.learner.log")));
         if let Some(sink) = &ctx.learner_messages {
@@ -417,14 +396,10 @@ pub fn fit_with_data(
             None
         }
     };
-    let learner_name = match learner {
-        Learner::External => ctx
-            .learners
-            .external
-            .as_ref()
-            .map(|e| e.name.clone())
-            .unwrap_or_default(),
-        _ => learner.name().to_string(),
+    let learner_name = if learner.is_external() {
+        ctx.learners.external().map(|e| e.name).unwrap_or_default()
+    } else {
+        learner.name().to_string()
     };
     let repr = Representation {
         encoder,
@@ -627,8 +602,11 @@ pub fn execute(
         learner_fit_s,
         encode_s: explored.encode_s,
         train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
-        external: (spec.algo.learner() == Some(Learner::External))
-            .then(|| serde_json::to_value(&ctx.learners.external).expect("serialisable")),
+        external: spec
+            .algo
+            .learner()
+            .is_some_and(Learner::is_external)
+            .then(|| serde_json::to_value(ctx.learners.external()).expect("serialisable")),
         host: host_name().into(),
         cpu: Some(cpu_info().clone()),
         latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
@@ -790,7 +768,9 @@ pub fn run_campaign(
     // External-learner cells whose fit failed: (env, learner, latents) -> the failed run.
     let failed_external: Mutex<HashMap<String, String>> = Mutex::new(HashMap::new());
     let external_cell = |spec: &RunSpec| {
-        (spec.algo.learner() == Some(Learner::External))
+        spec.algo
+            .learner()
+            .is_some_and(Learner::is_external)
             .then(|| format!("{}/{}", spec.env.name(), spec.latents))
     };
     let run_group = |key: &Option<String>, specs: &[&RunSpec]| -> GroupResult {

@@ -10,7 +10,7 @@ pub mod rpe;
 
 use serde::{Deserialize, Serialize};
 
-use crate::repr::neural::Model;
+pub use crate::repr::registry::Learner;
 pub use history::{Checkpoint, ExplorationLog};
 pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, run_rge};
 pub use rpe::run_rpe;
@@ -81,74 +81,6 @@ impl ExploreConfig {
     }
 }
 
-/// The representation learners of IMGEP-UGL (PAPER-NOTES.md section 5).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Learner {
-    /// The paper's PCA: non-centred truncated SVD.
-    Pca,
-    /// Ordinary mean-centred PCA.
-    PcaCentred,
-    /// Isomap (5 neighbours).
-    Isomap,
-    /// The dense auto-encoder (sigmoid latents).
-    Ae,
-    /// The dense variational auto-encoder (encoding = mu; prior N(0, I)).
-    Vae,
-    /// The VAE with 10 radial flows (prior N(0, I)).
-    Rfvae,
-    /// A program outside this project, through the external-learner protocol.
-    External,
-}
-
-impl Learner {
-    /// All learners of this build.
-    pub const ALL: [Learner; 7] = [
-        Learner::Pca,
-        Learner::PcaCentred,
-        Learner::Isomap,
-        Learner::Ae,
-        Learner::Vae,
-        Learner::Rfvae,
-        Learner::External,
-    ];
-
-    /// Name of the learner (`pca`, `pca-centred`, `isomap`, `ae`, `vae`, `rfvae`, `external`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Learner::Pca => "pca",
-            Learner::PcaCentred => "pca-centred",
-            Learner::Isomap => "isomap",
-            Learner::Ae => "ae",
-            Learner::Vae => "vae",
-            Learner::Rfvae => "rfvae",
-            Learner::External => "external",
-        }
-    }
-
-    /// The network of a neural learner.
-    pub fn model(self) -> Option<Model> {
-        match self {
-            Learner::Ae => Some(Model::Ae),
-            Learner::Vae => Some(Model::Vae),
-            Learner::Rfvae => Some(Model::Rfvae),
-            _ => None,
-        }
-    }
-
-    /// The variants this learner's runs are crossed with: faithful and corrected for the VAE
-    /// and RFVAE (the original code had defects there); one for the others (the AE's two
-    /// variants train identically, so it runs once).
-    pub fn has_variants(self) -> bool {
-        matches!(self, Learner::Vae | Learner::Rfvae)
-    }
-
-    /// Whether the goal space has a prior to sample goals from (`--sampler gaussian`): the
-    /// VAE and RFVAE (N(0, I)), and an external program that writes `prior.npy`.
-    pub fn may_have_prior(self) -> bool {
-        matches!(self, Learner::Vae | Learner::Rfvae | Learner::External)
-    }
-}
-
 /// Which exploration algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Algo {
@@ -164,7 +96,7 @@ impl Algo {
     /// All algorithms known to this build.
     pub fn all() -> Vec<Algo> {
         let mut v = vec![Algo::Rpe, Algo::RgeEfr];
-        v.extend(Learner::ALL.iter().map(|&l| Algo::Rge(l)));
+        v.extend(Learner::all().map(Algo::Rge));
         v
     }
 
@@ -173,13 +105,7 @@ impl Algo {
         match self {
             Algo::Rpe => "rpe",
             Algo::RgeEfr => "rge-efr",
-            Algo::Rge(Learner::Pca) => "rge-pca",
-            Algo::Rge(Learner::PcaCentred) => "rge-pca-centred",
-            Algo::Rge(Learner::Isomap) => "rge-isomap",
-            Algo::Rge(Learner::Ae) => "rge-ae",
-            Algo::Rge(Learner::Vae) => "rge-vae",
-            Algo::Rge(Learner::Rfvae) => "rge-rfvae",
-            Algo::Rge(Learner::External) => "rge-external",
+            Algo::Rge(l) => l.entry().algo,
         }
     }
 

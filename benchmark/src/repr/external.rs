@@ -38,6 +38,8 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use rand::Rng;
 
+use super::neural_model::Variant;
+use super::params::{LearnerParams, ParamGuard};
 use super::{
     Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
     check_latents,
@@ -64,6 +66,96 @@ const STDERR_LINE_MAX: usize = 1000;
 /// Longest `READY` line and npy header accepted (protection against garbage).
 const READY_LINE_MAX: u64 = 4096;
 const NPY_HEADER_MAX: usize = 1 << 20;
+
+/// `[learners.external]`: a learner program speaking the protocol of
+/// `docs/external-learners.md` (unchecked: [`ParamGuard::check`] validates it).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalConfig {
+    /// A short name for results and the report.
+    pub name: String,
+    /// The command line (run with `sh -c`).
+    pub command: String,
+    /// Seconds allowed from the program's start to its `READY` line, i.e. its whole fit
+    /// (default 3600). Not part of the runs' identity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ready_timeout_s: Option<f64>,
+    /// Seconds allowed for each encode answer (default 300). Not part of the runs' identity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub answer_timeout_s: Option<f64>,
+}
+
+impl ExternalConfig {
+    /// What the runs depend on: the name and the command (not the timeouts).
+    pub fn identity(&self) -> ExternalConfig {
+        ExternalConfig {
+            name: self.name.clone(),
+            command: self.command.clone(),
+            ready_timeout_s: None,
+            answer_timeout_s: None,
+        }
+    }
+}
+
+/// A checked [`ExternalConfig`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExternalParams(ExternalConfig);
+
+impl ExternalParams {
+    /// The configuration.
+    pub fn config(&self) -> &ExternalConfig {
+        &self.0
+    }
+}
+
+impl ParamGuard for ExternalConfig {
+    type Checked = ExternalParams;
+    fn check(self) -> Result<ExternalParams, String> {
+        if self.command.trim().is_empty() || self.name.trim().is_empty() {
+            return Err("name and command must not be empty".into());
+        }
+        for (key, v) in [
+            ("ready_timeout_s", self.ready_timeout_s),
+            ("answer_timeout_s", self.answer_timeout_s),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0 && v <= 1e7)
+            {
+                return Err(format!(
+                    "{key} must be a positive number of seconds (at most 1e7), got {v}"
+                ));
+            }
+        }
+        Ok(ExternalParams(self))
+    }
+}
+
+impl ExternalParams {
+    /// The learner, with the configured timeouts.
+    pub fn learner(&self) -> ExternalLearner {
+        let e = &self.0;
+        let mut l = ExternalLearner::new(e.name.clone(), e.command.clone());
+        if let Some(t) = e.ready_timeout_s {
+            l.ready_timeout = Duration::from_secs_f64(t);
+        }
+        if let Some(t) = e.answer_timeout_s {
+            l.answer_timeout = Duration::from_secs_f64(t);
+        }
+        l
+    }
+}
+
+impl LearnerParams for ExternalParams {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn identity(&self, _variant: Option<Variant>) -> serde_json::Value {
+        serde_json::to_value(self.0.identity()).expect("serialisable")
+    }
+    fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
+        Box::new(self.learner())
+    }
+}
 
 /// A representation learner run as an external program (protocol v1).
 #[derive(Clone, Debug, PartialEq)]

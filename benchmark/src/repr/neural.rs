@@ -33,7 +33,11 @@ use super::nets::{DenseNet, HostNet, Scratch, TfAdagrad, TfAdam};
 pub use super::neural_model::{
     Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, normals, tensor2,
 };
-use super::{Encoder, GaussianPrior, ImageSet, Latents, ReprError, check_fit_input, check_latents};
+use super::params::{LearnerParams, ParamGuard};
+use super::{
+    Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
+    check_latents,
+};
 use crate::repr::{ae, rfvae, vae};
 use crate::seed::Stream;
 
@@ -181,7 +185,13 @@ impl NeuralConfig {
 
     /// Check every value for `model`; the message names the key.
     pub fn validate(&self, model: Model, who: &str) -> Result<(), ReprError> {
-        let bad = |msg: String| Err(ReprError::InvalidInput(format!("{who}: {msg}")));
+        let bad = |msg: String| {
+            Err(ReprError::InvalidInput(if who.is_empty() {
+                msg
+            } else {
+                format!("{who}: {msg}")
+            }))
+        };
         if self.iterations == 0 {
             return bad("iterations must be at least 1".into());
         }
@@ -260,6 +270,59 @@ impl NeuralSection {
             init: self.init.unwrap_or(p.init),
             engine: self.engine.unwrap_or(p.engine),
         }
+    }
+}
+
+impl ParamGuard for (Model, NeuralSection) {
+    type Checked = NeuralParams;
+    fn check(self) -> Result<NeuralParams, String> {
+        let (model, section) = self;
+        if model.spec().paper_warmup() == 0 && section.warmup.is_some() {
+            return Err("warmup: only the rfvae has a KL warm-up".into());
+        }
+        section
+            .resolve(model, Variant::Faithful)
+            .validate(model, "")
+            .map_err(|e| match e {
+                ReprError::InvalidInput(m) => m,
+                other => other.to_string(),
+            })?;
+        Ok(NeuralParams { model, section })
+    }
+}
+
+/// The checked `[learners.ae|vae|rfvae]` table of a model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NeuralParams {
+    model: Model,
+    section: NeuralSection,
+}
+
+impl NeuralParams {
+    /// The complete training configuration for a run of `variant` (default: faithful).
+    pub fn config(&self, variant: Option<Variant>) -> NeuralConfig {
+        self.section
+            .resolve(self.model, variant.unwrap_or_default())
+    }
+}
+
+impl LearnerParams for NeuralParams {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn identity(&self, variant: Option<Variant>) -> serde_json::Value {
+        serde_json::to_value(
+            self.section
+                .resolve(self.model, variant.unwrap_or_default()),
+        )
+        .expect("serialisable")
+    }
+    fn build(&self, variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
+        Box::new(NeuralLearner::new(
+            self.model,
+            self.section
+                .resolve(self.model, variant.unwrap_or_default()),
+        ))
     }
 }
 

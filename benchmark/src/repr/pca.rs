@@ -11,6 +11,8 @@
 
 use rand_distr::{Distribution, StandardNormal};
 
+use super::neural_model::Variant;
+use super::params::{LearnerParams, ParamGuard};
 use super::sparse::SparseRows;
 use super::{
     Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
@@ -27,6 +29,55 @@ pub struct TruncatedSvd {
     pub n_iter: usize,
     /// Subtract the training mean (ordinary PCA) instead of the paper's raw SVD.
     pub centre: bool,
+}
+
+/// `[learners.pca]`: the paper's PCA has no parameters (sklearn's defaults); the table must be
+/// empty.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PcaConfig {}
+
+impl ParamGuard for PcaConfig {
+    type Checked = PcaConfig;
+    fn check(self) -> Result<PcaConfig, String> {
+        Ok(self)
+    }
+}
+
+impl LearnerParams for PcaConfig {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn identity(&self, _variant: Option<Variant>) -> serde_json::Value {
+        serde_json::Value::Null
+    }
+    fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
+        Box::new(TruncatedSvd::default())
+    }
+}
+
+/// `[learners.pca-centred]`: no parameters; the table must be empty.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CentredPcaConfig {}
+
+impl ParamGuard for CentredPcaConfig {
+    type Checked = CentredPcaConfig;
+    fn check(self) -> Result<CentredPcaConfig, String> {
+        Ok(self)
+    }
+}
+
+impl LearnerParams for CentredPcaConfig {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn identity(&self, _variant: Option<Variant>) -> serde_json::Value {
+        serde_json::Value::Null
+    }
+    fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
+        Box::new(CentredPca)
+    }
 }
 
 impl Default for TruncatedSvd {

@@ -12,8 +12,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    ALGOS, FONT, FigureFile, Icon, colour, condition_name, env_name, legend_height, legend_strip,
-    marker, marker_points, sampler_name, star_points, write_svg,
+    FONT, FigureFile, Icon, colour, condition_name, env_name, legend_height, legend_strip, marker,
+    marker_points, sampler_name, star_points, write_svg,
 };
 use crate::ReportError;
 use crate::load::campaign_display;
@@ -24,7 +24,8 @@ const PANEL_H: u32 = 440;
 const TITLE_H: u32 = 36;
 
 fn slot(algo: &str) -> usize {
-    ALGOS.iter().position(|a| *a == algo).unwrap_or(ALGOS.len())
+    let known = super::algos();
+    known.iter().position(|a| *a == algo).unwrap_or(known.len())
 }
 
 /// The file of a learner's budget figure: `budget_vae.svg` for `rge-vae`.

@@ -198,7 +198,7 @@ fn styles(members: &[&ConditionSummary]) -> Vec<Style> {
     let mut unknown: Vec<&str> = members
         .iter()
         .map(|c| c.key.algo.as_str())
-        .filter(|a| !super::ALGOS.contains(a))
+        .filter(|a| !super::algos().contains(a))
         .collect();
     unknown.sort_unstable();
     unknown.dedup();
@@ -230,7 +230,7 @@ fn label(c: &ConditionSummary) -> String {
         s.push_str(&format!(", {} goals", sampler_name(&c.key.sampler)));
     }
     s.push_str(&format!(", n={}", c.seeds.len()));
-    if !super::ALGOS.contains(&c.key.algo.as_str()) {
+    if !super::algos().contains(&c.key.algo.as_str()) {
         s.push_str(" (not in the paper)");
     }
     s

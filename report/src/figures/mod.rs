@@ -21,6 +21,7 @@ use plotters::style::RGBColor;
 
 use crate::ReportError;
 use crate::load::rank;
+use ugl_bench::repr::registry::Learner;
 
 /// A figure written by the report, with what the markdown needs to show it.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,16 +43,18 @@ pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<
 
 pub const FONT: &str = "sans-serif";
 
-/// Known algorithms, in the report's order; they index [`ALGO_COLOURS`] and the marker shapes.
-pub const ALGOS: [&str; 7] = [
-    "rpe",
-    "rge-efr",
-    "rge-pca",
-    "rge-isomap",
-    "rge-ae",
-    "rge-vae",
-    "rge-rfvae",
-];
+/// The paper's algorithms, in the report's order: RPE, RGE-EFR, then the registry's learners
+/// that the paper evaluated (PCA, Isomap, AE, VAE, RFVAE). They index [`ALGO_COLOURS`] and the
+/// marker shapes; every other algorithm takes the following slots.
+pub fn algos() -> Vec<&'static str> {
+    let mut v = vec!["rpe", "rge-efr"];
+    v.extend(
+        Learner::all()
+            .filter(|l| l.entry().in_paper)
+            .map(|l| l.entry().algo),
+    );
+    v
+}
 
 /// Okabe–Ito without its yellow (too pale on white), one per known algorithm, then extra colours.
 pub const ALGO_COLOURS: [RGBColor; 10] = [
@@ -76,19 +79,16 @@ pub fn env_name(env: &str) -> String {
     }
 }
 
-/// Display name of an algorithm (`rge-vae` → `RGE-VAE`).
+/// Display name of an algorithm (`rge-vae` → `RGE-VAE`): `RGE-` and the registry's display
+/// name of the learner; unknown names in capitals.
 pub fn algo_name(algo: &str) -> String {
     match algo {
         "rpe" => "RPE".into(),
         "rge-efr" => "RGE-EFR".into(),
-        "rge-pca" => "RGE-PCA".into(),
-        "rge-isomap" => "RGE-Isomap".into(),
-        "rge-pca-centred" => "RGE-PCA (centred)".into(),
-        "rge-ae" => "RGE-AE".into(),
-        "rge-vae" => "RGE-VAE".into(),
-        "rge-rfvae" => "RGE-RFVAE".into(),
-        "rge-external" => "RGE-external".into(),
-        other => other.to_uppercase(),
+        other => match Learner::by_algo(other) {
+            Some(l) => format!("RGE-{}", l.entry().display),
+            None => other.to_uppercase(),
+        },
     }
 }
 
@@ -113,9 +113,12 @@ pub fn sampler_name(sampler: &str) -> String {
     }
 }
 
-/// Display name of a neural learner (`vae` → `VAE`).
+/// Display name of a learner (`vae` → `VAE`): the registry's, else in capitals.
 pub fn learner_name(learner: &str) -> String {
-    learner.to_uppercase()
+    match Learner::by_name(learner) {
+        Some(l) => l.entry().display.to_string(),
+        None => learner.to_uppercase(),
+    }
 }
 
 /// The environment's true latent dimension (the paper's "complete" representation): 2 for
@@ -262,11 +265,12 @@ pub fn klc_max(env: &str) -> Option<f64> {
 /// Colour and marker slot of an algorithm: its position among the known ones; unknown algorithms
 /// take the following slots in the order given by `unknown_index`.
 pub fn algo_slot(algo: &str, unknown_index: usize) -> usize {
-    let r = rank(algo, &ALGOS);
-    if r < ALGOS.len() {
+    let known = algos();
+    let r = rank(algo, &known);
+    if r < known.len() {
         r
     } else {
-        ALGOS.len() + unknown_index
+        known.len() + unknown_index
     }
 }
 

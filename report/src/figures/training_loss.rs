@@ -20,7 +20,7 @@ use super::{
 };
 use crate::ReportError;
 use crate::load::rank;
-use crate::neural::{LEARNERS, LossCurve};
+use crate::neural::{self, LossCurve};
 
 pub const FILE: &str = "training_loss.svg";
 const PANEL_W: u32 = 480;
@@ -88,7 +88,8 @@ pub fn draw(curves: &[LossCurve], fig_dir: &Path) -> Result<Option<FigureFile>, 
             learners.push(&c.learner);
         }
     }
-    learners.sort_by_key(|l| (rank(l, &LEARNERS), l.to_string()));
+    let order = neural::learners();
+    learners.sort_by_key(|l| (rank(l, &order), l.to_string()));
     let path = fig_dir.join(FILE);
     let (rows, cols) = (envs.len(), learners.len());
     let width = PANEL_W * cols as u32;

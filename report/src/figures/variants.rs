@@ -10,8 +10,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    ALGOS, FONT, FigureFile, KeyedAxis, algo_name, colour, env_name, marker, marker_points,
-    panel_order, sampler_name, write_svg,
+    FONT, FigureFile, KeyedAxis, algo_name, colour, env_name, marker, marker_points, panel_order,
+    sampler_name, write_svg,
 };
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
@@ -30,7 +30,8 @@ const GREY: RGBColor = RGBColor(0xAA, 0xAA, 0xAA);
 
 /// Colour and marker slot of an algorithm, as in the curve figures.
 fn slot(algo: &str) -> usize {
-    ALGOS.iter().position(|a| *a == algo).unwrap_or(ALGOS.len())
+    let known = super::algos();
+    known.iter().position(|a| *a == algo).unwrap_or(known.len())
 }
 
 /// The pairs of each (env, latents) panel, in the paper's panel order.

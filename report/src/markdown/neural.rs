@@ -12,7 +12,7 @@ use crate::figures::budget::series_title;
 use crate::figures::sampler_compare::{self, SAMPLERS};
 use crate::figures::{algo_name, condition_name, env_name, learner_name, sampler_name};
 use crate::load::campaign_display;
-use crate::neural::{self, BudgetPoint, PAPER_TRAINING, paper_training};
+use crate::neural::{self, BudgetPoint, paper_training};
 use crate::stats::{self, Summary};
 
 /// What faithful and corrected mean, for the report's readers.
@@ -217,13 +217,17 @@ fn budget_deviation(inp: &Inputs<'_>) -> Option<String> {
         parts.join("; ")
     );
     if !hidden.is_empty() {
+        let paper_layers = neural::learners()
+            .first()
+            .and_then(|l| paper_training(l))
+            .map_or([1200, 1200], |p| p.hidden);
         let _ = write!(
             s,
             "{}hidden layers {} instead of [{}, {}]",
             if parts.is_empty() { "" } else { "; " },
             hidden.join(", "),
-            PAPER_TRAINING[0].hidden[0],
-            PAPER_TRAINING[0].hidden[1]
+            paper_layers[0],
+            paper_layers[1]
         );
     }
     s.push_str(

@@ -86,7 +86,7 @@ pub(crate) fn recipe_lines(
         }
         (!seen.is_empty()).then(|| seen.into_keys().collect::<Vec<_>>().join(" / "))
     };
-    for l in crate::neural::LEARNERS {
+    for l in crate::neural::learners() {
         let Some(ours) = describe(runs, l) else {
             continue;
         };

@@ -71,10 +71,13 @@ use faer::linalg::solvers::SelfAdjointEigen;
 use faer::{Accum, MatMut, MatRef, Par, Side};
 use rand::RngExt;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::{
     Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
 };
+use crate::repr::neural_model::Variant;
+use crate::repr::params::{LearnerParams, ParamGuard};
 use crate::seed::Stream;
 
 mod eigen;
@@ -84,6 +87,58 @@ mod knn;
 use eigen::*;
 use geodesics::*;
 use knn::*;
+
+/// `[learners.isomap]`: the unchecked parameters of Isomap ([`ParamGuard`] → [`Isomap`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IsomapConfig {
+    /// Neighbours of the kNN graph (sklearn's default, used by the paper: 5).
+    pub n_neighbors: usize,
+    /// What to do when the kNN graph is disconnected: `connect-closest-pairs` (sklearn >= 1.0;
+    /// the default) or `error`. With 10,000 ArmBall images it always is: positions are
+    /// truncated to pixels, so groups of 6+ identical images are each other's only neighbours.
+    /// The paper's sklearn (< 1.0) silently set the distances between pieces to 0, a defect we
+    /// do not reproduce.
+    pub disconnected: Disconnected,
+}
+
+impl Default for IsomapConfig {
+    fn default() -> Self {
+        IsomapConfig {
+            n_neighbors: 5,
+            disconnected: Disconnected::ConnectClosestPairs,
+        }
+    }
+}
+
+impl ParamGuard for IsomapConfig {
+    type Checked = Isomap;
+    fn check(self) -> Result<Isomap, String> {
+        if self.n_neighbors == 0 {
+            return Err("n_neighbors must be at least 1".into());
+        }
+        Ok(Isomap {
+            n_neighbors: self.n_neighbors,
+            disconnected: self.disconnected,
+        })
+    }
+}
+
+impl LearnerParams for Isomap {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn identity(&self, _variant: Option<Variant>) -> serde_json::Value {
+        serde_json::to_value(IsomapConfig {
+            n_neighbors: self.n_neighbors,
+            disconnected: self.disconnected,
+        })
+        .expect("serialisable")
+    }
+    fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
+        Box::new(self.clone())
+    }
+}
 
 /// Isomap learner (PAPER-NOTES.md section 5): sklearn `Isomap(n_components=latents)` defaults.
 #[derive(Clone, Debug, PartialEq, Eq)]

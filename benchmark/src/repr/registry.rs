@@ -1,0 +1,357 @@
+//! The one list of representation learners ([`LEARNERS`]). An entry names a learner, says how it
+//! is shown, what its goal space offers (variants, a prior) and how its `[learners.NAME]` table
+//! of a campaign file becomes a checked learner.
+//!
+//! Adding a learner = one module implementing [`RepresentationLearner`] (with its parameters,
+//! [`ParamGuard`] and [`LearnerParams`]) + one entry here. The command line (`--algo rge-NAME`,
+//! `ugl compare --learner NAME`), campaign files, the conformance suite
+//! (`benchmark/tests/learner_conformance.rs`) and the report (display names, colours, the
+//! paper's rows) all read this list; nothing else in the workspace names a concrete learner.
+//!
+//! Parameters follow linfa's `ParamGuard` pattern: the table is deserialised into *unchecked*
+//! parameters (missing keys take the defaults, unknown keys are errors), [`ParamGuard::check`]
+//! validates them and returns the *checked* parameters, which alone can build a learner.
+
+use std::fmt::Debug;
+
+use serde::de::DeserializeOwned;
+
+use super::external::ExternalConfig;
+use super::isomap::IsomapConfig;
+use super::neural::{Model, NeuralConfig, NeuralSection};
+pub use super::params::{LearnerParams, ParamGuard};
+use super::pca::PcaConfig;
+
+/// How the harness fits a learner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// In this process, through [`RepresentationLearner::fit`].
+    InProcess,
+    /// A dense network trained with the model cache, checkpoints and training evidence.
+    Neural(Model),
+    /// A program outside this project (the external-learner protocol): its stderr is logged.
+    External,
+}
+
+/// Whether a learner's goal space has a prior to sample goals from (`--sampler gaussian`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Prior {
+    /// Never.
+    None,
+    /// Always (N(0, I) of a VAE).
+    Always,
+    /// When the fitted model declares one (an external program writing `prior.npy`).
+    Declared,
+}
+
+/// One learner of the registry.
+#[derive(Debug)]
+pub struct LearnerEntry {
+    /// Name in campaign files, results and on the command line (`vae`).
+    pub name: &'static str,
+    /// The algorithm that explores its goal space (`rge-vae`): `rge-` + name.
+    pub algo: &'static str,
+    /// Name in the report (`VAE`).
+    pub display: &'static str,
+    /// One line for `--help` and the docs.
+    pub description: &'static str,
+    /// How it is fitted.
+    pub kind: Kind,
+    /// Whether its runs are crossed with the variants faithful / corrected (the original
+    /// code had defects there, PAPER-NOTES.md section 5).
+    pub has_variants: bool,
+    /// Whether its goal space has a prior.
+    pub prior: Prior,
+    /// Whether the paper evaluated it: the report gives the paper's learners fixed colours and
+    /// markers, in this list's order, and compares them with the paper's numbers.
+    pub in_paper: bool,
+    /// Parse and check its `[learners.NAME]` table (None: the campaign file has none).
+    pub params: fn(Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String>,
+}
+
+impl LearnerEntry {
+    /// The paper's training of a neural learner (PAPER-NOTES.md section 5).
+    pub fn paper_training(&self) -> Option<NeuralConfig> {
+        match self.kind {
+            Kind::Neural(model) => Some(NeuralConfig::paper(model)),
+            _ => None,
+        }
+    }
+}
+
+/// Every learner of this build, in the report's order.
+pub static LEARNERS: [LearnerEntry; 8] = [
+    LearnerEntry {
+        name: "pca",
+        algo: "rge-pca",
+        display: "PCA",
+        description: "the paper's PCA: non-centred truncated SVD (randomized, as sklearn's TruncatedSVD)",
+        kind: Kind::InProcess,
+        has_variants: false,
+        prior: Prior::None,
+        in_paper: true,
+        params: parse::<PcaConfig>,
+    },
+    LearnerEntry {
+        name: "pca-centred",
+        algo: "rge-pca-centred",
+        display: "PCA (centred)",
+        description: "ordinary mean-centred PCA (the same randomized solver, centred implicitly)",
+        kind: Kind::InProcess,
+        has_variants: false,
+        prior: Prior::None,
+        in_paper: false,
+        params: parse::<super::pca::CentredPcaConfig>,
+    },
+    LearnerEntry {
+        name: "isomap",
+        algo: "rge-isomap",
+        display: "Isomap",
+        description: "Isomap (kNN graph, geodesics, classical MDS; sklearn's defaults)",
+        kind: Kind::InProcess,
+        has_variants: false,
+        prior: Prior::None,
+        in_paper: true,
+        params: parse::<IsomapConfig>,
+    },
+    LearnerEntry {
+        name: "ae",
+        algo: "rge-ae",
+        display: "AE",
+        description: "dense auto-encoder, sigmoid latents, Adagrad",
+        kind: Kind::Neural(Model::Ae),
+        has_variants: false,
+        prior: Prior::None,
+        in_paper: true,
+        params: neural::<AE>,
+    },
+    LearnerEntry {
+        name: "vae",
+        algo: "rge-vae",
+        display: "VAE",
+        description: "dense variational auto-encoder (encoding: the mean), Adam",
+        kind: Kind::Neural(Model::Vae),
+        has_variants: true,
+        prior: Prior::Always,
+        in_paper: true,
+        params: neural::<VAE>,
+    },
+    LearnerEntry {
+        name: "rfvae",
+        algo: "rge-rfvae",
+        display: "RFVAE",
+        description: "the VAE with 10 radial flows and a KL warm-up, Adam",
+        kind: Kind::Neural(Model::Rfvae),
+        has_variants: true,
+        prior: Prior::Always,
+        in_paper: true,
+        params: neural::<RFVAE>,
+    },
+    LearnerEntry {
+        name: "gaussian-projection",
+        algo: "rge-gaussian-projection",
+        display: "Gaussian projection",
+        description: "a seeded Gaussian random projection of the pixels: an untrained control",
+        kind: Kind::InProcess,
+        has_variants: false,
+        prior: Prior::None,
+        in_paper: false,
+        params: parse::<super::gaussian_projection::GaussianProjectionConfig>,
+    },
+    LearnerEntry {
+        name: "external",
+        algo: "rge-external",
+        display: "external",
+        description: "a program outside this project, through the external-learner protocol (docs/external-learners.md)",
+        kind: Kind::External,
+        has_variants: false,
+        prior: Prior::Declared,
+        in_paper: false,
+        params: external,
+    },
+];
+
+/// A learner of the registry: a small copyable handle ([`LEARNERS`]`[i]`), ordered as the list.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Learner(u8);
+
+impl Learner {
+    /// Every learner, in the registry's order.
+    pub fn all() -> impl Iterator<Item = Learner> {
+        (0..LEARNERS.len()).map(|i| Learner(i as u8))
+    }
+
+    /// The learner called `name` (`vae`).
+    pub fn by_name(name: &str) -> Option<Learner> {
+        Learner::all().find(|l| l.name() == name)
+    }
+
+    /// The learner whose algorithm is `algo` (`rge-vae`).
+    pub fn by_algo(algo: &str) -> Option<Learner> {
+        Learner::all().find(|l| l.entry().algo == algo)
+    }
+
+    /// Its registry entry.
+    pub fn entry(self) -> &'static LearnerEntry {
+        &LEARNERS[self.0 as usize]
+    }
+
+    /// Name in campaign files, results and on the command line (`vae`).
+    pub fn name(self) -> &'static str {
+        self.entry().name
+    }
+
+    /// The network of a neural learner.
+    pub fn model(self) -> Option<Model> {
+        match self.entry().kind {
+            Kind::Neural(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// Whether it is an external program.
+    pub fn is_external(self) -> bool {
+        self.entry().kind == Kind::External
+    }
+
+    /// Whether its runs are crossed with the variants (faithful, corrected).
+    pub fn has_variants(self) -> bool {
+        self.entry().has_variants
+    }
+
+    /// Whether its goal space may have a prior to sample goals from.
+    pub fn may_have_prior(self) -> bool {
+        self.entry().prior != Prior::None
+    }
+}
+
+impl Debug for Learner {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Learner({})", self.name())
+    }
+}
+
+impl std::fmt::Display for Learner {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The names of every learner, for error messages.
+pub fn names() -> Vec<&'static str> {
+    LEARNERS.iter().map(|e| e.name).collect()
+}
+
+/// Deserialise a table (absent: the defaults) into `U` and check it.
+fn parse<U>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String>
+where
+    U: DeserializeOwned + Default + ParamGuard,
+    U::Checked: LearnerParams + 'static,
+{
+    let unchecked: U = match table {
+        None => U::default(),
+        Some(t) => t.clone().try_into().map_err(|e| one_line(&e))?,
+    };
+    Ok(Box::new(unchecked.check()?))
+}
+
+/// The model of a neural entry, as a type (the registry's entries are `fn` pointers).
+trait ModelOf {
+    const MODEL: Model;
+}
+struct AE;
+struct VAE;
+struct RFVAE;
+impl ModelOf for AE {
+    const MODEL: Model = Model::Ae;
+}
+impl ModelOf for VAE {
+    const MODEL: Model = Model::Vae;
+}
+impl ModelOf for RFVAE {
+    const MODEL: Model = Model::Rfvae;
+}
+
+fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String> {
+    let section: NeuralSection = match table {
+        None => NeuralSection::default(),
+        Some(t) => t.clone().try_into().map_err(|e| one_line(&e))?,
+    };
+    Ok(Box::new((M::MODEL, section).check()?))
+}
+
+fn external(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String> {
+    let Some(t) = table else {
+        return Err("there is no [learners.external] section (name, command)".into());
+    };
+    let unchecked: ExternalConfig = t.clone().try_into().map_err(|e| one_line(&e))?;
+    Ok(Box::new(unchecked.check()?))
+}
+
+fn one_line(e: &toml::de::Error) -> String {
+    e.message()
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .trim()
+        .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_algos_are_rge_name() {
+        for (i, e) in LEARNERS.iter().enumerate() {
+            assert_eq!(e.algo, format!("rge-{}", e.name));
+            assert!(
+                LEARNERS[..i].iter().all(|o| o.name != e.name),
+                "{} twice",
+                e.name
+            );
+            assert_eq!(Learner::by_name(e.name).unwrap().entry().name, e.name);
+        }
+        assert!(Learner::by_name("nope").is_none());
+    }
+
+    #[test]
+    fn every_entry_but_external_has_default_params() {
+        for l in Learner::all() {
+            let p = (l.entry().params)(None);
+            assert_eq!(p.is_ok(), !l.is_external(), "{l}");
+        }
+    }
+
+    #[test]
+    fn unknown_keys_and_bad_values_are_named() {
+        let t: toml::Value = toml::from_str("iteration = 5").unwrap();
+        let e = (Learner::by_name("vae").unwrap().entry().params)(Some(&t)).unwrap_err();
+        assert!(e.contains("iteration"), "{e}");
+        let t: toml::Value = toml::from_str("n_neighbors = 0").unwrap();
+        let e = (Learner::by_name("isomap").unwrap().entry().params)(Some(&t)).unwrap_err();
+        assert!(e.contains("n_neighbors"), "{e}");
+        let t: toml::Value = toml::from_str("warmup = 5").unwrap();
+        let e = (Learner::by_name("ae").unwrap().entry().params)(Some(&t)).unwrap_err();
+        assert!(e.contains("warmup"), "{e}");
+        let t: toml::Value = toml::from_str("n_iter = 5").unwrap();
+        assert!((Learner::by_name("pca").unwrap().entry().params)(Some(&t)).is_err());
+    }
+
+    #[test]
+    fn neural_entries_resolve_the_paper_budget() {
+        let vae = Learner::by_name("vae").unwrap();
+        let p = (vae.entry().params)(None).unwrap();
+        let c = p
+            .as_any()
+            .downcast_ref::<crate::repr::neural::NeuralParams>()
+            .unwrap()
+            .config(Some(crate::repr::neural::Variant::Corrected));
+        assert_eq!(c.iterations, 100_000);
+        assert_eq!(c.variant, crate::repr::neural::Variant::Corrected);
+        assert_eq!(
+            vae.entry().paper_training().unwrap().iterations,
+            c.iterations
+        );
+    }
+}
