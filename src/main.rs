@@ -275,11 +275,12 @@ struct CompareArgs {
 /// Where trained neural models are kept.
 #[derive(clap::Args, Debug)]
 struct CacheArgs {
-    /// Model cache directory for trained neural representations (default: OUT/models). A
-    /// model is keyed by the hash of everything it depends on; an invalid file is retrained.
+    /// Model cache directory for fitted representations that persist: trained networks, PCA
+    /// (default: OUT/models). A model is keyed by the hash of everything it depends on; an
+    /// invalid file is refitted.
     #[arg(long)]
     cache: Option<PathBuf>,
-    /// Do not read or write the model cache (always train).
+    /// Do not read or write the model cache (always fit).
     #[arg(long, conflicts_with = "cache")]
     no_cache: bool,
     /// Save a checkpoint of each neural training every N iterations in the model cache (0:

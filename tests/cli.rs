@@ -743,6 +743,57 @@ fn neural_runs_share_the_model_cache_and_rebuild_a_corrupted_one() {
     assert_ne!(k["train"]["key"], m["train"]["key"]);
 }
 
+/// The one fit path caches every learner whose encoders persist, PCA included: a second run
+/// loads the model (the file is not rewritten) and gives the same bytes; a damaged file is
+/// refitted and rewritten.
+#[test]
+fn pca_runs_share_the_model_cache_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let id = "armball.rge-pca.kde.l3.s0";
+    let run = |out: &Path| {
+        let o = ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rge-pca",
+            "--latents",
+            "3",
+            "--images",
+            "300",
+            "--epochs",
+            "200",
+            "--profile",
+            "smoke",
+            "--cache",
+            p(&cache),
+            "--out",
+            p(out),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out.join(format!("{id}.parquet"))).unwrap()
+    };
+    let first = run(&dir.path().join("a"));
+    let models: Vec<_> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(models.len(), 1, "one model stored");
+    let stored = std::fs::read(&models[0]).unwrap();
+    let mtime = || std::fs::metadata(&models[0]).unwrap().modified().unwrap();
+    let before = mtime();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    assert_eq!(run(&dir.path().join("b")), first, "loaded model, same run");
+    assert_eq!(mtime(), before, "a hit does not rewrite the model");
+    let mut bad = stored.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0x40;
+    std::fs::write(&models[0], &bad).unwrap();
+    assert_eq!(run(&dir.path().join("c")), first, "refitted, same run");
+    assert_eq!(std::fs::read(&models[0]).unwrap(), stored, "rewritten");
+}
+
 #[test]
 fn neural_run_errors() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,6 +1,8 @@
 //! The plug-in conformance suite: every registered representation learner must fit
 //! deterministically for a seed, return (n, latents) finite encodings, and encode its training
-//! images stably (batch and single-image paths agree with the fitted encodings).
+//! images stably (batch and single-image paths agree with the fitted encodings), fit the same
+//! with the harness's context, and, where its encoders persist in the model cache, load them
+//! back bit-identical.
 //!
 //! A new learner is covered by its entry in the registry (`repr/registry.rs`); the external
 //! learner runs with the example program when python3 + numpy are present. The neural learners
@@ -12,9 +14,9 @@ use ugl_bench::campaign::config::LearnersConfig;
 use ugl_bench::campaign::runner::make_learner;
 use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::Learner;
-use ugl_bench::repr::ImageSet;
 use ugl_bench::repr::dataset::generate;
 use ugl_bench::repr::neural::Variant;
+use ugl_bench::repr::{FitContext, ImageSet};
 use ugl_bench::seed::{Component, stream, stream_named};
 
 fn images(kind: EnvKind, n: usize) -> ImageSet {
@@ -99,6 +101,36 @@ fn every_registered_learner_conforms() {
                         "{who}: encode_one of image {i}: {a} vs {b}"
                     );
                 }
+            }
+            // The harness's fit (with a context) is the plain fit.
+            let (_, z3) = l
+                .fit_in(
+                    &set,
+                    latents,
+                    &mut stream_named(1, "learner"),
+                    &FitContext::default(),
+                )
+                .unwrap();
+            assert_eq!(z.data, z3.data, "{who}: fit_in differs from fit");
+            // A learner whose encoders persist loads them back bit-identical: same training
+            // latents (what the KDE is fitted on), same encodings; other keys and damaged
+            // bytes are refused.
+            if l.persists() {
+                let bytes = enc
+                    .save("k")
+                    .unwrap_or_else(|| panic!("{who}: persists but saves nothing"));
+                let mut back = l.load("k", &bytes).unwrap_or_else(|e| panic!("{who}: {e}"));
+                assert_eq!(back.training_latents(&set).unwrap().data, z.data, "{who}");
+                assert_eq!(back.encode(&set).unwrap().data, again.data, "{who}");
+                assert!(l.load("other", &bytes).is_err(), "{who}: key");
+                let mut bad = bytes.clone();
+                let at = bad.len() / 2;
+                bad[at] ^= 1;
+                assert!(l.load("k", &bad).is_err(), "{who}: flipped byte");
+                assert!(
+                    l.load("k", &bytes[..bytes.len() - 1]).is_err(),
+                    "{who}: cut"
+                );
             }
             // Bad input is an error, never a panic.
             assert!(

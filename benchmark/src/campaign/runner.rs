@@ -23,11 +23,11 @@ use crate::explore::{
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
 use crate::repr::dataset::{dataset_identity, generate};
-use crate::repr::evidence::{EVIDENCE_IMAGES, TrainingEvidence, mean_image_loss};
-use crate::repr::external::{ExternalLearner, ExternalParams, LineSink};
-use crate::repr::neural::{self, NeuralConfig, NeuralLearner, TrainProgress, Variant};
+use crate::repr::evidence::TrainingEvidence;
+use crate::repr::external::LineSink;
+use crate::repr::neural::{self, TrainProgress, Variant};
 use crate::repr::quality::{self, LatentQuality};
-use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use crate::repr::{Encoder, FitContext, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 /// Bumped whenever a change alters results for the same configuration.
@@ -173,11 +173,11 @@ pub fn measure_quality(
     quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)
 }
 
-/// How a neural representation was obtained, recorded in the manifests of its runs.
+/// How a trained network was obtained, recorded in the manifests of its runs.
 #[derive(Clone, Debug, Serialize)]
 pub struct TrainInfo {
-    /// The complete training configuration.
-    pub config: NeuralConfig,
+    /// The complete training configuration (the learner's parameters, resolved).
+    pub config: serde_json::Value,
     /// The recorded loss curve, `(iteration, mini-batch loss)`.
     pub losses: Vec<(usize, f64)>,
     /// `hit` (loaded from the model cache), `miss` (trained and stored), `rebuilt` (a cache
@@ -203,19 +203,11 @@ pub fn make_learner(
         .build(variant))
 }
 
-/// The configured external learner (`[learners.external]`).
-fn external_learner(learner: Learner, cfg: &LearnersConfig) -> Result<ExternalLearner, ReprError> {
-    let p = cfg.params(learner).map_err(ReprError::InvalidInput)?;
-    p.as_any()
-        .downcast_ref::<ExternalParams>()
-        .map(ExternalParams::learner)
-        .ok_or_else(|| ReprError::InvalidInput(format!("{learner} is not an external learner")))
-}
-
-/// The model-cache key of a neural representation: BLAKE3 of everything it depends on (the
+/// The model-cache key of a representation: BLAKE3 of everything it depends on (the
 /// environment and its constants, learner, variant, latents, data-set size and seed, learner
-/// seed, training configuration, backend, and the cache and results versions).
-pub fn model_key(spec: &RunSpec, ctx: &RunContext, cfg: &NeuralConfig) -> String {
+/// seed, the learner's parameters (`identity`, [`crate::repr::registry::LearnerParams`]),
+/// backend, and the cache and results versions).
+pub fn model_key(spec: &RunSpec, ctx: &RunContext, identity: &serde_json::Value) -> String {
     let images = ctx.ugl.images;
     let input = serde_json::json!({
         "cache_format": crate::repr::cache::FORMAT_VERSION,
@@ -228,35 +220,71 @@ pub fn model_key(spec: &RunSpec, ctx: &RunContext, cfg: &NeuralConfig) -> String
         "images": images,
         "dataset_seed": run_seed(ctx.campaign_seed, &dataset_identity(spec.env, images, spec.seed)),
         "learner_seed": spec.learner_seed_identity(images).map(|id| run_seed(ctx.campaign_seed, &id)),
-        "config": cfg,
+        "config": identity,
         "backend": neural::BACKEND,
     });
     let json = serde_json::to_vec(&input).expect("key serialises");
     blake3::hash(&json).to_hex().to_string()
 }
 
-/// Train (or load from the cache) the neural representation of `spec` on `images`.
-fn fit_neural(
+/// What the harness offers the fit of `spec`'s representation: progress bars and messages
+/// under its label, checkpoints in the model cache under `key`, the training's threads.
+fn fit_context(
     spec: &RunSpec,
     ctx: &RunContext,
+    key: &str,
+    cache: Option<&ModelCache>,
+) -> FitContext {
+    let label = representation_label(spec);
+    FitContext {
+        progress: ctx.train_progress.as_ref().map(|sink| {
+            let (sink, label) = (sink.clone(), label.clone());
+            Arc::new(move |p: TrainProgress| sink(&label, p)) as neural::ProgressFn
+        }),
+        checkpoint: cache
+            .filter(|_| ctx.checkpoint_every > 0)
+            .map(|c| neural::CheckpointSpec {
+                dir: c.dir.clone(),
+                key: key.to_string(),
+                every: ctx.checkpoint_every,
+            }),
+        threads: ctx.train_threads,
+        // An external program's stderr: a log file beside the runs, and its lines to the caller.
+        log_file: ctx.log_dir.map(|d| d.join(format!("{label}.learner.log"))),
+        messages: ctx.learner_messages.as_ref().map(|sink| {
+            let (sink, label) = (sink.clone(), label.clone());
+            LineSink(Arc::new(move |line| sink(&label, Some(line))))
+        }),
+    }
+}
+
+/// Fit `spec`'s representation on `images`, or load it from the model cache (learners whose
+/// encoders persist): the one fit path of every learner. Returns the encoder, the training
+/// latents, for a trained network how it was obtained, and the learner's name in results (an
+/// external program's configured name).
+fn fit_or_load(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    learner: Learner,
     images: &ImageSet,
     rng: &mut crate::seed::Stream,
-) -> Result<(Box<dyn Encoder>, Latents, TrainInfo), ReprError> {
-    let learner = spec.algo.learner().expect("learned algorithm");
-    let model = learner.model().expect("neural learner");
-    let cfg = ctx
+) -> Result<(Box<dyn Encoder>, Latents, Option<TrainInfo>, String), ReprError> {
+    let params = ctx
         .learners
-        .neural_config(model, spec.variant.unwrap_or_default())
+        .params(learner)
         .map_err(ReprError::InvalidInput)?;
-    let key = model_key(spec, ctx, &cfg);
+    let identity = params.identity(spec.variant);
+    let fitter = params.build(spec.variant);
+    let key = model_key(spec, ctx, &identity);
+    let cache = ctx.cache.filter(|_| fitter.persists());
     let mut status = "off";
-    let cached = match ctx.cache.map(|c| c.load(&key)) {
+    let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
         Some(CacheEntry::Hit(enc)) => {
             status = "hit";
-            Some(*enc)
+            Some(enc)
         }
         Some(CacheEntry::Invalid(why)) => {
-            tracing::warn!("model cache: ignoring an invalid file ({why}); training again");
+            tracing::warn!("model cache: ignoring an invalid file ({why}); fitting again");
             status = "rebuilt";
             None
         }
@@ -266,66 +294,37 @@ fn fit_neural(
         }
         None => None,
     };
-    let mut enc = match cached {
-        Some(enc) => enc,
+    let (encoder, z) = match cached {
+        Some(mut enc) => {
+            let z = enc.training_latents(images)?;
+            (enc, z)
+        }
         None => {
-            if let Some(c) = ctx.cache {
+            if let Some(c) = cache {
                 c.check_writable()?;
             }
-            let mut l = NeuralLearner::new(model, cfg.clone());
-            if let Some(sink) = &ctx.train_progress {
-                let sink = sink.clone();
-                let label = representation_label(spec);
-                l = l.with_progress(Arc::new(move |p| sink(&label, p)));
+            let fit_ctx = fit_context(spec, ctx, &key, cache);
+            let fitted = fitter.fit_in(images, spec.latents, rng, &fit_ctx);
+            if let Some(sink) = &ctx.learner_messages {
+                sink(&representation_label(spec), None);
             }
-            let ckpt =
-                ctx.cache
-                    .filter(|_| ctx.checkpoint_every > 0)
-                    .map(|c| neural::CheckpointSpec {
-                        dir: c.dir.clone(),
-                        key: key.clone(),
-                        every: ctx.checkpoint_every,
-                    });
-            let mut train = || {
-                neural::train_with_checkpoints(
-                    model,
-                    &l.config,
-                    images,
-                    spec.latents,
-                    rng,
-                    l.progress(),
-                    ckpt.as_ref(),
-                )
-            };
-            let enc = if ctx.train_threads > 0 {
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(ctx.train_threads)
-                    .build()
-                    .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
-                    .install(train)?
-            } else {
-                train()?
-            };
-            if let Some(c) = ctx.cache {
-                c.store(&key, &enc)?;
+            let (enc, z) = fitted?;
+            if let Some(c) = cache
+                && let Some(bytes) = enc.save(&key)
+            {
+                c.store(&key, &bytes)?;
             }
-            enc
+            (enc, z)
         }
     };
-    let z = enc.training_latents(images)?;
-    let evidence = {
-        let head = images.head(EVIDENCE_IMAGES);
-        let rec = neural::reconstruction_loss(enc.model, &enc.net, &head, head.n);
-        TrainingEvidence::new(mean_image_loss(&head), rec, head.n)
-    };
-    let info = TrainInfo {
-        config: cfg,
-        losses: enc.losses.clone(),
+    let info = encoder.training_record(images).map(|r| TrainInfo {
+        config: identity,
+        losses: r.losses,
         cache: status,
         key,
-        evidence,
-    };
-    Ok((Box::new(enc), z, info))
+        evidence: r.evidence,
+    });
+    Ok((encoder, z, info, fitter.name().to_string()))
 }
 
 /// A short label of a run's representation, for progress bars and messages:
@@ -366,40 +365,14 @@ pub fn fit_with_data(
         .learner_seed_identity(ctx.ugl.images)
         .expect("learned algorithm");
     let mut rng = stream(run_seed(ctx.campaign_seed, &seed_id), Component::Learner);
-    let (mut encoder, train, info) = if learner.model().is_some() {
-        let (e, z, info) = fit_neural(spec, ctx, &data.images, &mut rng)?;
-        (e, z, Some(info))
-    } else if learner.is_external() {
-        // The program's stderr: a log file beside the runs, and the last line to the caller.
-        let mut l = external_learner(learner, ctx.learners)?;
-        let label = representation_label(spec);
-        l.log_file = ctx.log_dir.map(|d| d.join(format!("{label}.learner.log")));
-        if let Some(sink) = &ctx.learner_messages {
-            let (sink, label) = (sink.clone(), label.clone());
-            l.on_stderr = Some(LineSink(Arc::new(move |line| sink(&label, Some(line)))));
-        }
-        let fitted = l.fit(&data.images, spec.latents, &mut rng);
-        if let Some(sink) = &ctx.learner_messages {
-            sink(&label, None);
-        }
-        let (e, z) = fitted?;
-        (e, z, None)
-    } else {
-        let l = make_learner(learner, ctx.learners, spec.variant)?;
-        let (e, z) = l.fit(&data.images, spec.latents, &mut rng)?;
-        (e, z, None)
-    };
+    let (mut encoder, train, info, learner_name) =
+        fit_or_load(spec, ctx, learner, &data.images, &mut rng)?;
     let quality = match measure_quality(encoder.as_mut(), env.as_ref(), &data, ds_seed) {
         Ok(q) => Some(q),
         Err(e) => {
             tracing::warn!("{}: latent quality not measured: {e}", spec.run_id());
             None
         }
-    };
-    let learner_name = if learner.is_external() {
-        ctx.learners.external().map(|e| e.name).unwrap_or_default()
-    } else {
-        learner.name().to_string()
     };
     let repr = Representation {
         encoder,
@@ -540,32 +513,10 @@ pub fn execute(
             UglConfig::default().images
         ));
     }
-    if let (Some(t), Some(model)) = (&train, spec.algo.learner().and_then(|l| l.model())) {
-        let p = NeuralConfig::paper(model);
-        if t.config.iterations < p.iterations {
-            notes.push(format!(
-                "{} training iterations instead of the paper's {}",
-                t.config.iterations, p.iterations
-            ));
-        }
-        if t.config.hidden != p.hidden {
-            notes.push(format!(
-                "hidden layers {:?} instead of the paper's {:?}",
-                t.config.hidden, p.hidden
-            ));
-        }
-        if t.config.init != p.init {
-            notes.push(format!(
-                "{} weight init instead of the paper's truncated normal (std 0.001)",
-                t.config.init
-            ));
-        }
-        if t.config.batch != p.batch || t.config.lr != p.lr {
-            notes.push(format!(
-                "batch {} / lr {} instead of the paper's {} / {}",
-                t.config.batch, t.config.lr, p.batch, p.lr
-            ));
-        }
+    if let Some(l) = spec.algo.learner()
+        && let Ok(params) = ctx.learners.params(l)
+    {
+        notes.extend(params.deviations(spec.variant));
     }
     let manifest = Manifest {
         run_id: spec.run_id(),

@@ -1,15 +1,19 @@
-//! The model cache: trained neural representations on disk, keyed by the hash of everything
-//! they depend on (see [`crate::campaign::runner::model_key`]), so the samplers of a cell and a
-//! rerun of a campaign do not retrain.
+//! The model cache: fitted representations on disk, keyed by the hash of everything they
+//! depend on (see [`crate::campaign::runner::model_key`]), so the samplers of a cell and a
+//! rerun of a campaign do not fit again. Every learner whose encoders persist
+//! ([`super::RepresentationLearner::persists`]) is kept: the neural networks, PCA, the Gaussian
+//! projection.
 //!
-//! File format (`<dir>/<key>.model`, little-endian), written atomically (temp + rename):
-//! `b"UGL-MODEL\0"`, format version `u32`, header length `u64`, the header (JSON: key, model,
-//! variant, shapes, loss curve, encoder seed), then every layer's weights and biases as `f32`
-//! in the header's order, then the BLAKE3 hash (32 bytes) of everything before it.
+//! File framing (`<dir>/<key>.model`, little-endian), written atomically (temp + rename):
+//! `b"UGL-MODEL\0"`, format version `u32`, header length `u64`, the header (JSON, with the
+//! key), the payload, then the BLAKE3 hash (32 bytes) of everything before it ([`seal`],
+//! [`unseal`]). The header and payload belong to the learner: a neural network's header holds
+//! the model, variant, shapes, loss curve and encoder seed, its payload every layer's weights
+//! and biases as `f32` in the header's order ([`to_bytes`]).
 //!
 //! A file is trusted only if its magic, version, length, checksum, key and shapes all match;
 //! anything else (truncated, corrupted, written by another version, a key collision) is
-//! reported as [`CacheEntry::Invalid`] and the caller retrains and overwrites it.
+//! reported as [`CacheEntry::Invalid`] and the caller fits again and overwrites it.
 
 use std::path::{Path, PathBuf};
 
@@ -38,9 +42,9 @@ struct Header {
 }
 
 /// What [`ModelCache::load`] found.
-pub enum CacheEntry {
+pub enum CacheEntry<T> {
     /// A valid model.
-    Hit(Box<NeuralEncoder>),
+    Hit(T),
     /// No file.
     Miss,
     /// A file that cannot be trusted; the reason.
@@ -53,38 +57,22 @@ pub struct ModelCache {
     pub dir: PathBuf,
 }
 
-/// Serialise an encoder under `key`.
-pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
-    let net = &enc.net;
-    let header = Header {
-        key: key.into(),
-        model: enc.model,
-        variant: enc.variant,
-        dim: net.dim,
-        hidden: net.hidden,
-        latents: net.latents,
-        layers: net.layers().iter().map(|l| (l.inp, l.out)).collect(),
-        losses: enc.losses.clone(),
-        encode_seed: hex(&enc.encode_seed),
-    };
-    let header = serde_json::to_vec(&header).expect("header serialises");
-    let mut out = Vec::with_capacity(64 + header.len() + 4 * net.num_params());
+/// Frame a header and a payload: magic, version, header length, header, payload, BLAKE3.
+pub fn seal(header: &[u8], payload: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(MAGIC.len() + 12 + header.len() + payload.len() + 32);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     out.extend_from_slice(&(header.len() as u64).to_le_bytes());
-    out.extend_from_slice(&header);
-    for l in net.layers() {
-        for v in l.w.iter().chain(&l.b) {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
-    }
+    out.extend_from_slice(header);
+    out.extend_from_slice(payload);
     let sum = blake3::hash(&out);
     out.extend_from_slice(sum.as_bytes());
     out
 }
 
-/// Parse and check a file's bytes; `Err` says why it cannot be trusted.
-pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
+/// The header and payload of framed bytes, after checking the magic, checksum, version and
+/// lengths; `Err` says why the bytes cannot be trusted.
+pub fn unseal(bytes: &[u8]) -> Result<(&[u8], &[u8]), String> {
     let n = bytes.len();
     if n < MAGIC.len() + 12 + 32 || &bytes[..MAGIC.len()] != MAGIC {
         return Err("not a model file (bad magic or too short)".into());
@@ -107,8 +95,53 @@ pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
         .checked_add(hlen)
         .filter(|&e| e <= body.len())
         .ok_or("header length out of range")?;
-    let h: Header =
-        serde_json::from_slice(&body[at..hend]).map_err(|e| format!("bad header: {e}"))?;
+    Ok((&body[at..hend], &body[hend..]))
+}
+
+/// Little-endian `f64`s.
+pub fn f64_bytes(values: &[f64]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+/// The `f64`s of [`f64_bytes`]; `Err` if the length is not a multiple of 8.
+pub fn f64s(bytes: &[u8]) -> Result<Vec<f64>, String> {
+    if bytes.len() % 8 != 0 {
+        return Err(format!("{} payload bytes are not f64 values", bytes.len()));
+    }
+    Ok(bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect())
+}
+
+/// Serialise a neural encoder under `key`.
+pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
+    let net = &enc.net;
+    let header = Header {
+        key: key.into(),
+        model: enc.model,
+        variant: enc.variant,
+        dim: net.dim,
+        hidden: net.hidden,
+        latents: net.latents,
+        layers: net.layers().iter().map(|l| (l.inp, l.out)).collect(),
+        losses: enc.losses.clone(),
+        encode_seed: hex(&enc.encode_seed),
+    };
+    let header = serde_json::to_vec(&header).expect("header serialises");
+    let mut payload = Vec::with_capacity(4 * net.num_params());
+    for l in net.layers() {
+        for v in l.w.iter().chain(&l.b) {
+            payload.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    seal(&header, &payload)
+}
+
+/// Parse and check a neural encoder's bytes; `Err` says why they cannot be trusted.
+pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
+    let (header, payload) = unseal(bytes)?;
+    let h: Header = serde_json::from_slice(header).map_err(|e| format!("bad header: {e}"))?;
     if h.key != key {
         return Err(format!("key mismatch (file holds {})", h.key));
     }
@@ -126,14 +159,14 @@ pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
         return Err("layer shapes do not match the model".into());
     }
     let values: usize = expect.iter().map(|(i, o)| i * o + o).sum();
-    if body.len() - hend != 4 * values {
+    if payload.len() != 4 * values {
         return Err(format!(
             "weights have {} bytes, the shapes need {}",
-            body.len() - hend,
+            payload.len(),
             4 * values
         ));
     }
-    let mut floats = body[hend..]
+    let mut floats = payload
         .chunks_exact(4)
         .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")));
     let mut take = |k: usize| -> Vec<f32> { floats.by_ref().take(k).collect() };
@@ -184,14 +217,18 @@ impl ModelCache {
         self.dir.join(format!("{key}.model"))
     }
 
-    /// Look `key` up.
-    pub fn load(&self, key: &str) -> CacheEntry {
+    /// Look `key` up; `decode` turns trusted-looking bytes into the model (`Err`: why not).
+    pub fn load<T>(
+        &self,
+        key: &str,
+        decode: impl FnOnce(&[u8]) -> Result<T, String>,
+    ) -> CacheEntry<T> {
         let path = self.path(key);
         match std::fs::read(&path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => CacheEntry::Miss,
             Err(e) => CacheEntry::Invalid(format!("cannot read {}: {e}", path.display())),
-            Ok(bytes) => match from_bytes(key, &bytes) {
-                Ok(enc) => CacheEntry::Hit(Box::new(enc)),
+            Ok(bytes) => match decode(&bytes) {
+                Ok(model) => CacheEntry::Hit(model),
                 Err(why) => CacheEntry::Invalid(format!("{}: {why}", path.display())),
             },
         }
@@ -218,14 +255,14 @@ impl ModelCache {
         Ok(())
     }
 
-    /// Store `enc` under `key` (atomically: temp file + rename).
-    pub fn store(&self, key: &str, enc: &NeuralEncoder) -> Result<(), ReprError> {
+    /// Store a model's bytes under `key` (atomically: temp file + rename).
+    pub fn store(&self, key: &str, bytes: &[u8]) -> Result<(), ReprError> {
         let io = |what: &str, p: &Path, e: std::io::Error| {
             ReprError::Cache(format!("cannot {what} {}: {e}", p.display()))
         };
         std::fs::create_dir_all(&self.dir).map_err(|e| io("create", &self.dir, e))?;
         let path = self.path(key);
-        crate::fsio::write_atomic(&path, &to_bytes(key, enc)).map_err(|e| io("write", &path, e))
+        crate::fsio::write_atomic(&path, bytes).map_err(|e| io("write", &path, e))
     }
 }
 
@@ -280,14 +317,21 @@ mod tests {
     fn the_cache_directory() {
         let dir = tempfile::tempdir().unwrap();
         let cache = ModelCache::new(dir.path().join("models"));
-        assert!(matches!(cache.load("abc"), CacheEntry::Miss));
-        cache.store("abc", &encoder(Model::Vae)).unwrap();
-        assert!(matches!(cache.load("abc"), CacheEntry::Hit(_)));
+        let decode = |b: &[u8]| from_bytes("abc", b);
+        assert!(matches!(cache.load("abc", decode), CacheEntry::Miss));
+        cache
+            .store("abc", &to_bytes("abc", &encoder(Model::Vae)))
+            .unwrap();
+        assert!(matches!(cache.load("abc", decode), CacheEntry::Hit(_)));
         std::fs::write(cache.path("abc"), b"junk").unwrap();
-        assert!(matches!(cache.load("abc"), CacheEntry::Invalid(_)));
+        assert!(matches!(cache.load("abc", decode), CacheEntry::Invalid(_)));
         // A directory where the cache should be is an error, not a panic.
         let blocked = ModelCache::new(dir.path().join("file"));
         std::fs::write(&blocked.dir, b"").unwrap();
-        assert!(blocked.store("abc", &encoder(Model::Ae)).is_err());
+        assert!(
+            blocked
+                .store("abc", &to_bytes("abc", &encoder(Model::Ae)))
+                .is_err()
+        );
     }
 }

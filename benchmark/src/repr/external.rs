@@ -219,6 +219,21 @@ impl RepresentationLearner for ExternalLearner {
         let (encoder, z) = self.fit_external(images, latents, rng)?;
         Ok((Box::new(encoder), z))
     }
+
+    /// The fit with the program's stderr also going to the context's log file and message
+    /// sink (where given; else this learner's own).
+    fn fit_in(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        ctx: &super::FitContext,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let mut l = self.clone();
+        l.log_file = ctx.log_file.clone().or(l.log_file);
+        l.on_stderr = ctx.messages.clone().or(l.on_stderr);
+        l.fit(images, latents, rng)
+    }
 }
 
 impl ExternalLearner {

@@ -26,9 +26,12 @@ pub mod rfvae;
 pub mod sparse;
 pub mod vae;
 
+use std::path::PathBuf;
+
 use thiserror::Error;
 
 use crate::seed::Stream;
+use evidence::TrainingEvidence;
 
 /// A set of images, row-major `n x dim` (dim = 4900 for the 70x70 renderer, pixel (x, y) of
 /// image i at `i * dim + x * 70 + y`), values in [0,1].
@@ -146,6 +149,64 @@ pub trait Encoder: Send {
     fn reported_fit_s(&self) -> Option<f64> {
         None
     }
+    /// The latents of the training images the goal samplers are fitted on (the KDE); by
+    /// default their encodings. A model whose training latents are samples (the faithful
+    /// RFVAE's z0) overrides it; it must return what [`RepresentationLearner::fit`] returned,
+    /// for an encoder loaded from the model cache as well.
+    fn training_latents(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        self.encode(images)
+    }
+    /// The encoder as bytes for the model cache, under `key` (checked again when it is loaded
+    /// with [`RepresentationLearner::load`]); None for encoders that are not kept.
+    fn save(&self, key: &str) -> Option<Vec<u8>> {
+        let _ = key;
+        None
+    }
+    /// How a trained network got here (its loss curve, and its reconstruction loss against the
+    /// mean-image plateau on the first [`evidence::EVIDENCE_IMAGES`] of `images`), recorded in
+    /// the manifests; None for learners that are not trained by iterations.
+    fn training_record(&self, images: &ImageSet) -> Option<TrainingRecord> {
+        let _ = images;
+        None
+    }
+}
+
+/// The training of an iteratively trained encoder ([`Encoder::training_record`]).
+#[derive(Clone, Debug)]
+pub struct TrainingRecord {
+    /// The recorded loss curve, `(iteration, mini-batch loss)`.
+    pub losses: Vec<(usize, f64)>,
+    /// The reconstruction loss against the plateau, and whether the network left it.
+    pub evidence: TrainingEvidence,
+}
+
+/// What the harness offers one fit: where to report, where to checkpoint, how many threads. A
+/// learner uses what applies to it and ignores the rest (the default
+/// [`RepresentationLearner::fit_in`] ignores all of it).
+#[derive(Clone, Default)]
+pub struct FitContext {
+    /// Progress of a training, after every iteration.
+    pub progress: Option<neural::ProgressFn>,
+    /// Mid-training checkpoints of a long training (resumed bit-identically after a kill).
+    pub checkpoint: Option<neural::CheckpointSpec>,
+    /// Threads of a training: 0 = the calling pool's.
+    pub threads: usize,
+    /// A file the learner's own messages are appended to (an external program's stderr).
+    pub log_file: Option<PathBuf>,
+    /// The learner's messages, line by line as they come.
+    pub messages: Option<external::LineSink>,
+}
+
+impl std::fmt::Debug for FitContext {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FitContext")
+            .field("progress", &self.progress.is_some())
+            .field("checkpoint", &self.checkpoint)
+            .field("threads", &self.threads)
+            .field("log_file", &self.log_file)
+            .field("messages", &self.messages.is_some())
+            .finish()
+    }
 }
 
 /// A representation learner (the UGL stage).
@@ -161,6 +222,35 @@ pub trait RepresentationLearner: Send + Sync {
         latents: usize,
         rng: &mut Stream,
     ) -> Result<(Box<dyn Encoder>, Latents), ReprError>;
+    /// [`RepresentationLearner::fit`] with the harness's support ([`FitContext`]: progress,
+    /// checkpoints, threads, a log). Same stream, same encoder, whatever the context. The
+    /// default ignores the context.
+    fn fit_in(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        ctx: &FitContext,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let _ = ctx;
+        self.fit(images, latents, rng)
+    }
+    /// Whether its encoders are kept in the model cache ([`Encoder::save`] gives their bytes,
+    /// [`RepresentationLearner::load`] reads them back). Learners whose fit is cheap or whose
+    /// encoder is larger than a fit is slow (Isomap keeps the n x n geodesic matrix) say no.
+    fn persists(&self) -> bool {
+        false
+    }
+    /// An encoder from the bytes [`Encoder::save`] wrote under `key`; `Err` says why the bytes
+    /// cannot be trusted (the harness fits again and overwrites them). A loaded encoder must
+    /// encode bit-identically to the one that was saved.
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+        let _ = (key, bytes);
+        Err(format!(
+            "{} encoders are not kept in the model cache",
+            self.name()
+        ))
+    }
 }
 
 /// Check the common preconditions of a fit.

@@ -317,6 +317,36 @@ impl LearnerParams for NeuralParams {
         )
         .expect("serialisable")
     }
+    fn deviations(&self, variant: Option<Variant>) -> Vec<String> {
+        let t = self.config(variant);
+        let p = NeuralConfig::paper(self.model);
+        let mut notes = Vec::new();
+        if t.iterations < p.iterations {
+            notes.push(format!(
+                "{} training iterations instead of the paper's {}",
+                t.iterations, p.iterations
+            ));
+        }
+        if t.hidden != p.hidden {
+            notes.push(format!(
+                "hidden layers {:?} instead of the paper's {:?}",
+                t.hidden, p.hidden
+            ));
+        }
+        if t.init != p.init {
+            notes.push(format!(
+                "{} weight init instead of the paper's truncated normal (std 0.001)",
+                t.init
+            ));
+        }
+        if t.batch != p.batch || t.lr != p.lr {
+            notes.push(format!(
+                "batch {} / lr {} instead of the paper's {} / {}",
+                t.batch, t.lr, p.batch, p.lr
+            ));
+        }
+        notes
+    }
     fn build(&self, variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
         Box::new(NeuralLearner::new(
             self.model,
@@ -400,6 +430,58 @@ impl super::RepresentationLearner for NeuralLearner {
     ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         let (enc, z) = self.fit_neural(images, latents, rng)?;
         Ok((Box::new(enc), z))
+    }
+
+    /// The training with the context's progress (else this learner's own), checkpoints and
+    /// thread count: bit-identical to [`NeuralLearner::fit_neural`] whatever the context.
+    fn fit_in(
+        &self,
+        images: &ImageSet,
+        latents: usize,
+        rng: &mut Stream,
+        ctx: &super::FitContext,
+    ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+        let progress = ctx.progress.as_ref().or(self.progress.as_ref());
+        let mut train = || {
+            train_with_checkpoints(
+                self.model,
+                &self.config,
+                images,
+                latents,
+                rng,
+                progress,
+                ctx.checkpoint.as_ref(),
+            )
+        };
+        let mut enc = if ctx.threads > 0 {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(ctx.threads)
+                .build()
+                .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
+                .install(train)?
+        } else {
+            train()?
+        };
+        let z = enc.training_latents(images)?;
+        Ok((Box::new(enc), z))
+    }
+
+    fn persists(&self) -> bool {
+        true
+    }
+
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+        let enc = super::cache::from_bytes(key, bytes)?;
+        if (enc.model, enc.variant) != (self.model, self.config.variant) {
+            return Err(format!(
+                "the file holds a {} ({}), not a {} ({})",
+                enc.model.name(),
+                enc.variant,
+                self.model.name(),
+                self.config.variant
+            ));
+        }
+        Ok(Box::new(enc))
     }
 }
 
@@ -532,6 +614,27 @@ impl Encoder for NeuralEncoder {
 
     fn begin_run(&mut self, rng: Stream) {
         self.rng = rng;
+    }
+
+    fn training_latents(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
+        NeuralEncoder::training_latents(self, images)
+    }
+
+    fn save(&self, key: &str) -> Option<Vec<u8>> {
+        Some(super::cache::to_bytes(key, self))
+    }
+
+    fn training_record(&self, images: &ImageSet) -> Option<super::TrainingRecord> {
+        let head = images.head(super::evidence::EVIDENCE_IMAGES);
+        let rec = reconstruction_loss(self.model, &self.net, &head, head.n);
+        Some(super::TrainingRecord {
+            losses: self.losses.clone(),
+            evidence: super::evidence::TrainingEvidence::new(
+                super::evidence::mean_image_loss(&head),
+                rec,
+                head.n,
+            ),
+        })
     }
 
     fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {

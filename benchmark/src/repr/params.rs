@@ -22,6 +22,12 @@ pub trait LearnerParams: Debug + Send + Sync {
     fn identity(&self, variant: Option<Variant>) -> serde_json::Value;
     /// The learner for a run of `variant`.
     fn build(&self, variant: Option<Variant>) -> Box<dyn RepresentationLearner>;
+    /// Where these parameters depart from the paper's (a smaller training budget, another
+    /// init...), one phrase each, for the manifests' `budget_note` and the report's deviations.
+    fn deviations(&self, variant: Option<Variant>) -> Vec<String> {
+        let _ = variant;
+        Vec::new()
+    }
     /// The concrete type, for the harness's [`super::registry::Kind`]-specific paths (a neural
     /// learner's training configuration, an external learner's program).
     fn as_any(&self) -> &dyn Any;

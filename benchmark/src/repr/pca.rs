@@ -103,9 +103,68 @@ pub struct ProjectionEncoder {
     pub offset: Vec<f64>,
 }
 
+/// The model-cache header of a [`ProjectionEncoder`] (its payload: the components, the
+/// singular values and the offset, as `f64`).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ProjectionHeader {
+    key: String,
+    encoder: String,
+    dim: usize,
+    latents: usize,
+    singular_values: usize,
+}
+
+impl ProjectionEncoder {
+    /// The encoder from the bytes of [`Encoder::save`]; `Err` says why they cannot be trusted.
+    pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<ProjectionEncoder, String> {
+        let (header, payload) = super::cache::unseal(bytes)?;
+        let h: ProjectionHeader =
+            serde_json::from_slice(header).map_err(|e| format!("bad header: {e}"))?;
+        if h.key != key {
+            return Err(format!("key mismatch (file holds {})", h.key));
+        }
+        if h.encoder != "projection" {
+            return Err(format!("a {} encoder, not a projection", h.encoder));
+        }
+        let values = super::cache::f64s(payload)?;
+        let (nc, ns) = (h.dim * h.latents, h.singular_values);
+        if values.len() != nc + ns + h.latents {
+            return Err(format!(
+                "{} values, the shapes need {}",
+                values.len(),
+                nc + ns + h.latents
+            ));
+        }
+        Ok(ProjectionEncoder {
+            components: values[..nc].to_vec(),
+            dim: h.dim,
+            latents: h.latents,
+            singular_values: values[nc..nc + ns].to_vec(),
+            offset: values[nc + ns..].to_vec(),
+        })
+    }
+}
+
 impl Encoder for ProjectionEncoder {
     fn latents(&self) -> usize {
         self.latents
+    }
+    fn save(&self, key: &str) -> Option<Vec<u8>> {
+        let header = ProjectionHeader {
+            key: key.to_string(),
+            encoder: "projection".into(),
+            dim: self.dim,
+            latents: self.latents,
+            singular_values: self.singular_values.len(),
+        };
+        let header = serde_json::to_vec(&header).expect("header serialises");
+        let mut values = self.components.clone();
+        values.extend_from_slice(&self.singular_values);
+        values.extend_from_slice(&self.offset);
+        Some(super::cache::seal(
+            &header,
+            &super::cache::f64_bytes(&values),
+        ))
     }
     fn encode(&mut self, images: &ImageSet) -> Result<Latents, ReprError> {
         if images.dim != self.dim {
@@ -152,6 +211,14 @@ impl Encoder for ProjectionEncoder {
 impl RepresentationLearner for TruncatedSvd {
     fn name(&self) -> &str {
         if self.centre { "pca-centred" } else { "pca" }
+    }
+
+    fn persists(&self) -> bool {
+        true
+    }
+
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+        Ok(Box::new(ProjectionEncoder::from_bytes(key, bytes)?))
     }
 
     fn fit(
@@ -342,6 +409,12 @@ pub struct CentredPca;
 impl RepresentationLearner for CentredPca {
     fn name(&self) -> &str {
         "pca-centred"
+    }
+    fn persists(&self) -> bool {
+        true
+    }
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+        Ok(Box::new(ProjectionEncoder::from_bytes(key, bytes)?))
     }
     fn fit(
         &self,
