@@ -16,6 +16,7 @@ use serde::Serialize;
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::plan::parse_shard;
 use ugl_bench::campaign::runner::{MessageSink, TrainSink};
+use ugl_bench::campaign::single::{self, RunRequest};
 use ugl_bench::campaign::{CampaignOptions, Progress, RunContext, RunSpec, plan, run_campaign};
 use ugl_bench::env::render::{Image70, PIXELS, write_npy, write_png};
 use ugl_bench::env::{EnvConfig, EnvKind, PARAMS, make_env};
@@ -455,7 +456,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             name,
             cache,
         } => run(
-            RunArgs {
+            RunRequest {
                 env,
                 algo,
                 sampler,
@@ -628,130 +629,10 @@ fn render(kind: EnvKind, state: &str, out: &Path) -> Result<()> {
     Ok(())
 }
 
-struct RunArgs {
-    env: EnvKind,
-    algo: Algo,
-    sampler: SamplerKind,
-    variant: Option<Variant>,
-    latents: usize,
-    images: Option<usize>,
-    seed: u64,
-    epochs: Option<usize>,
-    command: Option<String>,
-    name: Option<String>,
-}
-
-/// The results store keeps repetition indices as signed 64-bit integers (parquet `seed`).
-fn check_seed(seed: u64) -> Result<()> {
-    if seed > i64::MAX as u64 {
-        bail!(
-            "--seed must be below 2^63 = {} (the results store keeps it as a signed 64-bit integer), got {seed}",
-            i64::MAX as u64 + 1
-        );
-    }
-    Ok(())
-}
-
-fn run(a: RunArgs, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
-    check_seed(a.seed)?;
+fn run(a: RunRequest, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
     let path = resolve_profile(profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
-    if let Some(e) = a.epochs {
-        cfg.explore.epochs = e;
-        cfg.explore
-            .validate()
-            .map_err(|m| anyhow::anyhow!("--epochs: {m}"))?;
-    }
-    if let Some(n) = a.images {
-        if n < 2 {
-            bail!("--images must be at least 2, got {n}");
-        }
-        ugl_bench::limits::check_images(n).map_err(|m| anyhow::anyhow!("--images: {m}"))?;
-        cfg.ugl.images = n;
-    }
-    let spec = match a.algo.learner() {
-        None => RunSpec::baseline(a.env, a.algo, a.seed),
-        Some(_) => {
-            if !matches!(a.sampler, SamplerKind::Kde | SamplerKind::Gaussian) {
-                bail!("--sampler must be kde or gaussian for {}", a.algo);
-            }
-            if a.latents == 0 || a.latents >= cfg.ugl.images {
-                bail!(
-                    "--latents must be between 1 and the number of images - 1 ({}), got {}",
-                    cfg.ugl.images - 1,
-                    a.latents
-                );
-            }
-            RunSpec::learned(
-                a.env,
-                a.algo,
-                a.sampler,
-                a.latents,
-                a.variant.unwrap_or_default(),
-                a.seed,
-            )
-        }
-    };
-    if a.variant.is_some() && !a.algo.learner().is_some_and(|l| l.has_variants()) {
-        let with_variants: Vec<&str> = Learner::all()
-            .filter(|l| l.has_variants())
-            .map(|l| l.entry().algo)
-            .collect();
-        bail!(
-            "--variant applies to {} only (the other algorithms have one behaviour), not {}",
-            with_variants.join(" and "),
-            a.algo
-        );
-    }
-    if a.sampler == SamplerKind::Gaussian && !a.algo.learner().is_some_and(|l| l.may_have_prior()) {
-        let with_prior: Vec<&str> = Learner::all()
-            .filter(|l| l.may_have_prior())
-            .map(|l| l.entry().algo)
-            .collect();
-        bail!(
-            "--sampler gaussian needs a goal-space prior: {}, not {} (use kde)",
-            with_prior.join(", "),
-            a.algo
-        );
-    }
-    let external = a.algo.learner().is_some_and(Learner::is_external);
-    if !external && (a.command.is_some() || a.name.is_some()) {
-        bail!(
-            "--command and --name apply to --algo rge-external only, not {}",
-            a.algo
-        );
-    }
-    if external {
-        if let Some(cmd) = &a.command {
-            if cmd.trim().is_empty() {
-                bail!("--command must not be empty");
-            }
-            let configured = cfg.learners.external();
-            let name = a
-                .name
-                .clone()
-                .or_else(|| configured.as_ref().map(|e| e.name.clone()))
-                .unwrap_or_else(|| "external".into());
-            cfg.learners
-                .set_external(&ugl_bench::campaign::config::ExternalConfig {
-                    name,
-                    command: cmd.clone(),
-                    ready_timeout_s: configured.as_ref().and_then(|e| e.ready_timeout_s),
-                    answer_timeout_s: configured.as_ref().and_then(|e| e.answer_timeout_s),
-                });
-        } else if let (Some(name), Some(mut e)) = (&a.name, cfg.learners.external()) {
-            e.name = name.clone();
-            cfg.learners.set_external(&e);
-        }
-        if cfg.learners.external().is_none() {
-            bail!(
-                "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
-                path.display()
-            );
-        }
-        cfg.validate()
-            .map_err(|m| anyhow::anyhow!("--name/--command: {m}"))?;
-    }
+    let spec = a.resolve(&mut cfg, &path).map_err(anyhow::Error::msg)?;
     check_out_dir(out)?;
     let model_cache = cache.resolve(out);
     let mp = progress_area();
@@ -877,27 +758,14 @@ fn refresh_config(
 
 /// `ugl embed`: the latents of one fitted goal space.
 fn embed(a: EmbedArgs) -> Result<()> {
-    check_seed(a.seed)?;
+    single::check_seed(a.seed).map_err(anyhow::Error::msg)?;
     let path = resolve_profile(&a.profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
-    if let Some(n) = a.images {
-        if n < 2 {
-            bail!("--images must be at least 2, got {n}");
-        }
-        ugl_bench::limits::check_images(n).map_err(|m| anyhow::anyhow!("--images: {m}"))?;
-        cfg.ugl.images = n;
-    }
-    let learner = resolve_learner(&a.learner, a.command.as_deref(), &mut cfg)?;
-    if a.variant.is_some() && !learner.has_variants() {
-        bail!("--variant applies to vae and rfvae only, not {}", a.learner);
-    }
-    if a.latents == 0 || a.latents >= cfg.ugl.images {
-        bail!(
-            "--latents must be between 1 and the number of images - 1 ({}), got {}",
-            cfg.ugl.images - 1,
-            a.latents
-        );
-    }
+    single::set_images(&mut cfg, a.images).map_err(anyhow::Error::msg)?;
+    let learner = single::resolve_learner(&a.learner, a.command.as_deref(), &mut cfg)
+        .map_err(anyhow::Error::msg)?;
+    single::check_learner_variant(learner, a.variant).map_err(anyhow::Error::msg)?;
+    single::check_latents(a.latents, cfg.ugl.images).map_err(anyhow::Error::msg)?;
     if !(2..=1000).contains(&a.grid) {
         bail!("--grid must be between 2 and 1000, got {}", a.grid);
     }
@@ -997,65 +865,15 @@ fn learners() {
     }
 }
 
-/// The learner named `name`: a registered one, or with `command` an external program (set in
-/// `cfg.learners.external`).
-fn resolve_learner(name: &str, command: Option<&str>, cfg: &mut CampaignConfig) -> Result<Learner> {
-    let registered: Vec<Learner> = Learner::all().filter(|l| !l.is_external()).collect();
-    match (registered.iter().find(|l| l.name() == name), command) {
-        (Some(l), None) => Ok(*l),
-        (Some(_), Some(_)) => bail!(
-            "--learner {name} is a registered learner: drop --command, or give the external program another name"
-        ),
-        (None, Some(cmd)) => {
-            if cmd.trim().is_empty() {
-                bail!("--command must not be empty");
-            }
-            cfg.learners
-                .set_external(&ugl_bench::campaign::config::ExternalConfig {
-                    name: name.to_string(),
-                    command: cmd.to_string(),
-                    ready_timeout_s: None,
-                    answer_timeout_s: None,
-                });
-            Learner::all()
-                .find(|l| l.is_external())
-                .ok_or_else(|| anyhow::anyhow!("this build has no external learner"))
-        }
-        (None, None) => {
-            let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
-            bail!(
-                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
-                names.join(", ")
-            )
-        }
-    }
-}
-
 /// `ugl compare`: the paper's matrix cells and seeds for one more learner.
 fn compare(a: CompareArgs) -> Result<()> {
-    let mut cfg = CampaignConfig::load(&a.config)?;
-    let name = a.learner.trim().to_string();
-    if name.is_empty()
-        || !name
-            .chars()
-            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
-    {
-        bail!(
-            "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
-        );
-    }
-    let algo = Algo::Rge(resolve_learner(&name, a.command.as_deref(), &mut cfg)?);
-    // Same campaign seed, matrix cells, reps and budgets as the base campaign: the same run
-    // seeds and UGL data sets, so the new learner is compared on paired runs.
-    let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
-    cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
-    cfg.matrix.algos = vec![algo];
-    if algo.learner().is_some_and(Learner::is_external) && !a.gaussian {
-        cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);
-        if cfg.matrix.samplers.is_empty() {
-            cfg.matrix.samplers = vec![SamplerKind::Kde];
-        }
-    }
+    let (cfg, base) = single::compare_campaign(
+        CampaignConfig::load(&a.config)?,
+        &a.learner,
+        a.command.as_deref(),
+        a.gaussian,
+    )
+    .map_err(anyhow::Error::msg)?;
     cfg.validate()
         .map_err(|m| anyhow::anyhow!("{}: {m}", a.config.display()))?;
     let out = a

@@ -12,5 +12,6 @@ pub mod fsio;
 pub mod goals;
 pub mod limits;
 pub mod metrics;
+pub mod npy;
 pub mod repr;
 pub mod seed;

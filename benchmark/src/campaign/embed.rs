@@ -7,8 +7,6 @@
 //! - a `grid x grid` lattice of object positions over [-1, 1]^2 (ArmArrow: angle 0), with its
 //!   states.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
 use super::plan::RunSpec;
@@ -75,15 +73,7 @@ pub fn grid_images(env: &dyn Environment, grid: usize) -> Result<(Vec<f64>, Imag
     Ok((states, ImageSet::new(grid * grid, PIXELS, pixels)?))
 }
 
-/// Write a float64 `rows x cols` array as .npy (C order).
+/// Write a float64 `rows x cols` array as .npy (C order): [`crate::npy::write_npy_f64_file`].
 pub fn write_npy_f64(path: &Path, rows: usize, cols: usize, data: &[f64]) -> std::io::Result<()> {
-    use npyz::WriterBuilder;
-    let file = File::create(path)?;
-    let mut writer = npyz::WriteOptions::<f64>::new()
-        .default_dtype()
-        .shape(&[rows as u64, cols as u64])
-        .writer(BufWriter::new(file))
-        .begin_nd()?;
-    writer.extend(data.iter().copied())?;
-    writer.finish()
+    crate::npy::write_npy_f64_file(path, rows, cols, data)
 }

@@ -9,6 +9,7 @@ pub mod merge;
 pub mod plan;
 pub mod remeasure;
 pub mod runner;
+pub mod single;
 pub mod slurm;
 pub mod store;
 

@@ -766,21 +766,11 @@ fn check_len(img: &Image70, path: &Path) -> Result<(), RenderError> {
 /// Write as .npy: float32, shape (70, 70), C order, indexed `[x][y]` (what the original's
 /// `array2d`-based images look like to numpy).
 pub fn write_npy(img: &Image70, path: &Path) -> Result<(), RenderError> {
-    use npyz::WriterBuilder;
     check_len(img, path)?;
-    let io_err = |source| RenderError::Io {
+    crate::npy::write_npy_f32_file(path, SIDE, SIDE, &img.0).map_err(|source| RenderError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let file = File::create(path).map_err(io_err)?;
-    let mut writer = npyz::WriteOptions::<f32>::new()
-        .default_dtype()
-        .shape(&[SIDE as u64, SIDE as u64])
-        .writer(BufWriter::new(file))
-        .begin_nd()
-        .map_err(io_err)?;
-    writer.extend(img.0.iter().copied()).map_err(io_err)?;
-    writer.finish().map_err(io_err)
+    })
 }
 
 /// Upscaling factor of [`write_png`].

@@ -1,0 +1,381 @@
+//! One run, one representation or one more learner from command-line choices (`ugl run`,
+//! `ugl embed`, `ugl compare`): the checks and the changes they make to a profile, so that the
+//! command line only parses arguments, shows progress and prints. Every error is one line that
+//! names the flag.
+
+use std::path::Path;
+
+use super::config::{CampaignConfig, ExternalConfig};
+use super::plan::RunSpec;
+use crate::env::EnvKind;
+use crate::explore::{Algo, Learner, SamplerKind};
+use crate::repr::neural::Variant;
+
+/// The choices of `ugl run`.
+#[derive(Clone, Debug)]
+pub struct RunRequest {
+    pub env: EnvKind,
+    pub algo: Algo,
+    pub sampler: SamplerKind,
+    pub variant: Option<Variant>,
+    pub latents: usize,
+    /// Override of the profile's number of UGL training images.
+    pub images: Option<usize>,
+    pub seed: u64,
+    /// Override of the profile's number of exploration epochs.
+    pub epochs: Option<usize>,
+    /// `rge-external`: the program's command line (replaces the profile's).
+    pub command: Option<String>,
+    /// `rge-external`: the program's name in results.
+    pub name: Option<String>,
+}
+
+impl RunRequest {
+    /// Check the request against the profile `cfg` (read from `profile`), apply its
+    /// overrides to `cfg`, and return the run.
+    pub fn resolve(&self, cfg: &mut CampaignConfig, profile: &Path) -> Result<RunSpec, String> {
+        check_seed(self.seed)?;
+        if let Some(e) = self.epochs {
+            cfg.explore.epochs = e;
+            cfg.explore
+                .validate()
+                .map_err(|m| format!("--epochs: {m}"))?;
+        }
+        set_images(cfg, self.images)?;
+        let spec = match self.algo.learner() {
+            None => RunSpec::baseline(self.env, self.algo, self.seed),
+            Some(_) => {
+                if !matches!(self.sampler, SamplerKind::Kde | SamplerKind::Gaussian) {
+                    return Err(format!(
+                        "--sampler must be kde or gaussian for {}",
+                        self.algo
+                    ));
+                }
+                check_latents(self.latents, cfg.ugl.images)?;
+                RunSpec::learned(
+                    self.env,
+                    self.algo,
+                    self.sampler,
+                    self.latents,
+                    self.variant.unwrap_or_default(),
+                    self.seed,
+                )
+            }
+        };
+        check_variant(self.algo, self.variant)?;
+        if self.sampler == SamplerKind::Gaussian
+            && !self.algo.learner().is_some_and(|l| l.may_have_prior())
+        {
+            let with_prior: Vec<&str> = Learner::all()
+                .filter(|l| l.may_have_prior())
+                .map(|l| l.entry().algo)
+                .collect();
+            return Err(format!(
+                "--sampler gaussian needs a goal-space prior: {}, not {} (use kde)",
+                with_prior.join(", "),
+                self.algo
+            ));
+        }
+        let external = self.algo.learner().is_some_and(Learner::is_external);
+        if !external && (self.command.is_some() || self.name.is_some()) {
+            return Err(format!(
+                "--command and --name apply to --algo rge-external only, not {}",
+                self.algo
+            ));
+        }
+        if external {
+            self.set_external(cfg, profile)?;
+        }
+        Ok(spec)
+    }
+
+    /// `--command` / `--name` of an external run, over the profile's `[learners.external]`.
+    fn set_external(&self, cfg: &mut CampaignConfig, profile: &Path) -> Result<(), String> {
+        if let Some(cmd) = &self.command {
+            if cmd.trim().is_empty() {
+                return Err("--command must not be empty".into());
+            }
+            let configured = cfg.learners.external();
+            let name = self
+                .name
+                .clone()
+                .or_else(|| configured.as_ref().map(|e| e.name.clone()))
+                .unwrap_or_else(|| "external".into());
+            cfg.learners.set_external(&ExternalConfig {
+                name,
+                command: cmd.clone(),
+                ready_timeout_s: configured.as_ref().and_then(|e| e.ready_timeout_s),
+                answer_timeout_s: configured.as_ref().and_then(|e| e.answer_timeout_s),
+            });
+        } else if let (Some(name), Some(mut e)) = (&self.name, cfg.learners.external()) {
+            e.name = name.clone();
+            cfg.learners.set_external(&e);
+        }
+        if cfg.learners.external().is_none() {
+            return Err(format!(
+                "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                profile.display()
+            ));
+        }
+        cfg.validate().map_err(|m| format!("--name/--command: {m}"))
+    }
+}
+
+/// The results store keeps repetition indices as signed 64-bit integers (parquet `seed`).
+pub fn check_seed(seed: u64) -> Result<(), String> {
+    if seed > i64::MAX as u64 {
+        return Err(format!(
+            "--seed must be below 2^63 = {} (the results store keeps it as a signed 64-bit integer), got {seed}",
+            i64::MAX as u64 + 1
+        ));
+    }
+    Ok(())
+}
+
+/// `--images`: override the profile's number of UGL training images.
+pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(), String> {
+    if let Some(n) = images {
+        if n < 2 {
+            return Err(format!("--images must be at least 2, got {n}"));
+        }
+        crate::limits::check_images(n).map_err(|m| format!("--images: {m}"))?;
+        cfg.ugl.images = n;
+    }
+    Ok(())
+}
+
+/// `--latents` of a learned goal space fitted on `images` images.
+pub fn check_latents(latents: usize, images: usize) -> Result<(), String> {
+    if latents == 0 || latents >= images {
+        return Err(format!(
+            "--latents must be between 1 and the number of images - 1 ({}), got {latents}",
+            images - 1
+        ));
+    }
+    Ok(())
+}
+
+/// `--variant` applies to the algorithms whose learner has variants only (the registry says
+/// which).
+pub fn check_variant(algo: Algo, variant: Option<Variant>) -> Result<(), String> {
+    variant_applies(
+        algo.learner(),
+        variant,
+        |l| l.entry().algo,
+        &algo.to_string(),
+    )
+}
+
+/// [`check_variant`] for a command that names learners (`ugl embed --learner`).
+pub fn check_learner_variant(learner: Learner, variant: Option<Variant>) -> Result<(), String> {
+    variant_applies(Some(learner), variant, Learner::name, learner.name())
+}
+
+fn variant_applies(
+    learner: Option<Learner>,
+    variant: Option<Variant>,
+    name: fn(Learner) -> &'static str,
+    given: &str,
+) -> Result<(), String> {
+    if variant.is_some() && !learner.is_some_and(|l| l.has_variants()) {
+        let with_variants: Vec<&str> = Learner::all()
+            .filter(|l| l.has_variants())
+            .map(name)
+            .collect();
+        return Err(format!(
+            "--variant applies to {} only (the others have one behaviour), not {given}",
+            with_variants.join(" and ")
+        ));
+    }
+    Ok(())
+}
+
+/// The learner named `name`: a registered one, or with `command` an external program (set in
+/// `cfg.learners.external`).
+pub fn resolve_learner(
+    name: &str,
+    command: Option<&str>,
+    cfg: &mut CampaignConfig,
+) -> Result<Learner, String> {
+    let registered: Vec<Learner> = Learner::all().filter(|l| !l.is_external()).collect();
+    match (registered.iter().find(|l| l.name() == name), command) {
+        (Some(l), None) => Ok(*l),
+        (Some(_), Some(_)) => Err(format!(
+            "--learner {name} is a registered learner: drop --command, or give the external program another name"
+        )),
+        (None, Some(cmd)) => {
+            if cmd.trim().is_empty() {
+                return Err("--command must not be empty".into());
+            }
+            cfg.learners.set_external(&ExternalConfig {
+                name: name.to_string(),
+                command: cmd.to_string(),
+                ready_timeout_s: None,
+                answer_timeout_s: None,
+            });
+            Learner::all()
+                .find(|l| l.is_external())
+                .ok_or_else(|| "this build has no external learner".to_string())
+        }
+        (None, None) => {
+            let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
+            Err(format!(
+                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
+                names.join(", ")
+            ))
+        }
+    }
+}
+
+/// `ugl compare`: the campaign `compare-NAME` that runs one more learner on the cells, seeds,
+/// reps and budgets of `cfg` (so its runs pair with the base campaign's: same run seeds and
+/// UGL data sets). Returns it and the base campaign's name. An external program gets
+/// Gaussian-prior goals only with `gaussian` (it must write a prior).
+pub fn compare_campaign(
+    mut cfg: CampaignConfig,
+    learner: &str,
+    command: Option<&str>,
+    gaussian: bool,
+) -> Result<(CampaignConfig, String), String> {
+    let name = learner.trim().to_string();
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
+    {
+        return Err(format!(
+            "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
+        ));
+    }
+    let algo = Algo::Rge(resolve_learner(&name, command, &mut cfg)?);
+    let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
+    cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
+    cfg.matrix.algos = vec![algo];
+    if algo.learner().is_some_and(Learner::is_external) && !gaussian {
+        cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);
+        if cfg.matrix.samplers.is_empty() {
+            cfg.matrix.samplers = vec![SamplerKind::Kde];
+        }
+    }
+    Ok((cfg, base))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PROFILE: &str = "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+        algos = [\"rpe\", \"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\", \"gaussian\"]\n\
+        latents = [\"true\"]\n[ugl]\nimages = 200\n";
+
+    fn cfg() -> CampaignConfig {
+        CampaignConfig::from_toml(PROFILE, Path::new("base.toml")).unwrap()
+    }
+
+    fn request(algo: &str) -> RunRequest {
+        RunRequest {
+            env: EnvKind::ArmBall,
+            algo: algo.parse().unwrap(),
+            sampler: SamplerKind::Kde,
+            variant: None,
+            latents: 2,
+            images: None,
+            seed: 0,
+            epochs: None,
+            command: None,
+            name: None,
+        }
+    }
+
+    #[test]
+    fn a_run_request_is_checked_and_applied() {
+        let mut c = cfg();
+        let spec = RunRequest {
+            images: Some(300),
+            epochs: Some(50),
+            ..request("rge-pca")
+        }
+        .resolve(&mut c, Path::new("base.toml"))
+        .unwrap();
+        assert_eq!(spec.run_id(), "armball.rge-pca.kde.l2.s0");
+        assert_eq!((c.ugl.images, c.explore.epochs), (300, 50));
+        let err = |r: RunRequest| r.resolve(&mut cfg(), Path::new("base.toml")).unwrap_err();
+        assert!(
+            err(RunRequest {
+                variant: Some(Variant::Corrected),
+                ..request("rge-pca")
+            })
+            .contains("--variant applies to rge-vae and rge-rfvae")
+        );
+        assert!(
+            err(RunRequest {
+                sampler: SamplerKind::Gaussian,
+                ..request("rge-isomap")
+            })
+            .contains("prior")
+        );
+        assert!(
+            err(RunRequest {
+                latents: 200,
+                ..request("rge-pca")
+            })
+            .contains("--latents")
+        );
+        assert!(
+            err(RunRequest {
+                seed: u64::MAX,
+                ..request("rpe")
+            })
+            .contains("--seed")
+        );
+        assert!(
+            err(RunRequest {
+                images: Some(1),
+                ..request("rge-pca")
+            })
+            .contains("--images")
+        );
+        assert!(
+            err(RunRequest {
+                command: Some("x".into()),
+                ..request("rge-pca")
+            })
+            .contains("--command and --name")
+        );
+        assert!(err(request("rge-external")).contains("[learners.external]"));
+        let mut c = cfg();
+        RunRequest {
+            command: Some("python3 x.py".into()),
+            ..request("rge-external")
+        }
+        .resolve(&mut c, Path::new("base.toml"))
+        .unwrap();
+        assert_eq!(c.learners.external().unwrap().name, "external");
+    }
+
+    #[test]
+    fn a_compare_campaign_keeps_the_cells_and_seeds() {
+        let (c, base) = compare_campaign(cfg(), "pca-centred", None, false).unwrap();
+        assert_eq!(base, "base");
+        assert_eq!(c.campaign.name, "compare-pca-centred");
+        assert_eq!(c.campaign.seed, cfg().campaign.seed);
+        assert_eq!(c.matrix.algos, vec!["rge-pca-centred".parse().unwrap()]);
+        // An external program: no Gaussian goals unless asked.
+        let (c, _) = compare_campaign(cfg(), "mine", Some("python3 m.py"), false).unwrap();
+        assert_eq!(c.matrix.samplers, vec![SamplerKind::Kde]);
+        assert_eq!(c.learners.external().unwrap().name, "mine");
+        let (c, _) = compare_campaign(cfg(), "mine", Some("python3 m.py"), true).unwrap();
+        assert_eq!(c.matrix.samplers.len(), 2);
+        assert!(compare_campaign(cfg(), "Bad Name", None, false).is_err());
+        assert!(
+            compare_campaign(cfg(), "nosuch", None, false)
+                .unwrap_err()
+                .contains("not a registered learner")
+        );
+        assert!(
+            compare_campaign(cfg(), "pca", Some("true"), false)
+                .unwrap_err()
+                .contains("registered learner")
+        );
+    }
+}
