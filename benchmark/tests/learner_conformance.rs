@@ -35,12 +35,18 @@ fn python_numpy() -> bool {
 }
 
 fn learners_config() -> LearnersConfig {
-    let text = format!(
+    let mut text = format!(
         "[external]\nname = \"random-projection\"\n\
-         command = \"python3 {}/../scripts/external_learners/random_projection.py\"\n\
-         [ae]\n{TINY}[vae]\n{TINY}[rfvae]\n{TINY}warmup = 10\n",
+         command = \"python3 {}/../scripts/external_learners/random_projection.py\"\n",
         env!("CARGO_MANIFEST_DIR")
     );
+    // Every neural learner of the registry, with a tiny network and budget (a new one too).
+    for model in Learner::all().filter_map(Learner::model) {
+        text.push_str(&format!("[{}]\n{TINY}", model.name()));
+        if model.spec().paper_warmup() > 0 {
+            text.push_str("warmup = 10\n");
+        }
+    }
     let cfg: LearnersConfig = toml::from_str(&text).unwrap();
     cfg.validate().unwrap();
     cfg

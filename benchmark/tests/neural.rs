@@ -1,4 +1,4 @@
-//! The neural learners (AE, VAE, RFVAE; `repr::neural`), on tiny networks (hidden [32, 16])
+//! The neural learners (AE, VAE, RFVAE, β-VAE; `repr::neural`), on tiny networks (hidden [32, 16])
 //! and ~200 rendered images, so the whole file runs in seconds on 2 cores.
 
 use std::sync::Arc;
@@ -569,7 +569,6 @@ fn host_engine_gradients_match_burn_autodiff() {
     use burn::optim::GradientsParams;
     use ugl_bench::repr::host_train::{HostOptimizer, HostTrainer};
     use ugl_bench::repr::neural::{Init, LatentInput, StepInput, tensor2, training_device};
-    use ugl_bench::repr::{ae, rfvae, vae};
     let set = images(EnvKind::ArmBall, 60);
     let (rows, d, step) = (40, 3, 3);
     let x: Vec<f32> = (0..rows).flat_map(|i| set.row(i).to_vec()).collect();
@@ -596,16 +595,13 @@ fn host_engine_gradients_match_burn_autodiff() {
                     latents: d,
                     step,
                     warmup: cfg.warmup,
+                    beta: cfg.beta.unwrap_or(1.0),
                     variant,
                     device: &device,
                 },
             };
             let mut rng = stream_named(5, "noise");
-            let loss = match model {
-                Model::Ae => ae::loss(&module, input),
-                Model::Vae => vae::loss(&module, input, &mut rng),
-                Model::Rfvae => rfvae::loss(&module, input, &mut rng),
-            };
+            let loss = model.spec().loss(&module, input, &mut rng);
             let burn_loss = f64::from(loss.clone().into_scalar::<f32>());
             let grads = GradientsParams::from_grads(loss.backward(), &module);
             let what = format!("{} {}", model.name(), variant.name());
@@ -832,5 +828,31 @@ fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
         )
         .unwrap();
         assert_eq!(again.net, reference.net);
+    }
+}
+
+/// The β-VAE (`bvae.rs`) with β = 1 is the corrected VAE, bit for bit, on both engines: same
+/// loss curve, same encodings. β = 4 weighs the KL more: another training.
+#[test]
+fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
+    use ugl_bench::repr::neural::Engine;
+    let set = images(EnvKind::ArmBall, 150);
+    for engine in [Engine::Host, Engine::Burn] {
+        let vae = NeuralConfig {
+            engine,
+            ..tiny(Model::Vae, Variant::Corrected, 25)
+        };
+        let beta = |b: f64| NeuralConfig {
+            engine,
+            beta: Some(b),
+            ..tiny(Model::Bvae, Variant::Faithful, 25)
+        };
+        let (v, zv) = fit_neural(Model::Vae, vae, &set, 3, 4);
+        let (b1, zb1) = fit_neural(Model::Bvae, beta(1.0), &set, 3, 4);
+        assert_eq!(v.losses, b1.losses, "{engine:?}: loss curves");
+        assert_eq!(zv.data, zb1.data, "{engine:?}: encodings");
+        let (b4, zb4) = fit_neural(Model::Bvae, beta(4.0), &set, 3, 4);
+        assert_ne!(zb4.data, zv.data, "{engine:?}");
+        assert_ne!(b4.losses, v.losses, "{engine:?}");
     }
 }

@@ -649,6 +649,7 @@ impl HostTrainer {
             latents: d,
             step,
             warmup: cfg.warmup,
+            beta: cfg.beta.unwrap_or(1.0),
             variant: cfg.variant,
             device: &self.device,
         };

@@ -7,6 +7,7 @@
 //! every registered learner.
 
 pub mod ae;
+pub mod bvae;
 pub mod cache;
 pub mod checkpoint;
 pub mod dataset;

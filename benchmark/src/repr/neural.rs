@@ -38,7 +38,7 @@ use super::{
     Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
     check_latents,
 };
-use crate::repr::{ae, rfvae, vae};
+use crate::repr::{ae, bvae, rfvae, vae};
 use crate::seed::Stream;
 
 /// The backend neural training runs on (part of the model-cache key, so models trained on
@@ -105,11 +105,13 @@ pub enum Model {
     Vae,
     /// Dense VAE with 10 amortised radial flows, KL warm-up, Adam.
     Rfvae,
+    /// Dense β-VAE (the follow-up paper's learner), Adam.
+    Bvae,
 }
 
 impl Model {
-    /// All three.
-    pub const ALL: [Model; 3] = [Model::Ae, Model::Vae, Model::Rfvae];
+    /// All of them.
+    pub const ALL: [Model; 4] = [Model::Ae, Model::Vae, Model::Rfvae, Model::Bvae];
 
     /// What the model is: the one place a model's identity maps to its code.
     pub fn spec(self) -> &'static dyn NeuralModel {
@@ -117,10 +119,11 @@ impl Model {
             Model::Ae => &ae::Ae,
             Model::Vae => &vae::Vae,
             Model::Rfvae => &rfvae::Rfvae,
+            Model::Bvae => &bvae::Bvae,
         }
     }
 
-    /// `ae`, `vae`, `rfvae`.
+    /// `ae`, `vae`, `rfvae`, `bvae`.
     pub fn name(self) -> &'static str {
         self.spec().name()
     }
@@ -165,6 +168,10 @@ pub struct NeuralConfig {
     /// all trained on burn.
     #[serde(default = "Engine::before_v3")]
     pub engine: Engine,
+    /// β-VAE only: the weight of the KL term (absent for the other models, which weigh it by
+    /// 1, so their configurations and hashes are what they were before the β-VAE existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
 }
 
 impl NeuralConfig {
@@ -178,6 +185,7 @@ impl NeuralConfig {
             variant: Variant::Faithful,
             log_every: 100,
             warmup: model.spec().paper_warmup(),
+            beta: model.spec().default_beta(),
             init: Init::Paper,
             engine: Engine::Host,
         }
@@ -212,6 +220,11 @@ impl NeuralConfig {
         }
         if self.log_every == 0 {
             return bad("log_every must be at least 1".into());
+        }
+        if let Some(b) = self.beta
+            && !(b.is_finite() && b > 0.0 && b <= 1e6)
+        {
+            return bad(format!("beta must be positive and at most 1e6, got {b}"));
         }
         if model.spec().paper_warmup() > 0 && self.warmup == 0 {
             return bad("warmup must be at least 1".into());
@@ -253,6 +266,8 @@ pub struct NeuralSection {
     pub init: Option<Init>,
     /// Training engine: `host` (default) or `burn` ([`Engine`]).
     pub engine: Option<Engine>,
+    /// β-VAE: the weight of the KL term (only valid in `[learners.bvae]`).
+    pub beta: Option<f64>,
 }
 
 impl NeuralSection {
@@ -269,6 +284,7 @@ impl NeuralSection {
             warmup: self.warmup.unwrap_or(p.warmup),
             init: self.init.unwrap_or(p.init),
             engine: self.engine.unwrap_or(p.engine),
+            beta: p.beta.map(|b| self.beta.unwrap_or(b)),
         }
     }
 }
@@ -279,6 +295,9 @@ impl ParamGuard for (Model, NeuralSection) {
         let (model, section) = self;
         if model.spec().paper_warmup() == 0 && section.warmup.is_some() {
             return Err("warmup: only the rfvae has a KL warm-up".into());
+        }
+        if model.spec().default_beta().is_none() && section.beta.is_some() {
+            return Err("beta: only the bvae has a KL weight".into());
         }
         section
             .resolve(model, Variant::Faithful)
@@ -829,6 +848,7 @@ impl<'a> Trainer<'a> {
                         latents: self.latents,
                         step: self.step,
                         warmup: self.cfg.warmup,
+                        beta: self.cfg.beta.unwrap_or(1.0),
                         variant: self.cfg.variant,
                         device,
                     },

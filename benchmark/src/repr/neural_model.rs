@@ -1,6 +1,6 @@
 //! The model-specific part of the dense neural learners (PAPER-NOTES.md section 5): one
-//! [`NeuralModel`] trait that the AE (`ae.rs`), the VAE (`vae.rs`) and the RFVAE (`rfvae.rs`)
-//! implement, with the types their code shares. `neural.rs` is the generic part (training loop,
+//! [`NeuralModel`] trait that the AE (`ae.rs`), the VAE (`vae.rs`), the RFVAE (`rfvae.rs`) and
+//! the β-VAE (`bvae.rs`) implement, with the types their code shares. `neural.rs` is the generic part (training loop,
 //! encoder, cache keys) and reaches a model only through [`super::neural::Model::spec`]; the
 //! model files depend on this module and on `nets.rs`, never on `neural.rs`.
 
@@ -32,6 +32,11 @@ pub trait NeuralModel: Sync {
     /// The paper's KL warm-up (0: the model has none).
     fn paper_warmup(&self) -> usize {
         0
+    }
+    /// The weight β of the KL term when the configuration does not set one (None: the model
+    /// has no such weight and `beta` may not be set; the others weigh their KL by 1).
+    fn default_beta(&self) -> Option<f64> {
+        None
     }
     /// The original's optimiser.
     fn optimiser(&self) -> Optimiser;
@@ -110,6 +115,8 @@ pub struct LatentInput<'a> {
     pub step: usize,
     /// RFVAE warm-up length.
     pub warmup: usize,
+    /// β-VAE: the weight of the KL term (1 for every other model).
+    pub beta: f64,
     pub variant: Variant,
     pub device: &'a Device,
 }

@@ -80,7 +80,7 @@ impl LearnerEntry {
 }
 
 /// Every learner of this build, in the report's order.
-pub static LEARNERS: [LearnerEntry; 8] = [
+pub static LEARNERS: [LearnerEntry; 9] = [
     LearnerEntry {
         name: "pca",
         algo: "rge-pca",
@@ -146,6 +146,17 @@ pub static LEARNERS: [LearnerEntry; 8] = [
         prior: Prior::Always,
         in_paper: true,
         params: neural::<RFVAE>,
+    },
+    LearnerEntry {
+        name: "bvae",
+        algo: "rge-bvae",
+        display: "β-VAE",
+        description: "the dense VAE with its KL weighted by beta ([learners.bvae] beta, default 4; beta = 1 is the VAE), Adam",
+        kind: Kind::Neural(Model::Bvae),
+        has_variants: false,
+        prior: Prior::Always,
+        in_paper: false,
+        params: neural::<BVAE>,
     },
     LearnerEntry {
         name: "gaussian-projection",
@@ -262,6 +273,10 @@ trait ModelOf {
 struct AE;
 struct VAE;
 struct RFVAE;
+struct BVAE;
+impl ModelOf for BVAE {
+    const MODEL: Model = Model::Bvae;
+}
 impl ModelOf for AE {
     const MODEL: Model = Model::Ae;
 }
