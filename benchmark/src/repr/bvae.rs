@@ -17,26 +17,12 @@ use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
 use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant};
-use super::vae::{encoding, eps};
+use super::vae::{code, encoding};
 use crate::seed::Stream;
 
 /// β when `[learners.bvae]` does not set it: 4, the value Higgins et al. used on their 2-D
 /// shapes data and a common default (the follow-up's is not public).
 pub const DEFAULT_BETA: f64 = 4.0;
-
-/// The reparameterised code of the heads `[B, P]`: `(z, mu, logvar)`, one `eps` per sample.
-fn code(
-    heads: Tensor<2>,
-    input: &LatentInput<'_>,
-    rng: &mut Stream,
-) -> (Tensor<2>, Tensor<2>, Tensor<2>) {
-    let d = input.latents;
-    let mu = heads.clone().narrow(1, 0, d);
-    let logvar = heads.narrow(1, d, d);
-    let e = eps(Variant::Corrected, input.batch, d, rng, input.device);
-    let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
-    (z, mu, logvar)
-}
 
 /// The β-VAE as a [`NeuralModel`]: TF Adam, prior N(0, I).
 pub struct Bvae;
@@ -62,12 +48,13 @@ impl NeuralModel for Bvae {
         true
     }
     fn loss(&self, net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
-        let (z, mu, logvar) = code(net.heads(input.x.clone()), &input.latent, rng);
+        let heads = net.heads(input.x.clone());
+        let (z, mu, logvar) = code(heads, &input.latent, Variant::Corrected, rng);
         let rec = bce_with_logits_sum(net.decode(z), input.x);
         (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean()
     }
     fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
-        let (z, mu, logvar) = code(heads, input, rng);
+        let (z, mu, logvar) = code(heads, input, Variant::Corrected, rng);
         Latent {
             z,
             extra: Some(kl_std_normal(mu, logvar).mul_scalar(input.beta).mean()),

@@ -34,23 +34,26 @@ pub fn eps(
     tensor2(normals(rng, rows * d), rows, d, device)
 }
 
-/// The reparameterised code of the heads `[B, P]`: `(z, mu, logvar)` (draws the noise).
-fn code(
+/// The reparameterised code of the heads `[B, P]`: `(z, mu, logvar)` (draws the noise of
+/// `variant`).
+pub fn code(
     heads: Tensor<2>,
     input: &LatentInput<'_>,
+    variant: Variant,
     rng: &mut Stream,
 ) -> (Tensor<2>, Tensor<2>, Tensor<2>) {
     let d = input.latents;
     let mu = heads.clone().narrow(1, 0, d);
     let logvar = heads.narrow(1, d, d);
-    let e = eps(input.variant, input.batch, d, rng, input.device);
+    let e = eps(variant, input.batch, d, rng, input.device);
     let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
     (z, mu, logvar)
 }
 
 /// The training loss of one mini-batch: `mean_b (sum_pixels BCE + KL)`.
 pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
-    let (z, mu, logvar) = code(net.heads(input.x.clone()), &input.latent, rng);
+    let variant = input.latent.variant;
+    let (z, mu, logvar) = code(net.heads(input.x.clone()), &input.latent, variant, rng);
     let rec = bce_with_logits_sum(net.decode(z), input.x);
     (rec + kl_std_normal(mu, logvar)).mean()
 }
@@ -58,7 +61,7 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
 /// The host engine's middle (same noise draws as [`loss`]): `z = mu + eps exp(logvar / 2)`,
 /// loss = the batch-mean reconstruction + the batch-mean KL.
 pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
-    let (z, mu, logvar) = code(heads, input, rng);
+    let (z, mu, logvar) = code(heads, input, input.variant, rng);
     Latent {
         z,
         extra: Some(kl_std_normal(mu, logvar).mean()),
