@@ -31,20 +31,20 @@ pub struct TruncatedSvd {
     pub centre: bool,
 }
 
-/// `[learners.pca]`: the paper's PCA has no parameters (sklearn's defaults); the table must be
-/// empty.
+/// `[learners.pca]` (`CENTRE = false`) and `[learners.pca-centred]` (`true`): neither has
+/// parameters (sklearn's defaults); the table must be empty.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct PcaConfig {}
+pub struct PcaConfig<const CENTRE: bool> {}
 
-impl ParamGuard for PcaConfig {
-    type Checked = PcaConfig;
-    fn check(self) -> Result<PcaConfig, String> {
+impl<const CENTRE: bool> ParamGuard for PcaConfig<CENTRE> {
+    type Checked = PcaConfig<CENTRE>;
+    fn check(self) -> Result<PcaConfig<CENTRE>, String> {
         Ok(self)
     }
 }
 
-impl LearnerParams for PcaConfig {
+impl<const CENTRE: bool> LearnerParams for PcaConfig<CENTRE> {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
@@ -52,31 +52,10 @@ impl LearnerParams for PcaConfig {
         serde_json::Value::Null
     }
     fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
-        Box::new(TruncatedSvd::default())
-    }
-}
-
-/// `[learners.pca-centred]`: no parameters; the table must be empty.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CentredPcaConfig {}
-
-impl ParamGuard for CentredPcaConfig {
-    type Checked = CentredPcaConfig;
-    fn check(self) -> Result<CentredPcaConfig, String> {
-        Ok(self)
-    }
-}
-
-impl LearnerParams for CentredPcaConfig {
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-    fn identity(&self, _variant: Option<Variant>) -> serde_json::Value {
-        serde_json::Value::Null
-    }
-    fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
-        Box::new(CentredPca)
+        Box::new(TruncatedSvd {
+            centre: CENTRE,
+            ..TruncatedSvd::default()
+        })
     }
 }
 

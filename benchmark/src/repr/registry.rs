@@ -90,7 +90,7 @@ pub static LEARNERS: [LearnerEntry; 9] = [
         has_variants: false,
         prior: Prior::None,
         in_paper: true,
-        params: parse::<PcaConfig>,
+        params: parse::<PcaConfig<false>>,
     },
     LearnerEntry {
         name: "pca-centred",
@@ -101,7 +101,7 @@ pub static LEARNERS: [LearnerEntry; 9] = [
         has_variants: false,
         prior: Prior::None,
         in_paper: false,
-        params: parse::<super::pca::CentredPcaConfig>,
+        params: parse::<PcaConfig<true>>,
     },
     LearnerEntry {
         name: "isomap",
