@@ -4,6 +4,7 @@
 
 pub mod history;
 pub mod imgep;
+pub mod interest;
 pub mod meta_policy;
 pub mod nn;
 pub mod rpe;
