@@ -12,7 +12,7 @@ use crate::explore::{Algo, ExploreConfig, SamplerKind};
 pub use crate::repr::external::ExternalConfig;
 use crate::repr::external::ExternalParams;
 pub use crate::repr::isomap::IsomapConfig;
-use crate::repr::neural::{Model, NeuralConfig, NeuralParams, Variant};
+use crate::repr::neural::Variant;
 use crate::repr::registry::{self, Learner, LearnerParams};
 
 /// Errors reading or validating a configuration.
@@ -175,18 +175,6 @@ impl LearnersConfig {
             l.name(),
             toml::Value::try_from(e).expect("an external config serialises"),
         );
-    }
-
-    /// The complete training configuration of a neural model and variant.
-    pub fn neural_config(&self, model: Model, variant: Variant) -> Result<NeuralConfig, String> {
-        let l = Learner::all()
-            .find(|l| l.model() == Some(model))
-            .expect("every model is registered");
-        let p = self.params(l)?;
-        p.as_any()
-            .downcast_ref::<NeuralParams>()
-            .map(|p| p.config(Some(variant)))
-            .ok_or_else(|| format!("{l} is not a neural learner"))
     }
 
     /// The part of the configuration a learner depends on (hashed into its runs' config hash,

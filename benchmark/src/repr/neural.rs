@@ -405,11 +405,6 @@ impl NeuralLearner {
         self
     }
 
-    /// The progress callback, if any.
-    pub fn progress(&self) -> Option<&ProgressFn> {
-        self.progress.as_ref()
-    }
-
     /// Fit and return the concrete encoder (with its loss curve) and the training latents.
     pub fn fit_neural(
         &self,
