@@ -40,16 +40,21 @@ enum Command {
     /// Run episodes: prints a JSON array with, per parameter vector, the final object state,
     /// whether the object was caught, and the hand position.
     Rollout {
-        /// armball or armarrow.
+        /// armball, armarrow or armballs (the follow-up's ball and distractor).
         #[arg(long)]
         env: EnvKind,
         /// JSON file: an array of arrays of 21 numbers (motor parameters; clipped to [-1,1]).
         #[arg(long)]
         params: PathBuf,
+        /// armballs: the distractor's random walk draws from this seed's `distractor` stream,
+        /// episode after episode (the other environments draw nothing).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
     },
     /// KL-coverage of a set of engineered outcomes (prints the value, or `inf`).
     Klc {
-        /// armball (CSV header `x,y`) or armarrow (`x,y,angle`).
+        /// armball (CSV header `x,y`), armarrow (`x,y,angle`) or armballs (`x,y`: the
+        /// controllable ball; the distractor is not measured).
         #[arg(long)]
         env: EnvKind,
         /// CSV file of outcomes in [-1,1].
@@ -58,10 +63,11 @@ enum Command {
     },
     /// Render an object state as the 70x70 image the learners see.
     Render {
-        /// armball or armarrow.
+        /// armball, armarrow or armballs (the follow-up's ball and distractor).
         #[arg(long)]
         env: EnvKind,
-        /// Engineered state: `x,y` (ball) or `x,y,angle` (arrow), each in [-1,1].
+        /// Engineered state: `x,y` (ball), `x,y,angle` (arrow) or `x,y,dx,dy` (armballs: ball,
+        /// then distractor), each in [-1,1].
         #[arg(long, allow_hyphen_values = true)]
         state: String,
         /// Output file: `.npy` (float32 70x70 indexed [x][y]) or `.png` (for people).
@@ -71,7 +77,7 @@ enum Command {
     /// One exploration run; writes DIR/<run-id>.parquet (+ .outcomes.parquet, .json) and prints
     /// a JSON summary as its last line.
     Run {
-        /// armball or armarrow.
+        /// armball, armarrow or armballs (the follow-up's ball and distractor).
         #[arg(long)]
         env: EnvKind,
         #[arg(long, help = algo_help())]
@@ -438,7 +444,7 @@ fn one_line(e: &anyhow::Error) -> String {
 
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
-        Command::Rollout { env, params } => rollout(env, &params),
+        Command::Rollout { env, params, seed } => rollout(env, &params, seed),
         Command::Klc { env, outcomes } => klc(env, &outcomes),
         Command::Render { env, state, out } => render(env, &state, &out),
         Command::Run {
@@ -550,7 +556,7 @@ struct RolloutOut {
     hand: [f64; 2],
 }
 
-fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
+fn rollout(kind: EnvKind, params: &Path, seed: u64) -> Result<()> {
     let text = std::fs::read_to_string(params)
         .with_context(|| format!("cannot read {}", params.display()))?;
     let v: Vec<Vec<f64>> = serde_json::from_str(&text).with_context(|| {
@@ -560,6 +566,7 @@ fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
         )
     })?;
     let env = make_env(kind, &EnvConfig::default());
+    let mut noise = ugl_bench::seed::stream(seed, ugl_bench::seed::Component::Distractor);
     let mut out = Vec::with_capacity(v.len());
     for (i, theta) in v.iter().enumerate() {
         let theta: [f64; PARAMS] = theta.as_slice().try_into().map_err(|_| {
@@ -572,7 +579,7 @@ fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
         if theta.iter().any(|x| !x.is_finite()) {
             bail!("{}: entry {i} has a non-finite number", params.display());
         }
-        let r = env.rollout(&theta);
+        let r = env.rollout(&theta, &mut noise);
         out.push(RolloutOut {
             object: r.outcome().to_vec(),
             moved: r.caught,
@@ -584,8 +591,10 @@ fn rollout(kind: EnvKind, params: &Path) -> Result<()> {
 }
 
 fn klc(kind: EnvKind, path: &Path) -> Result<()> {
-    let pts = read_outcomes_csv(path, kind.state_dim())?;
-    let k = KlCoverage::new(kind.state_dim())?;
+    // Measured on the controllable object (armballs: the ball's x, y).
+    let dim = kind.metric_dims().len();
+    let pts = read_outcomes_csv(path, dim)?;
+    let k = KlCoverage::new(dim)?;
     let v = k.evaluate(pts.iter().map(|p| &p[..]))?;
     if v.is_infinite() {
         println!("inf")
@@ -669,6 +678,7 @@ fn single_context<'a>(
         env: &cfg.env,
         ugl: &cfg.ugl,
         learners: &cfg.learners,
+        mge: &cfg.mge,
         threads: rayon::current_num_threads(),
         cache: model_cache,
         train_progress: Some(training_bars(mp, None)),

@@ -11,13 +11,14 @@ fn bench(c: &mut Criterion) {
     let thetas: Vec<_> = (0..1024).map(|_| random_params(&mut rng)).collect();
     let mut g = c.benchmark_group("rollout");
     g.throughput(Throughput::Elements(thetas.len() as u64));
-    for kind in EnvKind::ALL {
+    for kind in EnvKind::PAPER {
         let env = make_env(kind, &EnvConfig::default());
+        let mut noise = stream(0, Component::Distractor);
         g.bench_function(format!("{kind}_x1024"), |b| {
             b.iter(|| {
                 let mut acc = 0.0;
                 for t in &thetas {
-                    acc += env.rollout(black_box(t)).hand[0];
+                    acc += env.rollout(black_box(t), &mut noise).hand[0];
                 }
                 acc
             })

@@ -40,6 +40,10 @@ pub enum Component {
     /// The held-out images on which a representation's latent quality is measured (states and,
     /// for a stochastic encoder, its encoding noise), drawn from the data set's seed.
     HeldOut,
+    /// The environment's own motion (ArmBalls' distractor), consumed episode after episode.
+    Distractor,
+    /// Modular exploration's module choice (random or by learning progress).
+    ModuleChoice,
 }
 
 impl Component {
@@ -54,6 +58,8 @@ impl Component {
             Component::Learner => "learner",
             Component::Encoding => "encoding",
             Component::HeldOut => "held-out",
+            Component::Distractor => "distractor",
+            Component::ModuleChoice => "module-choice",
         }
     }
 }

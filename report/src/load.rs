@@ -17,6 +17,8 @@ use crate::ReportError;
 
 const CURVE_SUFFIX: &str = ".parquet";
 const OUTCOMES_SUFFIX: &str = ".outcomes.parquet";
+/// Modular explorations' interest per module (`armballs.rs` reads it; not a run of its own).
+pub const INTEREST_SUFFIX: &str = ".interest.parquet";
 const MANIFEST_SUFFIX: &str = ".json";
 
 /// A condition: everything that identifies a curve in the figures, except the seed.
@@ -348,8 +350,8 @@ pub fn scan_store(dir: &Path) -> Result<Vec<CampaignDir>, ReportError> {
             let Some(file) = path.file_name().and_then(|n| n.to_str()) else {
                 continue;
             };
-            if file.starts_with('.') {
-                continue; // temporary files of the atomic writer, editor files
+            if file.starts_with('.') || file.ends_with(INTEREST_SUFFIX) {
+                continue; // temporary files of the atomic writer, editor files; interest tables
             }
             let (stem, slot) = if let Some(s) = file.strip_suffix(OUTCOMES_SUFFIX) {
                 (s, 1)
@@ -675,13 +677,13 @@ fn column_error(path: &Path, column: &str, problem: impl Into<String>) -> Report
 }
 
 /// Typed, checked access to the columns of one file.
-struct Cols<'a> {
-    df: &'a DataFrame,
-    path: &'a Path,
+pub(crate) struct Cols<'a> {
+    pub(crate) df: &'a DataFrame,
+    pub(crate) path: &'a Path,
 }
 
 impl Cols<'_> {
-    fn require(&self, name: &str) -> Result<&Column, ReportError> {
+    pub(crate) fn require(&self, name: &str) -> Result<&Column, ReportError> {
         self.df.column(name).map_err(|_| {
             let mut present: Vec<String> = self
                 .df
@@ -726,7 +728,7 @@ impl Cols<'_> {
         Ok(())
     }
 
-    fn strs(&self, name: &str) -> Result<Vec<String>, ReportError> {
+    pub(crate) fn strs(&self, name: &str) -> Result<Vec<String>, ReportError> {
         let col = self.require(name)?;
         let ca = self.typed(name, col, "str", Column::str)?;
         self.no_nulls(name, col)?;
@@ -736,21 +738,21 @@ impl Cols<'_> {
             .collect())
     }
 
-    fn i64s(&self, name: &str) -> Result<Vec<i64>, ReportError> {
+    pub(crate) fn i64s(&self, name: &str) -> Result<Vec<i64>, ReportError> {
         let col = self.require(name)?;
         let ca = self.typed(name, col, "i64", Column::i64)?;
         self.no_nulls(name, col)?;
         Ok(ca.iter().map(|v| v.unwrap_or_default()).collect())
     }
 
-    fn f64s(&self, name: &str) -> Result<Vec<f64>, ReportError> {
+    pub(crate) fn f64s(&self, name: &str) -> Result<Vec<f64>, ReportError> {
         let col = self.require(name)?;
         let ca = self.typed(name, col, "f64", Column::f64)?;
         self.no_nulls(name, col)?;
         Ok(ca.iter().map(|v| v.unwrap_or_default()).collect())
     }
 
-    fn f64s_nullable(&self, name: &str) -> Result<Vec<Option<f64>>, ReportError> {
+    pub(crate) fn f64s_nullable(&self, name: &str) -> Result<Vec<Option<f64>>, ReportError> {
         let col = self.require(name)?;
         // An all-null column may have been written with the Null type.
         if col.dtype() == &DataType::Null {

@@ -217,6 +217,9 @@ pub struct CampaignConfig {
     pub ugl: UglConfig,
     #[serde(default)]
     pub learners: LearnersConfig,
+    /// Modular goal exploration (`mge-*` algorithms; follow-up paper).
+    #[serde(default)]
+    pub mge: crate::explore::MgeConfig,
 }
 
 impl CampaignConfig {
@@ -305,6 +308,22 @@ impl CampaignConfig {
             );
         }
         self.learners.validate()?;
+        self.mge.validate()?;
+        for a in self.matrix.algos.iter().filter(|a| a.modules().is_some()) {
+            if a.learner().is_some()
+                && a.modules() != Some(crate::explore::Modules::Flat)
+                && let Some(n) = self.matrix.latents.iter().find_map(|l| match l {
+                    LatentSize::N(n) if n % self.mge.module_size != 0 => Some(*n),
+                    _ => None,
+                })
+            {
+                return Err(format!(
+                    "matrix.algos has {a}, whose modules take mge.module_size = {} latents, \
+                     but matrix.latents has {n}",
+                    self.mge.module_size
+                ));
+            }
+        }
         for l in self.matrix.algos.iter().filter_map(|a| a.learner()) {
             self.learners
                 .params(l)

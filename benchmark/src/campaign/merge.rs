@@ -81,11 +81,12 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
             let to = store::run_paths(into, &manifest.run_id);
             if to.manifest.exists() {
                 let theirs = store::read_manifest(&to.manifest)?;
-                let identical_data = from
-                    .data()
-                    .iter()
-                    .zip(to.data())
-                    .all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
+                let identical_data = from.data().len() == to.data().len()
+                    && from
+                        .data()
+                        .iter()
+                        .zip(to.data())
+                        .all(|(a, b)| std::fs::read(a).ok() == std::fs::read(b).ok());
                 if theirs.config_hash != manifest.config_hash || !identical_data {
                     return Err(MergeError::Conflict {
                         run_id: manifest.run_id,
@@ -101,12 +102,8 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
                 continue;
             }
             // Data files first, manifest last.
-            for (a, b) in from
-                .data()
-                .into_iter()
-                .chain([from.manifest.as_path()])
-                .zip(to.data().into_iter().chain([to.manifest.as_path()]))
-            {
+            for a in from.data().into_iter().chain([from.manifest.as_path()]) {
+                let b = &into.join(a.file_name().expect("a run file has a name"));
                 let bytes = std::fs::read(a).map_err(|source| MergeError::Read {
                     path: a.to_path_buf(),
                     source,

@@ -17,8 +17,8 @@ use super::plan::{RunSpec, plan};
 use super::store::{self, Manifest, StoreError, Summary};
 use crate::env::{EnvConfig, Environment, make_env};
 use crate::explore::{
-    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
-    run_rge, run_rpe,
+    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, MgeConfig,
+    SamplerKind, goal_modules, run_mge, run_rge, run_rpe,
 };
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
 use crate::repr::cache::{CacheEntry, ModelCache};
@@ -71,6 +71,9 @@ struct HashInput<'a> {
     ugl: Option<&'a UglConfig>,
     #[serde(skip_serializing_if = "Option::is_none")]
     learner: Option<serde_json::Value>,
+    /// Modular explorations only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mge: Option<&'a MgeConfig>,
 }
 
 /// Receives the training progress of neural representations: the representation's label
@@ -91,6 +94,8 @@ pub struct RunContext<'a> {
     pub env: &'a EnvConfig,
     pub ugl: &'a UglConfig,
     pub learners: &'a LearnersConfig,
+    /// Modular goal exploration's constants (`mge-*` algorithms).
+    pub mge: &'a MgeConfig,
     pub threads: usize,
     /// Where trained neural models are kept (None: always train).
     pub cache: Option<&'a ModelCache>,
@@ -126,6 +131,7 @@ impl RunContext<'_> {
                 .algo
                 .learner()
                 .map(|l| self.learners.hash_value(l, spec.variant)),
+            mge: spec.algo.modules().map(|_| self.mge),
         };
         let json = serde_json::to_vec(&input).expect("config serialises");
         blake3::hash(&json).to_hex().to_string()
@@ -170,7 +176,19 @@ pub fn measure_quality(
     let z_heldout = encoder.encode(&heldout.images)?;
     let (y_train, names) = quality::targets(&data.states, d);
     let (y_heldout, _) = quality::targets(&heldout.states, d);
-    quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)
+    let mut q = quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)?;
+    let objects = env.kind().objects();
+    if objects.len() > 1 {
+        q.per_latent = quality::per_latent_r2(
+            &data.states,
+            &z_train,
+            &heldout.states,
+            &z_heldout,
+            d,
+            &objects,
+        );
+    }
+    Ok(q)
 }
 
 /// How a trained network was obtained, recorded in the manifests of its runs.
@@ -402,6 +420,11 @@ pub fn explore(
     let env = make_env(spec.env, ctx.env);
     let env: &dyn Environment = env.as_ref();
     let d = env.state_dim();
+    let run_err = |source| RunError::Repr {
+        run: spec.run_id(),
+        source,
+    };
+    let mge_err = |m: String| run_err(ReprError::InvalidInput(m));
     let log = match spec.algo {
         Algo::Rpe => run_rpe(env, ctx.explore, seed),
         Algo::RgeEfr => run_rge(
@@ -411,39 +434,72 @@ pub fn explore(
             ctx.explore,
             seed,
         ),
-        Algo::Rge(_) => {
-            let repr_err = |source| RunError::Repr {
-                run: spec.run_id(),
-                source,
-            };
+        Algo::MgeEfr(m) => {
+            let objects = spec.env.objects();
+            let modules =
+                goal_modules(m, d, Some(&objects), &[], ctx.mge.module_size).map_err(mge_err)?;
+            let mut samplers: Vec<Box<dyn GoalSampler>> = modules
+                .iter()
+                .map(|g| Box::new(UniformGoals::unit(g.dims.len())) as Box<dyn GoalSampler>)
+                .collect();
+            run_mge(
+                env,
+                &mut EngineeredSpace::new(d),
+                &modules,
+                &mut samplers,
+                m,
+                ctx.explore,
+                ctx.mge,
+                seed,
+            )
+            .map_err(mge_err)?
+        }
+        Algo::Rge(_) | Algo::Mge(..) => {
             let repr = repr.ok_or_else(|| {
-                repr_err(ReprError::InvalidInput(
+                run_err(ReprError::InvalidInput(
                     "no representation was fitted".into(),
                 ))
             })?;
-            let mut sampler: Box<dyn GoalSampler> = match spec.sampler {
-                SamplerKind::Kde => Box::new(KdeGoals::fit(&repr.train).map_err(repr_err)?),
-                SamplerKind::Gaussian => match repr.encoder.prior() {
-                    Some(prior) => Box::new(GaussianGoals::from_prior(&prior)),
-                    None => {
-                        return Err(repr_err(ReprError::InvalidInput(format!(
-                            "the gaussian sampler needs a goal-space prior, and {} has none \
-                             (use kde)",
-                            spec.algo
-                        ))));
-                    }
-                },
-                other => {
-                    return Err(repr_err(ReprError::InvalidInput(format!(
-                        "sampler {other} is not for learned goal spaces"
-                    ))));
-                }
+            let dim = repr.encoder.latents();
+            let modules = match spec.algo.modules() {
+                None => None,
+                Some(m) => Some(
+                    goal_modules(
+                        m,
+                        dim,
+                        None,
+                        &latent_spread(&repr.train),
+                        ctx.mge.module_size,
+                    )
+                    .map_err(mge_err)?,
+                ),
+            };
+            let mut samplers: Vec<Box<dyn GoalSampler>> = match &modules {
+                None => vec![goal_sampler(spec, repr, None).map_err(run_err)?],
+                Some(ms) => ms
+                    .iter()
+                    .map(|g| goal_sampler(spec, repr, Some(&g.dims)))
+                    .collect::<Result<_, _>>()
+                    .map_err(run_err)?,
             };
             repr.encoder.begin_run(stream(seed, Component::Encoding));
             let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
-            let log = run_rge(env, &mut space, sampler.as_mut(), ctx.explore, seed);
+            let log = match (&modules, spec.algo.modules()) {
+                (Some(ms), Some(m)) => run_mge(
+                    env,
+                    &mut space,
+                    ms,
+                    &mut samplers,
+                    m,
+                    ctx.explore,
+                    ctx.mge,
+                    seed,
+                )
+                .map_err(mge_err)?,
+                _ => run_rge(env, &mut space, samplers[0].as_mut(), ctx.explore, seed),
+            };
             if let Some(e) = space.error.take() {
-                return Err(repr_err(e));
+                return Err(run_err(e));
             }
             return Ok(Explored {
                 log,
@@ -454,6 +510,62 @@ pub fn explore(
     Ok(Explored {
         log,
         encode_s: None,
+    })
+}
+
+/// The spread of each latent over the training encodings (its variance), which orders the
+/// latents into modules ([`goal_modules`]).
+fn latent_spread(train: &Latents) -> Vec<f64> {
+    let (n, d) = (train.n as f64, train.latents);
+    (0..d)
+        .map(|k| {
+            let mean = (0..train.n).map(|i| train.row(i)[k]).sum::<f64>() / n;
+            (0..train.n)
+                .map(|i| (train.row(i)[k] - mean).powi(2))
+                .sum::<f64>()
+                / n
+        })
+        .collect()
+}
+
+/// The goal sampler of a learned goal space, over every latent (`dims` None) or over one
+/// module's latents (the KDE of those latents of the training encodings; the prior's marginal).
+fn goal_sampler(
+    spec: &RunSpec,
+    repr: &Representation,
+    dims: Option<&[usize]>,
+) -> Result<Box<dyn GoalSampler>, ReprError> {
+    Ok(match spec.sampler {
+        SamplerKind::Kde => Box::new(match dims {
+            None => KdeGoals::fit(&repr.train)?,
+            Some(dims) => KdeGoals::fit(&Latents {
+                n: repr.train.n,
+                latents: dims.len(),
+                data: (0..repr.train.n)
+                    .flat_map(|i| dims.iter().map(move |&k| repr.train.row(i)[k]))
+                    .collect(),
+            })?,
+        }),
+        SamplerKind::Gaussian => match repr.encoder.prior() {
+            Some(prior) => Box::new(GaussianGoals::from_prior(&match dims {
+                None => prior,
+                Some(dims) => crate::repr::GaussianPrior {
+                    mean: dims.iter().map(|&k| prior.mean[k]).collect(),
+                    std: dims.iter().map(|&k| prior.std[k]).collect(),
+                },
+            })),
+            None => {
+                return Err(ReprError::InvalidInput(format!(
+                    "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
+                    spec.algo
+                )));
+            }
+        },
+        other => {
+            return Err(ReprError::InvalidInput(format!(
+                "sampler {other} is not for learned goal spaces"
+            )));
+        }
     })
 }
 
@@ -615,6 +727,7 @@ pub(crate) fn campaign_context<'a>(
         env: &cfg.env,
         ugl: &cfg.ugl,
         learners: &cfg.learners,
+        mge: &cfg.mge,
         threads: opts.jobs,
         cache: opts.cache,
         train_progress: opts.train_progress.clone(),

@@ -202,14 +202,21 @@ pub struct RunPaths {
     pub curve: PathBuf,
     /// `<run_id>.outcomes.parquet`: every outcome.
     pub outcomes: PathBuf,
+    /// `<run_id>.interest.parquet`: modular exploration's interest per module (only those runs).
+    pub interest: PathBuf,
     /// `<run_id>.json`: the manifest, written last (a run is complete when it exists).
     pub manifest: PathBuf,
 }
 
 impl RunPaths {
-    /// The data files, in the order they are written (the manifest comes after them).
-    pub fn data(&self) -> [&Path; 2] {
-        [&self.curve, &self.outcomes]
+    /// The data files present, in the order they are written (the manifest comes after them):
+    /// the curve, the outcomes and, for a modular exploration, the interest.
+    pub fn data(&self) -> Vec<&Path> {
+        let mut v = vec![self.curve.as_path(), self.outcomes.as_path()];
+        if self.interest.is_file() {
+            v.push(&self.interest);
+        }
+        v
     }
 }
 
@@ -218,15 +225,17 @@ pub fn run_paths(dir: &Path, run_id: &str) -> RunPaths {
     RunPaths {
         curve: dir.join(format!("{run_id}.parquet")),
         outcomes: dir.join(format!("{run_id}.outcomes.parquet")),
+        interest: dir.join(format!("{run_id}.interest.parquet")),
         manifest: dir.join(format!("{run_id}.json")),
     }
 }
 
-/// The curve table of a run.
+/// The curve table of a run. Where the scene has an object the agent cannot control
+/// (ArmBalls), its KL-coverage and cell coverage follow as `control_klc`, `control_coverage`.
 pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
     let n = log.checkpoints.len();
     let c = &log.checkpoints;
-    df!(
+    let mut df = df!(
         "run_id" => vec![spec.run_id(); n],
         "env" => vec![spec.env.name(); n],
         "algo" => vec![spec.algo.name(); n],
@@ -239,10 +248,20 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         "klc" => c.iter().map(|p| p.klc).collect::<Vec<_>>(),
         "n_moved" => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
         "coverage" => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
-    )
+    )?;
+    if c.iter().any(|p| p.control.is_some()) {
+        let control = |f: fn((f64, f64)) -> f64| {
+            c.iter()
+                .map(|p| p.control.map(f))
+                .collect::<Vec<Option<f64>>>()
+        };
+        df.with_column(Column::new("control_klc".into(), control(|v| v.0)))?;
+        df.with_column(Column::new("control_coverage".into(), control(|v| v.1)))?;
+    }
+    Ok(df)
 }
 
-/// The outcomes table of a run.
+/// The outcomes table of a run; ArmBalls' distractor adds `distractor_x`, `distractor_y`.
 pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
     let n = log.outcomes.len();
     let angle: Vec<Option<f64>> = log
@@ -250,7 +269,7 @@ pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Data
         .iter()
         .map(|s| if log.dim == 3 { Some(s[2]) } else { None })
         .collect();
-    df!(
+    let mut df = df!(
         "run_id" => vec![spec.run_id(); n],
         "index" => (0..n as i64).collect::<Vec<_>>(),
         "epoch" => log.epochs.iter().map(|&e| e as i64).collect::<Vec<_>>(),
@@ -258,7 +277,52 @@ pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Data
         "y" => log.outcomes.iter().map(|s| s[1]).collect::<Vec<_>>(),
         "angle" => angle,
         "moved" => log.moved.clone(),
+    )?;
+    if log.dim == 4 {
+        for (name, k) in [("distractor_x", 2), ("distractor_y", 3)] {
+            let v: Vec<f64> = log.outcomes.iter().map(|s| s[k]).collect();
+            df.with_column(Column::new(name.into(), v))?;
+        }
+    }
+    Ok(df)
+}
+
+/// The interest table of a modular exploration (`<run_id>.interest.parquet`): per evaluation
+/// epoch and module, the module's goal-space coordinates, its interest and how many goals were
+/// chosen in it so far. None for the other explorers.
+pub fn interest_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Option<DataFrame>> {
+    if log.interest.is_empty() {
+        return Ok(None);
+    }
+    let p = &log.interest;
+    let n = p.len();
+    let name = |m: usize| {
+        log.modules
+            .get(m)
+            .map(|(n, _)| n.clone())
+            .unwrap_or_default()
+    };
+    let dims = |m: usize| {
+        log.modules
+            .get(m)
+            .map(|(_, d)| {
+                d.iter()
+                    .map(|k| k.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .unwrap_or_default()
+    };
+    df!(
+        "run_id" => vec![spec.run_id(); n],
+        "epoch" => p.iter().map(|q| q.epoch as i64).collect::<Vec<_>>(),
+        "module" => p.iter().map(|q| q.module as i64).collect::<Vec<_>>(),
+        "module_name" => p.iter().map(|q| name(q.module)).collect::<Vec<_>>(),
+        "dims" => p.iter().map(|q| dims(q.module)).collect::<Vec<_>>(),
+        "interest" => p.iter().map(|q| q.interest).collect::<Vec<_>>(),
+        "n_chosen" => p.iter().map(|q| q.n_chosen as i64).collect::<Vec<_>>(),
     )
+    .map(Some)
 }
 
 /// Write `bytes` to `path` atomically ([`crate::fsio::write_atomic`]).
@@ -295,6 +359,7 @@ pub fn write_run(
     let RunPaths {
         curve: curve_p,
         outcomes: outcomes_p,
+        interest: interest_p,
         ..
     } = run_paths(dir, &spec.run_id());
     let enc = |p: &Path, e: PolarsError| StoreError::Encode {
@@ -303,8 +368,13 @@ pub fn write_run(
     };
     let mut curve = curve_frame(spec, log).map_err(|e| enc(&curve_p, e))?;
     let mut outcomes = outcomes_frame(spec, log).map_err(|e| enc(&outcomes_p, e))?;
+    let mut interest = interest_frame(spec, log).map_err(|e| enc(&interest_p, e))?;
     let mut digests = Vec::new();
-    for (path, frame) in [(&curve_p, &mut curve), (&outcomes_p, &mut outcomes)] {
+    let mut frames = vec![(&curve_p, &mut curve), (&outcomes_p, &mut outcomes)];
+    if let Some(frame) = interest.as_mut() {
+        frames.push((&interest_p, frame));
+    }
+    for (path, frame) in frames {
         let bytes = parquet_bytes(frame, path)?;
         write_atomic(path, &bytes)?;
         let name = path

@@ -38,7 +38,7 @@ impl Environment for ArmArrow {
         &self.initial
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS]) -> Rollout {
+    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut crate::seed::Stream) -> Rollout {
         let (caught, pose) = self.body.run(theta, [self.initial[0], self.initial[1]]);
         let s = if caught {
             [pose.hand[0], pose.hand[1], wrap_angle(pose.last_link)]
@@ -46,7 +46,7 @@ impl Environment for ArmArrow {
             self.initial
         };
         Rollout {
-            state: s.map(|v| v.clamp(-1.0, 1.0)),
+            state: [s[0], s[1], s[2], 0.0].map(|v| v.clamp(-1.0, 1.0)),
             dim: 3,
             caught,
             hand: pose.hand,

@@ -29,11 +29,11 @@ impl Environment for ArmBall {
         &self.initial
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS]) -> Rollout {
+    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut crate::seed::Stream) -> Rollout {
         let (caught, pose) = self.body.run(theta, self.initial);
         let ball = if caught { pose.hand } else { self.initial };
         Rollout {
-            state: [ball[0].clamp(-1.0, 1.0), ball[1].clamp(-1.0, 1.0), 0.0],
+            state: [ball[0].clamp(-1.0, 1.0), ball[1].clamp(-1.0, 1.0), 0.0, 0.0],
             dim: 2,
             caught,
             hand: pose.hand,

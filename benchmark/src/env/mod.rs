@@ -1,5 +1,5 @@
-//! The environments of the paper (Section 4.1; PAPER-NOTES.md section 1) and the renderer
-//! (PAPER-NOTES.md section 2).
+//! The environments of the paper (Section 4.1; PAPER-NOTES.md section 1), the follow-up's
+//! ArmBalls (a distractor ball; `armballs.rs`) and the renderer (PAPER-NOTES.md section 2).
 //!
 //! A rollout runs one 50-step DMP movement of the 7-joint arm from rest; the object (ball or
 //! arrow) is caught, stickily, as soon as the hand comes within `object_size` of it, and then
@@ -8,6 +8,7 @@
 pub mod arm;
 pub mod armarrow;
 pub mod armball;
+pub mod armballs;
 pub mod dmp;
 pub mod render;
 
@@ -16,9 +17,12 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::seed::Stream;
+
 pub use arm::{ArmConfig, ArmPose, JOINTS};
 pub use armarrow::ArmArrow;
 pub use armball::ArmBall;
+pub use armballs::ArmBalls;
 pub use dmp::{DmpConfig, DmpTable, DmpWidths, PARAMS};
 
 /// Which environment.
@@ -29,17 +33,22 @@ pub enum EnvKind {
     ArmBall,
     /// An arrow that the arm can catch, move and orient (3-D outcome).
     ArmArrow,
+    /// The ball and a distractor ball that follows a random walk (follow-up paper; 4-D outcome).
+    ArmBalls,
 }
 
 impl EnvKind {
-    /// All environments, in the report's order.
-    pub const ALL: [EnvKind; 2] = [EnvKind::ArmBall, EnvKind::ArmArrow];
+    /// The paper's environments, in the report's order.
+    pub const PAPER: [EnvKind; 2] = [EnvKind::ArmBall, EnvKind::ArmArrow];
+    /// Every environment.
+    pub const ALL: [EnvKind; 3] = [EnvKind::ArmBall, EnvKind::ArmArrow, EnvKind::ArmBalls];
 
     /// The name used on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             EnvKind::ArmBall => "armball",
             EnvKind::ArmArrow => "armarrow",
+            EnvKind::ArmBalls => "armballs",
         }
     }
 
@@ -48,6 +57,36 @@ impl EnvKind {
         match self {
             EnvKind::ArmBall => 2,
             EnvKind::ArmArrow => 3,
+            EnvKind::ArmBalls => 4,
+        }
+    }
+
+    /// The outcome coordinates that exploration is measured on (KL-coverage, cell coverage,
+    /// moves): the controllable object's. All of them except in ArmBalls, where the distractor
+    /// is left out.
+    pub fn metric_dims(self) -> std::ops::Range<usize> {
+        match self {
+            EnvKind::ArmBall | EnvKind::ArmArrow => 0..self.state_dim(),
+            EnvKind::ArmBalls => 0..2,
+        }
+    }
+
+    /// The outcome coordinates of an object the agent cannot control, measured the same way
+    /// as a control (exploration cannot help there): ArmBalls' distractor.
+    pub fn control_dims(self) -> Option<std::ops::Range<usize>> {
+        match self {
+            EnvKind::ArmBall | EnvKind::ArmArrow => None,
+            EnvKind::ArmBalls => Some(2..4),
+        }
+    }
+
+    /// The objects of the scene and their outcome coordinates (the modules of modular
+    /// exploration with engineered features): one object, or ArmBalls' ball and distractor.
+    pub fn objects(self) -> Vec<(&'static str, std::ops::Range<usize>)> {
+        match self {
+            EnvKind::ArmBall => vec![("ball", 0..2)],
+            EnvKind::ArmArrow => vec![("arrow", 0..3)],
+            EnvKind::ArmBalls => vec![("ball", 0..2), ("distractor", 2..4)],
         }
     }
 }
@@ -64,8 +103,9 @@ impl FromStr for EnvKind {
         match s {
             "armball" => Ok(EnvKind::ArmBall),
             "armarrow" => Ok(EnvKind::ArmArrow),
+            "armballs" => Ok(EnvKind::ArmBalls),
             other => Err(format!(
-                "unknown environment '{other}' (expected armball or armarrow)"
+                "unknown environment '{other}' (expected armball, armarrow or armballs)"
             )),
         }
     }
@@ -85,6 +125,28 @@ pub struct EnvConfig {
     pub ball_initial: [f64; 2],
     /// Initial arrow pose (x, y, angle in units of pi).
     pub arrow_initial: [f64; 3],
+    /// ArmBalls: the distractor's position at the start of every episode (CDGE
+    /// `distract_initial_pose`). Serialised only when it differs from the default, so that
+    /// the other environments' config hashes do not depend on it.
+    #[serde(skip_serializing_if = "is_default_distractor_initial")]
+    pub distractor_initial: [f64; 2],
+    /// ArmBalls: standard deviation of the distractor's step per time step (CDGE
+    /// `distract_noise`; 0 keeps it still). Serialised only when it differs from the default.
+    #[serde(skip_serializing_if = "is_default_distractor_noise")]
+    pub distractor_noise: f64,
+}
+
+/// The follow-up's distractor start (CDGE `distract_initial_pose`).
+const DISTRACTOR_INITIAL: [f64; 2] = [0.7, -0.45];
+/// The follow-up's distractor step (CDGE `--distract_noise`, committed configs).
+const DISTRACTOR_NOISE: f64 = 0.1;
+
+fn is_default_distractor_initial(v: &[f64; 2]) -> bool {
+    *v == DISTRACTOR_INITIAL
+}
+
+fn is_default_distractor_noise(v: &f64) -> bool {
+    *v == DISTRACTOR_NOISE
 }
 
 impl Default for EnvConfig {
@@ -95,6 +157,8 @@ impl Default for EnvConfig {
             object_size: 0.1,
             ball_initial: [0.6, 0.6],
             arrow_initial: [0.6, 0.6, 0.6],
+            distractor_initial: DISTRACTOR_INITIAL,
+            distractor_noise: DISTRACTOR_NOISE,
         }
     }
 }
@@ -104,7 +168,7 @@ impl Default for EnvConfig {
 pub struct Rollout {
     /// Final object state (engineered outcome), clipped to [-1,1]; only the first
     /// `state_dim` entries are meaningful.
-    pub state: [f64; 3],
+    pub state: [f64; 4],
     /// Number of meaningful entries in `state`.
     pub dim: usize,
     /// The object was caught (and so moved with the hand) during the episode.
@@ -134,8 +198,11 @@ pub trait Environment: Send + Sync {
     }
     /// The object's initial state.
     fn initial_state(&self) -> &[f64];
-    /// Run one episode with motor parameters `theta` (each clipped to [-1,1]).
-    fn rollout(&self, theta: &[f64; PARAMS]) -> Rollout;
+    /// Run one episode with motor parameters `theta` (each clipped to [-1,1]). `noise` is the
+    /// run's environment stream ([`crate::seed::Component::Distractor`]), consumed episode
+    /// after episode by the environments that move on their own (ArmBalls' distractor);
+    /// ArmBall and ArmArrow draw nothing from it.
+    fn rollout(&self, theta: &[f64; PARAMS], noise: &mut Stream) -> Rollout;
     /// Render an object state (engineered coordinates) into a 70x70 x-major buffer.
     fn render_into(&self, state: &[f64], out: &mut [f32]);
 }
@@ -145,6 +212,7 @@ pub fn make_env(kind: EnvKind, cfg: &EnvConfig) -> Box<dyn Environment> {
     match kind {
         EnvKind::ArmBall => Box::new(ArmBall::new(cfg)),
         EnvKind::ArmArrow => Box::new(ArmArrow::new(cfg)),
+        EnvKind::ArmBalls => Box::new(ArmBalls::new(cfg)),
     }
 }
 
@@ -277,9 +345,12 @@ mod tests {
 
     #[test]
     fn rest_pose_no_catch() {
-        for k in EnvKind::ALL {
+        for k in EnvKind::PAPER {
             let env = make_env(k, &EnvConfig::default());
-            let r = env.rollout(&[0.0; PARAMS]);
+            let r = env.rollout(
+                &[0.0; PARAMS],
+                &mut crate::seed::stream(0, crate::seed::Component::Distractor),
+            );
             assert!(!r.caught);
             assert!(r.hand[0].abs() < 1e-15 && (r.hand[1] - 1.0).abs() < 1e-15);
             assert_eq!(r.outcome(), env.initial_state());

@@ -1,7 +1,34 @@
-//! What an exploration run records: every outcome in order, and the KL-coverage curve.
+//! What an exploration run records: every outcome in order, the KL-coverage curve, and, for
+//! modular exploration, the interest of every module over time.
 
-use crate::env::Rollout;
+use std::ops::Range;
+
+use crate::env::{Environment, Rollout};
 use crate::metrics::{CoverageHistogram, KlCoverage, moved};
+
+/// The coverage measures of an environment: on the controllable object's outcome coordinates
+/// ([`crate::env::EnvKind::metric_dims`]) and, where the scene has one, on the object the agent
+/// cannot control ([`crate::env::EnvKind::control_dims`]).
+pub(crate) struct Metrics {
+    object: KlCoverage,
+    object_dims: Range<usize>,
+    control: Option<(KlCoverage, Range<usize>)>,
+}
+
+impl Metrics {
+    pub fn for_env(env: &dyn Environment) -> Self {
+        let kind = env.kind();
+        let klc = |dims: &Range<usize>| {
+            KlCoverage::new(dims.len()).expect("an object has 2 or 3 outcome coordinates")
+        };
+        let object_dims = kind.metric_dims();
+        Metrics {
+            object: klc(&object_dims),
+            control: kind.control_dims().map(|d| (klc(&d), d)),
+            object_dims,
+        }
+    }
+}
 
 /// One point of the exploration curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,6 +43,22 @@ pub struct Checkpoint {
     pub n_moved: usize,
     /// Fraction of achievable cells reached.
     pub coverage: f64,
+    /// KL-coverage and cell coverage of the uncontrollable object's outcomes (ArmBalls'
+    /// distractor), a control; None where the scene has none.
+    pub control: Option<(f64, f64)>,
+}
+
+/// The interest of one module at one point of a modular exploration (`explore::mge`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InterestPoint {
+    /// Exploration iterations done.
+    pub epoch: usize,
+    /// Module index (0-based).
+    pub module: usize,
+    /// Its interest (|learning progress|; `explore::interest`).
+    pub interest: f64,
+    /// How many goals were chosen in it so far.
+    pub n_chosen: usize,
 }
 
 /// Everything a run produced.
@@ -24,7 +67,7 @@ pub struct ExplorationLog {
     /// Engineered outcome dimension.
     pub dim: usize,
     /// Engineered outcomes, in order (first `dim` entries meaningful).
-    pub outcomes: Vec<[f64; 3]>,
+    pub outcomes: Vec<[f64; 4]>,
     /// The iteration that produced each outcome (0 = warm-up).
     pub epochs: Vec<usize>,
     /// Whether each outcome moved the object (‖s − s₀‖ > 1e-3).
@@ -34,11 +77,17 @@ pub struct ExplorationLog {
     /// Iterations that used random parameters / goal babbling.
     pub n_random: usize,
     pub n_goal: usize,
+    /// Modular exploration: the modules (name and goal-space coordinates) and their interest
+    /// at every evaluation epoch; empty otherwise.
+    pub modules: Vec<(String, Vec<usize>)>,
+    pub interest: Vec<InterestPoint>,
 }
 
 /// Accumulates outcomes and evaluates the curve at the configured epochs.
 pub(crate) struct Recorder<'k> {
     hist: CoverageHistogram<'k>,
+    dims: Range<usize>,
+    control: Option<(CoverageHistogram<'k>, Range<usize>)>,
     initial: Vec<f64>,
     log: ExplorationLog,
     n_moved: usize,
@@ -47,9 +96,19 @@ pub(crate) struct Recorder<'k> {
 }
 
 impl<'k> Recorder<'k> {
-    pub fn new(klc: &'k KlCoverage, initial: &[f64], eval_at: Vec<usize>, capacity: usize) -> Self {
+    pub fn new(
+        metrics: &'k Metrics,
+        initial: &[f64],
+        eval_at: Vec<usize>,
+        capacity: usize,
+    ) -> Self {
         Recorder {
-            hist: klc.histogram(),
+            hist: metrics.object.histogram(),
+            dims: metrics.object_dims.clone(),
+            control: metrics
+                .control
+                .as_ref()
+                .map(|(k, d)| (k.histogram(), d.clone())),
             initial: initial.to_vec(),
             log: ExplorationLog {
                 dim: initial.len(),
@@ -59,6 +118,8 @@ impl<'k> Recorder<'k> {
                 checkpoints: Vec::with_capacity(eval_at.len()),
                 n_random: 0,
                 n_goal: 0,
+                modules: Vec::new(),
+                interest: Vec::new(),
             },
             n_moved: 0,
             eval_at,
@@ -68,12 +129,16 @@ impl<'k> Recorder<'k> {
 
     /// Store the outcome of the episode run at `epoch`.
     pub fn push(&mut self, epoch: usize, r: &Rollout, random: bool) {
-        let s = r.outcome();
+        let s = &r.outcome()[self.dims.clone()];
         // Outcomes are clipped rollouts: finite and of the right dimension by construction.
         self.hist
             .add(s)
             .expect("rollout outcome is finite and of the environment's dimension");
-        let m = moved(s, &self.initial);
+        if let Some((h, d)) = &mut self.control {
+            h.add(&r.outcome()[d.clone()])
+                .expect("rollout outcome is finite and of the environment's dimension");
+        }
+        let m = moved(s, &self.initial[self.dims.clone()]);
         self.n_moved += m as usize;
         self.log.outcomes.push(r.state);
         self.log.epochs.push(epoch);
@@ -99,13 +164,34 @@ impl<'k> Recorder<'k> {
                     .expect("at least one outcome at an evaluation epoch"),
                 n_moved: self.n_moved,
                 coverage: self.hist.coverage(),
+                control: self.control.as_ref().map(|(h, _)| {
+                    (
+                        h.klc()
+                            .expect("at least one outcome at an evaluation epoch"),
+                        h.coverage(),
+                    )
+                }),
             });
             self.next_eval += 1;
         }
     }
 
-    /// Whether some stored outcome differs from the initial state in every coordinate (the
-    /// original's bootstrap test).
+    /// Whether the next [`Self::end_epoch`] of `epoch` evaluates the curve.
+    pub fn evaluates_at(&self, epoch: usize) -> bool {
+        self.eval_at.get(self.next_eval) == Some(&epoch)
+    }
+
+    /// Record the modules of a modular exploration.
+    pub fn set_modules(&mut self, modules: Vec<(String, Vec<usize>)>) {
+        self.log.modules = modules;
+    }
+
+    /// Record one module's interest.
+    pub fn push_interest(&mut self, point: InterestPoint) {
+        self.log.interest.push(point);
+    }
+
+    /// The log.
     pub fn finish(self) -> ExplorationLog {
         self.log
     }

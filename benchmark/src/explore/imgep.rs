@@ -9,13 +9,12 @@
 //! stored outcome encoding, and perturbs them.
 
 use super::ExploreConfig;
-use super::history::{ExplorationLog, Recorder};
+use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use crate::env::render::PIXELS;
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;
-use crate::metrics::KlCoverage;
 use crate::repr::{Encoder, ReprError};
 use crate::seed::{Component, stream};
 use rand::RngExt;
@@ -115,8 +114,13 @@ pub fn run_rge(
         sampler.dim(),
         "goal sampler and outcome space dimensions differ"
     );
-    let klc = KlCoverage::new(env.state_dim()).expect("environment dimension is 2 or 3");
-    let mut rec = Recorder::new(&klc, env.initial_state(), cfg.eval_epochs(), cfg.epochs + 1);
+    let metrics = Metrics::for_env(env);
+    let mut rec = Recorder::new(
+        &metrics,
+        env.initial_state(),
+        cfg.eval_epochs(),
+        cfg.epochs + 1,
+    );
     let mut params_rng = stream(run_seed, Component::Params);
     let mut choice_rng = stream(run_seed, Component::ExploreChoice);
     let mut goal_rng = stream(run_seed, Component::Goals);
@@ -126,8 +130,9 @@ pub fn run_rge(
         index: NnIndex::new(space.dim()),
         thetas: Vec::with_capacity(cfg.epochs + 1),
         z: vec![0.0; space.dim()],
-        initial: env.initial_state().to_vec(),
+        initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
         ever_moved: false,
+        env_rng: stream(run_seed, Component::Distractor),
     };
     let mut goal = vec![0.0; space.dim()];
 
@@ -160,9 +165,13 @@ struct History {
     index: NnIndex,
     thetas: Vec<[f64; PARAMS]>,
     z: Vec<f64>,
+    /// The controllable object's initial state ([`crate::env::EnvKind::metric_dims`]).
     initial: Vec<f64>,
-    /// Some outcome differs from the initial state in every coordinate.
+    /// Some outcome differs from the initial state in every coordinate of the controllable
+    /// object.
     ever_moved: bool,
+    /// The environment's own stream (ArmBalls' distractor).
+    env_rng: crate::seed::Stream,
 }
 
 impl History {
@@ -175,9 +184,12 @@ impl History {
         epoch: usize,
         random: bool,
     ) {
-        let r = env.rollout(&theta);
+        let r = env.rollout(&theta, &mut self.env_rng);
         let s = r.outcome();
-        self.ever_moved |= s.iter().zip(&self.initial).all(|(a, b)| a != b);
+        self.ever_moved |= s[env.kind().metric_dims()]
+            .iter()
+            .zip(&self.initial)
+            .all(|(a, b)| a != b);
         space.encode(s, &mut self.z);
         self.index.insert(&self.z);
         self.thetas.push(theta);

@@ -1,11 +1,13 @@
 //! The explorers (paper Section 3 and Appendix D, Algorithm 3; PAPER-NOTES.md section 3):
 //! random parameter exploration (RPE) and random goal exploration (RGE) with a nearest-neighbour
-//! meta-policy, in an engineered (EFR) or learned goal space.
+//! meta-policy, in an engineered (EFR) or learned goal space; and the follow-up paper's modular
+//! goal exploration (MGE, `mge.rs`) with curiosity-driven module choice (`interest.rs`).
 
 pub mod history;
 pub mod imgep;
 pub mod interest;
 pub mod meta_policy;
+pub mod mge;
 pub mod nn;
 pub mod rpe;
 
@@ -14,6 +16,7 @@ use serde::{Deserialize, Serialize};
 pub use crate::repr::registry::Learner;
 pub use history::{Checkpoint, ExplorationLog};
 pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, run_rge};
+pub use mge::{GoalModule, MgeConfig, Modules, goal_modules, run_mge};
 pub use rpe::run_rpe;
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
@@ -91,6 +94,11 @@ pub enum Algo {
     RgeEfr,
     /// Random goal exploration in a goal space learned from images (IMGEP-UGL, RGE-REP).
     Rge(Learner),
+    /// Modular goal exploration (follow-up paper, `mge.rs`) with engineered features, one
+    /// module per object (`mge-efr-lp`, `mge-efr-random`; `mge-efr-flat`: one module).
+    MgeEfr(Modules),
+    /// Modular goal exploration in a learned goal space (`mge-vae-lp`, ...).
+    Mge(Learner, Modules),
 }
 
 impl Algo {
@@ -98,25 +106,63 @@ impl Algo {
     pub fn all() -> Vec<Algo> {
         let mut v = vec![Algo::Rpe, Algo::RgeEfr];
         v.extend(Learner::all().map(Algo::Rge));
+        v.extend(Modules::ALL.map(Algo::MgeEfr));
+        for l in Learner::all() {
+            v.extend(Modules::ALL.map(|m| Algo::Mge(l, m)));
+        }
         v
     }
 
-    /// Name on the command line and in results (`rpe`, `rge-efr`, `rge-pca`, ...).
+    /// Name on the command line and in results (`rpe`, `rge-efr`, `rge-pca`, `mge-efr-lp`,
+    /// `mge-vae-random`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Algo::Rpe => "rpe",
             Algo::RgeEfr => "rge-efr",
             Algo::Rge(l) => l.entry().algo,
+            Algo::MgeEfr(m) => match m {
+                Modules::Flat => "mge-efr-flat",
+                Modules::Random => "mge-efr-random",
+                Modules::Progress => "mge-efr-lp",
+            },
+            Algo::Mge(l, m) => mge_name(l, m),
         }
     }
 
-    /// The learner, for RGE-REP algorithms.
+    /// The learner, for algorithms in a learned goal space.
     pub fn learner(self) -> Option<Learner> {
         match self {
-            Algo::Rge(l) => Some(l),
+            Algo::Rge(l) | Algo::Mge(l, _) => Some(l),
             _ => None,
         }
     }
+
+    /// The module choice of a modular exploration.
+    pub fn modules(self) -> Option<Modules> {
+        match self {
+            Algo::MgeEfr(m) | Algo::Mge(_, m) => Some(m),
+            _ => None,
+        }
+    }
+}
+
+/// `mge-<learner>-<modules>`, built once per learner (names must live as long as the registry).
+fn mge_name(l: Learner, m: Modules) -> &'static str {
+    use std::sync::OnceLock;
+    static NAMES: OnceLock<Vec<[&'static str; 3]>> = OnceLock::new();
+    let names = NAMES.get_or_init(|| {
+        Learner::all()
+            .map(|l| {
+                Modules::ALL
+                    .map(|m| &*Box::leak(format!("mge-{}-{}", l.name(), m.name()).into_boxed_str()))
+            })
+            .collect()
+    });
+    let k = Modules::ALL
+        .iter()
+        .position(|x| *x == m)
+        .expect("every module choice is in ALL");
+    names[l.index()][k]
 }
 
 impl Serialize for Algo {

@@ -75,10 +75,26 @@ pub struct LatentQuality {
     /// Trustworthiness and continuity per state space (version 3 and later; empty before).
     #[serde(default)]
     pub neighbourhoods: Vec<Neighbourhoods>,
+    /// Scenes with several objects (ArmBalls): per object, how much of each latent its
+    /// position explains ([`per_latent_r2`]); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub per_latent: Vec<ObjectR2>,
     /// Training and held-out set sizes, and `k`.
     pub n_train: usize,
     pub n_heldout: usize,
     pub k: usize,
+}
+
+/// Disentanglement (follow-up paper): for one object, the held-out R² of a k-NN regression
+/// (`k` = [`KNN_K`]) from the object's (x, y) to each latent, fitted on the training images. A
+/// latent that encodes only the ball scores high for the ball and about 0 for the
+/// distractor; an entangled latent scores in between for both.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ObjectR2 {
+    /// `ball` or `distractor`.
+    pub object: String,
+    /// Per latent, in the encoder's order; None for a constant (collapsed) latent.
+    pub r2: Vec<Option<f64>>,
 }
 
 /// The mean R² of one group of targets.
@@ -106,15 +122,16 @@ const NEIGHBOURHOOD_SPACES: [(&str, &[&str]); 2] = [
 ];
 
 /// The groups of targets, by name prefix: what a reader asks of a goal space.
-const GROUPS: [(&str, &[&str]); 3] = [
+const GROUPS: [(&str, &[&str]); 4] = [
     ("position", &["x", "y"]),
+    ("distractor", &["distractor_x", "distractor_y"]),
     ("angle", &["cos_angle", "sin_angle"]),
     ("angle_mod_120", &["cos_3angle", "sin_3angle"]),
 ];
 
 /// The regression targets of engineered states (`state_dim` 2: ball x, y; 3: arrow x, y, and
-/// the angle a (in units of pi) as cos a, sin a, cos 3a, sin 3a): row-major `n x targets`, and
-/// the names.
+/// the angle a (in units of pi) as cos a, sin a, cos 3a, sin 3a; 4: ball x, y, distractor x,
+/// y): row-major `n x targets`, and the names.
 pub fn targets(states: &[f64], state_dim: usize) -> (Vec<f64>, Vec<String>) {
     let mut out = Vec::new();
     for s in states.chunks_exact(state_dim) {
@@ -123,10 +140,16 @@ pub fn targets(states: &[f64], state_dim: usize) -> (Vec<f64>, Vec<String>) {
             let a = s[2] * std::f64::consts::PI;
             out.extend([a.cos(), a.sin(), (3.0 * a).cos(), (3.0 * a).sin()]);
         }
+        if state_dim == 4 {
+            out.extend_from_slice(&s[2..4]);
+        }
     }
     let mut names = vec!["x", "y"];
     if state_dim == 3 {
         names.extend(["cos_angle", "sin_angle", "cos_3angle", "sin_3angle"]);
+    }
+    if state_dim == 4 {
+        names.extend(["distractor_x", "distractor_y"]);
     }
     (out, names.into_iter().map(String::from).collect())
 }
@@ -193,6 +216,7 @@ pub fn latent_quality(
         .collect();
     Ok(LatentQuality {
         version: MEASURE_VERSION,
+        per_latent: Vec::new(),
         neighbourhoods,
         targets: names,
         linear_r2_mean: mean(&linear_r2),
@@ -204,6 +228,46 @@ pub fn latent_quality(
         n_heldout: heldout.n,
         k: KNN_K.min(train.n),
     })
+}
+
+/// Per object (name and its coordinates among the `state_dim` state columns), the held-out R²
+/// of each latent predicted from that object's coordinates ([`ObjectR2`]). `*_states` are
+/// row-major `n x state_dim`.
+pub fn per_latent_r2(
+    train_states: &[f64],
+    train: &Latents,
+    heldout_states: &[f64],
+    heldout: &Latents,
+    state_dim: usize,
+    objects: &[(&str, std::ops::Range<usize>)],
+) -> Vec<ObjectR2> {
+    let d = train.latents;
+    let coords = |states: &[f64], dims: &std::ops::Range<usize>| Latents {
+        n: states.len() / state_dim,
+        latents: dims.len(),
+        data: states
+            .chunks_exact(state_dim)
+            .flat_map(|s| s[dims.clone()].to_vec())
+            .collect(),
+    };
+    objects
+        .iter()
+        .map(|(object, dims)| {
+            let pred = knn_predictions(
+                &coords(train_states, dims),
+                &train.data,
+                &coords(heldout_states, dims),
+                d,
+            );
+            ObjectR2 {
+                object: object.to_string(),
+                r2: r2(&pred, &heldout.data, d)
+                    .into_iter()
+                    .map(|v| v.is_finite().then_some(v))
+                    .collect(),
+            }
+        })
+        .collect()
 }
 
 /// For each point, the ranks of all points by distance from it (itself rank 0, its nearest
@@ -381,6 +445,38 @@ mod tests {
     use super::*;
     use crate::seed::stream_named;
     use rand::RngExt;
+
+    #[test]
+    fn per_latent_r2_tells_which_object_a_latent_encodes() {
+        // Latent 0 = ball x, latent 1 = distractor y, latent 2 = their sum, latent 3 constant.
+        let mut rng = stream_named(11, "test");
+        let mut draw = |n: usize| {
+            let s: Vec<f64> = (0..n * 4).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let z: Vec<f64> = s
+                .chunks(4)
+                .flat_map(|s| [s[0], s[3], s[0] + s[3], 0.5])
+                .collect();
+            (s, latents(n, 4, z))
+        };
+        let (s_tr, z_tr) = draw(3000);
+        let (s_te, z_te) = draw(500);
+        let objects = [("ball", 0..2), ("distractor", 2..4)];
+        let r = per_latent_r2(&s_tr, &z_tr, &s_te, &z_te, 4, &objects);
+        assert_eq!(r[0].object, "ball");
+        let (ball, distractor) = (&r[0].r2, &r[1].r2);
+        assert!(
+            ball[0].unwrap() > 0.95 && distractor[0].unwrap() < 0.05,
+            "{r:?}"
+        );
+        assert!(
+            distractor[1].unwrap() > 0.95 && ball[1].unwrap() < 0.05,
+            "{r:?}"
+        );
+        for v in [ball[2], distractor[2]] {
+            assert!((0.3..0.7).contains(&v.unwrap()), "{r:?}");
+        }
+        assert_eq!((ball[3], distractor[3]), (None, None));
+    }
 
     fn latents(n: usize, d: usize, data: Vec<f64>) -> Latents {
         Latents {

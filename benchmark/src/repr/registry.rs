@@ -202,7 +202,12 @@ impl Learner {
         Learner::all().find(|l| l.entry().algo == algo)
     }
 
-    /// Its registry entry.
+    /// Position in the registry.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// The learner's registry entry.
     pub fn entry(self) -> &'static LearnerEntry {
         &LEARNERS[self.0 as usize]
     }

@@ -124,7 +124,12 @@ pub fn catching_parameters(cfg: &EnvConfig) -> Option<(u64, [f64; PARAMS])> {
     (0..10_000u64).find_map(|seed| {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let theta: [f64; PARAMS] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
-        env.rollout(&theta).caught.then_some((seed, theta))
+        env.rollout(
+            &theta,
+            &mut ugl_bench::seed::stream(0, ugl_bench::seed::Component::Distractor),
+        )
+        .caught
+        .then_some((seed, theta))
     })
 }
 
@@ -136,7 +141,10 @@ pub fn draw_dmp_episode(fig_dir: &Path) -> Result<Option<FigureFile>, ReportErro
         return Ok(None);
     };
     let traj = dmp::trajectory(&cfg.dmp, &theta);
-    let end = make_env(EnvKind::ArmBall, &cfg).rollout(&theta);
+    let end = make_env(EnvKind::ArmBall, &cfg).rollout(
+        &theta,
+        &mut ugl_bench::seed::stream(0, ugl_bench::seed::Component::Distractor),
+    );
     let path = fig_dir.join(FIG6);
     let steps = traj.len();
     let title = format!(
@@ -232,7 +240,10 @@ mod tests {
     fn the_episode_shown_catches_and_moves_the_ball() {
         let cfg = EnvConfig::default();
         let (_, theta) = catching_parameters(&cfg).expect("a catching episode among 10,000");
-        let r = make_env(EnvKind::ArmBall, &cfg).rollout(&theta);
+        let r = make_env(EnvKind::ArmBall, &cfg).rollout(
+            &theta,
+            &mut ugl_bench::seed::stream(0, ugl_bench::seed::Component::Distractor),
+        );
         assert!(r.caught);
         assert!((r.state[0] - 0.6).hypot(r.state[1] - 0.6) > 1e-3);
     }

@@ -1,0 +1,464 @@
+//! Modular goal exploration (MGE) of the follow-up paper (Laversanne-Finot, Péré, Oudeyer,
+//! CoRL 2018; its code's `ActiveGoalExplorationUgl.act`, `docs/followup-paper-sources.md`
+//! section 3, `docs/armballs.md`).
+//!
+//! The goal space is split into **modules**: pairs of latents, or one module per object for
+//! engineered features ([`goal_modules`]). One warm-up random episode, then `epochs`
+//! iterations. While the explorer bootstraps (the first `bootstrap_epochs` iterations, or no
+//! stored outcome differs yet from the initial state, or fewer than two distinct outcome
+//! encodings are stored) an iteration is a random episode. After that, iterations come in
+//! **cycles of one goal**:
+//! 1. a module is chosen: uniformly ([`Modules::Random`]) or by learning progress
+//!    ([`Modules::Progress`]: `explore::interest::choose_module`, uniform with probability
+//!    `eps`, else in proportion to the interests);
+//! 2. a goal is drawn in that module's coordinates;
+//! 3. `n_explore` exploration episodes: the parameters of the stored outcome nearest to the
+//!    goal *in the module's coordinates*, plus the meta-policy's Gaussian noise;
+//! 4. one exploitation episode: the same nearest parameters without noise; its outcome updates
+//!    the chosen module's interest (`explore::interest::ModuleInterest`).
+//!
+//! [`Modules::Flat`] is one module holding every coordinate: the follow-up's "RGE" (its
+//! `n_modules = 1`), the same loop without a module choice. Every episode's outcome is stored
+//! for every module. Unlike this project's ICLR RGE (`imgep.rs`) there is no random episode
+//! after the bootstrap (the follow-up's loop has none).
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use super::ExploreConfig;
+use super::history::{ExplorationLog, InterestPoint, Metrics, Recorder};
+use super::imgep::OutcomeSpace;
+use super::interest::{ModuleInterest, choose_module};
+use super::meta_policy::{perturb, random_params};
+use super::nn::NnIndex;
+use crate::env::{Environment, PARAMS};
+use crate::goals::GoalSampler;
+use crate::seed::{Component, Stream, stream};
+
+/// How the goal space is split and a module chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Modules {
+    /// One module of every coordinate (the follow-up's RGE).
+    Flat,
+    /// Modules chosen uniformly at random.
+    Random,
+    /// Modules chosen by learning progress (curiosity).
+    Progress,
+}
+
+impl Modules {
+    /// Every kind, in the report's order.
+    pub const ALL: [Modules; 3] = [Modules::Flat, Modules::Random, Modules::Progress];
+
+    /// Name in algorithm names (`mge-vae-lp`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Modules::Flat => "flat",
+            Modules::Random => "random",
+            Modules::Progress => "lp",
+        }
+    }
+}
+
+impl fmt::Display for Modules {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Modules {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Modules::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown module choice '{s}' (expected flat, random or lp)"))
+    }
+}
+
+/// Constants of modular exploration (`[mge]` of a campaign file); the defaults are the
+/// follow-up code's (`docs/followup-paper-sources.md` section 3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MgeConfig {
+    /// Latents per module of a learned goal space (2: the follow-up's 5 modules of 10 latents).
+    pub module_size: usize,
+    /// Noisy exploration episodes per goal, before the exploitation episode (4).
+    pub n_explore: usize,
+    /// The interest is an exponential moving average of the progress with rate 1 / window
+    /// (1000).
+    pub interest_window: f64,
+    /// Learning-progress choice: a uniformly random module with this probability (0.1).
+    pub eps: f64,
+}
+
+impl Default for MgeConfig {
+    fn default() -> Self {
+        MgeConfig {
+            module_size: 2,
+            n_explore: 4,
+            interest_window: 1000.0,
+            eps: 0.1,
+        }
+    }
+}
+
+impl MgeConfig {
+    /// Check the values; the error names the offending key.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.module_size == 0 {
+            return Err("mge.module_size must be at least 1".into());
+        }
+        if !(self.interest_window.is_finite() && self.interest_window >= 1.0) {
+            return Err(format!(
+                "mge.interest_window must be at least 1, got {}",
+                self.interest_window
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.eps) {
+            return Err(format!("mge.eps must be in [0, 1], got {}", self.eps));
+        }
+        Ok(())
+    }
+}
+
+/// A goal module: a name and its goal-space coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoalModule {
+    /// `ball` / `distractor` (engineered features), `z3,z7` (latents), `all` (flat).
+    pub name: String,
+    /// Goal-space coordinates, in order.
+    pub dims: Vec<usize>,
+}
+
+/// The modules of a goal space.
+/// - Flat: one module `all` of the `dim` coordinates.
+/// - Engineered features (`objects` given): one module per object, its (x, y) coordinates.
+/// - Learned: consecutive groups of `module_size` latents taken in decreasing order of
+///   `spread` (the follow-up orders latents by their mean KL divergence to the prior; we use
+///   the variance of the training encodings, which every learner has: a collapsed latent has
+///   none). `Err` if `dim` is not a multiple of `module_size`.
+pub fn goal_modules(
+    modules: Modules,
+    dim: usize,
+    objects: Option<&[(&str, std::ops::Range<usize>)]>,
+    spread: &[f64],
+    module_size: usize,
+) -> Result<Vec<GoalModule>, String> {
+    if modules == Modules::Flat {
+        return Ok(vec![GoalModule {
+            name: "all".into(),
+            dims: (0..dim).collect(),
+        }]);
+    }
+    if let Some(objects) = objects {
+        return Ok(objects
+            .iter()
+            .map(|(name, r)| GoalModule {
+                name: name.to_string(),
+                dims: r.clone().collect(),
+            })
+            .collect());
+    }
+    if module_size == 0 || dim % module_size != 0 || spread.len() != dim {
+        return Err(format!(
+            "{dim} latents cannot be split into modules of {module_size} (mge.module_size)"
+        ));
+    }
+    let mut order: Vec<usize> = (0..dim).collect();
+    order.sort_by(|&a, &b| spread[b].total_cmp(&spread[a]).then(a.cmp(&b)));
+    Ok(order
+        .chunks(module_size)
+        .map(|c| GoalModule {
+            name: c
+                .iter()
+                .map(|k| format!("z{k}"))
+                .collect::<Vec<_>>()
+                .join(","),
+            dims: c.to_vec(),
+        })
+        .collect())
+}
+
+/// The explorer's memory: parameters and outcome encodings, with one nearest-neighbour index
+/// per module (on the module's coordinates).
+struct Memory {
+    thetas: Vec<[f64; PARAMS]>,
+    indices: Vec<NnIndex>,
+    full: NnIndex,
+    z: Vec<f64>,
+    part: Vec<f64>,
+    initial: Vec<f64>,
+    ever_moved: bool,
+    env_rng: Stream,
+}
+
+impl Memory {
+    /// Run `theta`, store its outcome; returns the outcome's encoding.
+    fn store(
+        &mut self,
+        env: &dyn Environment,
+        space: &mut dyn OutcomeSpace,
+        modules: &[GoalModule],
+        rec: &mut Recorder,
+        theta: [f64; PARAMS],
+        epoch: usize,
+        random: bool,
+    ) -> &[f64] {
+        let r = env.rollout(&theta, &mut self.env_rng);
+        let s = r.outcome();
+        self.ever_moved |= s[env.kind().metric_dims()]
+            .iter()
+            .zip(&self.initial)
+            .all(|(a, b)| a != b);
+        space.encode(s, &mut self.z);
+        self.full.insert(&self.z);
+        for (m, index) in modules.iter().zip(&mut self.indices) {
+            self.part.clear();
+            self.part.extend(m.dims.iter().map(|&k| self.z[k]));
+            index.insert(&self.part);
+        }
+        self.thetas.push(theta);
+        rec.push(epoch, &r, random);
+        &self.z
+    }
+}
+
+/// Run modular goal exploration in `space`, with `modules` and one goal sampler per module
+/// (of the module's dimension).
+#[allow(clippy::too_many_arguments)]
+pub fn run_mge(
+    env: &dyn Environment,
+    space: &mut dyn OutcomeSpace,
+    modules: &[GoalModule],
+    samplers: &mut [Box<dyn GoalSampler>],
+    choice: Modules,
+    cfg: &ExploreConfig,
+    mge: &MgeConfig,
+    run_seed: u64,
+) -> Result<ExplorationLog, String> {
+    if modules.is_empty() || modules.len() != samplers.len() {
+        return Err(format!(
+            "{} modules and {} goal samplers",
+            modules.len(),
+            samplers.len()
+        ));
+    }
+    for (m, s) in modules.iter().zip(samplers.iter()) {
+        if s.dim() != m.dims.len() || m.dims.iter().any(|&k| k >= space.dim()) {
+            return Err(format!(
+                "module {} ({:?}) does not fit its sampler (dim {}) or the goal space (dim {})",
+                m.name,
+                m.dims,
+                s.dim(),
+                space.dim()
+            ));
+        }
+    }
+    let metrics = Metrics::for_env(env);
+    let mut rec = Recorder::new(
+        &metrics,
+        env.initial_state(),
+        cfg.eval_epochs(),
+        cfg.epochs + 1,
+    );
+    rec.set_modules(
+        modules
+            .iter()
+            .map(|m| (m.name.clone(), m.dims.clone()))
+            .collect(),
+    );
+    let mut params_rng = stream(run_seed, Component::Params);
+    let mut choice_rng = stream(run_seed, Component::ModuleChoice);
+    let mut goal_rng = stream(run_seed, Component::Goals);
+    let mut noise_rng = stream(run_seed, Component::Noise);
+    let mut interests: Vec<ModuleInterest> = modules
+        .iter()
+        .map(|m| ModuleInterest::new(m.dims.len(), mge.interest_window))
+        .collect::<Result<_, _>>()?;
+    let mut chosen = vec![0usize; modules.len()];
+    let mut mem = Memory {
+        thetas: Vec::with_capacity(cfg.epochs + 1),
+        indices: modules.iter().map(|m| NnIndex::new(m.dims.len())).collect(),
+        full: NnIndex::new(space.dim()),
+        z: vec![0.0; space.dim()],
+        part: Vec::new(),
+        initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
+        ever_moved: false,
+        env_rng: stream(run_seed, Component::Distractor),
+    };
+    let record_interest =
+        |rec: &mut Recorder, epoch: usize, ints: &[ModuleInterest], n: &[usize]| {
+            if rec.evaluates_at(epoch) {
+                for (module, (i, &n_chosen)) in ints.iter().zip(n).enumerate() {
+                    rec.push_interest(InterestPoint {
+                        epoch,
+                        module,
+                        interest: i.interest(),
+                        n_chosen,
+                    });
+                }
+            }
+        };
+
+    // Warm-up episode.
+    let theta = random_params(&mut params_rng);
+    mem.store(env, space, modules, &mut rec, theta, 0, true);
+    rec.end_epoch(0);
+
+    let mut goal = Vec::new();
+    let mut epoch = 0;
+    while epoch < cfg.epochs {
+        let bootstrapping =
+            !mem.ever_moved || mem.full.n_distinct() < 2 || epoch < cfg.bootstrap_epochs;
+        if bootstrapping {
+            epoch += 1;
+            let theta = random_params(&mut params_rng);
+            mem.store(env, space, modules, &mut rec, theta, epoch, true);
+            record_interest(&mut rec, epoch, &interests, &chosen);
+            rec.end_epoch(epoch);
+            continue;
+        }
+        // One goal: choose a module, draw the goal in it.
+        let m = match choice {
+            Modules::Flat => 0,
+            Modules::Random => choose_module(&vec![0.0; modules.len()], 1.0, &mut choice_rng)?,
+            Modules::Progress => {
+                let v: Vec<f64> = interests.iter().map(ModuleInterest::interest).collect();
+                choose_module(&v, mge.eps, &mut choice_rng)?
+            }
+        };
+        chosen[m] += 1;
+        goal.resize(modules[m].dims.len(), 0.0);
+        samplers[m].sample(&mut goal_rng, &mut goal);
+        for k in 0..=mge.n_explore {
+            if epoch == cfg.epochs {
+                break;
+            }
+            epoch += 1;
+            let (j, _) = mem.indices[m]
+                .nearest(&goal)
+                .expect("the memory is not empty");
+            let exploit = k == mge.n_explore;
+            let theta = if exploit {
+                mem.thetas[j]
+            } else {
+                perturb(&mem.thetas[j], cfg.noise_sigma, &mut noise_rng)
+            };
+            let z = mem.store(env, space, modules, &mut rec, theta, epoch, false);
+            if exploit {
+                let reached: Vec<f64> = modules[m].dims.iter().map(|&d| z[d]).collect();
+                interests[m].update(&goal, &reached)?;
+            }
+            record_interest(&mut rec, epoch, &interests, &chosen);
+            rec.end_epoch(epoch);
+        }
+    }
+    Ok(rec.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::{EnvConfig, EnvKind, make_env};
+    use crate::explore::EngineeredSpace;
+    use crate::goals::UniformGoals;
+
+    fn efr_run(env: EnvKind, choice: Modules, seed: u64) -> ExplorationLog {
+        let env = make_env(env, &EnvConfig::default());
+        let d = env.state_dim();
+        let objects = env.kind().objects();
+        let modules = goal_modules(choice, d, Some(&objects), &[], 2).unwrap();
+        let mut samplers: Vec<Box<dyn GoalSampler>> = modules
+            .iter()
+            .map(|m| Box::new(UniformGoals::unit(m.dims.len())) as Box<dyn GoalSampler>)
+            .collect();
+        let cfg = ExploreConfig {
+            epochs: 600,
+            bootstrap_epochs: 50,
+            ..ExploreConfig::default()
+        };
+        run_mge(
+            env.as_ref(),
+            &mut EngineeredSpace::new(d),
+            &modules,
+            &mut samplers,
+            choice,
+            &cfg,
+            &MgeConfig::default(),
+            seed,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn modules_of_latents_follow_the_spread_and_of_features_the_objects() {
+        let m = goal_modules(Modules::Progress, 4, None, &[0.1, 3.0, 0.0, 2.0], 2).unwrap();
+        assert_eq!(m[0].dims, vec![1, 3]);
+        assert_eq!(m[0].name, "z1,z3");
+        assert_eq!(m[1].dims, vec![0, 2]);
+        assert!(goal_modules(Modules::Random, 5, None, &[1.0; 5], 2).is_err());
+        let objects = EnvKind::ArmBalls.objects();
+        let m = goal_modules(Modules::Random, 4, Some(&objects), &[], 2).unwrap();
+        assert_eq!(
+            m.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(),
+            ["ball", "distractor"]
+        );
+        let flat = goal_modules(Modules::Flat, 4, Some(&objects), &[], 2).unwrap();
+        assert_eq!(flat.len(), 1);
+        assert_eq!(flat[0].dims, vec![0, 1, 2, 3]);
+    }
+
+    #[test]
+    fn a_run_is_deterministic_counts_its_episodes_and_records_interest() {
+        let a = efr_run(EnvKind::ArmBalls, Modules::Progress, 3);
+        assert_eq!(a, efr_run(EnvKind::ArmBalls, Modules::Progress, 3));
+        assert_ne!(a, efr_run(EnvKind::ArmBalls, Modules::Progress, 4));
+        assert_eq!(a.outcomes.len(), 601);
+        assert_eq!(a.n_random + a.n_goal, 600);
+        assert!(a.n_random >= 50);
+        // Interest of both modules at every evaluation epoch.
+        assert_eq!(a.interest.len(), 2 * a.checkpoints.len() - 0);
+        let last: Vec<_> = a.interest.iter().rev().take(2).collect();
+        let n_goals: usize = last.iter().map(|p| p.n_chosen).sum();
+        // 550 goal episodes in cycles of 5 (the last cycle may be cut).
+        assert_eq!(n_goals, a.n_goal.div_ceil(5));
+        // The distractor is measured as a control.
+        assert!(a.checkpoints.iter().all(|c| c.control.is_some()));
+    }
+
+    #[test]
+    fn learning_progress_prefers_the_ball_over_the_distractor() {
+        // The arm can bring the ball near ball goals; it can do nothing for distractor goals,
+        // whose "progress" is noise around 0. Over seeds the ball module is chosen more.
+        let (mut ball, mut distractor) = (0, 0);
+        for seed in 0..4 {
+            let log = efr_run(EnvKind::ArmBalls, Modules::Progress, seed);
+            let n = log.interest.len();
+            ball += log.interest[n - 2].n_chosen;
+            distractor += log.interest[n - 1].n_chosen;
+        }
+        assert!(ball > distractor, "ball {ball} distractor {distractor}");
+    }
+
+    #[test]
+    fn flat_mge_on_armball_explores_like_rge() {
+        let log = efr_run(EnvKind::ArmBall, Modules::Flat, 1);
+        let rpe = crate::explore::run_rpe(
+            make_env(EnvKind::ArmBall, &EnvConfig::default()).as_ref(),
+            &ExploreConfig {
+                epochs: 600,
+                ..ExploreConfig::default()
+            },
+            1,
+        );
+        let (a, b) = (
+            log.checkpoints.last().unwrap().coverage,
+            rpe.checkpoints.last().unwrap().coverage,
+        );
+        assert!(a > b, "flat goal exploration {a} vs random parameters {b}");
+    }
+}
