@@ -214,7 +214,7 @@ enum Command {
 
 #[derive(clap::Args, Debug)]
 struct EmbedArgs {
-    /// armball or armarrow.
+    /// armball, armarrow or armballs.
     #[arg(long)]
     env: EnvKind,
     #[arg(long, help = learner_help())]
@@ -833,7 +833,9 @@ fn algo_help() -> String {
     let algos: Vec<&str> = Learner::all().map(|l| l.entry().algo).collect();
     format!(
         "rpe, rge-efr, or a learned goal space rge-NAME: {} (parameters in the profile's \
-         [learners.NAME]; `ugl learners` describes them)",
+         [learners.NAME]; `ugl learners` describes them); the follow-up paper's modular goal \
+         exploration (docs/armballs.md): mge-efr-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one \
+         module), random or lp (learning progress), constants in the profile's [mge]",
         algos.join(", ")
     )
 }

@@ -1636,3 +1636,141 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
     assert_one_line_error(&o, "no READY line within the ready timeout (1.5s)");
     assert!(t0.elapsed().as_secs() < 30);
 }
+
+#[test]
+fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section() {
+    // A tiny follow-up campaign: RPE, flat and learning-progress goal exploration with
+    // engineered features, and the same in a learned (PCA) goal space, 3 seeds.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("armballs.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"armballs\"\nreps = 3\n[matrix]\nenvs = [\"armballs\"]\n\
+         algos = [\"rpe\", \"mge-efr-flat\", \"mge-efr-lp\", \"mge-pca-lp\"]\n\
+         samplers = [\"kde\"]\nlatents = [4]\n[ugl]\nimages = 300\n\
+         [explore]\nepochs = 400\nbootstrap_epochs = 50\n[mge]\ninterest_window = 20.0\n",
+    )
+    .unwrap();
+    // Modules of 2 latents need an even latent count: a one-line error naming the keys.
+    let odd = dir.path().join("odd.toml");
+    std::fs::write(
+        &odd,
+        std::fs::read_to_string(&cfg)
+            .unwrap()
+            .replace("latents = [4]", "latents = [3]"),
+    )
+    .unwrap();
+    assert_one_line_error(
+        &ugl(&["plan", "--config", p(&odd)]),
+        "mge.module_size = 2 latents, but matrix.latents has 3",
+    );
+    let results = dir.path().join("results");
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&results.join("armballs")),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ab = results.join("armballs");
+    // Modular runs write their interest; the others do not.
+    assert!(ab.join("armballs.mge-efr-lp.s0.interest.parquet").is_file());
+    assert!(
+        ab.join("armballs.mge-pca-lp.kde.l4.s1.interest.parquet")
+            .is_file()
+    );
+    assert!(!ab.join("armballs.rpe.s0.interest.parquet").exists());
+    let m = manifest(&ab.join("armballs.mge-efr-lp.s0.json"));
+    let files: Vec<&str> = m["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["name"].as_str().unwrap())
+        .collect();
+    assert!(
+        files.contains(&"armballs.mge-efr-lp.s0.interest.parquet"),
+        "{files:?}"
+    );
+    // Per-latent R² per object in a learned space's manifest.
+    let m = manifest(&ab.join("armballs.mge-pca-lp.kde.l4.s0.json"));
+    let per = m["latent_quality"]["per_latent"].as_array().unwrap();
+    assert_eq!(per.len(), 2);
+    assert_eq!(per[1]["object"], "distractor");
+    assert_eq!(per[0]["r2"].as_array().unwrap().len(), 4);
+    // `ugl run` gives the same bytes as the campaign.
+    let single = dir.path().join("single");
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armballs",
+        "--algo",
+        "mge-efr-lp",
+        "--seed",
+        "2",
+        "--profile",
+        p(&cfg),
+        "--out",
+        p(&single),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in [
+        "armballs.mge-efr-lp.s2.parquet",
+        "armballs.mge-efr-lp.s2.interest.parquet",
+    ] {
+        assert_eq!(
+            std::fs::read(ab.join(f)).unwrap(),
+            std::fs::read(single.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // The report needs a main campaign: a tiny ArmBall one.
+    let main = dir.path().join("main.toml");
+    std::fs::write(
+        &main,
+        "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-efr\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
+         [explore]\nepochs = 150\n",
+    )
+    .unwrap();
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&main),
+        "--out",
+        p(&results.join("base")),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = dir.path().join("report");
+    let o = ugl(&[
+        "report",
+        "--results",
+        p(&results),
+        "--out",
+        p(&report),
+        "--main",
+        "base",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("## Beyond the paper: a distractor (ArmBalls)"),
+        "{md}"
+    );
+    let page = std::fs::read_to_string(report.join("armballs.md")).unwrap();
+    for needle in [
+        "| RPE | 3 |",
+        "| RGE-EFR (flat) | 3 |",
+        "| MGE-EFR (LP) | 0 (ball) |",
+        "| MGE-EFR (LP) | 1 (distractor) |",
+        "| C4 |",
+        "| C6 |",
+        "## Disentanglement of the learned goal spaces",
+    ] {
+        assert!(page.contains(needle), "no `{needle}` in:\n{page}");
+    }
+    assert!(report.join("figures/armballs_coverage.svg").is_file());
+    assert!(report.join("figures/armballs_interest.svg").is_file());
+}

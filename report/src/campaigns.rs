@@ -60,6 +60,8 @@ pub struct Campaigns {
     pub compare: Vec<Campaign>,
     /// `<main>-*` campaigns (training-recipe variants of the main campaign), sorted by name.
     pub recipe: Vec<Campaign>,
+    /// The follow-up paper's campaigns (`armballs`, `armballs-*`), sorted by name.
+    pub followup: Vec<Campaign>,
     /// Everything else, sorted by name.
     pub unused: Vec<Unused>,
 }
@@ -73,6 +75,7 @@ impl Campaigns {
                 .iter()
                 .chain(&self.compare)
                 .chain(&self.recipe)
+                .chain(&self.followup)
                 .map(|c| c.store.runs.len())
                 .sum::<usize>()
     }
@@ -167,6 +170,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
     let mut budget = Vec::new();
     let mut compare = Vec::new();
     let mut recipe = Vec::new();
+    let mut followup = Vec::new();
     let mut unused = Vec::new();
     for d in &dirs {
         if d.name == main {
@@ -185,6 +189,12 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
                 name: d.name.clone(),
                 path: d.path.clone(),
                 store,
+            });
+        } else if crate::armballs::is_followup_campaign(&d.name) {
+            followup.push(Campaign {
+                name: d.name.clone(),
+                path: d.path.clone(),
+                store: d.load()?,
             });
         } else if is_recipe_campaign(&d.name, main) {
             recipe.push(Campaign {
@@ -206,6 +216,7 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
         budget,
         compare,
         recipe,
+        followup,
         unused,
     })
 }

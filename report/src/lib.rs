@@ -7,6 +7,7 @@
 //! the bootstrap is seeded, and nothing depends on the clock or the host.
 
 pub mod aggregate;
+pub mod armballs;
 pub mod campaigns;
 pub mod claims;
 pub mod data;
@@ -201,6 +202,21 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         .chain(&appendix_figs)
         .map(|f| f.path.clone())
         .collect();
+    // The follow-up paper's campaign `armballs` and its variants `armballs-*`: one page.
+    let mut followup = None;
+    if let Some(main) = camps.followup.iter().find(|c| c.name == armballs::CAMPAIGN) {
+        let variants: Vec<&campaigns::Campaign> = camps
+            .followup
+            .iter()
+            .filter(|c| c.name != armballs::CAMPAIGN)
+            .collect();
+        if let Some(section) =
+            armballs::render(main, &variants, &fig_dir, opts.n_boot, opts.bootstrap_seed)?
+        {
+            figure_files.extend(section.figures.iter().map(|f| f.path.clone()));
+            followup = Some(section);
+        }
+    }
     remove_stale_figures(&fig_dir, &figure_files)?;
 
     let md = markdown::render(&markdown::Inputs {
@@ -224,6 +240,17 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         claims: &claims_input,
         leaderboard: &board,
     });
+    // The follow-up paper's section: its own page, its claims in REPORT.md.
+    let mut md = md;
+    let mut followup_pages = Vec::new();
+    if let Some(section) = &followup {
+        let page = opts.out.join(armballs::PAGE);
+        write_file(&page, section.page.as_bytes())?;
+        followup_pages.push(page);
+        md.push('\n');
+        md.push_str(&section.summary);
+    }
+    remove_stale_page(&opts.out.join(armballs::PAGE), &followup_pages)?;
     let report_path = opts.out.join("REPORT.md");
     write_file(&report_path, md.as_bytes())?;
     // One page per new learner.
@@ -247,6 +274,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     figure_files.sort();
     let mut files = vec![report_path];
     files.extend(compare_pages);
+    files.extend(followup_pages);
     files.extend(figure_files);
     files.extend(data_files);
     Ok(ReportSummary {
@@ -296,6 +324,17 @@ fn remove_stale_pages(out: &Path, written: &[PathBuf]) -> Result<(), ReportError
     Ok(())
 }
 
+/// An earlier render's page at `path` that this render did not write.
+fn remove_stale_page(path: &Path, written: &[PathBuf]) -> Result<(), ReportError> {
+    if path.is_file() && !written.iter().any(|w| w == path) {
+        std::fs::remove_file(path).map_err(|source| ReportError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    }
+    Ok(())
+}
+
 fn create_dir(dir: &Path) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
         path: dir.to_path_buf(),
@@ -329,6 +368,7 @@ fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), Repor
                 || name.starts_with("outcomes_")
                 || name.starts_with("budget_")
                 || name.starts_with("goal_space_")
+                || name.starts_with("armballs_")
                 || OWN_FIGURES.contains(&name)))
             || (name.ends_with(".png") && name.starts_with("recon_"));
         if ours && !written.contains(&path) {

@@ -14,7 +14,7 @@
 //! - module choice: uniform with probability `eps` (or when every interest is 0), else in
 //!   proportion to the interests.
 //!
-//! Building block only: no explorer uses it yet (the MGE loop is the next step of issue 17).
+//! Used by modular goal exploration (`explore::mge`).
 
 use rand::RngExt;
 

@@ -421,7 +421,7 @@ mod tests {
         assert_eq!(a.n_random + a.n_goal, 600);
         assert!(a.n_random >= 50);
         // Interest of both modules at every evaluation epoch.
-        assert_eq!(a.interest.len(), 2 * a.checkpoints.len() - 0);
+        assert_eq!(a.interest.len(), 2 * a.checkpoints.len());
         let last: Vec<_> = a.interest.iter().rev().take(2).collect();
         let n_goals: usize = last.iter().map(|p| p.n_chosen).sum();
         // 550 goal episodes in cycles of 5 (the last cycle may be cut).

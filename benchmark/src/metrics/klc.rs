@@ -84,6 +84,16 @@ impl KlCoverage {
         })
     }
 
+    /// The measure over the whole square [-1, 1]², every one of the 900 cells achievable: for
+    /// an object whose reachable set is not the arm's disk (ArmBalls' distractor walks in
+    /// [-0.95, 0.95]², which meets every cell).
+    pub fn whole_square() -> Self {
+        let mut k = KlCoverage::new(2).expect("2 is a supported dimension");
+        k.achievable.fill(true);
+        k.n_achievable = k.achievable.len();
+        k
+    }
+
     /// Outcome dimension.
     pub fn dim(&self) -> usize {
         self.dim
@@ -243,6 +253,19 @@ impl CoverageHistogram<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_whole_square_counts_every_cell() {
+        let k = KlCoverage::whole_square();
+        assert_eq!((k.n_achievable(), k.n_cells()), (900, 900));
+        // A corner outcome is outside the disk's cells, inside the square's.
+        let corner: &[f64] = &[0.95, -0.95];
+        assert_eq!(
+            KlCoverage::new(2).unwrap().evaluate([corner]).unwrap(),
+            f64::INFINITY
+        );
+        assert!((k.evaluate([corner]).unwrap() - (900f64).ln()).abs() < 1e-12);
+    }
 
     #[test]
     fn achievable_counts() {
