@@ -976,6 +976,8 @@ pub fn claims(runs: &[FollowupRun], n_boot: usize, seed: u64) -> Vec<Claim> {
 fn colour(algo: &str) -> RGBColor {
     let (space, choice) = parts(algo);
     let base = match space {
+        // Variant campaigns (`@still`): reddish purple.
+        _ if algo.contains('@') => (0xCC, 0x79, 0xA7),
         "efr" => (0x00, 0x9E, 0x73),
         "vae" => (0x00, 0x72, 0xB2),
         "bvae" => (0xD5, 0x5E, 0x00),
@@ -1021,6 +1023,7 @@ fn draw_lines(
     y_label: &str,
     series: &[(String, RGBColor, Option<(i32, i32)>, Vec<(f64, f64)>)],
     log_y: bool,
+    legend: Option<SeriesLabelPosition>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let x_max = series
         .iter()
@@ -1059,12 +1062,14 @@ fn draw_lines(
             .label(name.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.3))
-            .label_font((FONT, 11))
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()?;
+        if let Some(pos) = legend {
+            c.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.mix(0.3))
+                .label_font((FONT, 11))
+                .position(pos)
+                .draw()?;
+        }
     } else {
         let mut c = chart.build_cartesian_2d(0.0..x_max, 0.0..y_hi * 1.08)?;
         c.configure_mesh()
@@ -1088,12 +1093,14 @@ fn draw_lines(
             .label(name.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.3))
-            .label_font((FONT, 11))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()?;
+        if let Some(pos) = legend {
+            c.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.mix(0.3))
+                .label_font((FONT, 11))
+                .position(pos)
+                .draw()?;
+        }
     }
     Ok(())
 }
@@ -1137,13 +1144,15 @@ fn draw_coverage(runs: &[FollowupRun], fig_dir: &Path) -> Result<FigureFile, Rep
             "exploration ratio (cells / 900)",
             &ball,
             false,
+            None,
         )?;
         draw_lines(
             &r,
-            "distractor (control)",
+            "distractor (control; legend for both panels)",
             "exploration ratio (cells / 900)",
             &distractor,
             false,
+            Some(SeriesLabelPosition::LowerRight),
         )?;
         Ok(())
     })?;
@@ -1212,7 +1221,14 @@ fn draw_interest(runs: &[FollowupRun], fig_dir: &Path) -> Result<Option<FigureFi
     write_svg(&path, (w, 420), |root| {
         let areas = root.split_evenly((1, panels.len()));
         for (area, (title, series)) in areas.iter().zip(&panels) {
-            draw_lines(area, title, "interest (log scale)", series, true)?;
+            draw_lines(
+                area,
+                title,
+                "interest (log scale)",
+                series,
+                true,
+                Some(SeriesLabelPosition::LowerRight),
+            )?;
         }
         Ok(())
     })?;
