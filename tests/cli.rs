@@ -1715,9 +1715,30 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
         p(&single),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // And in a learned space, where the campaign shared one fitted PCA between runs and
+    // `ugl run` fits its own.
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armballs",
+        "--algo",
+        "mge-pca-lp",
+        "--latents",
+        "4",
+        "--seed",
+        "1",
+        "--profile",
+        p(&cfg),
+        "--out",
+        p(&single),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
     for f in [
         "armballs.mge-efr-lp.s2.parquet",
         "armballs.mge-efr-lp.s2.interest.parquet",
+        "armballs.mge-pca-lp.kde.l4.s1.parquet",
+        "armballs.mge-pca-lp.kde.l4.s1.outcomes.parquet",
+        "armballs.mge-pca-lp.kde.l4.s1.interest.parquet",
     ] {
         assert_eq!(
             std::fs::read(ab.join(f)).unwrap(),

@@ -1279,7 +1279,12 @@ mod tests {
             runs.push(run("rpe", s, 0.10 + 0.001 * s as f64));
             runs.push(run("mge-efr-flat", s, 0.20 + 0.002 * s as f64));
             runs.push(run("mge-efr-lp", s, 0.30 + 0.002 * s as f64));
+            runs.push(run("mge-efr-flat@still", s, 0.35 + 0.002 * s as f64));
         }
+        assert_eq!(
+            label("mge-efr-flat@still"),
+            "RGE-EFR (flat), still distractor"
+        );
         let c = claims(&runs, 500, 0);
         let get = |id: &str| c.iter().find(|c| c.id == id).unwrap();
         assert_eq!(get("C4").verdict, "supported");
@@ -1290,6 +1295,11 @@ mod tests {
             if r.algo == "mge-efr-flat" {
                 r.ball_coverage[0] *= 3.0;
             }
+            // Variant campaigns are not goal explorers of C6.
+            assert!(
+                !c.iter()
+                    .any(|c| c.id == "C6" && c.measured.contains("still"))
+            );
         }
         let c = claims(&runs, 500, 0);
         assert_eq!(
