@@ -596,6 +596,7 @@ fn host_engine_gradients_match_burn_autodiff() {
                     step,
                     warmup: cfg.warmup,
                     beta: cfg.beta.unwrap_or(1.0),
+                    capacity: cfg.capacity_at(step),
                     variant,
                     device: &device,
                 },
@@ -855,4 +856,32 @@ fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
         assert_ne!(zb4.data, zv.data, "{engine:?}");
         assert_ne!(b4.losses, v.losses, "{engine:?}");
     }
+}
+
+#[test]
+fn capacity_annealing_is_the_beta_kl_against_a_rising_target() {
+    use ugl_bench::repr::neural::Engine;
+    let set = images(EnvKind::ArmBall, 150);
+    let cfg = |capacity: Option<f64>| NeuralConfig {
+        engine: Engine::Host,
+        beta: Some(4.0),
+        capacity,
+        ..tiny(Model::Bvae, Variant::Faithful, 25)
+    };
+    // C rises linearly to `capacity` over the training.
+    let c = cfg(Some(20.0));
+    assert_eq!(c.capacity_at(0), Some(0.0));
+    assert_eq!(c.capacity_at(c.iterations / 5), Some(4.0));
+    assert_eq!(c.capacity_at(c.iterations * 2), Some(20.0));
+    assert_eq!(cfg(None).capacity_at(3), None);
+    // A target of 0 nats is the plain objective (β |KL - 0| = β KL: the same loss up to the
+    // order of the sums); a rising target trains another network.
+    let (plain, zp) = fit_neural(Model::Bvae, cfg(None), &set, 3, 4);
+    let (zero, _) = fit_neural(Model::Bvae, cfg(Some(0.0)), &set, 3, 4);
+    for ((i, a), (j, b)) in plain.losses.iter().zip(&zero.losses) {
+        assert_eq!(i, j);
+        assert!((a - b).abs() <= 1e-3 * a.abs(), "iteration {i}: {a} vs {b}");
+    }
+    let (_, z50) = fit_neural(Model::Bvae, cfg(Some(50.0)), &set, 3, 4);
+    assert_ne!(zp.data, z50.data);
 }

@@ -211,6 +211,17 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
         }
     }
     budget.sort_by_key(|c| natural_key(&c.name));
+    // Variants (`armballs-*`) are drawn next to `armballs` only: without it they are unused.
+    if !followup.iter().any(|c| c.name == crate::armballs::CAMPAIGN) {
+        for c in followup.drain(..) {
+            unused.push(Unused {
+                complete: c.store.runs.len(),
+                incomplete: c.store.incomplete.len(),
+                name: c.name,
+            });
+        }
+        unused.sort_by(|a, b| a.name.cmp(&b.name));
+    }
     Ok(Campaigns {
         main: main_campaign,
         budget,

@@ -650,6 +650,7 @@ impl HostTrainer {
             step,
             warmup: cfg.warmup,
             beta: cfg.beta.unwrap_or(1.0),
+            capacity: cfg.capacity_at(step),
             variant: cfg.variant,
             device: &self.device,
         };

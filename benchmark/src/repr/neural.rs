@@ -172,9 +172,20 @@ pub struct NeuralConfig {
     /// 1, so their configurations and hashes are what they were before the β-VAE existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta: Option<f64>,
+    /// β-VAE only: Burgess et al.'s capacity annealing (the follow-up's objective): the KL term
+    /// becomes `β |mean_b KL_b − C|`, C rising linearly from 0 to `capacity` nats over the
+    /// training. Absent: the plain β-VAE (and every other model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
 }
 
 impl NeuralConfig {
+    /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
+    pub fn capacity_at(&self, step: usize) -> Option<f64> {
+        self.capacity
+            .map(|c| c * (step as f64 / self.iterations as f64).min(1.0))
+    }
+
     /// The paper's configuration of `model`, faithful variant.
     pub fn paper(model: Model) -> NeuralConfig {
         NeuralConfig {
@@ -186,6 +197,7 @@ impl NeuralConfig {
             log_every: 100,
             warmup: model.spec().paper_warmup(),
             beta: model.spec().default_beta(),
+            capacity: None,
             init: Init::Paper,
             engine: Engine::Host,
         }
@@ -225,6 +237,11 @@ impl NeuralConfig {
             && !(b.is_finite() && b > 0.0 && b <= 1e6)
         {
             return bad(format!("beta must be positive and at most 1e6, got {b}"));
+        }
+        if let Some(c) = self.capacity
+            && !(c.is_finite() && (0.0..=1e4).contains(&c))
+        {
+            return bad(format!("capacity must be between 0 and 1e4 nats, got {c}"));
         }
         if model.spec().paper_warmup() > 0 && self.warmup == 0 {
             return bad("warmup must be at least 1".into());
@@ -268,6 +285,9 @@ pub struct NeuralSection {
     pub engine: Option<Engine>,
     /// β-VAE: the weight of the KL term (only valid in `[learners.bvae]`).
     pub beta: Option<f64>,
+    /// β-VAE: capacity annealing, the KL target's final value in nats (only valid in
+    /// `[learners.bvae]`).
+    pub capacity: Option<f64>,
 }
 
 impl NeuralSection {
@@ -285,6 +305,7 @@ impl NeuralSection {
             init: self.init.unwrap_or(p.init),
             engine: self.engine.unwrap_or(p.engine),
             beta: p.beta.map(|b| self.beta.unwrap_or(b)),
+            capacity: p.beta.and(self.capacity),
         }
     }
 }
@@ -298,6 +319,9 @@ impl ParamGuard for (Model, NeuralSection) {
         }
         if model.spec().default_beta().is_none() && section.beta.is_some() {
             return Err("beta: only the bvae has a KL weight".into());
+        }
+        if model.spec().default_beta().is_none() && section.capacity.is_some() {
+            return Err("capacity: only the bvae anneals a KL capacity".into());
         }
         section
             .resolve(model, Variant::Faithful)
@@ -844,6 +868,7 @@ impl<'a> Trainer<'a> {
                         step: self.step,
                         warmup: self.cfg.warmup,
                         beta: self.cfg.beta.unwrap_or(1.0),
+                        capacity: self.cfg.capacity_at(self.step),
                         variant: self.cfg.variant,
                         device,
                     },

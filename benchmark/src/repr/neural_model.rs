@@ -117,6 +117,8 @@ pub struct LatentInput<'a> {
     pub warmup: usize,
     /// β-VAE: the weight of the KL term (1 for every other model).
     pub beta: f64,
+    /// β-VAE with capacity annealing: the KL target C at this iteration (None: plain KL term).
+    pub capacity: Option<f64>,
     pub variant: Variant,
     pub device: &'a Device,
 }
