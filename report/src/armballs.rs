@@ -234,6 +234,11 @@ fn load_interest(curve: &Path) -> Result<Interest, ReportError> {
     Ok((modules, points))
 }
 
+/// The variant campaign's tag of an algorithm (`still` in `mge-efr-flat@still`), or "".
+fn tag(algo: &str) -> &str {
+    algo.split_once('@').map(|t| t.1).unwrap_or("")
+}
+
 /// `mge-<space>-<choice>[@tag]` → (space, choice); `rpe` → ("", "").
 fn parts(algo: &str) -> (&str, &str) {
     let algo = algo.split('@').next().unwrap_or(algo);
@@ -263,10 +268,10 @@ fn algo_order(algo: &str) -> (String, usize, String, usize) {
 /// The follow-up's names: `RGE-EFR` (flat), `MGE-β-VAE (LP)`, `MGE-VAE (random)`, `RPE`.
 pub fn label(algo: &str) -> String {
     if let Some((base, tag)) = algo.split_once('@') {
-        let tag = if tag == "still" {
-            "still distractor".to_string()
-        } else {
-            tag.to_string()
+        let tag = match tag {
+            "still" => "still distractor".to_string(),
+            "capacity" => "capacity annealing".to_string(),
+            other => other.to_string(),
         };
         return format!("{}, {tag}", label(base));
     }
@@ -538,7 +543,7 @@ pub fn render(
         let mut seen = std::collections::BTreeSet::new();
         runs.iter()
             .filter(|r| r.per_latent.is_some())
-            .filter(|r| seen.insert((r.learner.clone(), r.seed)))
+            .filter(|r| seen.insert((tag(&r.algo).to_string(), r.learner.clone(), r.seed)))
             .collect()
     };
     if !learned.is_empty() {
@@ -570,7 +575,11 @@ pub fn render(
             let _ = writeln!(
                 p,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                r.learner.as_deref().map(learner_name).unwrap_or_default(),
+                match (r.learner.as_deref().map(learner_name), tag(&r.algo)) {
+                    (Some(l), "") => l,
+                    (Some(l), t) => format!("{l}, {t}"),
+                    (None, _) => String::new(),
+                },
                 r.seed,
                 r.loss_fraction.map(f2).unwrap_or_else(|| "n/a".into()),
                 r.knn_ball.map(f2).unwrap_or_else(|| "n/a".into()),
@@ -693,7 +702,7 @@ fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
         let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
             continue;
         };
-        if l != learner || !seen.insert(r.seed) {
+        if l != learner || !seen.insert((tag(&r.algo).to_string(), r.seed)) {
             continue;
         }
         n += 1;
