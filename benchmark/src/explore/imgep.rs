@@ -126,14 +126,7 @@ pub fn run_rge(
     let mut goal_rng = stream(run_seed, Component::Goals);
     let mut noise_rng = stream(run_seed, Component::Noise);
 
-    let mut h = History {
-        index: NnIndex::new(space.dim()),
-        thetas: Vec::with_capacity(cfg.epochs + 1),
-        z: vec![0.0; space.dim()],
-        initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
-        ever_moved: false,
-        env_rng: stream(run_seed, Component::Distractor),
-    };
+    let mut h = History::new(env, space.dim(), cfg.epochs + 1, run_seed);
     let mut goal = vec![0.0; space.dim()];
 
     // Warm-up episode.
@@ -160,22 +153,37 @@ pub fn run_rge(
     rec.finish()
 }
 
-/// The explorer's memory: parameters and outcome encodings, with the nearest-neighbour index.
-struct History {
-    index: NnIndex,
-    thetas: Vec<[f64; PARAMS]>,
-    z: Vec<f64>,
+/// The explorer's memory: parameters and outcome encodings, with the nearest-neighbour index
+/// (also the base of modular exploration's memory, `mge.rs`).
+pub(crate) struct History {
+    pub index: NnIndex,
+    pub thetas: Vec<[f64; PARAMS]>,
+    /// The encoding of the last stored outcome.
+    pub z: Vec<f64>,
     /// The controllable object's initial state ([`crate::env::EnvKind::metric_dims`]).
     initial: Vec<f64>,
     /// Some outcome differs from the initial state in every coordinate of the controllable
     /// object.
-    ever_moved: bool,
+    pub ever_moved: bool,
     /// The environment's own stream (ArmBalls' distractor).
     env_rng: crate::seed::Stream,
 }
 
 impl History {
-    fn store(
+    /// An empty memory for a goal space of dimension `dim`.
+    pub fn new(env: &dyn Environment, dim: usize, capacity: usize, run_seed: u64) -> Self {
+        History {
+            index: NnIndex::new(dim),
+            thetas: Vec::with_capacity(capacity),
+            z: vec![0.0; dim],
+            initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
+            ever_moved: false,
+            env_rng: stream(run_seed, Component::Distractor),
+        }
+    }
+
+    /// Run `theta`, encode and store its outcome (its encoding is then in `z`).
+    pub fn store(
         &mut self,
         env: &dyn Environment,
         space: &mut dyn OutcomeSpace,

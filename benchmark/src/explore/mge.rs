@@ -29,13 +29,13 @@ use serde::{Deserialize, Serialize};
 
 use super::ExploreConfig;
 use super::history::{ExplorationLog, InterestPoint, Metrics, Recorder};
-use super::imgep::OutcomeSpace;
+use super::imgep::{History, OutcomeSpace};
 use super::interest::{ModuleInterest, choose_module};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;
-use crate::seed::{Component, Stream, stream};
+use crate::seed::{Component, stream};
 
 /// How the goal space is split and a module chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -183,21 +183,17 @@ pub fn goal_modules(
         .collect())
 }
 
-/// The explorer's memory: parameters and outcome encodings, with one nearest-neighbour index
-/// per module (on the module's coordinates).
+/// The explorer's memory (RGE's, with the index on every coordinate) and one
+/// nearest-neighbour index per module, on the module's coordinates.
 struct Memory {
-    thetas: Vec<[f64; PARAMS]>,
+    history: History,
     indices: Vec<NnIndex>,
-    full: NnIndex,
-    z: Vec<f64>,
     part: Vec<f64>,
-    initial: Vec<f64>,
-    ever_moved: bool,
-    env_rng: Stream,
 }
 
 impl Memory {
     /// Run `theta`, store its outcome; returns the outcome's encoding.
+    #[allow(clippy::too_many_arguments)]
     fn store(
         &mut self,
         env: &dyn Environment,
@@ -208,22 +204,14 @@ impl Memory {
         epoch: usize,
         random: bool,
     ) -> &[f64] {
-        let r = env.rollout(&theta, &mut self.env_rng);
-        let s = r.outcome();
-        self.ever_moved |= s[env.kind().metric_dims()]
-            .iter()
-            .zip(&self.initial)
-            .all(|(a, b)| a != b);
-        space.encode(s, &mut self.z);
-        self.full.insert(&self.z);
+        self.history.store(env, space, rec, theta, epoch, random);
+        let z = &self.history.z;
         for (m, index) in modules.iter().zip(&mut self.indices) {
             self.part.clear();
-            self.part.extend(m.dims.iter().map(|&k| self.z[k]));
+            self.part.extend(m.dims.iter().map(|&k| z[k]));
             index.insert(&self.part);
         }
-        self.thetas.push(theta);
-        rec.push(epoch, &r, random);
-        &self.z
+        z
     }
 }
 
@@ -281,14 +269,9 @@ pub fn run_mge(
         .collect::<Result<_, _>>()?;
     let mut chosen = vec![0usize; modules.len()];
     let mut mem = Memory {
-        thetas: Vec::with_capacity(cfg.epochs + 1),
+        history: History::new(env, space.dim(), cfg.epochs + 1, run_seed),
         indices: modules.iter().map(|m| NnIndex::new(m.dims.len())).collect(),
-        full: NnIndex::new(space.dim()),
-        z: vec![0.0; space.dim()],
         part: Vec::new(),
-        initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
-        ever_moved: false,
-        env_rng: stream(run_seed, Component::Distractor),
     };
     let record_interest =
         |rec: &mut Recorder, epoch: usize, ints: &[ModuleInterest], n: &[usize]| {
@@ -312,8 +295,9 @@ pub fn run_mge(
     let mut goal = Vec::new();
     let mut epoch = 0;
     while epoch < cfg.epochs {
-        let bootstrapping =
-            !mem.ever_moved || mem.full.n_distinct() < 2 || epoch < cfg.bootstrap_epochs;
+        let bootstrapping = !mem.history.ever_moved
+            || mem.history.index.n_distinct() < 2
+            || epoch < cfg.bootstrap_epochs;
         if bootstrapping {
             epoch += 1;
             let theta = random_params(&mut params_rng);
@@ -344,9 +328,9 @@ pub fn run_mge(
                 .expect("the memory is not empty");
             let exploit = k == mge.n_explore;
             let theta = if exploit {
-                mem.thetas[j]
+                mem.history.thetas[j]
             } else {
-                perturb(&mem.thetas[j], cfg.noise_sigma, &mut noise_rng)
+                perturb(&mem.history.thetas[j], cfg.noise_sigma, &mut noise_rng)
             };
             let z = mem.store(env, space, modules, &mut rec, theta, epoch, false);
             if exploit {
