@@ -14,6 +14,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use serde_json::Value;
 
@@ -1052,64 +1053,61 @@ fn draw_lines(
         .x_label_area_size(36)
         .y_label_area_size(64);
     if log_y {
-        let mut c = chart
+        // Zero (the initial interest decays towards it, never reaching it) has no place on a
+        // log axis.
+        let positive: Vec<_> = series
+            .iter()
+            .map(|(n, c, d, pts)| {
+                (
+                    n.clone(),
+                    *c,
+                    *d,
+                    pts.iter().copied().filter(|p| p.1 > 0.0).collect(),
+                )
+            })
+            .collect();
+        let c = chart
             .build_cartesian_2d(0.0..x_max, (y_lo.max(1e-12) * 0.8..y_hi * 1.25).log_scale())?;
-        c.configure_mesh()
-            .x_desc("exploration iterations")
-            .y_desc(y_label)
-            .label_style((FONT, 12))
-            .draw()?;
-        for (name, col, d, pts) in series {
-            let pts: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.1 > 0.0).collect();
-            let style = ShapeStyle::from(col).stroke_width(2);
-            match d {
-                None => c.draw_series(LineSeries::new(pts, style))?,
-                Some((a, b)) => c.draw_series(std::iter::once(
-                    plotters::element::DashedPathElement::new(pts, *a as u32, *b as u32, style),
-                ))?,
-            }
-            .label(name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-        }
-        if let Some(pos) = legend {
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.3))
-                .label_font((FONT, 11))
-                .position(pos)
-                .draw()?;
-        }
+        plot_series(c, y_label, &positive, legend)
     } else {
-        let mut c = chart.build_cartesian_2d(0.0..x_max, 0.0..y_hi * 1.08)?;
-        c.configure_mesh()
-            .x_desc("exploration iterations")
-            .y_desc(y_label)
-            .label_style((FONT, 12))
+        let c = chart.build_cartesian_2d(0.0..x_max, 0.0..y_hi * 1.08)?;
+        plot_series(c, y_label, series, legend)
+    }
+}
+
+/// Mesh, curves (dashed where a dash is given) and legend, on a linear or logarithmic y axis.
+fn plot_series<'a, 'b: 'a, Y>(
+    mut c: ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, Y>>,
+    y_label: &str,
+    series: &[(String, RGBColor, Option<(i32, i32)>, Vec<(f64, f64)>)],
+    legend: Option<SeriesLabelPosition>,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    c.configure_mesh()
+        .x_desc("exploration iterations")
+        .y_desc(y_label)
+        .label_style((FONT, 12))
+        .draw()?;
+    for (name, col, d, pts) in series {
+        let style = ShapeStyle::from(col).stroke_width(2);
+        match d {
+            None => c.draw_series(LineSeries::new(pts.clone(), style))?,
+            Some((a, b)) => c.draw_series(std::iter::once(
+                plotters::element::DashedPathElement::new(pts.clone(), *a as u32, *b as u32, style),
+            ))?,
+        }
+        .label(name.clone())
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+    }
+    if let Some(pos) = legend {
+        c.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.3))
+            .label_font((FONT, 11))
+            .position(pos)
             .draw()?;
-        for (name, col, d, pts) in series {
-            let style = ShapeStyle::from(col).stroke_width(2);
-            match d {
-                None => c.draw_series(LineSeries::new(pts.clone(), style))?,
-                Some((a, b)) => {
-                    c.draw_series(std::iter::once(plotters::element::DashedPathElement::new(
-                        pts.clone(),
-                        *a as u32,
-                        *b as u32,
-                        style,
-                    )))?
-                }
-            }
-            .label(name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-        }
-        if let Some(pos) = legend {
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.3))
-                .label_font((FONT, 11))
-                .position(pos)
-                .draw()?;
-        }
     }
     Ok(())
 }
