@@ -1115,34 +1115,26 @@ where
 /// Ball (left) and distractor (right) exploration ratio against the iterations, mean over seeds.
 fn draw_coverage(runs: &[FollowupRun], fig_dir: &Path) -> Result<FigureFile, ReportError> {
     let path = fig_dir.join(COVERAGE_FIGURE);
-    let ball: Vec<_> = algos(runs)
-        .iter()
-        .map(|a| {
-            (
-                label(a),
-                colour(a),
-                dash(a),
-                mean_curve(&of(runs, a), |r, i| {
-                    r.ball_coverage
-                        .get(i)
-                        .map(|c| c * REACHABLE_CELLS / ALL_CELLS)
-                }),
-            )
-        })
-        .collect();
-    let distractor: Vec<_> = algos(runs)
-        .iter()
-        .map(|a| {
-            (
-                label(a),
-                colour(a),
-                dash(a),
-                mean_curve(&of(runs, a), |r, i| {
-                    r.distractor_coverage.get(i).copied().flatten()
-                }),
-            )
-        })
-        .collect();
+    // One mean curve per algorithm of the value `value(run, checkpoint)`.
+    let series = |value: &dyn Fn(&FollowupRun, usize) -> Option<f64>| -> Vec<_> {
+        algos(runs)
+            .iter()
+            .map(|a| {
+                (
+                    label(a),
+                    colour(a),
+                    dash(a),
+                    mean_curve(&of(runs, a), value),
+                )
+            })
+            .collect()
+    };
+    let ball = series(&|r, i| {
+        r.ball_coverage
+            .get(i)
+            .map(|c| c * REACHABLE_CELLS / ALL_CELLS)
+    });
+    let distractor = series(&|r, i| r.distractor_coverage.get(i).copied().flatten());
     write_svg(&path, (1100, 460), |root| {
         let (l, r) = root.split_horizontally(550);
         draw_lines(
