@@ -14,8 +14,8 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
+use ugl_bench::campaign::context::{MessageSink, TrainSink};
 use ugl_bench::campaign::plan::parse_shard;
-use ugl_bench::campaign::runner::{MessageSink, TrainSink};
 use ugl_bench::campaign::single::{self, RunRequest};
 use ugl_bench::campaign::{CampaignOptions, Progress, RunContext, RunSpec, plan, run_campaign};
 use ugl_bench::env::render::{Image70, PIXELS, write_npy, write_png};
@@ -686,6 +686,7 @@ fn single_context<'a>(
         log_dir: Some(out),
         learner_messages: Some(learner_lines(mp, None)),
         checkpoint_every: cache.checkpoint_every,
+        role: None,
     }
 }
 
@@ -820,7 +821,7 @@ fn embed(a: EmbedArgs) -> Result<()> {
     println!(
         "{}",
         serde_json::json!({
-            "representation": ugl_bench::campaign::runner::representation_label(&spec),
+            "representation": ugl_bench::campaign::fit::representation_label(&spec),
             "files": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
             "latent_quality": e.quality,
         })

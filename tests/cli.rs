@@ -320,7 +320,10 @@ fn campaign_plan_and_resume() {
         "2",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 12);
+    // Three files for each of the four runs, and the campaign's record.
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 13);
+    let record = std::fs::read_to_string(out.join("campaign.toml")).unwrap();
+    assert!(record.contains("role = \"main\""), "{record}");
     // The campaign's run equals the single run with the same seed.
     let single = dir.path().join("single");
     let prof = p(&cfg);
@@ -1645,7 +1648,7 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     let cfg = dir.path().join("armballs.toml");
     std::fs::write(
         &cfg,
-        "[campaign]\nname = \"armballs\"\nreps = 3\n[matrix]\nenvs = [\"armballs\"]\n\
+        "[campaign]\nname = \"armballs\"\nreps = 3\nrole = \"followup\"\n[matrix]\nenvs = [\"armballs\"]\n\
          algos = [\"rpe\", \"mge-efr-flat\", \"mge-efr-lp\", \"mge-pca-lp\"]\n\
          samplers = [\"kde\"]\nlatents = [4]\n[ugl]\nimages = 300\n\
          [explore]\nepochs = 400\nbootstrap_epochs = 50\n[mge]\ninterest_window = 20.0\n",

@@ -11,7 +11,7 @@
 //! defect, which it reproduces on purpose; `neural.rs` tests it).
 
 use ugl_bench::campaign::config::LearnersConfig;
-use ugl_bench::campaign::runner::make_learner;
+use ugl_bench::campaign::fit::make_learner;
 use ugl_bench::env::{EnvConfig, EnvKind, make_env};
 use ugl_bench::explore::Learner;
 use ugl_bench::repr::dataset::generate;

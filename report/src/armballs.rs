@@ -24,24 +24,25 @@ use crate::figures::{FONT, FigureFile, learner_name, write_svg};
 use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
 use crate::stats::{derive_seed, difference_of_means_ci, mean, summarize};
 
-/// The follow-up's campaign name.
-pub const CAMPAIGN: &str = "armballs";
 /// The page this section writes.
 pub const PAGE: &str = "armballs.md";
 /// Its figures.
 pub const COVERAGE_FIGURE: &str = "armballs_coverage.svg";
 pub const INTEREST_FIGURE: &str = "armballs_interest.svg";
 
-/// Whether a campaign is the follow-up's (`armballs`, `armballs-*`).
-pub fn is_followup_campaign(name: &str) -> bool {
-    name == CAMPAIGN || name.starts_with("armballs-")
-}
-
 /// Cells of the 30x30 grid over [-1, 1]^2 that meet the unit disk: the denominator of our cell
 /// coverage. The follow-up's "exploration ratio" divides the visited cells by all 900, so it is
 /// our coverage times 756 / 900 (the ball never leaves the disk).
-const REACHABLE_CELLS: f64 = 756.0;
-const ALL_CELLS: f64 = 900.0;
+/// ArmBalls' ball: the cells it can reach, of all cells of its grid (the registry's).
+fn ball_cells() -> (f64, f64) {
+    let grid = ugl_types::EnvSpec::by_name("armballs")
+        .expect("armballs is registered")
+        .klc;
+    (
+        grid.achievable_cells as f64,
+        (grid.bins as f64).powi(grid.dims as i32),
+    )
+}
 
 /// A latent "encodes" an object when the object's position explains at least this much of its
 /// variance (k-NN R²), and "ignores" it below [`IGNORES`].
@@ -74,11 +75,16 @@ pub struct FollowupRun {
     pub knn_ball: Option<f64>,
     pub knn_distractor: Option<f64>,
     pub per_latent: Option<(Vec<f64>, Vec<f64>)>,
+    /// A variant campaign's declared label (`[campaign] label`).
+    pub variant_label: Option<String>,
 }
 
 impl FollowupRun {
     fn final_ratio(&self) -> f64 {
-        self.ball_coverage.last().copied().unwrap_or(f64::NAN) * REACHABLE_CELLS / ALL_CELLS
+        {
+            let (reachable, all) = ball_cells();
+            self.ball_coverage.last().copied().unwrap_or(f64::NAN) * reachable / all
+        }
     }
 
     /// Per module: (ball R², distractor R²), the means over the module's latents.
@@ -100,11 +106,17 @@ impl FollowupRun {
     }
 }
 
-/// Reads the campaign's runs. The runs of a variant campaign `armballs-TAG` (e.g.
-/// `armballs-still`, a distractor that does not move) get the algorithm `ALGO@TAG`.
+/// Reads the campaign's runs. The runs of a variant campaign (`[campaign] variant_of`, e.g.
+/// `armballs-still`, a distractor that does not move, tag `still`) get the algorithm
+/// `ALGO@TAG`, and the label the campaign declares.
 pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
     let mut out = Vec::new();
-    let tag = campaign.name.strip_prefix("armballs-");
+    let decl = &campaign.decl;
+    let tag = decl
+        .variant_of
+        .as_ref()
+        .map(|_| decl.tag.clone().unwrap_or_else(|| campaign.name.clone()));
+    let tag = tag.as_deref();
     for run in &campaign.store.runs {
         let df = read_parquet(&run.curve_path)?;
         let c = Cols {
@@ -123,8 +135,7 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
         let epochs = c.i64s("epoch")?;
         let mut order: Vec<usize> = (0..epochs.len()).collect();
         order.sort_by_key(|&i| epochs[i]);
-        let raw = &run.manifest.raw;
-        let quality = raw.get("latent_quality");
+        let quality = run.manifest.latent_quality.as_ref();
         let group = |name: &str| {
             quality
                 .and_then(|q| q.get("groups"))
@@ -169,15 +180,16 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
             distractor_klc: order.iter().map(|&i| dklc[i]).collect(),
             modules,
             interest,
-            learner: run.manifest.text(&["learner"]),
-            loss_fraction: raw
-                .get("train")
-                .and_then(|t| t.get("evidence"))
+            learner: run.manifest.learner.clone(),
+            loss_fraction: run
+                .manifest
+                .train_field("evidence")
                 .and_then(|e| e.get("loss_fraction"))
                 .and_then(Value::as_f64),
             knn_ball: group("position"),
             knn_distractor: group("distractor"),
             per_latent,
+            variant_label: decl.label.clone(),
         });
     }
     out.sort_by(|a, b| {
@@ -266,14 +278,25 @@ fn algo_order(algo: &str) -> (String, usize, String, usize) {
     (tag, s, space.to_string(), c)
 }
 
-/// The follow-up's names: `RGE-EFR` (flat), `MGE-β-VAE (LP)`, `MGE-VAE (random)`, `RPE`.
+/// The name of `algo` among `runs`: [`label`], with a variant campaign's tag replaced by the
+/// label its campaign declares (`[campaign] label`: `still distractor`).
+fn display(runs: &[FollowupRun], algo: &str) -> String {
+    match algo.split_once('@') {
+        Some((base, tag)) => {
+            let declared = runs
+                .iter()
+                .find(|r| r.algo == algo)
+                .and_then(|r| r.variant_label.clone());
+            format!("{}, {}", label(base), declared.as_deref().unwrap_or(tag))
+        }
+        None => label(algo),
+    }
+}
+
+/// The follow-up's names: `RGE-EFR` (flat), `MGE-β-VAE (LP)`, `MGE-VAE (random)`, `RPE`; a
+/// variant's conditions (`ALGO@TAG`) keep their tag ([`display`] gives its declared label).
 pub fn label(algo: &str) -> String {
     if let Some((base, tag)) = algo.split_once('@') {
-        let tag = match tag {
-            "still" => "still distractor".to_string(),
-            "capacity" => "capacity annealing".to_string(),
-            other => other.to_string(),
-        };
         return format!("{}, {tag}", label(base));
     }
     if algo == "rpe" {
@@ -434,7 +457,7 @@ pub fn render(
         let _ = writeln!(
             p,
             "| {} | {} | {} [{}, {}] | {} | {} | {} |",
-            label(&a),
+            display(&runs, &a),
             rs.len(),
             f3(s.0),
             f3(s.1),
@@ -528,7 +551,7 @@ pub fn render(
                 let _ = writeln!(
                     p,
                     "| {} | {module} | {:.2e} | {} | {b} | {d} |",
-                    label(a),
+                    display(&runs, a),
                     mean(&interest),
                     f2(mean(&share)),
                 );
@@ -682,9 +705,9 @@ fn greater(
     Some((
         format!(
             "{} {} − {} {} = {} [{}, {}]",
-            label(b),
+            display(runs, b),
             f3(mean(&xb)),
-            label(a),
+            display(runs, a),
             f3(mean(&xa)),
             f3(d),
             f3(lo),
@@ -952,7 +975,7 @@ pub fn claims(runs: &[FollowupRun], n_boot: usize, seed: u64) -> Vec<Claim> {
                     derive_seed(seed, &format!("armballs-claim/{a}/rpe")),
                 )
                 .unwrap_or((f64::NAN, 0.0, 0.0));
-                lines.push(format!("{} {:+.3} ({v})", label(a), d));
+                lines.push(format!("{} {:+.3} ({v})", display(runs, a), d));
                 verdicts.push(v);
             }
         }
@@ -1121,7 +1144,7 @@ fn draw_coverage(runs: &[FollowupRun], fig_dir: &Path) -> Result<FigureFile, Rep
             .iter()
             .map(|a| {
                 (
-                    label(a),
+                    display(runs, a),
                     colour(a),
                     dash(a),
                     mean_curve(&of(runs, a), value),
@@ -1130,9 +1153,10 @@ fn draw_coverage(runs: &[FollowupRun], fig_dir: &Path) -> Result<FigureFile, Rep
             .collect()
     };
     let ball = series(&|r, i| {
-        r.ball_coverage
-            .get(i)
-            .map(|c| c * REACHABLE_CELLS / ALL_CELLS)
+        r.ball_coverage.get(i).map(|c| {
+            let (reachable, all) = ball_cells();
+            c * reachable / all
+        })
     });
     let distractor = series(&|r, i| r.distractor_coverage.get(i).copied().flatten());
     write_svg(&path, (1100, 460), |root| {
@@ -1212,7 +1236,7 @@ fn draw_interest(runs: &[FollowupRun], fig_dir: &Path) -> Result<Option<FigureFi
                     )
                 })
                 .collect();
-            (label(a), series)
+            (display(runs, a), series)
         })
         .collect();
     let path = fig_dir.join(INTEREST_FIGURE);
@@ -1248,7 +1272,10 @@ mod tests {
             algo: algo.into(),
             seed,
             epochs: vec![100],
-            ball_coverage: vec![ratio * ALL_CELLS / REACHABLE_CELLS],
+            ball_coverage: vec![{
+                let (reachable, all) = ball_cells();
+                ratio * all / reachable
+            }],
             ball_klc: vec![1.0],
             distractor_coverage: vec![Some(0.3)],
             distractor_klc: vec![Some(2.0)],
@@ -1259,6 +1286,7 @@ mod tests {
             knn_ball: None,
             knn_distractor: None,
             per_latent: None,
+            variant_label: algo.contains('@').then(|| "still distractor".into()),
         }
     }
 
@@ -1280,8 +1308,9 @@ mod tests {
             runs.push(run("mge-efr-lp", s, 0.30 + 0.002 * s as f64));
             runs.push(run("mge-efr-flat@still", s, 0.35 + 0.002 * s as f64));
         }
+        assert_eq!(label("mge-efr-flat@still"), "RGE-EFR (flat), still");
         assert_eq!(
-            label("mge-efr-flat@still"),
+            display(&runs, "mge-efr-flat@still"),
             "RGE-EFR (flat), still distractor"
         );
         let c = claims(&runs, 500, 0);

@@ -5,30 +5,36 @@
 //! same run id may appear in two of them (the `paper` campaign and a `budget-vae-3000` campaign
 //! share their seeds), and conditions are never merged across campaigns.
 //!
+//! What each campaign is for is declared in its TOML (`[campaign] role`, `variant_of`, `tag`,
+//! `label`) and recorded beside its runs (`campaign.toml`, [`ugl_types::CampaignRecord`]); the
+//! report reads the record and never infers a role from a directory name.
+//!
 //! - The **main** campaign ([`crate::ReportOptions::main_campaign`], default `paper`) feeds the
 //!   sections that reproduce the paper: the KL-coverage curves (its Figure 2), the outcome
 //!   scatters (Figure 3), Figure 4 (RGE-VAE with KDE vs Gaussian goals), the faithful-vs-corrected
 //!   comparison and the final table against the paper's values.
-//! - Campaigns named `budget-*` feed the training-budget sensitivity section.
-//! - Campaigns named `compare-*` (written by `ugl compare --learner NAME`) hold a new learner run
+//! - Campaigns of role `budget` feed the training-budget sensitivity section.
+//! - Campaigns of role `compare` (written by `ugl compare --learner NAME`) hold a new learner run
 //!   on the main campaign's cells and seeds: the leaderboard ranks it against the paper's
 //!   algorithms and the KL-coverage figures draw it. Their runs of the external learner are
 //!   labelled `rge-<NAME>` (the learner's name from the manifest), not `rge-external`.
-//! - Campaigns named `<main>-*` (e.g. `paper-init`, `paper-long`) rerun cells of the main
-//!   campaign with another training recipe for the neural learners, on the main campaign's run
-//!   seeds: the training-recipes section pairs each of their runs with the main run of the same
-//!   cell and seed.
-//! - Any other campaign is listed as present but not used (its runs are not even read).
+//! - Campaigns of role `recipe` with `variant_of` the main campaign (e.g. `paper-init`,
+//!   `paper-long`) rerun its cells with another training recipe for the neural learners, on its
+//!   run seeds: the training-recipes section pairs each of their runs with the main run of the
+//!   same cell and seed.
+//! - Campaigns of role `followup` feed the follow-up paper's page: the one without `variant_of`,
+//!   and the variants of it, drawn with their tag and label.
+//! - Any other campaign (another `main`, a recipe of another campaign, a store without a record)
+//!   is listed as present but not used (its runs are not even read).
 
 use std::path::{Path, PathBuf};
 
+use ugl_types::{CampaignDecl, CampaignRecord, CampaignRole};
+
 use crate::ReportError;
-use crate::load::{Store, campaign_display, scan_store};
+use crate::load::{CampaignDir, Store, campaign_display, scan_store};
 
-/// The prefix of the training-budget campaigns.
-pub const BUDGET_PREFIX: &str = "budget-";
-
-/// The prefix of the campaigns `ugl compare` writes.
+/// The prefix of the campaigns `ugl compare` writes (`compare-<learner>`).
 pub const COMPARE_PREFIX: &str = "compare-";
 
 /// A campaign that was read.
@@ -37,6 +43,8 @@ pub struct Campaign {
     /// Directory name (`""` for the store's top level).
     pub name: String,
     pub path: PathBuf,
+    /// What it declares itself to be (the default, `main`, where it has no record).
+    pub decl: CampaignDecl,
     /// Its runs; may be empty (only incomplete runs so far) for a budget campaign.
     pub store: Store,
 }
@@ -53,14 +61,15 @@ pub struct Unused {
 #[derive(Debug, Clone)]
 pub struct Campaigns {
     pub main: Campaign,
-    /// `budget-*` campaigns, sorted by name with numbers in numeric order (`budget-vae-300`
+    /// `budget` campaigns, sorted by name with numbers in numeric order (`budget-vae-300`
     /// before `budget-vae-1000`).
     pub budget: Vec<Campaign>,
-    /// `compare-*` campaigns, sorted by name, external learners relabelled `rge-<name>`.
+    /// `compare` campaigns, sorted by name, external learners relabelled `rge-<name>`.
     pub compare: Vec<Campaign>,
-    /// `<main>-*` campaigns (training-recipe variants of the main campaign), sorted by name.
+    /// `recipe` campaigns varying the main campaign, sorted by name.
     pub recipe: Vec<Campaign>,
-    /// The follow-up paper's campaigns (`armballs`, `armballs-*`), sorted by name.
+    /// The follow-up paper's campaign (the first `followup` campaign that varies no other) and
+    /// its variants, sorted by name.
     pub followup: Vec<Campaign>,
     /// Everything else, sorted by name.
     pub unused: Vec<Unused>,
@@ -105,37 +114,17 @@ pub fn natural_key(name: &str) -> Vec<(String, u128)> {
     out
 }
 
-/// Whether a campaign holds a new learner to rank (`ugl compare`).
-pub fn is_compare_campaign(name: &str) -> bool {
-    name.starts_with(COMPARE_PREFIX)
-}
-
 /// Gives the runs of the external learner their learner's name: `rge-external` becomes
 /// `rge-<learner>` (the manifest's `learner`), so that two compared programs stay apart.
 pub fn relabel_external(store: &mut Store) {
     for run in &mut store.runs {
         if run.key.algo == "rge-external"
-            && let Some(name) = run.manifest.get(&["learner"]).and_then(|v| v.as_str())
+            && let Some(name) = run.manifest.learner.as_deref()
             && !name.is_empty()
         {
             run.key.algo = format!("rge-{name}");
         }
     }
-}
-
-/// Whether a campaign is a training-recipe variant of the main campaign `main`: named
-/// `<main>-<something>`.
-pub fn is_recipe_campaign(name: &str, main: &str) -> bool {
-    !main.is_empty()
-        && name
-            .strip_prefix(main)
-            .and_then(|rest| rest.strip_prefix('-'))
-            .is_some_and(|rest| !rest.is_empty())
-}
-
-/// Whether a campaign feeds the budget-sensitivity section.
-pub fn is_budget_campaign(name: &str) -> bool {
-    name.starts_with(BUDGET_PREFIX)
 }
 
 /// Reads the main campaign `main` and the budget campaigns of the store `dir`; counts the others.
@@ -155,65 +144,60 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
             found: dirs.iter().map(|d| campaign_display(&d.name)).collect(),
         });
     };
-    let store = main_dir.load()?;
-    if store.runs.is_empty() {
+    let main_campaign = read(main_dir, record(main_dir)?.unwrap_or_default())?;
+    if main_campaign.store.runs.is_empty() {
         return Err(ReportError::NoCompleteRuns {
             dir: main_dir.path.clone(),
-            incomplete: store.incomplete.len(),
+            incomplete: main_campaign.store.incomplete.len(),
         });
     }
-    let main_campaign = Campaign {
-        name: main_dir.name.clone(),
-        path: main_dir.path.clone(),
-        store,
-    };
     let mut budget = Vec::new();
     let mut compare = Vec::new();
     let mut recipe = Vec::new();
     let mut followup = Vec::new();
     let mut unused = Vec::new();
+    let varies_main = |decl: &CampaignDecl| decl.variant_of.as_deref().is_none_or(|v| v == main);
     for d in &dirs {
         if d.name == main {
             continue;
         }
-        if is_budget_campaign(&d.name) {
-            budget.push(Campaign {
-                name: d.name.clone(),
-                path: d.path.clone(),
-                store: d.load()?,
-            });
-        } else if is_compare_campaign(&d.name) {
-            let mut store = d.load()?;
-            relabel_external(&mut store);
-            compare.push(Campaign {
-                name: d.name.clone(),
-                path: d.path.clone(),
-                store,
-            });
-        } else if crate::armballs::is_followup_campaign(&d.name) {
-            followup.push(Campaign {
-                name: d.name.clone(),
-                path: d.path.clone(),
-                store: d.load()?,
-            });
-        } else if is_recipe_campaign(&d.name, main) {
-            recipe.push(Campaign {
-                name: d.name.clone(),
-                path: d.path.clone(),
-                store: d.load()?,
-            });
-        } else {
-            unused.push(Unused {
+        let decl = record(d)?;
+        match decl.as_ref().map(|decl| decl.role) {
+            Some(CampaignRole::Budget) => budget.push(read(d, decl.unwrap_or_default())?),
+            Some(CampaignRole::Compare) if decl.as_ref().is_some_and(varies_main) => {
+                let mut c = read(d, decl.unwrap_or_default())?;
+                relabel_external(&mut c.store);
+                compare.push(c);
+            }
+            Some(CampaignRole::Recipe)
+                if decl
+                    .as_ref()
+                    .is_some_and(|decl| decl.variant_of.as_deref() == Some(main)) =>
+            {
+                recipe.push(read(d, decl.unwrap_or_default())?)
+            }
+            Some(CampaignRole::Followup) => followup.push(read(d, decl.unwrap_or_default())?),
+            _ => unused.push(Unused {
                 name: d.name.clone(),
                 complete: d.n_complete(),
                 incomplete: d.n_incomplete(),
-            });
+            }),
         }
     }
     budget.sort_by_key(|c| natural_key(&c.name));
-    // Variants (`armballs-*`) are drawn next to `armballs` only: without it they are unused.
-    if !followup.iter().any(|c| c.name == crate::armballs::CAMPAIGN) {
-        for c in followup.drain(..) {
+    // The follow-up's campaign is the first that varies no other; its variants are drawn next
+    // to it, and without it they (and any other follow-up campaign) are unused.
+    let lead = followup
+        .iter()
+        .find(|c| c.decl.variant_of.is_none())
+        .map(|c| c.name.clone());
+    let (kept, dropped): (Vec<Campaign>, Vec<Campaign>) = followup.into_iter().partition(|c| {
+        lead.as_deref()
+            .is_some_and(|lead| c.name == lead || c.decl.variant_of.as_deref() == Some(lead))
+    });
+    let followup = kept;
+    if !dropped.is_empty() {
+        for c in dropped {
             unused.push(Unused {
                 complete: c.store.runs.len(),
                 incomplete: c.store.incomplete.len(),
@@ -229,6 +213,39 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
         recipe,
         followup,
         unused,
+    })
+}
+
+impl Campaigns {
+    /// The follow-up paper's campaign and its variants, if the store has it.
+    pub fn followup_lead(&self) -> Option<(&Campaign, Vec<&Campaign>)> {
+        let lead = self.followup.iter().find(|c| c.decl.variant_of.is_none())?;
+        let variants = self
+            .followup
+            .iter()
+            .filter(|c| c.name != lead.name)
+            .collect();
+        Some((lead, variants))
+    }
+}
+
+/// The declaration a campaign directory records ([`CampaignRecord`]); None without a record.
+fn record(d: &CampaignDir) -> Result<Option<CampaignDecl>, ReportError> {
+    CampaignRecord::read(&d.path)
+        .map(|r| r.map(|r| r.decl()))
+        .map_err(|e| ReportError::Invalid {
+            path: CampaignRecord::path(&d.path),
+            problem: e.to_string(),
+        })
+}
+
+/// Reads a campaign's runs.
+fn read(d: &CampaignDir, decl: CampaignDecl) -> Result<Campaign, ReportError> {
+    Ok(Campaign {
+        name: d.name.clone(),
+        path: d.path.clone(),
+        decl,
+        store: d.load()?,
     })
 }
 
@@ -256,11 +273,5 @@ mod tests {
                 "budget-vae-10000"
             ]
         );
-        assert!(is_budget_campaign("budget-vae-300") && !is_budget_campaign("paper"));
-        assert!(is_recipe_campaign("paper-init", "paper"));
-        assert!(!is_recipe_campaign("paper", "paper"));
-        assert!(!is_recipe_campaign("paper-", "paper"));
-        assert!(!is_recipe_campaign("paperback", "paper"));
-        assert!(!is_recipe_campaign("quick-init", "paper"));
     }
 }

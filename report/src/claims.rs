@@ -236,11 +236,7 @@ pub struct Selector {
 
 /// The true dimension of an environment's outcome space (2 for ArmBall, 3 for ArmArrow).
 pub fn true_dimension(env: &str) -> Option<i64> {
-    match env {
-        "armball" => Some(2),
-        "armarrow" => Some(3),
-        _ => None,
-    }
+    ugl_types::EnvSpec::by_name(env).map(|e| e.true_latents as i64)
 }
 
 impl Selector {
@@ -802,7 +798,7 @@ pair_on = ["env"]
     /// A store with one condition per `(algo, latents, final KLC per seed)`, on ArmBall; every
     /// run's curve goes linearly from ln 756 at epoch 0 to its final value at epoch 100.
     pub(crate) fn synthetic(conds: &[(&str, i64, &[f64])]) -> (Store, Vec<ConditionSummary>) {
-        use crate::load::{CurvePoint, Manifest, Run};
+        use crate::load::{CurvePoint, Run};
         let mut runs = Vec::new();
         for (algo, latents, finals) in conds {
             for (seed, &f) in finals.iter().enumerate() {
@@ -829,9 +825,7 @@ pair_on = ["env"]
                     seed: seed as i64,
                     curve,
                     outcomes: Vec::new(),
-                    manifest: Manifest {
-                        raw: serde_json::json!({}),
-                    },
+                    manifest: crate::load::test_manifest(serde_json::json!({})),
                     curve_path: Default::default(),
                     outcomes_path: Default::default(),
                     manifest_path: Default::default(),

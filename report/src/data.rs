@@ -69,9 +69,8 @@ pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError>
         for r in runs_in_order(camp) {
             let key = key_fields(camp, r);
             let f = r.final_point();
-            let raw = &r.manifest.raw;
-            let evidence = raw.get("train").and_then(|t| t.get("evidence"));
-            let quality = raw.get("latent_quality");
+            let evidence = r.manifest.train_field("evidence");
+            let quality = r.manifest.latent_quality.as_ref();
             let _ = writeln!(
                 finals,
                 "{key},{},{},{},{},{},{},{},{},{},{},{},{},{}",

@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use crate::aggregate::ConditionSummary;
 use crate::claims::{self, Statistic};
 use crate::figures::klc_max;
-use crate::load::{Store, rank};
+use crate::load::Store;
 use crate::stats::{self, iqm, probability_of_improvement_ci, stratified_bootstrap_ci};
 
 /// A campaign's conditions with the store holding their runs.
@@ -105,7 +105,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             }
         }
     }
-    tasks.sort_by_key(|(env, l)| (rank(env, &["armball", "armarrow"]), env.clone(), -*l));
+    tasks.sort_by_key(|(env, l)| (ugl_types::EnvSpec::order(env), env.clone(), -*l));
     let alpha = 1.0 - confidence;
 
     // entry -> task -> (final values, auc values, paper value, final coverages)
@@ -166,7 +166,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             }
             if c.runs
                 .iter()
-                .any(|&i| src.store.runs[i].manifest.reduced_budget())
+                .any(|&i| src.store.runs[i].manifest.reduced_budget)
             {
                 reduced.insert(key.clone());
             }

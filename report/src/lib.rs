@@ -202,14 +202,9 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         .chain(&appendix_figs)
         .map(|f| f.path.clone())
         .collect();
-    // The follow-up paper's campaign `armballs` and its variants `armballs-*`: one page.
+    // The follow-up paper's campaign and its variants: one page.
     let mut followup = None;
-    if let Some(main) = camps.followup.iter().find(|c| c.name == armballs::CAMPAIGN) {
-        let variants: Vec<&campaigns::Campaign> = camps
-            .followup
-            .iter()
-            .filter(|c| c.name != armballs::CAMPAIGN)
-            .collect();
+    if let Some((main, variants)) = camps.followup_lead() {
         if let Some(section) =
             armballs::render(main, &variants, &fig_dir, opts.n_boot, opts.bootstrap_seed)?
         {

@@ -11,15 +11,12 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
-use serde_json::Value;
 
 use crate::ReportError;
 
-const CURVE_SUFFIX: &str = ".parquet";
-const OUTCOMES_SUFFIX: &str = ".outcomes.parquet";
 /// Modular explorations' interest per module (`armballs.rs` reads it; not a run of its own).
-pub const INTEREST_SUFFIX: &str = ".interest.parquet";
-const MANIFEST_SUFFIX: &str = ".json";
+pub use ugl_types::INTEREST_SUFFIX;
+use ugl_types::{CURVE_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX};
 
 /// A condition: everything that identifies a curve in the figures, except the seed.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -45,7 +42,7 @@ impl ConditionKey {
     /// alphabetically.
     pub fn order_key(&self) -> impl Ord + use<> {
         (
-            rank(&self.env, &["armball", "armarrow"]),
+            ugl_types::EnvSpec::order(&self.env),
             self.env.clone(),
             self.latents,
             rank(
@@ -95,108 +92,27 @@ pub struct Outcome {
     pub moved: bool,
 }
 
-/// The manifest, kept as JSON: its schema belongs to the runner. The report reads the fields
-/// it knows through [`Manifest::get`] (several spellings accepted, one level of nesting).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Manifest {
-    pub raw: Value,
-}
+/// The manifest of a run: the runner's own type (`ugl-types`), read through serde.
+pub use ugl_types::Manifest;
 
-impl Manifest {
-    /// The first of `names` found at the top level, else inside a top-level object (e.g.
-    /// `budgets.epochs`), looked up in sorted key order. Nulls count as absent.
-    pub fn get(&self, names: &[&str]) -> Option<&Value> {
-        let obj = self.raw.as_object()?;
-        for name in names {
-            if let Some(v) = obj.get(*name).filter(|v| !v.is_null()) {
-                return Some(v);
-            }
-        }
-        let mut keys: Vec<&String> = obj.keys().collect();
-        keys.sort();
-        for name in names {
-            for k in &keys {
-                if let Some(inner) = obj[k.as_str()].as_object()
-                    && let Some(v) = inner.get(*name).filter(|v| !v.is_null())
-                {
-                    return Some(v);
-                }
-            }
-        }
-        None
+/// A manifest for the report's tests: `fields` over a complete version-3 manifest of an
+/// ArmBall RPE run.
+#[cfg(test)]
+pub(crate) fn test_manifest(fields: serde_json::Value) -> Manifest {
+    let mut base = serde_json::json!({
+        "run_id": "armball.rpe.s0", "identity": "env=armball/algo=rpe/seed=0",
+        "env": "armball", "algo": "rpe", "sampler": "none", "latents": 0, "variant": "none",
+        "learner": null, "seed": 0, "run_seed": 0, "campaign": "test", "campaign_seed": 0,
+        "profile": "test", "config_hash": "", "explore": {}, "env_config": {}, "ugl": null,
+        "reduced_budget": false, "budget_note": "", "git_revision": "", "crate_versions":
+        {"results_version": 3}, "toolchain": "", "threads": 1, "wall_s": 0.0, "fit_s": null,
+        "encode_s": null, "host": "",
+        "summary": {"run": "armball.rpe.s0", "final_klc": 0.0, "n_moved": 0, "coverage": 0.0}
+    });
+    for (k, v) in fields.as_object().expect("an object of fields") {
+        base[k] = v.clone();
     }
-
-    /// A field rendered as text: strings as they are, anything else as compact JSON.
-    pub fn text(&self, names: &[&str]) -> Option<String> {
-        self.get(names).map(value_text)
-    }
-
-    pub fn number(&self, names: &[&str]) -> Option<f64> {
-        self.get(names).and_then(Value::as_f64)
-    }
-
-    pub fn flag(&self, names: &[&str]) -> bool {
-        self.get(names).and_then(Value::as_bool).unwrap_or(false)
-    }
-
-    pub fn profile(&self) -> Option<String> {
-        self.text(&["profile"])
-    }
-    pub fn git_revision(&self) -> Option<String> {
-        self.text(&["git_revision", "git_rev", "git_commit", "git"])
-    }
-    pub fn toolchain(&self) -> Option<String> {
-        self.text(&["toolchain", "rustc", "rustc_version"])
-    }
-    pub fn host(&self) -> Option<String> {
-        self.text(&["host", "hostname"])
-    }
-    /// Whether the run's neural representation left the mean-image plateau
-    /// (`train.evidence.trained`); None for other learners and older manifests.
-    pub fn trained(&self) -> Option<bool> {
-        self.raw
-            .get("train")?
-            .get("evidence")?
-            .get("trained")?
-            .as_bool()
-    }
-    /// `CPU model (SIMD level)`, from the manifest's `cpu` object.
-    pub fn cpu(&self) -> Option<String> {
-        let cpu = self.raw.get("cpu")?;
-        let model = cpu.get("model").and_then(Value::as_str)?;
-        let simd = cpu.get("simd").and_then(Value::as_str).unwrap_or("?");
-        Some(format!("{model} ({simd})"))
-    }
-    pub fn threads(&self) -> Option<String> {
-        self.text(&["threads", "n_threads", "thread_count"])
-    }
-    /// Wall time of the run, in seconds.
-    pub fn wall_time_s(&self) -> Option<f64> {
-        self.number(&["wall_time_s", "wall_s", "wall_seconds", "wall_time"])
-    }
-    /// Seconds spent fitting the run's representation (data set and training; a cache hit
-    /// records the load time). `None` for RPE and EFR, which fit nothing.
-    pub fn fit_time_s(&self) -> Option<f64> {
-        self.number(&["fit_s"])
-    }
-    /// Seconds spent encoding outcomes into the learned goal space.
-    pub fn encode_time_s(&self) -> Option<f64> {
-        self.number(&["encode_s"])
-    }
-    pub fn reduced_budget(&self) -> bool {
-        self.flag(&["reduced_budget"])
-    }
-    pub fn budget_note(&self) -> Option<String> {
-        self.text(&["budget_note"])
-    }
-}
-
-/// Strings as they are, other JSON values compactly.
-pub fn value_text(v: &Value) -> String {
-    match v {
-        Value::String(s) => s.clone(),
-        other => other.to_string(),
-    }
+    serde_json::from_value(base).expect("a complete manifest")
 }
 
 /// One complete run.
@@ -429,52 +345,30 @@ fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
     Ok(out)
 }
 
-/// Checks a run's data files against the lengths and BLAKE3 hashes its manifest records
-/// (`files`; manifests written before results version 3 have none and pass). A truncated or
-/// damaged file is an error naming it, before polars tries to parse it.
-fn verify_digests(manifest_path: &Path) -> Result<(), ReportError> {
-    let invalid = |path: &Path, problem: String| ReportError::Invalid {
-        path: path.to_path_buf(),
-        problem,
-    };
-    let Ok(text) = std::fs::read_to_string(manifest_path) else {
-        return Ok(()); // reported with its context when the manifest is read
-    };
-    let Ok(raw) = serde_json::from_str::<Value>(&text) else {
-        return Ok(());
-    };
-    let Some(files) = raw.get("files").and_then(Value::as_array) else {
-        return Ok(());
-    };
+/// Reads a run's manifest, then checks its data files against the lengths and BLAKE3 hashes it
+/// records ([`ugl_types::verify_files`]; manifests written before results version 3 have none
+/// and pass). A truncated or damaged file is an error naming it, before polars tries to parse it.
+fn read_manifest(manifest_path: &Path) -> Result<Manifest, ReportError> {
+    let text = std::fs::read_to_string(manifest_path).map_err(|source| ReportError::Io {
+        path: manifest_path.to_path_buf(),
+        source,
+    })?;
+    let manifest = Manifest::from_json(&text).map_err(|source| ReportError::Manifest {
+        path: manifest_path.to_path_buf(),
+        source,
+    })?;
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
-    for f in files {
-        let (Some(name), Some(bytes), Some(hash)) = (
-            f.get("name").and_then(Value::as_str),
-            f.get("bytes").and_then(Value::as_u64),
-            f.get("blake3").and_then(Value::as_str),
-        ) else {
-            return Err(invalid(
-                manifest_path,
-                "`files`: an entry lacks its name, bytes or blake3".into(),
-            ));
-        };
-        let path = dir.join(name);
-        let data = std::fs::read(&path).map_err(|source| ReportError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        if data.len() as u64 != bytes || blake3::hash(&data).to_hex().as_str() != hash {
-            return Err(invalid(
-                &path,
-                format!(
-                    "does not match its manifest ({} bytes, {bytes} recorded, or another hash): \
-                     truncated or damaged; resume the campaign to recompute the run",
-                    data.len()
-                ),
-            ));
-        }
-    }
-    Ok(())
+    ugl_types::verify_files(dir, &manifest).map_err(|e| match e {
+        ugl_types::DigestError::Io { path, source } => ReportError::Io { path, source },
+        e => ReportError::Invalid {
+            path: e.path().to_path_buf(),
+            problem: format!(
+                "does not match its manifest, truncated or damaged ({e}); resume the campaign \
+                 to recompute the run"
+            ),
+        },
+    })?;
+    Ok(manifest)
 }
 
 /// Reads one run from its three files.
@@ -482,7 +376,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
     let curve_path = with_suffix(stem, CURVE_SUFFIX);
     let outcomes_path = with_suffix(stem, OUTCOMES_SUFFIX);
     let manifest_path = with_suffix(stem, MANIFEST_SUFFIX);
-    verify_digests(&manifest_path)?;
+    let manifest = read_manifest(&manifest_path)?;
 
     let df = read_parquet(&curve_path)?;
     let c = Cols {
@@ -566,23 +460,8 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         })
         .collect();
 
-    let text = std::fs::read_to_string(&manifest_path).map_err(|source| ReportError::Io {
-        path: manifest_path.clone(),
-        source,
-    })?;
-    let raw: Value = serde_json::from_str(&text).map_err(|source| ReportError::Manifest {
-        path: manifest_path.clone(),
-        source,
-    })?;
-    if !raw.is_object() {
-        return Err(ReportError::Invalid {
-            path: manifest_path,
-            problem: "the manifest is not a JSON object".into(),
-        });
-    }
-
     let mut key = key;
-    reconcile_identity(&mut key, seed, &raw, &manifest_path)?;
+    reconcile_identity(&mut key, seed, &manifest, &manifest_path)?;
 
     Ok(Run {
         run_id,
@@ -591,7 +470,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         seed,
         curve,
         outcomes,
-        manifest: Manifest { raw },
+        manifest,
         curve_path,
         outcomes_path,
         manifest_path,
@@ -608,38 +487,39 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
 pub fn reconcile_identity(
     key: &mut ConditionKey,
     seed: i64,
-    manifest: &Value,
+    manifest: &Manifest,
     manifest_path: &Path,
 ) -> Result<(), ReportError> {
     let mismatch = |field: &str, curve: String, man: String| ReportError::Invalid {
         path: manifest_path.to_path_buf(),
         problem: format!("field `{field}` is `{man}` but the curve file's column holds `{curve}`"),
     };
-    for (field, value) in [
-        ("env", &key.env),
-        ("algo", &key.algo),
-        ("sampler", &key.sampler),
+    for (field, value, m) in [
+        ("env", &key.env, &manifest.env),
+        ("algo", &key.algo, &manifest.algo),
+        ("sampler", &key.sampler, &manifest.sampler),
     ] {
-        if let Some(m) = manifest.get(field).and_then(Value::as_str)
-            && m != value.as_str()
-        {
-            return Err(mismatch(field, value.clone(), m.to_string()));
+        if m != value {
+            return Err(mismatch(field, value.clone(), m.clone()));
         }
     }
-    for (field, value) in [("latents", key.latents), ("seed", seed)] {
-        if let Some(m) = manifest.get(field).and_then(Value::as_i64)
-            && m != value
-        {
+    for (field, value, m) in [
+        ("latents", key.latents, manifest.latents as i64),
+        ("seed", seed, manifest.seed as i64),
+    ] {
+        if m != value {
             return Err(mismatch(field, value.to_string(), m.to_string()));
         }
     }
-    if let Some(m) = manifest.get("variant").and_then(Value::as_str)
-        && m != key.variant
-    {
+    if manifest.variant != key.variant {
         if key.variant == "none" {
-            key.variant = m.to_string();
+            key.variant = manifest.variant.clone();
         } else {
-            return Err(mismatch("variant", key.variant.clone(), m.to_string()));
+            return Err(mismatch(
+                "variant",
+                key.variant.clone(),
+                manifest.variant.clone(),
+            ));
         }
     }
     Ok(())
@@ -840,15 +720,14 @@ mod tests {
     #[test]
     fn the_manifest_variant_replaces_a_curve_file_none() {
         let p = Path::new("m.json");
-        let m = serde_json::json!({"env": "armball", "algo": "rge-vae", "sampler": "kde",
-            "latents": 10, "seed": 3, "variant": "corrected"});
+        let m = test_manifest(serde_json::json!({"env": "armball", "algo": "rge-vae",
+            "sampler": "kde", "latents": 10, "seed": 3, "variant": "corrected"}));
         let mut k = key("none");
         reconcile_identity(&mut k, 3, &m, p).unwrap();
         assert_eq!(k.variant, "corrected");
         // Agreement, or no field, changes nothing.
         let mut k = key("corrected");
         reconcile_identity(&mut k, 3, &m, p).unwrap();
-        reconcile_identity(&mut k, 3, &serde_json::json!({}), p).unwrap();
         assert_eq!(k, key("corrected"));
         // A real disagreement is an error naming the field.
         let mut k = key("faithful");

@@ -89,7 +89,7 @@ pub struct Training {
 
 /// The `train` object of a manifest, if the run trained a neural representation.
 pub fn training(m: &Manifest) -> Option<Training> {
-    let t = m.raw.get("train")?.as_object()?;
+    let t = m.train.as_ref()?.as_object()?;
     let cfg = t.get("config").and_then(Value::as_object);
     let int = |name: &str| {
         cfg.and_then(|c| c.get(name))
@@ -131,7 +131,7 @@ pub fn training(m: &Manifest) -> Option<Training> {
 /// The neural learner of a run: the manifest's `learner`, else derived from the algorithm
 /// (`rge-vae` → `vae`); `None` for runs without a neural representation.
 pub fn learner(run: &Run) -> Option<String> {
-    if let Some(l) = run.manifest.raw.get("learner").and_then(Value::as_str)
+    if let Some(l) = run.manifest.learner.as_deref()
         && learners().contains(&l)
     {
         return Some(l.to_string());
@@ -199,9 +199,7 @@ pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
             Some(t.init.clone().unwrap_or_else(|| "paper".into())),
         );
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
-        keys.entry(l)
-            .or_default()
-            .insert(key, r.manifest.number(&["fit_s"]));
+        keys.entry(l).or_default().insert(key, r.manifest.fit_s);
     }
     for (l, ks) in keys {
         let b = by.get_mut(&l).expect("learner seen");
@@ -456,9 +454,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
         let plateau = r
             .manifest
-            .raw
-            .get("train")
-            .and_then(|t| t.get("evidence"))
+            .train_field("evidence")
             .and_then(|e| e.get("plateau_loss"))
             .and_then(|v| v.as_f64());
         groups
@@ -493,7 +489,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
         .collect();
     out.sort_by_key(|c| {
         (
-            rank(&c.env, &["armball", "armarrow"]),
+            ugl_types::EnvSpec::order(&c.env),
             c.env.clone(),
             rank(&c.learner, &learners()),
             c.learner.clone(),

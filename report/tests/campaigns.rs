@@ -3,6 +3,8 @@
 //! error, the faithful-vs-corrected paired differences, the budget section's iterations (read from
 //! the manifests), and byte-identical renders.
 
+mod common;
+
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -201,6 +203,8 @@ fn write_run(dir: &Path, s: &Spec) {
             .unwrap()
             .insert("latent_quality".into(), q);
     }
+    common::complete_manifest(&mut manifest, dir);
+    common::write_conventional_record(dir);
     std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
 }
 

@@ -6,6 +6,8 @@
 //! `UGL_REPORT_DEMO_OUT=/tmp/demo cargo test -p ugl-report --test demo -- --ignored`
 //! keeps the store and the report under that directory.
 
+mod common;
+
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -195,7 +197,7 @@ fn write_campaign(dir: &Path, conds: &[Cond], reps: i64, budget: Option<i64>) {
             write(&dir.join(format!("{id}.outcomes.parquet")), &mut odf);
             let mut manifest = serde_json::json!({
                 "run_id": id, "profile": "demo", "git_revision": "0000000", "toolchain": "rustc 1.95.0",
-                "threads": 2, "host": "demo", "wall_time_s": 600.0 + 10.0 * seed as f64,
+                "threads": 2, "host": "demo", "wall_s": 600.0 + 10.0 * seed as f64,
                 "reduced_budget": false, "variant": c.variant,
             });
             if let Some(it) = budget.or_else(|| iterations(c.algo)) {
@@ -221,6 +223,9 @@ fn write_campaign(dir: &Path, conds: &[Cond], reps: i64, budget: Option<i64>) {
                     .unwrap()
                     .insert("reduced_budget".into(), true.into());
             }
+            manifest["env"] = c.env.into();
+            common::complete_manifest(&mut manifest, &dir);
+            common::write_conventional_record(&dir);
             std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
         }
     }

@@ -2,6 +2,8 @@
 //! `data/results/README.md` exactly: 2 envs x 2 algos x 3 seeds, epochs 0, 100, ..., 500, in the
 //! main campaign `paper` (`tests/campaigns.rs` covers the other campaigns and the neural sections).
 
+mod common;
+
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -112,22 +114,23 @@ fn outcomes_frame(env: &str, algo: &str, seed: i64) -> DataFrame {
     .unwrap()
 }
 
-fn manifest(env: &str, algo: &str, seed: i64) -> String {
+fn manifest(dir: &Path, env: &str, algo: &str, seed: i64) -> String {
     let reduced = env == "armball";
-    serde_json::json!({
+    let mut m = serde_json::json!({
         "run_id": run_id(env, algo, seed),
-        "env": env, "algo": algo, "seed": seed,
+        "env": env, "algo": algo, "seed": seed, "sampler": sampler(algo),
         "profile": "test",
         "git_revision": "abc1234",
         "toolchain": "rustc 1.95.0",
         "threads": 2,
         "host": "testhost",
-        "wall_time_s": 10.0 + seed as f64,
+        "wall_s": 10.0 + seed as f64,
         "reduced_budget": reduced,
-        "budget_note": if reduced { serde_json::json!("500 epochs instead of 5000") } else { serde_json::Value::Null },
-        "final_klc": klc(env, algo, seed, 500),
-    })
-    .to_string()
+        "budget_note": if reduced { "500 epochs instead of 5000" } else { "" },
+    });
+    common::complete_manifest(&mut m, dir);
+    m["summary"]["final_klc"] = klc(env, algo, seed, 500).into();
+    m.to_string()
 }
 
 fn write_run(root: &Path, env: &str, algo: &str, seed: i64) {
@@ -142,7 +145,11 @@ fn write_run(root: &Path, env: &str, algo: &str, seed: i64) {
         &dir.join(format!("{id}.outcomes.parquet")),
         &mut outcomes_frame(env, algo, seed),
     );
-    std::fs::write(dir.join(format!("{id}.json")), manifest(env, algo, seed)).unwrap();
+    std::fs::write(
+        dir.join(format!("{id}.json")),
+        manifest(&dir, env, algo, seed),
+    )
+    .unwrap();
 }
 
 fn synthetic_store(root: &Path) {

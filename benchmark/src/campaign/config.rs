@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+use ugl_types::{CampaignDecl, CampaignRole};
 
 use crate::env::{EnvConfig, EnvKind};
 use crate::explore::{Algo, ExploreConfig, SamplerKind};
@@ -49,6 +50,33 @@ pub struct CampaignSection {
     /// Free text shown in the report.
     #[serde(default)]
     pub description: String,
+    /// What the campaign is for in the report (`main`, `budget`, `compare`, `recipe`,
+    /// `followup`; default `main`). Recorded beside the runs and in their manifests; not part
+    /// of any run's identity or config hash.
+    #[serde(default)]
+    pub role: CampaignRole,
+    /// The campaign this one is a variant of (recipe and compare campaigns: the main campaign
+    /// whose cells and seeds they share; follow-up variants: the follow-up campaign).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant_of: Option<String>,
+    /// A short name for its conditions beside the campaign it varies (`still`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tag: Option<String>,
+    /// How the report names the variant (`still distractor`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+}
+
+impl CampaignSection {
+    /// The campaign's declaration of its role.
+    pub fn decl(&self) -> CampaignDecl {
+        CampaignDecl {
+            role: self.role,
+            variant_of: self.variant_of.clone(),
+            tag: self.tag.clone(),
+            label: self.label.clone(),
+        }
+    }
 }
 
 /// The `[matrix]` section: which cells to run. Learned goal spaces (`rge-*` except `rge-efr`)

@@ -9,8 +9,9 @@
 
 use std::path::Path;
 
+use super::context::RunContext;
+use super::fit::fit_with_data;
 use super::plan::RunSpec;
-use super::runner::{RunContext, fit_with_data};
 use crate::env::render::PIXELS;
 use crate::env::{Environment, make_env};
 use crate::repr::quality::LatentQuality;

@@ -13,11 +13,10 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
-
+use super::context::RunContext;
 use super::embed::grid_images;
+use super::fit::{Representation, representation_label};
 use super::plan::RunSpec;
-use super::runner::{Representation, RunContext, representation_label};
 use super::store;
 use crate::env::make_env;
 use crate::env::render::write_png_grid;
@@ -30,29 +29,9 @@ pub const GRID: usize = 21;
 /// Held-out images reconstructed.
 pub const RECONSTRUCTIONS: usize = 8;
 /// The directory of the samples in a results store.
-pub const DIR_NAME: &str = "goal_spaces";
+pub const DIR_NAME: &str = ugl_types::GOAL_SPACE_DIR;
 
-/// The goal-space figure data of one representation.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct GoalSpaceSample {
-    /// `armball.rge-vae.faithful.l10.s0`.
-    pub representation: String,
-    pub env: String,
-    pub algo: String,
-    /// `faithful`, `corrected` or `none`.
-    pub variant: String,
-    pub latents: usize,
-    pub seed: u64,
-    /// Positions per side of the lattice.
-    pub grid: usize,
-    /// The lattice's object positions (x, y), x-major.
-    pub positions: Vec<[f64; 2]>,
-    /// Their latents, one row per position (f32: figure data).
-    pub grid_latents: Vec<Vec<f32>>,
-    /// File name (in the same directory) of the reconstruction figure, if the learner has a
-    /// decoder.
-    pub reconstructions: Option<String>,
-}
+pub use ugl_types::GoalSpaceSample;
 
 /// Whether a campaign keeps figure data for this run's representation: seed 0 of learned cells.
 pub fn wanted(spec: &RunSpec) -> bool {

@@ -7,16 +7,7 @@
 
 use std::sync::OnceLock;
 
-use serde::{Deserialize, Serialize};
-
-/// The CPU of a run.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct CpuInfo {
-    /// `model name` of /proc/cpuinfo (`unknown` where there is none).
-    pub model: String,
-    /// The SIMD level the float kernels can dispatch to ([`simd_level`]).
-    pub simd: String,
-}
+pub use ugl_types::CpuInfo;
 
 /// The CPU this process runs on (read once).
 pub fn cpu_info() -> &'static CpuInfo {

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::store::{self, StoreError};
+use ugl_types::CampaignRecord;
 
 /// Why a merge stopped.
 #[derive(Debug, Error)]
@@ -29,7 +30,7 @@ pub enum MergeError {
     Damaged {
         source_dir: PathBuf,
         run_id: String,
-        why: String,
+        why: store::DigestError,
     },
     #[error("run {run_id} exists in {into} with different {what}: refusing to overwrite")]
     Conflict {
@@ -40,6 +41,18 @@ pub enum MergeError {
     },
     #[error(transparent)]
     Store(#[from] StoreError),
+    #[error(transparent)]
+    Record(#[from] ugl_types::RecordError),
+    #[error(
+        "{} and {} record different campaigns ({} / {}): refusing to merge them",
+        source_dir.display(), into.display(), theirs, ours
+    )]
+    RecordConflict {
+        source_dir: PathBuf,
+        into: PathBuf,
+        theirs: String,
+        ours: String,
+    },
 }
 
 /// What a merge did.
@@ -68,6 +81,27 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
             .filter(|p| p.extension().is_some_and(|x| x == "json"))
             .collect();
         manifests.sort();
+        // The campaign record travels with the runs; two different records do not mix.
+        if let Some(record) = CampaignRecord::read(src)? {
+            match CampaignRecord::read(into)? {
+                Some(theirs) if theirs != record => {
+                    return Err(MergeError::RecordConflict {
+                        source_dir: src.clone(),
+                        into: into.to_path_buf(),
+                        theirs: format!("{} ({})", record.name, record.role.name()),
+                        ours: format!("{} ({})", theirs.name, theirs.role.name()),
+                    });
+                }
+                Some(_) => {}
+                None => {
+                    std::fs::create_dir_all(into).map_err(|source| MergeError::Read {
+                        path: into.to_path_buf(),
+                        source,
+                    })?;
+                    store::write_atomic(&CampaignRecord::path(into), record.to_text().as_bytes())?
+                }
+            }
+        }
         for m in manifests {
             let manifest = store::read_manifest(&m)?;
             let from = store::run_paths(src, &manifest.run_id);

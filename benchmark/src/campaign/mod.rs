@@ -2,11 +2,16 @@
 //! (DESIGN.md: `config -> plan -> runner -> store`).
 
 pub mod config;
+pub mod context;
 pub mod embed;
+pub mod error;
+pub mod execute;
+pub mod fit;
 pub mod goal_space;
 pub mod machine;
 pub mod merge;
 pub mod plan;
+pub mod provenance;
 pub mod remeasure;
 pub mod runner;
 pub mod single;
@@ -14,6 +19,9 @@ pub mod slurm;
 pub mod store;
 
 pub use config::{CampaignConfig, ConfigError};
+pub use context::RunContext;
+pub use error::RunError;
+pub use execute::{execute, explore};
 pub use plan::{RunSpec, plan};
-pub use runner::{CampaignOptions, Progress, RunContext, RunError, execute, explore, run_campaign};
+pub use runner::{CampaignOptions, Progress, run_campaign};
 pub use store::{Manifest, Summary};

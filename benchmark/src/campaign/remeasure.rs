@@ -13,11 +13,11 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 
 use super::config::CampaignConfig;
+use super::error::RunError;
+use super::fit::fit_representation;
 use super::goal_space;
 use super::plan::{RunSpec, plan, shard};
-use super::runner::{
-    CampaignOptions, RunError, campaign_context, fit_representation, for_each_group,
-};
+use super::runner::{CampaignOptions, campaign_context, for_each_group};
 use super::store::{self, Manifest};
 use crate::repr::ReprError;
 use crate::repr::quality::MEASURE_VERSION;
@@ -121,7 +121,7 @@ pub fn refresh_diagnostics(
                     store::write_manifest(out, &updated)?;
                 }
             }
-            on_measured(&super::runner::representation_label(first));
+            on_measured(&super::fit::representation_label(first));
             Ok((stale.len(), samples))
         };
         Some(refresh())

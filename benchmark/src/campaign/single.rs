@@ -250,6 +250,10 @@ pub fn compare_campaign(
     let algo = Algo::Rge(resolve_learner(&name, command, &mut cfg)?);
     let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
     cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
+    cfg.campaign.role = ugl_types::CampaignRole::Compare;
+    cfg.campaign.variant_of = Some(base.clone());
+    cfg.campaign.tag = None;
+    cfg.campaign.label = None;
     cfg.matrix.algos = vec![algo];
     if algo.learner().is_some_and(Learner::is_external) && !gaussian {
         cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);

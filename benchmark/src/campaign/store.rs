@@ -1,17 +1,21 @@
 //! The results store (`data/results/README.md` documents the schema): per run a curve parquet,
 //! an outcomes parquet and a JSON manifest, each written to a temporary file and renamed.
-//! A run is complete when its manifest exists (it is written last) and its two data files have
+//! A run is complete when its manifest exists (it is written last) and its data files have
 //! the lengths and BLAKE3 hashes the manifest records ([`Manifest::files`]; manifests written
-//! before results version 3 do not record them, and their files are taken as they are).
+//! before results version 3 do not record them, and their files are taken as they are). The
+//! types of the schema ([`Manifest`], [`RunPaths`], [`verify_files`]) are `ugl-types`', shared
+//! with the report.
 
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::plan::RunSpec;
 use crate::explore::ExplorationLog;
+pub use ugl_types::{
+    DigestError, FileDigest, Manifest, RunPaths, Summary, run_paths, verify_files,
+};
 
 /// Errors of the results store.
 #[derive(Debug, Error)]
@@ -25,209 +29,6 @@ pub enum StoreError {
     Encode { path: PathBuf, message: String },
     #[error("cannot read {path}: {message}")]
     Read { path: PathBuf, message: String },
-}
-
-/// The final numbers of a run, also printed by `ugl run` as its last line.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    pub run: String,
-    /// Final KL-coverage; JSON has no infinity, so +inf is written as the string "inf".
-    #[serde(with = "inf_as_string")]
-    pub final_klc: f64,
-    pub n_moved: usize,
-    pub coverage: f64,
-}
-
-/// Everything about a run that is not its data (DESIGN.md "Results store").
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Manifest {
-    pub run_id: String,
-    pub identity: String,
-    pub env: String,
-    pub algo: String,
-    pub sampler: String,
-    /// Latent size of a learned goal space (0 for RPE and EFR).
-    #[serde(default)]
-    pub latents: usize,
-    /// `none`, or `faithful` / `corrected` for the neural learners.
-    #[serde(default = "none_string")]
-    pub variant: String,
-    /// Name of the representation learner (the program's name for external learners).
-    #[serde(default)]
-    pub learner: Option<String>,
-    pub seed: u64,
-    /// The seed of the run's exploration streams, derived from (campaign seed,
-    /// [`super::RunSpec::exploration_identity`]).
-    pub run_seed: u64,
-    pub campaign: String,
-    pub campaign_seed: u64,
-    pub profile: String,
-    /// BLAKE3 of everything the run's results depend on.
-    pub config_hash: String,
-    /// The exploration budget and constants actually used.
-    pub explore: serde_json::Value,
-    pub env_config: serde_json::Value,
-    /// The UGL-stage settings (learned goal spaces only).
-    #[serde(default)]
-    pub ugl: Option<serde_json::Value>,
-    /// Whether the budget is below the paper's, and how.
-    pub reduced_budget: bool,
-    pub budget_note: String,
-    pub git_revision: String,
-    pub crate_versions: serde_json::Value,
-    pub toolchain: String,
-    pub threads: usize,
-    /// Seconds of exploration (excluding the representation's fit).
-    pub wall_s: f64,
-    /// Seconds to generate the UGL data set and fit the representation (shared between the
-    /// samplers of a cell in a campaign).
-    #[serde(default)]
-    pub fit_s: Option<f64>,
-    /// External learners: the fit time the program reported itself (`READY fit_s=...`),
-    /// without its start-up, imports and file I/O, which `fit_s` includes.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub learner_fit_s: Option<f64>,
-    /// Seconds spent rendering and encoding outcomes during exploration.
-    #[serde(default)]
-    pub encode_s: Option<f64>,
-    /// Training of a neural representation: configuration, loss curve, model-cache status.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub train: Option<serde_json::Value>,
-    /// The external learner program (`[learners.external]`: name, command) of an `rge-external`
-    /// run, so that the run can be reproduced from its manifest.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub external: Option<serde_json::Value>,
-    pub host: String,
-    /// The CPU model and SIMD level (absent in manifests written before it was recorded).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cpu: Option<super::machine::CpuInfo>,
-    /// Learned goal spaces: held-out R² of a linear and a k-NN map from latents to the true
-    /// object state (`repr::quality::LatentQuality`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub latent_quality: Option<serde_json::Value>,
-    pub summary: Summary,
-    /// The run's data files as written: name, length and BLAKE3 hash. A run is complete only
-    /// if its files still match (checked on resume, merge and report). Absent in manifests
-    /// written before it was recorded.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub files: Option<Vec<FileDigest>>,
-}
-
-/// A data file of a run as its manifest records it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FileDigest {
-    /// File name, in the run's directory.
-    pub name: String,
-    pub bytes: u64,
-    pub blake3: String,
-}
-
-impl FileDigest {
-    /// The digest of `bytes` written as `name`.
-    pub fn of(name: &str, bytes: &[u8]) -> FileDigest {
-        FileDigest {
-            name: name.to_string(),
-            bytes: bytes.len() as u64,
-            blake3: blake3::hash(bytes).to_hex().to_string(),
-        }
-    }
-}
-
-/// Check the data files of a run in `dir` against its manifest: each must exist with the
-/// recorded length and hash. The error says which file and how it differs. Manifests without
-/// digests (written before they were recorded) pass if the files exist.
-pub fn verify_files(dir: &Path, manifest: &Manifest) -> Result<(), String> {
-    let Some(files) = &manifest.files else {
-        let paths = run_paths(dir, &manifest.run_id);
-        return match paths.data().into_iter().find(|p| !p.is_file()) {
-            Some(p) => Err(format!("{} is missing", p.display())),
-            None => Ok(()),
-        };
-    };
-    for f in files {
-        let path = dir.join(&f.name);
-        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        if bytes.len() as u64 != f.bytes {
-            return Err(format!(
-                "{} has {} bytes, its manifest records {} (truncated or replaced)",
-                path.display(),
-                bytes.len(),
-                f.bytes
-            ));
-        }
-        if blake3::hash(&bytes).to_hex().as_str() != f.blake3 {
-            return Err(format!(
-                "{} does not match the BLAKE3 hash its manifest records (damaged)",
-                path.display()
-            ));
-        }
-    }
-    Ok(())
-}
-
-fn none_string() -> String {
-    "none".into()
-}
-
-mod inf_as_string {
-    use serde::{Deserialize, Deserializer, Serializer};
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        if v.is_infinite() && *v > 0.0 {
-            s.serialize_str("inf")
-        } else {
-            s.serialize_f64(*v)
-        }
-    }
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum V {
-            N(f64),
-            S(String),
-        }
-        match V::deserialize(d)? {
-            V::N(x) => Ok(x),
-            V::S(s) if s == "inf" => Ok(f64::INFINITY),
-            V::S(s) => Err(serde::de::Error::custom(format!(
-                "expected a number or \"inf\", got {s:?}"
-            ))),
-        }
-    }
-}
-
-/// The files of a run in a results directory.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RunPaths {
-    /// `<run_id>.parquet`: the exploration curve.
-    pub curve: PathBuf,
-    /// `<run_id>.outcomes.parquet`: every outcome.
-    pub outcomes: PathBuf,
-    /// `<run_id>.interest.parquet`: modular exploration's interest per module (only those runs).
-    pub interest: PathBuf,
-    /// `<run_id>.json`: the manifest, written last (a run is complete when it exists).
-    pub manifest: PathBuf,
-}
-
-impl RunPaths {
-    /// The data files present, in the order they are written (the manifest comes after them):
-    /// the curve, the outcomes and, for a modular exploration, the interest.
-    pub fn data(&self) -> Vec<&Path> {
-        let mut v = vec![self.curve.as_path(), self.outcomes.as_path()];
-        if self.interest.is_file() {
-            v.push(&self.interest);
-        }
-        v
-    }
-}
-
-/// Paths of a run's files in a results directory.
-pub fn run_paths(dir: &Path, run_id: &str) -> RunPaths {
-    RunPaths {
-        curve: dir.join(format!("{run_id}.parquet")),
-        outcomes: dir.join(format!("{run_id}.outcomes.parquet")),
-        interest: dir.join(format!("{run_id}.interest.parquet")),
-        manifest: dir.join(format!("{run_id}.json")),
-    }
 }
 
 /// The curve table of a run. Where the scene has an object the agent cannot control

@@ -19,9 +19,7 @@ use crate::seed::Stream;
 /// The distractor's walk is clipped to this box (CDGE `np.clip(…, -.95, 0.95)`).
 pub const DISTRACTOR_BOUND: f64 = 0.95;
 
-/// The gray level of the distractor in the rendered image (the ball is 1.0): CDGE's grayscale
-/// mode sums the RGB channels, ball (1, 1, 0) and distractor (0, 0, 1).
-pub const DISTRACTOR_GRAY: f32 = 0.5;
+pub use super::render::DISTRACTOR_GRAY;
 
 /// The ArmBalls environment.
 #[derive(Clone, Debug)]

@@ -18,6 +18,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::seed::Stream;
+pub use ugl_types::EnvSpec;
 
 pub use arm::{ArmConfig, ArmPose, JOINTS};
 pub use armarrow::ArmArrow;
@@ -43,51 +44,48 @@ impl EnvKind {
     /// Every environment.
     pub const ALL: [EnvKind; 3] = [EnvKind::ArmBall, EnvKind::ArmArrow, EnvKind::ArmBalls];
 
-    /// The name used on the command line and in results.
-    pub fn name(self) -> &'static str {
-        match self {
+    /// The environment's entry of the registry (`ugl_types::ENVIRONMENTS`): names, objects,
+    /// true latent size and KL-coverage grid are declared there, once.
+    pub fn spec(self) -> &'static EnvSpec {
+        let name = match self {
             EnvKind::ArmBall => "armball",
             EnvKind::ArmArrow => "armarrow",
             EnvKind::ArmBalls => "armballs",
-        }
+        };
+        EnvSpec::by_name(name).expect("every EnvKind has a registry entry")
+    }
+
+    /// The name used on the command line and in results.
+    pub fn name(self) -> &'static str {
+        self.spec().name
     }
 
     /// Dimension of the engineered outcome (and of the object state).
     pub fn state_dim(self) -> usize {
-        match self {
-            EnvKind::ArmBall => 2,
-            EnvKind::ArmArrow => 3,
-            EnvKind::ArmBalls => 4,
-        }
+        self.spec().state_dim
     }
 
     /// The outcome coordinates that exploration is measured on (KL-coverage, cell coverage,
     /// moves): the controllable object's. All of them except in ArmBalls, where the distractor
     /// is left out.
     pub fn metric_dims(self) -> std::ops::Range<usize> {
-        match self {
-            EnvKind::ArmBall | EnvKind::ArmArrow => 0..self.state_dim(),
-            EnvKind::ArmBalls => 0..2,
-        }
+        self.spec().metric_dims()
     }
 
     /// The outcome coordinates of an object the agent cannot control, measured the same way
     /// as a control (exploration cannot help there): ArmBalls' distractor.
     pub fn control_dims(self) -> Option<std::ops::Range<usize>> {
-        match self {
-            EnvKind::ArmBall | EnvKind::ArmArrow => None,
-            EnvKind::ArmBalls => Some(2..4),
-        }
+        self.spec().control_dims()
     }
 
     /// The objects of the scene and their outcome coordinates (the modules of modular
     /// exploration with engineered features): one object, or ArmBalls' ball and distractor.
     pub fn objects(self) -> Vec<(&'static str, std::ops::Range<usize>)> {
-        match self {
-            EnvKind::ArmBall => vec![("ball", 0..2)],
-            EnvKind::ArmArrow => vec![("arrow", 0..3)],
-            EnvKind::ArmBalls => vec![("ball", 0..2), ("distractor", 2..4)],
-        }
+        self.spec()
+            .objects
+            .iter()
+            .map(|o| (o.name, o.dims()))
+            .collect()
     }
 }
 
@@ -105,7 +103,8 @@ impl FromStr for EnvKind {
             "armarrow" => Ok(EnvKind::ArmArrow),
             "armballs" => Ok(EnvKind::ArmBalls),
             other => Err(format!(
-                "unknown environment '{other}' (expected armball, armarrow or armballs)"
+                "unknown environment '{other}' (expected {})",
+                EnvSpec::names_sentence()
             )),
         }
     }
@@ -305,6 +304,21 @@ mod tests {
             assert_eq!(k.name().parse::<EnvKind>().unwrap(), k);
         }
         assert!("armbal".parse::<EnvKind>().is_err());
+        // Every registry entry is an environment of this build, and the other way round.
+        assert_eq!(EnvKind::ALL.len(), ugl_types::ENVIRONMENTS.len());
+    }
+
+    /// The registry's KL-coverage grid is the measure's: same dimension, same achievable cells.
+    #[test]
+    fn registry_klc_grids_are_the_measures() {
+        for k in EnvKind::ALL {
+            let grid = k.spec().klc;
+            let m = crate::metrics::KlCoverage::new(grid.dims).unwrap();
+            assert_eq!(m.n_achievable(), grid.achievable_cells, "{k}");
+            assert_eq!(crate::metrics::klc::BINS, grid.bins, "{k}");
+            assert_eq!(m.max_klc(), grid.max_klc(), "{k}");
+            assert_eq!(k.metric_dims().len(), grid.dims, "{k}");
+        }
     }
 
     /// The step-by-step computation of the original, without the distance-bound shortcut.

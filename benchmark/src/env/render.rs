@@ -120,9 +120,13 @@ pub fn render_ball_into(x: f64, y: f64, out: &mut [f32]) {
     normalise(&gray, bbox, out);
 }
 
+/// The gray level of ArmBalls' distractor in the rendered image (the ball is 1.0): CDGE's
+/// grayscale mode sums the RGB channels, ball (1, 1, 0) and distractor (0, 0, 1).
+pub const DISTRACTOR_GRAY: f32 = 0.5;
+
 /// Render ArmBalls' two balls (`env::armballs`) into a caller-provided buffer of 4900 f32: the
 /// controllable ball at (x, y) white (1.0) and the distractor at (dx, dy) gray
-/// ([`super::armballs::DISTRACTOR_GRAY`], 0.5), drawn on top of it. Each ball is the ArmBall
+/// ([`DISTRACTOR_GRAY`], 0.5), drawn on top of it. Each ball is the ArmBall
 /// image of its position (same radius, same anti-aliasing, each normalised alone); the
 /// distractor's image is its coverage `a` in [0, 1], composited as `ball (1 - a) + 0.5 a`.
 /// Unlike the follow-up's gizeh renderer (RGB, 64x64, radii 5.44 / 4.8 px, per-image
@@ -133,7 +137,7 @@ pub fn render_balls_into(x: f64, y: f64, dx: f64, dy: f64, out: &mut [f32]) {
     let mut distractor = [0f32; PIXELS];
     render_ball_into(x, y, out);
     render_ball_into(dx, dy, &mut distractor);
-    let gray = super::armballs::DISTRACTOR_GRAY;
+    let gray = DISTRACTOR_GRAY;
     for (o, a) in out.iter_mut().zip(distractor) {
         *o = *o * (1.0 - a) + gray * a;
     }

@@ -17,11 +17,20 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::neural::{
-    CheckpointSpec, Engine, Model, NeuralConfig, NeuralEncoder, ResumeState, Trainer,
-};
-use super::{ImageSet, ReprError, cache};
+use super::neural_config::{Engine, Model, NeuralConfig};
+use super::neural_encoder::{self, NeuralEncoder};
+use super::trainer::{ResumeState, Trainer};
+use super::{ImageSet, ReprError};
 use crate::seed::Stream;
+
+/// Mid-training checkpoints: where, under which key, and how often.
+#[derive(Clone, Debug)]
+pub struct CheckpointSpec {
+    pub dir: PathBuf,
+    pub key: String,
+    /// Save every this many iterations (and never at the end: the model cache keeps that).
+    pub every: usize,
+}
 
 #[derive(Serialize, Deserialize)]
 struct State {
@@ -91,7 +100,7 @@ pub fn save(
         losses.to_vec(),
         [0; 32],
     );
-    let net_bytes = cache::to_bytes(&c.key, &enc);
+    let net_bytes = neural_encoder::to_bytes(&c.key, &enc);
     let net_path = dir.join("net.model");
     crate::fsio::write_atomic(&net_path, &net_bytes).map_err(|e| io("write", &net_path, e))?;
     let optim_path = dir.join(optim_file(&trainer.cfg));
@@ -175,7 +184,7 @@ fn try_load<'a>(
     if blake3::hash(&optim_bytes).to_hex().as_str() != state.optim_blake3 {
         return Err(format!("{} does not match its hash", optim_path.display()));
     }
-    let enc = cache::from_bytes(&c.key, &net_bytes)?;
+    let enc = neural_encoder::from_bytes(&c.key, &net_bytes)?;
     let word_pos: u128 = state
         .rng_word_pos
         .parse()

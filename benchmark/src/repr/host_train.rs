@@ -33,7 +33,8 @@ use rayon::prelude::*;
 
 use super::ReprError;
 use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
-use super::neural::{LatentInput, Model, NeuralConfig, Optimiser, tensor2};
+use super::neural_config::{Model, NeuralConfig};
+use super::neural_model::{LatentInput, Optimiser, tensor2};
 use crate::seed::Stream;
 
 /// A `rows x cols` matrix view on a slice, with strides (a transpose is a view with swapped

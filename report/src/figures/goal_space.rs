@@ -20,7 +20,7 @@ use super::{FONT, FigureFile, condition_name, env_name, file_safe, write_svg};
 use crate::ReportError;
 
 /// One representation's figure data, as the campaign writes it.
-pub use ugl_bench::campaign::goal_space::{DIR_NAME, GoalSpaceSample as Sample};
+pub use ugl_types::{GOAL_SPACE_DIR as DIR_NAME, GoalSpaceSample as Sample};
 
 const PANEL: u32 = 240;
 const TITLE_H: u32 = 36;
@@ -65,7 +65,7 @@ pub fn load(campaign_dir: &Path) -> Result<Vec<Sample>, ReportError> {
 
 /// The report's order of environments.
 fn env_order(env: &str) -> usize {
-    crate::load::rank(env, &["armball", "armarrow"])
+    ugl_types::EnvSpec::order(env)
 }
 
 /// The report's order of learners in a figure.

@@ -72,11 +72,7 @@ pub const ALGO_COLOURS: [RGBColor; 10] = [
 
 /// Display name of an environment.
 pub fn env_name(env: &str) -> String {
-    match env {
-        "armball" => "ArmBall".into(),
-        "armarrow" => "ArmArrow".into(),
-        other => other.to_string(),
-    }
+    ugl_types::EnvSpec::display_of(env)
 }
 
 /// Display name of an algorithm (`rge-vae` → `RGE-VAE`): `RGE-` and the registry's display
@@ -124,18 +120,14 @@ pub fn learner_name(learner: &str) -> String {
 /// The environment's true latent dimension (the paper's "complete" representation): 2 for
 /// ArmBall (ball x, y), 3 for ArmArrow (x, y, angle).
 pub fn true_latents(env: &str) -> Option<i64> {
-    match env {
-        "armball" => Some(2),
-        "armarrow" => Some(3),
-        _ => None,
-    }
+    ugl_types::EnvSpec::by_name(env).map(|e| e.true_latents as i64)
 }
 
 /// The paper's panel order for one algorithm's conditions: environments in the report's order,
 /// then the over-complete 10 latents before the true dimension (larger latents first).
 pub fn panel_order(env: &str, latents: i64) -> impl Ord + use<> {
     (
-        rank(env, &["armball", "armarrow"]),
+        ugl_types::EnvSpec::order(env),
         env.to_string(),
         std::cmp::Reverse(latents),
     )
@@ -255,11 +247,7 @@ pub fn draw_curve<'a, 'b: 'a>(
 /// The fixed KLC axis range of an environment: 0 .. ln(number of achievable cells), which is the
 /// KLC of outcomes all in one cell (PAPER-NOTES section 4). `None` for unknown environments.
 pub fn klc_max(env: &str) -> Option<f64> {
-    match env {
-        "armball" => Some(756f64.ln()),
-        "armarrow" => Some(22680f64.ln()),
-        _ => None,
-    }
+    ugl_types::EnvSpec::by_name(env).map(|e| e.klc.max_klc())
 }
 
 /// Colour and marker slot of an algorithm: its position among the known ones; unknown algorithms

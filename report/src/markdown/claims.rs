@@ -164,7 +164,7 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
     if inp.conditions.iter().any(|c| {
         c.runs
             .iter()
-            .any(|&i| inp.store.runs[i].manifest.reduced_budget())
+            .any(|&i| inp.store.runs[i].manifest.reduced_budget)
     }) {
         let _ = writeln!(
             w,

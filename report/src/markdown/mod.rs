@@ -128,11 +128,11 @@ fn fmt_epochs(e: &[i64]) -> String {
 fn compute_line(w: &mut String, runs: &[crate::load::Run]) {
     let explore: f64 = runs
         .iter()
-        .filter_map(|r| Some(r.manifest.wall_time_s()? + r.manifest.encode_time_s().unwrap_or(0.0)))
+        .filter_map(|r| Some(r.manifest.wall_s + r.manifest.encode_s.unwrap_or(0.0)))
         .sum();
     let mut fits: BTreeMap<String, f64> = BTreeMap::new();
     for r in runs {
-        if let Some(f) = r.manifest.fit_time_s() {
+        if let Some(f) = r.manifest.fit_s {
             let key = crate::neural::training(&r.manifest)
                 .and_then(|t| t.key)
                 .unwrap_or_else(|| format!("{}/{}", r.campaign, r.run_id));
@@ -194,17 +194,13 @@ pub fn render(inp: &Inputs<'_>) -> String {
     let reduced: Vec<&crate::load::Run> = used
         .iter()
         .copied()
-        .filter(|r| r.manifest.reduced_budget())
+        .filter(|r| r.manifest.reduced_budget)
         .collect();
     if !reduced.is_empty() {
         let mut notes: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         for r in &reduced {
             notes
-                .entry(
-                    r.manifest
-                        .budget_note()
-                        .unwrap_or_else(|| "(no budget note given)".into()),
-                )
+                .entry(r.manifest.budget_note.clone())
                 .or_default()
                 .insert(campaign_name(&r.campaign));
         }
@@ -288,11 +284,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
     let _ = writeln!(
         w,
         "- **Profile:** {}.",
-        distinct(runs.iter().map(|r| r.manifest.profile()))
+        distinct(runs.iter().map(|r| Some(r.manifest.profile.clone())))
     );
     let walls: Vec<f64> = runs
         .iter()
-        .filter_map(|r| r.manifest.wall_time_s())
+        .filter_map(|r| Some(r.manifest.wall_s))
         .collect();
     if walls.is_empty() {
         let _ = writeln!(w, "- **Exploration wall time:** not recorded.");
@@ -319,34 +315,37 @@ pub fn render(inp: &Inputs<'_>) -> String {
     let _ = writeln!(
         w,
         "- **Host:** {}.",
-        distinct(runs.iter().map(|r| r.manifest.host()))
+        distinct(runs.iter().map(|r| Some(r.manifest.host.clone())))
     );
     let _ = writeln!(
         w,
         "- **Results version:** {} (`RESULTS_VERSION` of the code that wrote them; a campaign \
          resumed with code of another version reruns those runs).",
-        distinct(runs.iter().map(|r| r.manifest.text(&["results_version"])))
+        distinct(
+            runs.iter()
+                .map(|r| r.manifest.results_version().map(|v| v.to_string()))
+        )
     );
     let _ = writeln!(
         w,
         "- **CPU (SIMD level):** {}. Results are bit-for-bit reproducible within one SIMD level \
          (README, Reproducibility).",
-        distinct(runs.iter().map(|r| r.manifest.cpu()))
+        distinct(runs.iter().map(|r| r.manifest.cpu_label()))
     );
     let _ = writeln!(
         w,
         "- **Threads:** {}.",
-        distinct(runs.iter().map(|r| r.manifest.threads()))
+        distinct(runs.iter().map(|r| Some(r.manifest.threads.to_string())))
     );
     let _ = writeln!(
         w,
         "- **Git revision:** {}.",
-        distinct(runs.iter().map(|r| r.manifest.git_revision()))
+        distinct(runs.iter().map(|r| Some(r.manifest.git_revision.clone())))
     );
     let _ = writeln!(
         w,
         "- **Toolchain:** {}.\n",
-        distinct(runs.iter().map(|r| r.manifest.toolchain()))
+        distinct(runs.iter().map(|r| Some(r.manifest.toolchain.clone())))
     );
 
     let _ = writeln!(
@@ -358,7 +357,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
         let ws: Vec<f64> = c
             .runs
             .iter()
-            .filter_map(|&i| runs[i].manifest.wall_time_s())
+            .filter_map(|&i| Some(runs[i].manifest.wall_s))
             .collect();
         let wall = if ws.is_empty() {
             "—".to_string()
@@ -710,7 +709,7 @@ fn reproduce(w: &mut String, inp: &Inputs<'_>) {
         let learner = c.name.trim_start_matches(crate::campaigns::COMPARE_PREFIX);
         // An external program's command, as its runs' manifests recorded it.
         let command = c.store.runs.iter().find_map(|r| {
-            let cmd = r.manifest.raw.get("external")?.get("command")?.as_str()?;
+            let cmd = r.manifest.external_command()?;
             Some(cmd.replace('\'', "'\\''"))
         });
         let _ = writeln!(

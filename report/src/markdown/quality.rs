@@ -38,8 +38,8 @@ struct Row {
 /// `state`), measure version 3 and later.
 pub fn neighbourhoods(m: &Manifest, space: &str) -> Option<(f64, f64)> {
     let all = m
-        .raw
-        .get("latent_quality")?
+        .latent_quality
+        .as_ref()?
         .get("neighbourhoods")?
         .as_array()?;
     let n = all
@@ -52,14 +52,14 @@ pub fn neighbourhoods(m: &Manifest, space: &str) -> Option<(f64, f64)> {
 }
 
 pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
-    let e = m.raw.get("train")?.get("evidence")?;
+    let e = m.train_field("evidence")?;
     Some((e.get("loss_fraction")?.as_f64()?, m.trained()?))
 }
 
 /// The (linear, k-NN) R² of a group of targets (`position`, `angle`, `angle_mod_120`) in a
 /// manifest's latent quality (measure version 2 and later).
 pub fn group_r2(m: &Manifest, group: &str) -> Option<(f64, f64)> {
-    let groups = m.raw.get("latent_quality")?.get("groups")?.as_array()?;
+    let groups = m.latent_quality.as_ref()?.get("groups")?.as_array()?;
     let g = groups
         .iter()
         .find(|g| g.get("group").and_then(|v| v.as_str()) == Some(group))?;
@@ -133,7 +133,7 @@ fn rows(inp: &Inputs<'_>) -> Vec<Row> {
                         r.angle_mod_120_knn.push(k);
                     }
                 }
-                None => r.old_measure += usize::from(m.raw.get("latent_quality").is_some()),
+                None => r.old_measure += usize::from(m.latent_quality.is_some()),
             }
             match neighbourhoods(m, "position") {
                 Some((t, c)) => {

@@ -27,7 +27,7 @@ const DEFAULT_FRACTION: f64 = 0.8;
 /// the run records no losses or no plateau, `Some(None)` when the loss never got there.
 pub fn left_plateau_at(run: &Run) -> Option<Option<i64>> {
     let t = training(&run.manifest)?;
-    let e = run.manifest.raw.get("train")?.get("evidence")?;
+    let e = run.manifest.train_field("evidence")?;
     let plateau = e.get("plateau_loss")?.as_f64()?;
     let fraction = e
         .get("untrained_fraction")
@@ -336,7 +336,7 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::load::{CurvePoint, Manifest};
+    use crate::load::CurvePoint;
     use serde_json::json;
     use std::path::PathBuf;
 
@@ -360,13 +360,11 @@ mod tests {
                 coverage: 0.0,
             }],
             outcomes: Vec::new(),
-            manifest: Manifest {
-                raw: json!({"train": {
-                    "config": {"warmup": warmup, "iterations": 1000},
-                    "evidence": {"plateau_loss": 400.0, "untrained_fraction": 0.8},
-                    "losses": losses,
-                }}),
-            },
+            manifest: crate::load::test_manifest(json!({"train": {
+                "config": {"warmup": warmup, "iterations": 1000},
+                "evidence": {"plateau_loss": 400.0, "untrained_fraction": 0.8},
+                "losses": losses,
+            }})),
             curve_path: PathBuf::new(),
             outcomes_path: PathBuf::new(),
             manifest_path: PathBuf::new(),

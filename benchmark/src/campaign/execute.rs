@@ -1,0 +1,303 @@
+//! Executing one run: environment + explorer (+ goal sampler in a learned space), then the
+//! results store.
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::config::UglConfig;
+use super::machine::{cpu_info, host_name};
+use super::plan::RunSpec;
+use super::store::{self, Manifest, Summary};
+use crate::env::{Environment, make_env};
+use crate::explore::{
+    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
+    goal_modules, run_mge, run_rge, run_rpe,
+};
+use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
+use crate::repr::{Latents, ReprError};
+use crate::seed::{Component, run_seed, stream};
+
+use super::context::RunContext;
+use super::error::RunError;
+use super::fit::{Representation, fit_representation};
+use super::provenance::git_revision;
+use ugl_types::RESULTS_VERSION;
+
+/// What an exploration produced, with its timings.
+pub struct Explored {
+    pub log: ExplorationLog,
+    /// Seconds spent rendering and encoding outcomes (learned goal spaces).
+    pub encode_s: Option<f64>,
+}
+
+/// Run the exploration of one spec (no I/O). Learned goal spaces need their representation.
+pub fn explore(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    repr: Option<&mut Representation>,
+) -> Result<Explored, RunError> {
+    let seed = run_seed(ctx.campaign_seed, &spec.exploration_identity());
+    let env = make_env(spec.env, ctx.env);
+    let env: &dyn Environment = env.as_ref();
+    let d = env.state_dim();
+    let run_err = |source| RunError::Repr {
+        run: spec.run_id(),
+        source,
+    };
+    let mge_err = |m: String| run_err(ReprError::InvalidInput(m));
+    let log = match spec.algo {
+        Algo::Rpe => run_rpe(env, ctx.explore, seed),
+        Algo::RgeEfr => run_rge(
+            env,
+            &mut EngineeredSpace::new(d),
+            &mut UniformGoals::unit(d),
+            ctx.explore,
+            seed,
+        ),
+        Algo::MgeEfr(m) => {
+            let objects = spec.env.objects();
+            let modules =
+                goal_modules(m, d, Some(&objects), &[], ctx.mge.module_size).map_err(mge_err)?;
+            let mut samplers: Vec<Box<dyn GoalSampler>> = modules
+                .iter()
+                .map(|g| Box::new(UniformGoals::unit(g.dims.len())) as Box<dyn GoalSampler>)
+                .collect();
+            run_mge(
+                env,
+                &mut EngineeredSpace::new(d),
+                &modules,
+                &mut samplers,
+                m,
+                ctx.explore,
+                ctx.mge,
+                seed,
+            )
+            .map_err(mge_err)?
+        }
+        Algo::Rge(_) | Algo::Mge(..) => {
+            let repr = repr.ok_or_else(|| {
+                run_err(ReprError::InvalidInput(
+                    "no representation was fitted".into(),
+                ))
+            })?;
+            let dim = repr.encoder.latents();
+            let modules = match spec.algo.modules() {
+                None => None,
+                Some(m) => Some(
+                    goal_modules(
+                        m,
+                        dim,
+                        None,
+                        &latent_spread(&repr.train),
+                        ctx.mge.module_size,
+                    )
+                    .map_err(mge_err)?,
+                ),
+            };
+            let mut samplers: Vec<Box<dyn GoalSampler>> = match &modules {
+                None => vec![goal_sampler(spec, repr, None).map_err(run_err)?],
+                Some(ms) => ms
+                    .iter()
+                    .map(|g| goal_sampler(spec, repr, Some(&g.dims)))
+                    .collect::<Result<_, _>>()
+                    .map_err(run_err)?,
+            };
+            repr.encoder.begin_run(stream(seed, Component::Encoding));
+            let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
+            let log = match (&modules, spec.algo.modules()) {
+                (Some(ms), Some(m)) => run_mge(
+                    env,
+                    &mut space,
+                    ms,
+                    &mut samplers,
+                    m,
+                    ctx.explore,
+                    ctx.mge,
+                    seed,
+                )
+                .map_err(mge_err)?,
+                _ => run_rge(env, &mut space, samplers[0].as_mut(), ctx.explore, seed),
+            };
+            if let Some(e) = space.error.take() {
+                return Err(run_err(e));
+            }
+            return Ok(Explored {
+                log,
+                encode_s: Some(space.encode_s),
+            });
+        }
+    };
+    Ok(Explored {
+        log,
+        encode_s: None,
+    })
+}
+
+/// The spread of each latent over the training encodings (its variance), which orders the
+/// latents into modules ([`goal_modules`]).
+fn latent_spread(train: &Latents) -> Vec<f64> {
+    let (n, d) = (train.n as f64, train.latents);
+    (0..d)
+        .map(|k| {
+            let mean = (0..train.n).map(|i| train.row(i)[k]).sum::<f64>() / n;
+            (0..train.n)
+                .map(|i| (train.row(i)[k] - mean).powi(2))
+                .sum::<f64>()
+                / n
+        })
+        .collect()
+}
+
+/// The goal sampler of a learned goal space, over every latent (`dims` None) or over one
+/// module's latents (the KDE of those latents of the training encodings; the prior's marginal).
+fn goal_sampler(
+    spec: &RunSpec,
+    repr: &Representation,
+    dims: Option<&[usize]>,
+) -> Result<Box<dyn GoalSampler>, ReprError> {
+    Ok(match spec.sampler {
+        SamplerKind::Kde => Box::new(match dims {
+            None => KdeGoals::fit(&repr.train)?,
+            Some(dims) => KdeGoals::fit(&Latents {
+                n: repr.train.n,
+                latents: dims.len(),
+                data: (0..repr.train.n)
+                    .flat_map(|i| dims.iter().map(move |&k| repr.train.row(i)[k]))
+                    .collect(),
+            })?,
+        }),
+        SamplerKind::Gaussian => match repr.encoder.prior() {
+            Some(prior) => Box::new(GaussianGoals::from_prior(&match dims {
+                None => prior,
+                Some(dims) => crate::repr::GaussianPrior {
+                    mean: dims.iter().map(|&k| prior.mean[k]).collect(),
+                    std: dims.iter().map(|&k| prior.std[k]).collect(),
+                },
+            })),
+            None => {
+                return Err(ReprError::InvalidInput(format!(
+                    "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
+                    spec.algo
+                )));
+            }
+        },
+        other => {
+            return Err(ReprError::InvalidInput(format!(
+                "sampler {other} is not for learned goal spaces"
+            )));
+        }
+    })
+}
+
+/// The summary of a finished log.
+pub fn summarize(spec: &RunSpec, log: &ExplorationLog) -> Summary {
+    let last = log.checkpoints.last().expect("at least one checkpoint");
+    Summary {
+        run: spec.run_id(),
+        final_klc: last.klc,
+        n_moved: last.n_moved,
+        coverage: last.coverage,
+    }
+}
+
+/// Execute one run and store it in `out`; returns its summary. A learned goal space is fitted
+/// first unless `repr` is given (campaigns share one fit between samplers).
+pub fn execute(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    out: &Path,
+    repr: Option<&mut Representation>,
+) -> Result<Summary, RunError> {
+    let mut own: Option<Representation> = None;
+    let repr = match (spec.algo.learner(), repr) {
+        (None, _) => None,
+        (Some(_), Some(r)) => Some(r),
+        (Some(_), None) => {
+            let fitted = fit_representation(spec, ctx).map_err(|source| RunError::Repr {
+                run: spec.run_id(),
+                source,
+            })?;
+            Some(own.insert(fitted))
+        }
+    };
+    let fit_s = repr.as_ref().map(|r| r.fit_s);
+    let learner_fit_s = repr.as_ref().and_then(|r| r.encoder.reported_fit_s());
+    let learner_name = repr.as_ref().map(|r| r.learner_name.clone());
+    let train = repr.as_ref().and_then(|r| r.training.clone());
+    let latent_quality = repr.as_ref().and_then(|r| r.quality.clone());
+    let t0 = Instant::now();
+    let explored = explore(spec, ctx, repr)?;
+    let wall_s = t0.elapsed().as_secs_f64();
+    let log = explored.log;
+    let summary = summarize(spec, &log);
+    let paper = ExploreConfig::default();
+    let mut notes = Vec::new();
+    if ctx.explore.epochs < paper.epochs {
+        notes.push(format!(
+            "{} exploration epochs instead of the paper's {}",
+            ctx.explore.epochs, paper.epochs
+        ));
+    }
+    if spec.algo.learner().is_some() && ctx.ugl.images < UglConfig::default().images {
+        notes.push(format!(
+            "{} UGL images instead of the paper's {}",
+            ctx.ugl.images,
+            UglConfig::default().images
+        ));
+    }
+    if let Some(l) = spec.algo.learner()
+        && let Ok(params) = ctx.learners.params(l)
+    {
+        notes.extend(params.deviations(spec.variant));
+    }
+    let manifest = Manifest {
+        run_id: spec.run_id(),
+        identity: spec.identity(),
+        env: spec.env.name().into(),
+        algo: spec.algo.name().into(),
+        sampler: spec.sampler.name().into(),
+        latents: spec.latents,
+        variant: spec.variant.map(|v| v.name()).unwrap_or("none").into(),
+        learner: learner_name,
+        seed: spec.seed,
+        run_seed: run_seed(ctx.campaign_seed, &spec.exploration_identity()),
+        campaign: ctx.campaign.into(),
+        role: ctx.role.clone(),
+        campaign_seed: ctx.campaign_seed,
+        profile: ctx.profile.into(),
+        config_hash: ctx.config_hash(spec),
+        explore: serde_json::to_value(ctx.explore).expect("serialisable"),
+        env_config: serde_json::to_value(ctx.env).expect("serialisable"),
+        ugl: spec
+            .algo
+            .learner()
+            .map(|_| serde_json::to_value(ctx.ugl).expect("serialisable")),
+        reduced_budget: !notes.is_empty(),
+        budget_note: notes.join("; "),
+        git_revision: git_revision().into(),
+        crate_versions: serde_json::json!({
+            "ugl-bench": env!("CARGO_PKG_VERSION"),
+            "results_version": RESULTS_VERSION,
+        }),
+        toolchain: env!("UGL_RUSTC_VERSION").into(),
+        threads: ctx.threads,
+        wall_s,
+        fit_s,
+        learner_fit_s,
+        encode_s: explored.encode_s,
+        train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
+        external: spec
+            .algo
+            .learner()
+            .is_some_and(Learner::is_external)
+            .then(|| serde_json::to_value(ctx.learners.external()).expect("serialisable")),
+        host: host_name().into(),
+        cpu: Some(cpu_info().clone()),
+        latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
+        summary: summary.clone(),
+        // Filled in by `write_run` from the bytes it writes.
+        files: None,
+    };
+    store::write_run(out, spec, &log, &manifest)?;
+    Ok(summary)
+}

@@ -1,0 +1,288 @@
+//! Fitting a run's representation: the UGL data set, the learner, the model cache and the
+//! training evidence and latent quality recorded in the manifest.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::config::LearnersConfig;
+use super::plan::RunSpec;
+use crate::env::{Environment, make_env};
+use crate::explore::Learner;
+use crate::repr::cache::{CacheEntry, ModelCache};
+use crate::repr::dataset::{dataset_identity, generate};
+use crate::repr::evidence::TrainingEvidence;
+use crate::repr::external::LineSink;
+use crate::repr::neural::{self, TrainProgress, Variant};
+use crate::repr::quality::{self, LatentQuality};
+use crate::repr::{Encoder, FitContext, ImageSet, Latents, ReprError, RepresentationLearner};
+use crate::seed::{Component, run_seed, stream};
+
+use super::context::RunContext;
+use ugl_types::RESULTS_VERSION;
+
+/// A fitted representation, shared by the runs that use it (every sampler of a cell).
+pub struct Representation {
+    pub encoder: Box<dyn Encoder>,
+    /// Encodings of the training images (the KDE is fitted on them).
+    pub train: Latents,
+    /// Seconds to generate the data set and fit.
+    pub fit_s: f64,
+    /// Name of the learner (the external program's configured name for `external`).
+    pub learner_name: String,
+    /// Training details of a neural representation.
+    pub training: Option<TrainInfo>,
+    /// How well the true object state can be read off the latents (None if it could not be
+    /// measured; the reason is logged).
+    pub quality: Option<LatentQuality>,
+}
+
+/// Held-out images of the latent-quality measure.
+pub const QUALITY_HELDOUT: usize = 1000;
+
+/// Measure the latent quality of a fitted encoder (measure version
+/// [`quality::MEASURE_VERSION`]): regressions fitted on the encodings of every training image,
+/// scored on [`QUALITY_HELDOUT`] fresh images from the data set's held-out stream. A stochastic
+/// encoder draws its noise from that stream too, and every run resets it
+/// ([`Encoder::begin_run`]), so this changes no run's results.
+pub fn measure_quality(
+    encoder: &mut dyn Encoder,
+    env: &dyn Environment,
+    data: &crate::repr::dataset::UglDataset,
+    ds_seed: u64,
+) -> Result<LatentQuality, ReprError> {
+    let d = env.state_dim();
+    let mut rng = stream(ds_seed, Component::HeldOut);
+    let heldout = generate(env, QUALITY_HELDOUT, &mut rng)?;
+    encoder.begin_run(rng);
+    let z_train = encoder.encode(&data.images)?;
+    let z_heldout = encoder.encode(&heldout.images)?;
+    let (y_train, names) = quality::targets(&data.states, d);
+    let (y_heldout, _) = quality::targets(&heldout.states, d);
+    let mut q = quality::latent_quality(&z_train, &y_train, &z_heldout, &y_heldout, names)?;
+    let objects = env.kind().objects();
+    if objects.len() > 1 {
+        q.per_latent = quality::per_latent_r2(
+            &data.states,
+            &z_train,
+            &heldout.states,
+            &z_heldout,
+            d,
+            &objects,
+        );
+    }
+    Ok(q)
+}
+
+/// How a trained network was obtained, recorded in the manifests of its runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrainInfo {
+    /// The complete training configuration (the learner's parameters, resolved).
+    pub config: serde_json::Value,
+    /// The recorded loss curve, `(iteration, mini-batch loss)`.
+    pub losses: Vec<(usize, f64)>,
+    /// `hit` (loaded from the model cache), `miss` (trained and stored), `rebuilt` (a cache
+    /// file was invalid: trained again and overwritten) or `off` (no cache).
+    pub cache: &'static str,
+    /// The cache key (BLAKE3 of everything the model depends on).
+    pub key: String,
+    /// The reconstruction loss against the mean-image loss (the plateau) of the first training
+    /// images, and whether the network left it ([`TrainingEvidence`]).
+    pub evidence: TrainingEvidence,
+}
+
+/// Build the learner of an algorithm from its checked `[learners.NAME]` parameters (the
+/// registry's entry parses them); `variant` is used by the learners that have variants.
+pub fn make_learner(
+    learner: Learner,
+    cfg: &LearnersConfig,
+    variant: Option<Variant>,
+) -> Result<Box<dyn RepresentationLearner>, ReprError> {
+    Ok(cfg
+        .params(learner)
+        .map_err(ReprError::InvalidInput)?
+        .build(variant))
+}
+
+/// The model-cache key of a representation: BLAKE3 of everything it depends on (the
+/// environment and its constants, learner, variant, latents, data-set size and seed, learner
+/// seed, the learner's parameters (`identity`, [`crate::repr::registry::LearnerParams`]),
+/// backend, and the cache and results versions).
+pub fn model_key(spec: &RunSpec, ctx: &RunContext, identity: &serde_json::Value) -> String {
+    let images = ctx.ugl.images;
+    let input = serde_json::json!({
+        "cache_format": crate::repr::cache::FORMAT_VERSION,
+        "results_version": RESULTS_VERSION,
+        "env": spec.env.name(),
+        "env_config": ctx.env,
+        "learner": spec.algo.learner().map(|l| l.name()),
+        "variant": spec.variant.map(|v| v.name()),
+        "latents": spec.latents,
+        "images": images,
+        "dataset_seed": run_seed(ctx.campaign_seed, &dataset_identity(spec.env, images, spec.seed)),
+        "learner_seed": spec.learner_seed_identity(images).map(|id| run_seed(ctx.campaign_seed, &id)),
+        "config": identity,
+        "backend": neural::BACKEND,
+    });
+    let json = serde_json::to_vec(&input).expect("key serialises");
+    blake3::hash(&json).to_hex().to_string()
+}
+
+/// What the harness offers the fit of `spec`'s representation: progress bars and messages
+/// under its label, checkpoints in the model cache under `key`, the training's threads.
+fn fit_context(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    key: &str,
+    cache: Option<&ModelCache>,
+) -> FitContext {
+    let label = representation_label(spec);
+    FitContext {
+        progress: ctx.train_progress.as_ref().map(|sink| {
+            let (sink, label) = (sink.clone(), label.clone());
+            Arc::new(move |p: TrainProgress| sink(&label, p)) as neural::ProgressFn
+        }),
+        checkpoint: cache
+            .filter(|_| ctx.checkpoint_every > 0)
+            .map(|c| neural::CheckpointSpec {
+                dir: c.dir.clone(),
+                key: key.to_string(),
+                every: ctx.checkpoint_every,
+            }),
+        threads: ctx.train_threads,
+        // An external program's stderr: a log file beside the runs, and its lines to the caller.
+        log_file: ctx.log_dir.map(|d| d.join(format!("{label}.learner.log"))),
+        messages: ctx.learner_messages.as_ref().map(|sink| {
+            let (sink, label) = (sink.clone(), label.clone());
+            LineSink(Arc::new(move |line| sink(&label, Some(line))))
+        }),
+    }
+}
+
+/// Fit `spec`'s representation on `images`, or load it from the model cache (learners whose
+/// encoders persist): the one fit path of every learner. Returns the encoder, the training
+/// latents, for a trained network how it was obtained, and the learner's name in results (an
+/// external program's configured name).
+fn fit_or_load(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    learner: Learner,
+    images: &ImageSet,
+    rng: &mut crate::seed::Stream,
+) -> Result<(Box<dyn Encoder>, Latents, Option<TrainInfo>, String), ReprError> {
+    let params = ctx
+        .learners
+        .params(learner)
+        .map_err(ReprError::InvalidInput)?;
+    let identity = params.identity(spec.variant);
+    let fitter = params.build(spec.variant);
+    let key = model_key(spec, ctx, &identity);
+    let cache = ctx.cache.filter(|_| fitter.persists());
+    let mut status = "off";
+    let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
+        Some(CacheEntry::Hit(enc)) => {
+            status = "hit";
+            Some(enc)
+        }
+        Some(CacheEntry::Invalid(why)) => {
+            tracing::warn!("model cache: ignoring an invalid file ({why}); fitting again");
+            status = "rebuilt";
+            None
+        }
+        Some(CacheEntry::Miss) => {
+            status = "miss";
+            None
+        }
+        None => None,
+    };
+    let (encoder, z) = match cached {
+        Some(mut enc) => {
+            let z = enc.training_latents(images)?;
+            (enc, z)
+        }
+        None => {
+            if let Some(c) = cache {
+                c.check_writable()?;
+            }
+            let fit_ctx = fit_context(spec, ctx, &key, cache);
+            let fitted = fitter.fit_in(images, spec.latents, rng, &fit_ctx);
+            if let Some(sink) = &ctx.learner_messages {
+                sink(&representation_label(spec), None);
+            }
+            let (enc, z) = fitted?;
+            if let Some(c) = cache
+                && let Some(bytes) = enc.save(&key)
+            {
+                c.store(&key, &bytes)?;
+            }
+            (enc, z)
+        }
+    };
+    let info = encoder.training_record(images).map(|r| TrainInfo {
+        config: identity,
+        losses: r.losses,
+        cache: status,
+        key,
+        evidence: r.evidence,
+    });
+    Ok((encoder, z, info, fitter.name().to_string()))
+}
+
+/// A short label of a run's representation, for progress bars and messages:
+/// `armball.rge-vae.faithful.l10.s0`.
+pub fn representation_label(spec: &RunSpec) -> String {
+    let v = spec.variant.map(|v| format!(".{v}")).unwrap_or_default();
+    format!(
+        "{}.{}{v}.l{}.s{}",
+        spec.env, spec.algo, spec.latents, spec.seed
+    )
+}
+
+/// Generate the UGL data set of the spec's repetition and fit its learner.
+pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representation, ReprError> {
+    fit_with_data(spec, ctx).map(|(r, _, _)| r)
+}
+
+/// [`fit_representation`], also returning the UGL data set it was fitted on and its seed.
+pub fn fit_with_data(
+    spec: &RunSpec,
+    ctx: &RunContext,
+) -> Result<(Representation, crate::repr::dataset::UglDataset, u64), ReprError> {
+    let learner = spec.algo.learner().ok_or_else(|| {
+        ReprError::InvalidInput(format!("{} learns no representation", spec.algo))
+    })?;
+    let t0 = Instant::now();
+    let env = make_env(spec.env, ctx.env);
+    let ds_seed = run_seed(
+        ctx.campaign_seed,
+        &dataset_identity(spec.env, ctx.ugl.images, spec.seed),
+    );
+    let data = generate(
+        env.as_ref(),
+        ctx.ugl.images,
+        &mut stream(ds_seed, Component::Dataset),
+    )?;
+    let seed_id = spec
+        .learner_seed_identity(ctx.ugl.images)
+        .expect("learned algorithm");
+    let mut rng = stream(run_seed(ctx.campaign_seed, &seed_id), Component::Learner);
+    let (mut encoder, train, info, learner_name) =
+        fit_or_load(spec, ctx, learner, &data.images, &mut rng)?;
+    let quality = match measure_quality(encoder.as_mut(), env.as_ref(), &data, ds_seed) {
+        Ok(q) => Some(q),
+        Err(e) => {
+            tracing::warn!("{}: latent quality not measured: {e}", spec.run_id());
+            None
+        }
+    };
+    let repr = Representation {
+        encoder,
+        train,
+        fit_s: t0.elapsed().as_secs_f64(),
+        learner_name,
+        training: info,
+        quality,
+    };
+    Ok((repr, data, ds_seed))
+}

@@ -1,0 +1,236 @@
+//! The configuration of a dense neural learner: which model, which engine, and the training
+//! recipe (`[learners.ae|vae|rfvae|bvae]`), with the paper's values.
+
+use burn::tensor::Device;
+use serde::{Deserialize, Serialize};
+
+use super::ReprError;
+use super::nets::Init;
+use super::neural_model::{NeuralModel, Variant};
+use crate::repr::{ae, bvae, rfvae, vae};
+
+/// The backend neural training runs on (part of the model-cache key, so models trained on
+/// another backend are never mixed up).
+#[cfg(not(feature = "cuda"))]
+pub const BACKEND: &str = "burn-0.22.1/flex/f32";
+
+/// The backend neural training runs on (part of the model-cache key).
+#[cfg(feature = "cuda")]
+pub const BACKEND: &str = "burn-0.22.1/cuda/f32";
+
+/// The device of training: burn's `flex` CPU backend (bit-for-bit deterministic for a seed and
+/// any thread count), or with the `cuda` cargo feature the first CUDA GPU (for the paper's
+/// budgets; not deterministic across GPU models, not built or tested by CI).
+pub fn training_device() -> Device {
+    #[cfg(feature = "cuda")]
+    {
+        Device::cuda(0).autodiff()
+    }
+    #[cfg(not(feature = "cuda"))]
+    {
+        Device::flex().autodiff()
+    }
+}
+
+/// What runs the training iterations (`engine` in `[learners.ae|vae|rfvae]`). Both train the
+/// same networks with the same stream draws, loss and update rules; they differ in summation
+/// order (so in the last bits) and in speed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Hand-written forward and backward passes on the `gemm` crate, with the sparse first
+    /// layer ([`super::host_train`]): the default, 2-3x faster than `burn` on CPU.
+    #[default]
+    Host,
+    /// burn's autodiff on [`training_device`] (`flex`, or CUDA with the `cuda` feature).
+    Burn,
+}
+
+impl Engine {
+    /// Every engine.
+    pub const ALL: [Engine; 2] = [Engine::Host, Engine::Burn];
+
+    /// The name in TOML files and manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Host => "host",
+            Engine::Burn => "burn",
+        }
+    }
+
+    /// The engine of manifests written before it was configurable (results versions 1 and 2).
+    fn before_v3() -> Engine {
+        Engine::Burn
+    }
+}
+
+/// Which network.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Model {
+    /// Dense auto-encoder, sigmoid latents, Adagrad.
+    Ae,
+    /// Dense VAE, Adam.
+    Vae,
+    /// Dense VAE with 10 amortised radial flows, KL warm-up, Adam.
+    Rfvae,
+    /// Dense β-VAE (the follow-up paper's learner), Adam.
+    Bvae,
+}
+
+impl Model {
+    /// All of them.
+    pub const ALL: [Model; 4] = [Model::Ae, Model::Vae, Model::Rfvae, Model::Bvae];
+
+    /// What the model is: the one place a model's identity maps to its code.
+    pub fn spec(self) -> &'static dyn NeuralModel {
+        match self {
+            Model::Ae => &ae::Ae,
+            Model::Vae => &vae::Vae,
+            Model::Rfvae => &rfvae::Rfvae,
+            Model::Bvae => &bvae::Bvae,
+        }
+    }
+
+    /// `ae`, `vae`, `rfvae`, `bvae`.
+    pub fn name(self) -> &'static str {
+        self.spec().name()
+    }
+
+    /// The widths of the encoder's head blocks for `latents` dimensions.
+    pub fn head_blocks(self, latents: usize) -> Vec<usize> {
+        self.spec().head_blocks(latents)
+    }
+
+    /// The paper's training length (the original's `fit`: AE 2e5, VAE 1e5, RFVAE 5e4).
+    pub fn paper_iterations(self) -> usize {
+        self.spec().paper_iterations()
+    }
+}
+
+/// Training configuration of a neural learner. Every field is required in serde form (it is the
+/// complete, hashable description of a training run); [`NeuralSection`] is the partial form for
+/// configuration files, with the paper's values per model as defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeuralConfig {
+    /// Optimiser steps.
+    pub iterations: usize,
+    /// Hidden sizes `[H1, H2]` (paper: 1200, 1200).
+    pub hidden: [usize; 2],
+    /// Mini-batch size (paper: 100; capped at the training set size).
+    pub batch: usize,
+    /// Learning rate (paper: 1e-3).
+    pub lr: f64,
+    /// Faithful or corrected.
+    pub variant: Variant,
+    /// Record the loss every this many iterations (the original logged every 100).
+    pub log_every: usize,
+    /// RFVAE only: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000
+    /// of 50,000); ignored by the AE and VAE.
+    pub warmup: usize,
+    /// How the weights are drawn (paper: truncated normal, std 0.001). Absent in manifests
+    /// written before it was configurable, which all used the paper's.
+    #[serde(default)]
+    pub init: Init,
+    /// What runs the iterations. Absent in manifests written before it was configurable, which
+    /// all trained on burn.
+    #[serde(default = "Engine::before_v3")]
+    pub engine: Engine,
+    /// β-VAE only: the weight of the KL term (absent for the other models, which weigh it by
+    /// 1, so their configurations and hashes are what they were before the β-VAE existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// β-VAE only: Burgess et al.'s capacity annealing (the follow-up's objective): the KL term
+    /// becomes `β |mean_b KL_b − C|`, C rising linearly from 0 to `capacity` nats over the
+    /// training. Absent: the plain β-VAE (and every other model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
+}
+
+impl NeuralConfig {
+    /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
+    pub fn capacity_at(&self, step: usize) -> Option<f64> {
+        self.capacity
+            .map(|c| c * (step as f64 / self.iterations as f64).min(1.0))
+    }
+
+    /// The paper's configuration of `model`, faithful variant.
+    pub fn paper(model: Model) -> NeuralConfig {
+        NeuralConfig {
+            iterations: model.paper_iterations(),
+            hidden: [1200, 1200],
+            batch: 100,
+            lr: 1e-3,
+            variant: Variant::Faithful,
+            log_every: 100,
+            warmup: model.spec().paper_warmup(),
+            beta: model.spec().default_beta(),
+            capacity: None,
+            init: Init::Paper,
+            engine: Engine::Host,
+        }
+    }
+
+    /// Check every value for `model`; the message names the key.
+    pub fn validate(&self, model: Model, who: &str) -> Result<(), ReprError> {
+        let bad = |msg: String| {
+            Err(ReprError::InvalidInput(if who.is_empty() {
+                msg
+            } else {
+                format!("{who}: {msg}")
+            }))
+        };
+        if self.iterations == 0 {
+            return bad("iterations must be at least 1".into());
+        }
+        if self.batch == 0 {
+            return bad("batch must be at least 1".into());
+        }
+        if self.hidden.contains(&0) {
+            return bad(format!(
+                "hidden sizes must be at least 1, got {:?}",
+                self.hidden
+            ));
+        }
+        if let Err(m) = crate::limits::check_hidden("hidden", self.hidden) {
+            return bad(m);
+        }
+        if !(self.lr.is_finite() && self.lr > 0.0) {
+            return bad(format!("lr must be positive and finite, got {}", self.lr));
+        }
+        if self.log_every == 0 {
+            return bad("log_every must be at least 1".into());
+        }
+        if let Some(b) = self.beta
+            && !(b.is_finite() && b > 0.0 && b <= 1e6)
+        {
+            return bad(format!("beta must be positive and at most 1e6, got {b}"));
+        }
+        if let Some(c) = self.capacity
+            && !(c.is_finite() && (0.0..=1e4).contains(&c))
+        {
+            return bad(format!("capacity must be between 0 and 1e4 nats, got {c}"));
+        }
+        if model.spec().paper_warmup() > 0 && self.warmup == 0 {
+            return bad("warmup must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+impl std::fmt::Display for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Variant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Variant::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| format!("unknown variant '{s}' (expected faithful or corrected)"))
+    }
+}

@@ -1,0 +1,174 @@
+//! What a campaign is for. Each campaign TOML declares it (`[campaign] role`, and for a variant
+//! what it varies and how the report labels it); `ugl campaign` records the declaration beside
+//! the runs ([`RECORD_FILE`]) and in every manifest, and the report reads it from there. Nothing
+//! infers a role from a directory name.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// The campaign record's file name in a campaign's results directory.
+pub const RECORD_FILE: &str = "campaign.toml";
+
+/// The role of a campaign in the report.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum CampaignRole {
+    /// A matrix that stands on its own: the report's main campaign is one (`--main`).
+    #[default]
+    Main,
+    /// A training-budget variant of the neural learners (the budget-sensitivity section).
+    Budget,
+    /// A new learner on the main campaign's cells and seeds (`ugl compare`; the leaderboard).
+    Compare,
+    /// A training-recipe variant of the main campaign, on its run seeds (paired with it).
+    Recipe,
+    /// The follow-up paper's setting (ArmBalls, modular goal exploration).
+    Followup,
+}
+
+impl CampaignRole {
+    pub const ALL: [CampaignRole; 5] = [
+        CampaignRole::Main,
+        CampaignRole::Budget,
+        CampaignRole::Compare,
+        CampaignRole::Recipe,
+        CampaignRole::Followup,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            CampaignRole::Main => "main",
+            CampaignRole::Budget => "budget",
+            CampaignRole::Compare => "compare",
+            CampaignRole::Recipe => "recipe",
+            CampaignRole::Followup => "followup",
+        }
+    }
+}
+
+/// A campaign's declaration of what it is (the role keys of its `[campaign]` table).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignDecl {
+    #[serde(default)]
+    pub role: CampaignRole,
+    /// The campaign it is a variant of (a recipe or compare campaign: the main campaign whose
+    /// cells and seeds it shares; a follow-up variant: the follow-up campaign it is drawn with).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant_of: Option<String>,
+    /// A short name for its conditions beside those of the campaign it varies (`still`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tag: Option<String>,
+    /// How the report names the variant in prose and legends (`still distractor`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+}
+
+/// The record of a campaign in its results directory ([`RECORD_FILE`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignRecord {
+    /// The campaign's name (`[campaign] name`).
+    pub name: String,
+    pub role: CampaignRole,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant_of: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tag: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+}
+
+/// Errors reading or writing a campaign record.
+#[derive(Debug, Error)]
+pub enum RecordError {
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a campaign record: {message}", path.display())]
+    Parse { path: PathBuf, message: String },
+}
+
+impl CampaignRecord {
+    /// The record of the campaign `name` declared as `decl`.
+    pub fn new(name: &str, decl: &CampaignDecl) -> CampaignRecord {
+        CampaignRecord {
+            name: name.to_string(),
+            role: decl.role,
+            variant_of: decl.variant_of.clone(),
+            tag: decl.tag.clone(),
+            label: decl.label.clone(),
+        }
+    }
+
+    /// The declaration it records.
+    pub fn decl(&self) -> CampaignDecl {
+        CampaignDecl {
+            role: self.role,
+            variant_of: self.variant_of.clone(),
+            tag: self.tag.clone(),
+            label: self.label.clone(),
+        }
+    }
+
+    /// The record file of the campaign directory `dir`.
+    pub fn path(dir: &Path) -> PathBuf {
+        dir.join(RECORD_FILE)
+    }
+
+    /// The record of `dir`; `Ok(None)` where there is none (a store written before records).
+    pub fn read(dir: &Path) -> Result<Option<CampaignRecord>, RecordError> {
+        let path = CampaignRecord::path(dir);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(source) => return Err(RecordError::Io { path, source }),
+        };
+        toml::from_str(&text)
+            .map(Some)
+            .map_err(|e| RecordError::Parse {
+                path,
+                message: e.message().to_string(),
+            })
+    }
+
+    /// The record's text: a comment line, then the TOML.
+    pub fn to_text(&self) -> String {
+        let body = toml::to_string(self).expect("a campaign record serialises");
+        format!(
+            "# What this campaign is, from the [campaign] table of its TOML (written by `ugl campaign`).\n{body}"
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_record_round_trips_and_rejects_unknown_roles() {
+        let decl = CampaignDecl {
+            role: CampaignRole::Followup,
+            variant_of: Some("armballs".into()),
+            tag: Some("still".into()),
+            label: Some("still distractor".into()),
+        };
+        let r = CampaignRecord::new("armballs-still", &decl);
+        assert_eq!(r.decl(), decl);
+        let text = r.to_text();
+        assert_eq!(toml::from_str::<CampaignRecord>(&text).unwrap(), r);
+        assert!(text.contains("role = \"followup\""), "{text}");
+        let bad = text.replace("followup", "sequel");
+        assert!(toml::from_str::<CampaignRecord>(&bad).is_err());
+        for role in CampaignRole::ALL {
+            let t = format!("name = \"x\"\nrole = \"{}\"\n", role.name());
+            assert_eq!(toml::from_str::<CampaignRecord>(&t).unwrap().role, role);
+        }
+    }
+}

@@ -1,0 +1,32 @@
+//! ugl-types: what the runner (`ugl-bench`) writes and the report (`ugl-report`) reads, declared
+//! once, with no dependency on the numeric stack (burn, faer, gemm, polars).
+//!
+//! - [`Manifest`]: the typed, versioned manifest of a run (older results versions read through
+//!   serde defaults), with its [`Summary`] and the [`FileDigest`]s of its data files;
+//! - [`RunPaths`]: the files of a run in a results directory, and [`verify_files`], the one
+//!   check of those files against their manifest;
+//! - [`EnvSpec`]: the environment registry (names, objects, true latent size, KL-coverage grid);
+//! - [`CampaignRole`] and [`CampaignRecord`]: what a campaign is for, declared in its TOML and
+//!   recorded beside its runs, so that the report never infers it from a directory name;
+//! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs.
+//!
+//! ```
+//! let ball = ugl_types::EnvSpec::by_name("armball").unwrap();
+//! assert_eq!((ball.display, ball.true_latents, ball.klc.achievable_cells), ("ArmBall", 2, 756));
+//! assert_eq!(ugl_types::EnvSpec::by_name("armarrow").unwrap().klc.achievable_cells, 22_680);
+//! ```
+
+mod campaign;
+mod env;
+mod goal_space;
+mod manifest;
+mod paths;
+
+pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
+pub use env::{ENVIRONMENTS, EnvSpec, KlcGrid, ObjectSpec};
+pub use goal_space::{GOAL_SPACE_DIR, GoalSpaceSample};
+pub use manifest::{CpuInfo, FileDigest, Manifest, RESULTS_VERSION, Summary};
+pub use paths::{
+    CURVE_SUFFIX, DigestError, INTEREST_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX, RunPaths,
+    run_paths, verify_files,
+};

@@ -1,0 +1,248 @@
+//! The manifest of a run: everything about it that is not its data (the schema is documented in
+//! `data/results/README.md`). The runner writes it last, through [`Manifest`]; the report reads it
+//! back through the same type.
+
+use serde::{Deserialize, Serialize};
+
+use crate::campaign::CampaignDecl;
+
+/// Bumped whenever a change alters results for the same configuration.
+/// 2: exploration streams of learned goal spaces derive from the run's exploration identity
+/// (paired across learners), and a stochastic encoder draws its noise from the run's own stream
+/// (order-independent results); the KDE's square root of its covariance comes from faer's
+/// symmetric eigen-solver (was: cyclic Jacobi).
+/// 3: the neural learners train on the host engine by default (`engine = "host"`: other
+/// summation orders than burn's), and gemm/faer use their AVX-512 kernels where the CPU has them.
+pub const RESULTS_VERSION: u32 = 3;
+
+/// The final numbers of a run, also printed by `ugl run` as its last line.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub run: String,
+    /// Final KL-coverage; JSON has no infinity, so +inf is written as the string "inf".
+    #[serde(with = "inf_as_string")]
+    pub final_klc: f64,
+    pub n_moved: usize,
+    pub coverage: f64,
+}
+
+/// The CPU of a run.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CpuInfo {
+    /// `model name` of /proc/cpuinfo (`unknown` where there is none).
+    pub model: String,
+    /// The SIMD level the float kernels can dispatch to.
+    pub simd: String,
+}
+
+/// Everything about a run that is not its data. Fields added after results version 1 have
+/// serde defaults, so that every committed manifest reads through this one type.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub run_id: String,
+    pub identity: String,
+    pub env: String,
+    pub algo: String,
+    pub sampler: String,
+    /// Latent size of a learned goal space (0 for RPE and EFR).
+    #[serde(default)]
+    pub latents: usize,
+    /// `none`, or `faithful` / `corrected` for the neural learners.
+    #[serde(default = "none_string")]
+    pub variant: String,
+    /// Name of the representation learner (the program's name for external learners).
+    #[serde(default)]
+    pub learner: Option<String>,
+    pub seed: u64,
+    /// The seed of the run's exploration streams, derived from (campaign seed, the run's
+    /// exploration identity).
+    pub run_seed: u64,
+    pub campaign: String,
+    /// What the campaign is for (`[campaign] role` of its TOML); absent in manifests written
+    /// before roles were declared (the campaign's [`crate::CampaignRecord`] says it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub role: Option<CampaignDecl>,
+    pub campaign_seed: u64,
+    pub profile: String,
+    /// BLAKE3 of everything the run's results depend on.
+    pub config_hash: String,
+    /// The exploration budget and constants actually used.
+    pub explore: serde_json::Value,
+    pub env_config: serde_json::Value,
+    /// The UGL-stage settings (learned goal spaces only).
+    #[serde(default)]
+    pub ugl: Option<serde_json::Value>,
+    /// Whether the budget is below the paper's, and how.
+    pub reduced_budget: bool,
+    pub budget_note: String,
+    pub git_revision: String,
+    /// The crate versions and `results_version`.
+    pub crate_versions: serde_json::Value,
+    pub toolchain: String,
+    pub threads: usize,
+    /// Seconds of exploration (excluding the representation's fit).
+    pub wall_s: f64,
+    /// Seconds to generate the UGL data set and fit the representation (shared between the
+    /// samplers of a cell in a campaign).
+    #[serde(default)]
+    pub fit_s: Option<f64>,
+    /// External learners: the fit time the program reported itself (`READY fit_s=...`),
+    /// without its start-up, imports and file I/O, which `fit_s` includes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learner_fit_s: Option<f64>,
+    /// Seconds spent rendering and encoding outcomes during exploration.
+    #[serde(default)]
+    pub encode_s: Option<f64>,
+    /// Training of a neural representation: configuration, loss curve, model-cache status.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub train: Option<serde_json::Value>,
+    /// The external learner program (`[learners.external]`: name, command) of an `rge-external`
+    /// run, so that the run can be reproduced from its manifest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external: Option<serde_json::Value>,
+    pub host: String,
+    /// The CPU model and SIMD level (absent in manifests written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu: Option<CpuInfo>,
+    /// Learned goal spaces: held-out R² of a linear and a k-NN map from latents to the true
+    /// object state.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub latent_quality: Option<serde_json::Value>,
+    pub summary: Summary,
+    /// The run's data files as written: name, length and BLAKE3 hash. A run is complete only
+    /// if its files still match (checked on resume, merge and report). Absent in manifests
+    /// written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<Vec<FileDigest>>,
+}
+
+impl Manifest {
+    /// Parses a manifest; the error is serde's, with line and column.
+    pub fn from_json(text: &str) -> Result<Manifest, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+
+    /// The results version the run was written with (`crate_versions.results_version`).
+    pub fn results_version(&self) -> Option<u64> {
+        self.crate_versions.get("results_version")?.as_u64()
+    }
+
+    /// A field of the `train` object (neural learners).
+    pub fn train_field(&self, name: &str) -> Option<&serde_json::Value> {
+        self.train.as_ref()?.get(name)
+    }
+
+    /// Whether the run's neural representation left the mean-image plateau
+    /// (`train.evidence.trained`); None for other learners and older manifests.
+    pub fn trained(&self) -> Option<bool> {
+        self.train_field("evidence")?.get("trained")?.as_bool()
+    }
+
+    /// `CPU model (SIMD level)`.
+    pub fn cpu_label(&self) -> Option<String> {
+        self.cpu
+            .as_ref()
+            .map(|c| format!("{} ({})", c.model, c.simd))
+    }
+
+    /// The command of an external learner (`external.command`).
+    pub fn external_command(&self) -> Option<&str> {
+        self.external.as_ref()?.get("command")?.as_str()
+    }
+}
+
+/// A data file of a run as its manifest records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileDigest {
+    /// File name, in the run's directory.
+    pub name: String,
+    pub bytes: u64,
+    pub blake3: String,
+}
+
+impl FileDigest {
+    /// The digest of `bytes` written as `name`.
+    pub fn of(name: &str, bytes: &[u8]) -> FileDigest {
+        FileDigest {
+            name: name.to_string(),
+            bytes: bytes.len() as u64,
+            blake3: blake3::hash(bytes).to_hex().to_string(),
+        }
+    }
+}
+
+fn none_string() -> String {
+    "none".into()
+}
+
+mod inf_as_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_infinite() && *v > 0.0 {
+            s.serialize_str("inf")
+        } else {
+            s.serialize_f64(*v)
+        }
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum V {
+            N(f64),
+            S(String),
+        }
+        match V::deserialize(d)? {
+            V::N(x) => Ok(x),
+            V::S(s) if s == "inf" => Ok(f64::INFINITY),
+            V::S(s) => Err(serde::de::Error::custom(format!(
+                "expected a number or \"inf\", got {s:?}"
+            ))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every committed manifest, of every results version, reads through the one type, and
+    /// writing it back gives the same JSON value (no field is lost or invented).
+    #[test]
+    fn every_committed_manifest_reads_and_round_trips() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/results");
+        let mut n = 0;
+        for campaign in std::fs::read_dir(&root).unwrap() {
+            let dir = campaign.unwrap().path();
+            if !dir.is_dir() {
+                continue;
+            }
+            for f in std::fs::read_dir(&dir).unwrap() {
+                let p = f.unwrap().path();
+                let name = p.file_name().unwrap().to_string_lossy().to_string();
+                if !name.ends_with(".json") || name.starts_with('.') || name == crate::RECORD_FILE {
+                    continue;
+                }
+                let text = std::fs::read_to_string(&p).unwrap();
+                let m = Manifest::from_json(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+                let raw: serde_json::Value = serde_json::from_str(&text).unwrap();
+                assert_eq!(serde_json::to_value(&m).unwrap(), raw, "{name}");
+                n += 1;
+            }
+        }
+        assert!(n > 500, "only {n} manifests found under {}", root.display());
+    }
+
+    #[test]
+    fn infinite_klc_is_written_as_a_string() {
+        let s = Summary {
+            run: "r".into(),
+            final_klc: f64::INFINITY,
+            n_moved: 0,
+            coverage: 0.0,
+        };
+        let j = serde_json::to_string(&s).unwrap();
+        assert!(j.contains("\"inf\""), "{j}");
+        assert_eq!(serde_json::from_str::<Summary>(&j).unwrap(), s);
+        assert!(serde_json::from_str::<Summary>(&j.replace("inf", "nan")).is_err());
+    }
+}
