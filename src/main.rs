@@ -40,8 +40,7 @@ enum Command {
     /// Run episodes: prints a JSON array with, per parameter vector, the final object state,
     /// whether the object was caught, and the hand position.
     Rollout {
-        /// armball, armarrow or armballs (the follow-up's ball and distractor).
-        #[arg(long)]
+        #[arg(long, help = env_help())]
         env: EnvKind,
         /// JSON file: an array of arrays of 21 numbers (motor parameters; clipped to [-1,1]).
         #[arg(long)]
@@ -53,9 +52,7 @@ enum Command {
     },
     /// KL-coverage of a set of engineered outcomes (prints the value, or `inf`).
     Klc {
-        /// armball (CSV header `x,y`), armarrow (`x,y,angle`) or armballs (`x,y`: the
-        /// controllable ball; the distractor is not measured).
-        #[arg(long)]
+        #[arg(long, help = klc_env_help())]
         env: EnvKind,
         /// CSV file of outcomes in [-1,1].
         #[arg(long)]
@@ -63,12 +60,9 @@ enum Command {
     },
     /// Render an object state as the 70x70 image the learners see.
     Render {
-        /// armball, armarrow or armballs (the follow-up's ball and distractor).
-        #[arg(long)]
+        #[arg(long, help = env_help())]
         env: EnvKind,
-        /// Engineered state: `x,y` (ball), `x,y,angle` (arrow) or `x,y,dx,dy` (armballs: ball,
-        /// then distractor), each in [-1,1].
-        #[arg(long, allow_hyphen_values = true)]
+        #[arg(long, allow_hyphen_values = true, help = state_help())]
         state: String,
         /// Output file: `.npy` (float32 70x70 indexed [x][y]) or `.png` (for people).
         #[arg(long)]
@@ -77,8 +71,7 @@ enum Command {
     /// One exploration run; writes DIR/<run-id>.parquet (+ .outcomes.parquet, .json) and prints
     /// a JSON summary as its last line.
     Run {
-        /// armball, armarrow or armballs (the follow-up's ball and distractor).
-        #[arg(long)]
+        #[arg(long, help = env_help())]
         env: EnvKind,
         #[arg(long, help = algo_help())]
         algo: Algo,
@@ -150,7 +143,8 @@ enum Command {
         /// Run nothing: bring the goal-space diagnostics of the finished runs up to date: the
         /// latent quality where a manifest holds an older measure, and the missing goal-space
         /// figure data of seed 0 (each representation concerned is fitted again, or loaded from
-        /// the model cache, once; the runs' data files are not touched).
+        /// the model cache, once). Runs are not touched: the new measure goes to
+        /// OUT/diagnostics/<run_id>.json.
         #[arg(long)]
         refresh_diagnostics: bool,
         #[command(flatten)]
@@ -214,8 +208,7 @@ enum Command {
 
 #[derive(clap::Args, Debug)]
 struct EmbedArgs {
-    /// armball, armarrow or armballs.
-    #[arg(long)]
+    #[arg(long, help = env_help())]
     env: EnvKind,
     #[arg(long, help = learner_help())]
     learner: String,
@@ -752,9 +745,9 @@ fn refresh_config(
         eprintln!("refreshed {label} ({:.0} s)", t0.elapsed().as_secs_f64())
     })?;
     eprintln!(
-        "goal-space diagnostics: {} representations refreshed: {} manifests given the latent \
-         quality measure version {} ({} already had it), {} figure samples written; {} \
-         learned-space runs not finished; in {:.1} s -> {}",
+        "goal-space diagnostics: {} representations refreshed: {} runs given the latent \
+         quality measure version {} in diagnostics/ ({} already had it), {} figure samples \
+         written; {} learned-space runs not finished; in {:.1} s -> {}",
         r.representations,
         r.runs,
         ugl_bench::repr::quality::MEASURE_VERSION,
@@ -842,6 +835,45 @@ fn algo_help() -> String {
 }
 
 /// `--learner`'s help, from the registry.
+/// `--env`: every environment of the registry, with its description.
+fn env_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| format!("{}: {}", e.name, e.description))
+        .collect();
+    format!("The environment: {}", envs.join("; "))
+}
+
+/// `ugl klc --env`: the CSV header of each environment, the measured coordinates.
+fn klc_env_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| {
+            format!(
+                "{} (CSV header `{}`)",
+                e.name,
+                e.outcome_columns[e.metric_dims()].join(",")
+            )
+        })
+        .collect();
+    format!(
+        "The environment: {}; only the controllable object is measured",
+        envs.join(", ")
+    )
+}
+
+/// `ugl render --state`: the engineered state of each environment.
+fn state_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| format!("`{}` ({})", e.outcome_columns.join(","), e.name))
+        .collect();
+    format!(
+        "Engineered state, each coordinate in [-1,1]: {}",
+        envs.join(", ")
+    )
+}
+
 fn learner_help() -> String {
     let names: Vec<&str> = Learner::all()
         .filter(|l| !l.is_external())

@@ -394,17 +394,24 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
         std::fs::write(path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
     }
     std::fs::remove_dir_all(&gs).unwrap();
+    let old = manifests(&out);
     let log = campaign(&["--refresh-diagnostics", "--jobs", "2"]);
     assert!(
-        log.contains("8 representations refreshed: 8 manifests")
+        log.contains("8 representations refreshed: 8 runs")
             && log.contains("4 figure samples written"),
         "{log}"
     );
-    let refreshed = manifests(&out);
-    assert!(
-        fresh == refreshed,
-        "refreshed manifests differ from fresh ones"
-    );
+    // Manifests are never rewritten: the new measure is in each run's diagnostics sidecar, and
+    // it is exactly what a fresh campaign measures.
+    assert!(manifests(&out) == old, "a manifest was rewritten");
+    for (path, m) in &fresh {
+        let run_id = m["run_id"].as_str().unwrap();
+        let d = ugl_types::Diagnostics::read(&out, run_id)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no diagnostics for {}", path.display()));
+        assert_eq!(d.latent_quality, m["latent_quality"], "{run_id}");
+        assert_eq!(d.crate_versions, m["crate_versions"], "{run_id}");
+    }
     for (name, bytes) in &samples {
         assert!(
             std::fs::read(gs.join(name)).unwrap() == *bytes,
@@ -414,7 +421,7 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
     assert!(common::parquet_files(&out) == data, "run data touched");
     let log = campaign(&["--refresh-diagnostics"]);
     assert!(
-        log.contains("0 representations refreshed: 0 manifests")
+        log.contains("0 representations refreshed: 0 runs")
             && log.contains("(8 already had it), 0 figure samples"),
         "{log}"
     );

@@ -825,6 +825,7 @@ pair_on = ["env"]
                     seed: seed as i64,
                     curve,
                     outcomes: Vec::new(),
+                    diagnostics: None,
                     manifest: crate::load::test_manifest(serde_json::json!({})),
                     curve_path: Default::default(),
                     outcomes_path: Default::default(),

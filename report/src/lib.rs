@@ -182,8 +182,11 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     let variants_fig = figures::variants::draw(&pairs, &fig_dir)?;
     let budget_figs = figures::budget::draw_all(&budget.series, &opts.main_campaign, &fig_dir)?;
     let loss_fig = figures::training_loss::draw(&losses, &fig_dir)?;
-    let mut appendix_figs = vec![figures::environment::draw_environments(&fig_dir)?];
+    let mut appendix_figs = Vec::new();
+    #[cfg(feature = "environment-figures")]
+    appendix_figs.push(figures::environment::draw_environments(&fig_dir)?);
     appendix_figs.push(figures::radial_flow::draw(&fig_dir)?);
+    #[cfg(feature = "environment-figures")]
     appendix_figs.extend(figures::environment::draw_dmp_episode(&fig_dir)?);
     let samples = figures::goal_space::load(&camps.main.path)?;
     let (mesh_figs, recon_figs) =
@@ -298,8 +301,8 @@ const OWN_FIGURES: [&str; 7] = [
     figures::variants::FILE,
     figures::training_loss::FILE,
     figures::radial_flow::FILE,
-    figures::environment::FIG1,
-    figures::environment::FIG6,
+    figures::FIG1,
+    figures::FIG6,
     "fig4_vae_kde_vs_gaussian.svg",
     "rfvae_kde_vs_gaussian.svg",
 ];

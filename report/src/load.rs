@@ -47,15 +47,10 @@ impl ConditionKey {
             self.latents,
             rank(
                 &self.algo,
-                &[
-                    "rpe",
-                    "rge-efr",
-                    "rge-pca",
-                    "rge-isomap",
-                    "rge-ae",
-                    "rge-vae",
-                    "rge-rfvae",
-                ],
+                &["rpe", "rge-efr"]
+                    .into_iter()
+                    .chain(ugl_types::LearnerInfo::paper_algos())
+                    .collect::<Vec<_>>(),
             ),
             self.algo.clone(),
             rank(&self.sampler, &["none", "uniform", "kde", "gaussian"]),
@@ -128,7 +123,11 @@ pub struct Run {
     pub curve: Vec<CurvePoint>,
     /// In history order.
     pub outcomes: Vec<Outcome>,
+    /// The manifest as the run wrote it, except `latent_quality`, which is its diagnostics
+    /// sidecar's where there is one ([`ugl_types::Diagnostics`]: a later measure).
     pub manifest: Manifest,
+    /// The later diagnostics of the run, with the code revision that measured them.
+    pub diagnostics: Option<ugl_types::Diagnostics>,
     /// The curve file (`<run_id>.parquet`).
     pub curve_path: PathBuf,
     pub outcomes_path: PathBuf,
@@ -462,6 +461,16 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
 
     let mut key = key;
     reconcile_identity(&mut key, seed, &manifest, &manifest_path)?;
+    let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    let diagnostics =
+        ugl_types::Diagnostics::read(dir, &run_id).map_err(|e| ReportError::Invalid {
+            path: ugl_types::Diagnostics::path(dir, &run_id),
+            problem: e.to_string(),
+        })?;
+    let mut manifest = manifest;
+    if let Some(d) = &diagnostics {
+        manifest.latent_quality = Some(d.latent_quality.clone());
+    }
 
     Ok(Run {
         run_id,
@@ -471,6 +480,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         curve,
         outcomes,
         manifest,
+        diagnostics,
         curve_path,
         outcomes_path,
         manifest_path,

@@ -17,21 +17,21 @@ use crate::aggregate::ConditionSummary;
 use crate::campaigns::Campaign;
 use crate::load::{ConditionKey, Manifest, Run, Store, rank};
 use crate::stats::{self, Summary};
-use ugl_bench::repr::registry::Learner;
+use ugl_types::LearnerInfo;
 
 /// The neural learners, in the registry's order (`ae`, `vae`, `rfvae`).
 pub fn learners() -> Vec<&'static str> {
-    Learner::all()
-        .filter(|l| l.model().is_some())
-        .map(Learner::name)
+    LearnerInfo::all()
+        .filter(|l| l.is_neural())
+        .map(|l| l.name)
         .collect()
 }
 
 /// The algorithms compared faithful vs corrected: the learners with variants.
 pub fn variant_algos() -> Vec<&'static str> {
-    Learner::all()
-        .filter(|l| l.has_variants())
-        .map(|l| l.entry().algo)
+    LearnerInfo::all()
+        .filter(|l| l.has_variants)
+        .map(|l| l.algo)
         .collect()
 }
 
@@ -52,17 +52,16 @@ pub struct PaperTraining {
 /// (Adagrad), VAE 100,000 (Adam), RFVAE 50,000 (Adam, 10,000 warm-up); all 4900-1200-1200
 /// dense networks, batch 100, learning rate 1e-3.
 pub fn paper_training(learner: &str) -> Option<PaperTraining> {
-    let l = Learner::by_name(learner)?;
-    let model = l.model()?;
-    let c = l.entry().paper_training()?;
+    let l = LearnerInfo::by_name(learner)?;
+    let c = l.paper_training?;
     Some(PaperTraining {
-        learner: l.name(),
+        learner: l.name,
         iterations: c.iterations as i64,
         hidden: [c.hidden[0] as i64, c.hidden[1] as i64],
         batch: c.batch as i64,
         lr: c.lr,
-        optimiser: format!("{:?}", model.spec().optimiser()),
-        warmup: (c.warmup > 0 && model.spec().paper_warmup() > 0).then_some(c.warmup as i64),
+        optimiser: c.optimiser.to_string(),
+        warmup: (c.warmup > 0).then_some(c.warmup as i64),
     })
 }
 

@@ -83,7 +83,7 @@ pub struct CampaignRecord {
     pub label: Option<String>,
 }
 
-/// Errors reading or writing a campaign record.
+/// Errors reading a campaign record or a run's diagnostics.
 #[derive(Debug, Error)]
 pub enum RecordError {
     #[error("cannot read {}: {source}", path.display())]
@@ -91,7 +91,7 @@ pub enum RecordError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}: not a campaign record: {message}", path.display())]
+    #[error("{}: cannot be read: {message}", path.display())]
     Parse { path: PathBuf, message: String },
 }
 

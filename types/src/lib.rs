@@ -8,6 +8,8 @@
 //! - [`EnvSpec`]: the environment registry (names, objects, true latent size, KL-coverage grid);
 //! - [`CampaignRole`] and [`CampaignRecord`]: what a campaign is for, declared in its TOML and
 //!   recorded beside its runs, so that the report never infers it from a directory name;
+//! - [`LearnerInfo`]: the representation learners' names, display names and paper training;
+//! - [`Diagnostics`]: measures taken after a run, beside it (manifests are immutable);
 //! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs.
 //!
 //! ```
@@ -17,14 +19,24 @@
 //! ```
 
 mod campaign;
+mod diagnostics;
 mod env;
 mod goal_space;
+mod learner;
 mod manifest;
 mod paths;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
+pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
 pub use env::{ENVIRONMENTS, EnvSpec, KlcGrid, ObjectSpec};
 pub use goal_space::{GOAL_SPACE_DIR, GoalSpaceSample};
+pub use learner::{LEARNERS, LearnerInfo, PaperTraining, Prior};
+/// Each learner's entry, by name (`ugl_types::learners::VAE`).
+pub mod learners {
+    pub use crate::learner::{
+        AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
+    };
+}
 pub use manifest::{CpuInfo, FileDigest, Manifest, RESULTS_VERSION, Summary};
 pub use paths::{
     CURVE_SUFFIX, DigestError, INTEREST_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX, RunPaths,

@@ -20,8 +20,7 @@ use crate::seed::{Component, run_seed, stream};
 use super::context::RunContext;
 use super::error::RunError;
 use super::fit::{Representation, fit_representation};
-use super::provenance::git_revision;
-use ugl_types::RESULTS_VERSION;
+use super::provenance::{crate_versions, git_revision};
 
 /// What an exploration produced, with its timings.
 pub struct Explored {
@@ -275,10 +274,7 @@ pub fn execute(
         reduced_budget: !notes.is_empty(),
         budget_note: notes.join("; "),
         git_revision: git_revision().into(),
-        crate_versions: serde_json::json!({
-            "ugl-bench": env!("CARGO_PKG_VERSION"),
-            "results_version": RESULTS_VERSION,
-        }),
+        crate_versions: crate_versions(),
         toolchain: env!("UGL_RUSTC_VERSION").into(),
         threads: ctx.threads,
         wall_s,

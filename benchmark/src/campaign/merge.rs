@@ -132,6 +132,7 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
                         },
                     });
                 }
+                copy_diagnostics(src, into, &manifest.run_id)?;
                 done.already_present += 1;
                 continue;
             }
@@ -144,8 +145,19 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
                 })?;
                 store::write_atomic(b, &bytes)?;
             }
+            copy_diagnostics(src, into, &manifest.run_id)?;
             done.copied += 1;
         }
     }
     Ok(done)
+}
+
+/// A run's diagnostics sidecar travels with it (where the destination has none).
+fn copy_diagnostics(src: &Path, into: &Path, run_id: &str) -> Result<(), MergeError> {
+    if let Some(d) = store::Diagnostics::read(src, run_id)?
+        && store::Diagnostics::read(into, run_id)?.is_none()
+    {
+        store::write_diagnostics(into, &d)?;
+    }
+    Ok(())
 }

@@ -2,6 +2,8 @@
 
 use std::sync::OnceLock;
 
+use ugl_types::RESULTS_VERSION;
+
 /// `git rev-parse HEAD` of the working directory, with `-dirty` if there are uncommitted
 /// changes; `unknown` outside a repository.
 pub fn git_revision() -> &'static str {
@@ -23,5 +25,13 @@ pub fn git_revision() -> &'static str {
             }
             None => "unknown".into(),
         }
+    })
+}
+
+/// The crate versions and results version of this code, as a manifest records them.
+pub fn crate_versions() -> serde_json::Value {
+    serde_json::json!({
+        "ugl-bench": env!("CARGO_PKG_VERSION"),
+        "results_version": RESULTS_VERSION,
     })
 }

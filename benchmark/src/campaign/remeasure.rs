@@ -5,9 +5,10 @@
 //! The diagnostics are not results: no run's data depend on them. When the measure improves,
 //! or figure data are missing, the finished runs keep their data files: each representation
 //! concerned is fitted again exactly as for its runs (a neural one is loaded from the model
-//! cache when it is there), measured once, its new measure written into the manifests of the
-//! runs that share it, and its figure data written. What is already current is left alone, so
-//! an interrupted refresh resumes where it stopped.
+//! cache when it is there), measured once, its new measure written beside each run that shares
+//! it ([`Diagnostics`], `DIR/diagnostics/<run_id>.json`, with this code's revision: manifests
+//! are never rewritten), and its figure data written. What is already current is left alone,
+//! so an interrupted refresh resumes where it stopped.
 
 use std::path::Path;
 use std::sync::atomic::Ordering;
@@ -17,17 +18,19 @@ use super::error::RunError;
 use super::fit::fit_representation;
 use super::goal_space;
 use super::plan::{RunSpec, plan, shard};
+use super::provenance::{crate_versions, git_revision};
 use super::runner::{CampaignOptions, campaign_context, for_each_group};
 use super::store::{self, Manifest};
 use crate::repr::ReprError;
 use crate::repr::quality::MEASURE_VERSION;
+use ugl_types::Diagnostics;
 
 /// What a remeasure did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Remeasured {
     /// Representations fitted (or loaded) and measured now.
     pub representations: usize,
-    /// Manifests rewritten.
+    /// Runs whose diagnostics sidecar was written.
     pub runs: usize,
     /// Finished learned-space runs that already held the current measure.
     pub current: usize,
@@ -37,8 +40,12 @@ pub struct Remeasured {
     pub samples: usize,
 }
 
-/// The measure version a manifest holds (1 when it predates versioning; 0 when it has none).
-pub fn measure_version(m: &Manifest) -> u64 {
+/// The measure version a run holds: its diagnostics sidecar's, else its manifest's (1 when it
+/// predates versioning; 0 when it has none).
+pub fn measure_version(m: &Manifest, sidecar: Option<&Diagnostics>) -> u64 {
+    if let Some(d) = sidecar {
+        return d.measure_version();
+    }
     match &m.latent_quality {
         None => 0,
         Some(q) => q.get("version").and_then(|v| v.as_u64()).unwrap_or(1),
@@ -69,7 +76,11 @@ pub fn refresh_diagnostics(
             continue;
         }
         let manifest = store::read_manifest(&store::run_paths(out, &spec.run_id()).manifest)?;
-        let stale = measure_version(&manifest) < u64::from(MEASURE_VERSION);
+        let sidecar = Diagnostics::read(out, &spec.run_id()).unwrap_or_else(|e| {
+            tracing::warn!("{e}: measured again");
+            None
+        });
+        let stale = measure_version(&manifest, sidecar.as_ref()) < u64::from(MEASURE_VERSION);
         done.current += usize::from(!stale);
         let key = spec
             .representation_identity(cfg.ugl.images)
@@ -114,11 +125,15 @@ pub fn refresh_diagnostics(
                 })?;
                 let value = serde_json::to_value(quality).expect("serialisable");
                 for manifest in &stale {
-                    let updated = Manifest {
-                        latent_quality: Some(value.clone()),
-                        ..(*manifest).clone()
-                    };
-                    store::write_manifest(out, &updated)?;
+                    store::write_diagnostics(
+                        out,
+                        &Diagnostics {
+                            run_id: manifest.run_id.clone(),
+                            git_revision: git_revision().into(),
+                            crate_versions: crate_versions(),
+                            latent_quality: value.clone(),
+                        },
+                    )?;
                 }
             }
             on_measured(&super::fit::representation_label(first));

@@ -14,7 +14,7 @@ use thiserror::Error;
 use super::plan::RunSpec;
 use crate::explore::ExplorationLog;
 pub use ugl_types::{
-    DigestError, FileDigest, Manifest, RunPaths, Summary, run_paths, verify_files,
+    Diagnostics, DigestError, FileDigest, Manifest, RunPaths, Summary, run_paths, verify_files,
 };
 
 /// Errors of the results store.
@@ -200,6 +200,23 @@ pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<(), StoreError>
     })?;
     json.push(b'\n');
     write_atomic(&manifest_p, &json)
+}
+
+/// Write (or replace, atomically) a run's diagnostics sidecar ([`Diagnostics`]).
+pub fn write_diagnostics(dir: &Path, d: &Diagnostics) -> Result<(), StoreError> {
+    let path = Diagnostics::path(dir, &d.run_id);
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|source| StoreError::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    let mut json = serde_json::to_vec_pretty(d).map_err(|e| StoreError::Encode {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    json.push(b'\n');
+    write_atomic(&path, &json)
 }
 
 /// Read a run's manifest, if it exists and parses.

@@ -21,6 +21,7 @@ use super::isomap::IsomapConfig;
 use super::neural::{Model, NeuralConfig, NeuralSection};
 pub use super::params::{LearnerParams, ParamGuard};
 use super::pca::PcaConfig;
+use ugl_types::learners;
 
 /// How the harness fits a learner.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,40 +34,25 @@ pub enum Kind {
     External,
 }
 
-/// Whether a learner's goal space has a prior to sample goals from (`--sampler gaussian`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Prior {
-    /// Never.
-    None,
-    /// Always (N(0, I) of a VAE).
-    Always,
-    /// When the fitted model declares one (an external program writing `prior.npy`).
-    Declared,
-}
+pub use ugl_types::{LearnerInfo, Prior};
 
-/// One learner of the registry.
+/// One learner of the registry: its description (names, display name, variants, prior, the
+/// paper's training: `ugl_types::LearnerInfo`, which the report reads too) and how this build
+/// fits it. The description's fields read through the entry (`entry.algo`).
 #[derive(Debug)]
 pub struct LearnerEntry {
-    /// Name in campaign files, results and on the command line (`vae`).
-    pub name: &'static str,
-    /// The algorithm that explores its goal space (`rge-vae`): `rge-` + name.
-    pub algo: &'static str,
-    /// Name in the report (`VAE`).
-    pub display: &'static str,
-    /// One line for `--help` and the docs.
-    pub description: &'static str,
+    pub info: &'static LearnerInfo,
     /// How it is fitted.
     pub kind: Kind,
-    /// Whether its runs are crossed with the variants faithful / corrected (the original
-    /// code had defects there, PAPER-NOTES.md section 5).
-    pub has_variants: bool,
-    /// Whether its goal space has a prior.
-    pub prior: Prior,
-    /// Whether the paper evaluated it: the report gives the paper's learners fixed colours and
-    /// markers, in this list's order, and compares them with the paper's numbers.
-    pub in_paper: bool,
     /// Parse and check its `[learners.NAME]` table (None: the campaign file has none).
     pub params: fn(Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String>,
+}
+
+impl std::ops::Deref for LearnerEntry {
+    type Target = LearnerInfo;
+    fn deref(&self) -> &LearnerInfo {
+        self.info
+    }
 }
 
 impl LearnerEntry {
@@ -82,102 +68,48 @@ impl LearnerEntry {
 /// Every learner of this build, in the report's order.
 pub static LEARNERS: [LearnerEntry; 9] = [
     LearnerEntry {
-        name: "pca",
-        algo: "rge-pca",
-        display: "PCA",
-        description: "the paper's PCA: non-centred truncated SVD (randomized, as sklearn's TruncatedSVD)",
+        info: &learners::PCA,
         kind: Kind::InProcess,
-        has_variants: false,
-        prior: Prior::None,
-        in_paper: true,
         params: parse::<PcaConfig<false>>,
     },
     LearnerEntry {
-        name: "pca-centred",
-        algo: "rge-pca-centred",
-        display: "PCA (centred)",
-        description: "ordinary mean-centred PCA (the same randomized solver, centred implicitly)",
+        info: &learners::PCA_CENTRED,
         kind: Kind::InProcess,
-        has_variants: false,
-        prior: Prior::None,
-        in_paper: false,
         params: parse::<PcaConfig<true>>,
     },
     LearnerEntry {
-        name: "isomap",
-        algo: "rge-isomap",
-        display: "Isomap",
-        description: "Isomap (kNN graph, geodesics, classical MDS; sklearn's defaults)",
+        info: &learners::ISOMAP,
         kind: Kind::InProcess,
-        has_variants: false,
-        prior: Prior::None,
-        in_paper: true,
         params: parse::<IsomapConfig>,
     },
     LearnerEntry {
-        name: "ae",
-        algo: "rge-ae",
-        display: "AE",
-        description: "dense auto-encoder, sigmoid latents, Adagrad",
+        info: &learners::AE,
         kind: Kind::Neural(Model::Ae),
-        has_variants: false,
-        prior: Prior::None,
-        in_paper: true,
         params: neural::<AE>,
     },
     LearnerEntry {
-        name: "vae",
-        algo: "rge-vae",
-        display: "VAE",
-        description: "dense variational auto-encoder (encoding: the mean), Adam",
+        info: &learners::VAE,
         kind: Kind::Neural(Model::Vae),
-        has_variants: true,
-        prior: Prior::Always,
-        in_paper: true,
         params: neural::<VAE>,
     },
     LearnerEntry {
-        name: "rfvae",
-        algo: "rge-rfvae",
-        display: "RFVAE",
-        description: "the VAE with 10 radial flows and a KL warm-up, Adam",
+        info: &learners::RFVAE,
         kind: Kind::Neural(Model::Rfvae),
-        has_variants: true,
-        prior: Prior::Always,
-        in_paper: true,
         params: neural::<RFVAE>,
     },
     LearnerEntry {
-        name: "bvae",
-        algo: "rge-bvae",
-        display: "β-VAE",
-        description: "the dense VAE with its KL weighted by beta ([learners.bvae] beta, default 4; beta = 1 is the VAE), Adam",
+        info: &learners::BVAE,
         kind: Kind::Neural(Model::Bvae),
-        has_variants: false,
-        prior: Prior::Always,
-        in_paper: false,
         params: neural::<BVAE>,
     },
     LearnerEntry {
-        name: "gaussian-projection",
-        algo: "rge-gaussian-projection",
-        display: "Gaussian projection",
-        description: "a seeded Gaussian random projection of the pixels: an untrained control",
+        info: &learners::GAUSSIAN_PROJECTION,
         kind: Kind::InProcess,
-        has_variants: false,
-        prior: Prior::None,
-        in_paper: false,
         params: parse::<super::gaussian_projection::GaussianProjectionConfig>,
     },
     LearnerEntry {
-        name: "external",
-        algo: "rge-external",
-        display: "external",
-        description: "a program outside this project, through the external-learner protocol (docs/external-learners.md)",
+        info: &learners::EXTERNAL,
         kind: Kind::External,
-        has_variants: false,
-        prior: Prior::Declared,
-        in_paper: false,
         params: external,
     },
 ];
@@ -320,6 +252,33 @@ fn one_line(e: &toml::de::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The shared description (`ugl_types::LEARNERS`) is this build's registry, in the same
+    /// order, and its paper training is what the neural learners train with by default.
+    #[test]
+    fn the_shared_description_is_the_registry() {
+        assert_eq!(LEARNERS.len(), ugl_types::LEARNERS.len());
+        for (e, info) in LEARNERS.iter().zip(ugl_types::LEARNERS) {
+            assert!(std::ptr::eq(e.info, info), "{}", e.name);
+            assert_eq!(
+                e.info.is_neural(),
+                matches!(e.kind, Kind::Neural(_)),
+                "{}",
+                e.name
+            );
+            if let Kind::Neural(model) = e.kind {
+                let ours = NeuralConfig::paper(model);
+                let shared = e.info.paper_training.unwrap();
+                assert_eq!(ours.iterations, shared.iterations, "{}", e.name);
+                assert_eq!(ours.hidden, shared.hidden, "{}", e.name);
+                assert_eq!(ours.batch, shared.batch, "{}", e.name);
+                assert_eq!(ours.lr, shared.lr, "{}", e.name);
+                assert_eq!(ours.warmup, shared.warmup, "{}", e.name);
+                let opt = format!("{:?}", model.spec().optimiser());
+                assert_eq!(opt, shared.optimiser, "{}", e.name);
+            }
+        }
+    }
 
     #[test]
     fn names_are_unique_and_algos_are_rge_name() {

@@ -11,11 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use ugl_bench::env::render::{PIXELS, SIDE, render_arrow_into, render_ball_into};
 use ugl_bench::env::{EnvConfig, EnvKind, JOINTS, PARAMS, dmp, make_env};
 
-use super::{FONT, FigureFile, PanelChart, plain_panel, write_svg};
+use super::{FIG1, FIG6, FONT, FigureFile, PanelChart, plain_panel, write_svg};
 use crate::ReportError;
 
-pub const FIG1: &str = "fig1_environments.svg";
-pub const FIG6: &str = "fig6_dmp_episode.svg";
 const PANEL: u32 = 340;
 const TITLE_H: u32 = 36;
 

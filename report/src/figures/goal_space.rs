@@ -70,9 +70,8 @@ fn env_order(env: &str) -> usize {
 
 /// The report's order of learners in a figure.
 fn order(s: &Sample) -> (usize, String) {
-    let algo = ["rge-pca", "rge-isomap", "rge-ae", "rge-vae", "rge-rfvae"]
-        .iter()
-        .position(|a| *a == s.algo)
+    let algo = ugl_types::LearnerInfo::paper_algos()
+        .position(|a| a == s.algo)
         .unwrap_or(usize::MAX);
     (algo, s.variant.clone())
 }

@@ -4,6 +4,9 @@
 //! pattern, so the curves stay apart on a greyscale print as well.
 
 pub mod budget;
+/// The environment illustrations (Figures 1 and 6) run the environment itself: they need the
+/// science crate, behind the `environment-figures` feature (on in the `ugl` binary).
+#[cfg(feature = "environment-figures")]
 pub mod environment;
 pub mod goal_space;
 pub mod klc_curves;
@@ -13,6 +16,11 @@ pub mod sampler_compare;
 pub mod training_loss;
 pub mod variants;
 
+/// Figure 1: the environments and their rendered images (`environment-figures`).
+pub const FIG1: &str = "fig1_environments.svg";
+/// Figure 6: one DMP episode on ArmBall (`environment-figures`).
+pub const FIG6: &str = "fig6_dmp_episode.svg";
+
 use std::path::{Path, PathBuf};
 
 use plotters::element::ComposedElement;
@@ -21,7 +29,7 @@ use plotters::style::RGBColor;
 
 use crate::ReportError;
 use crate::load::rank;
-use ugl_bench::repr::registry::Learner;
+use ugl_types::LearnerInfo;
 
 /// A figure written by the report, with what the markdown needs to show it.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,11 +56,7 @@ pub const FONT: &str = "sans-serif";
 /// marker shapes; every other algorithm takes the following slots.
 pub fn algos() -> Vec<&'static str> {
     let mut v = vec!["rpe", "rge-efr"];
-    v.extend(
-        Learner::all()
-            .filter(|l| l.entry().in_paper)
-            .map(|l| l.entry().algo),
-    );
+    v.extend(LearnerInfo::paper_algos());
     v
 }
 
@@ -81,8 +85,8 @@ pub fn algo_name(algo: &str) -> String {
     match algo {
         "rpe" => "RPE".into(),
         "rge-efr" => "RGE-EFR".into(),
-        other => match Learner::by_algo(other) {
-            Some(l) => format!("RGE-{}", l.entry().display),
+        other => match LearnerInfo::by_algo(other) {
+            Some(l) => format!("RGE-{}", l.display),
             None => other.to_uppercase(),
         },
     }
@@ -111,8 +115,8 @@ pub fn sampler_name(sampler: &str) -> String {
 
 /// Display name of a learner (`vae` → `VAE`): the registry's, else in capitals.
 pub fn learner_name(learner: &str) -> String {
-    match Learner::by_name(learner) {
-        Some(l) => l.entry().display.to_string(),
+    match LearnerInfo::by_name(learner) {
+        Some(l) => l.display.to_string(),
         None => learner.to_uppercase(),
     }
 }

@@ -139,7 +139,10 @@ pub fn claims(w: &mut String, inp: &Inputs<'_>) {
         .store
         .runs
         .iter()
-        .filter(|r| ["rge-ae", "rge-vae", "rge-rfvae"].contains(&r.key.algo.as_str()))
+        .filter(|r| {
+            ugl_types::LearnerInfo::by_algo(&r.key.algo)
+                .is_some_and(|l| l.in_paper && l.is_neural())
+        })
         .count();
     let untrained = flags.iter().filter(|t| !**t).count();
     let _ = writeln!(

@@ -360,6 +360,7 @@ mod tests {
                 coverage: 0.0,
             }],
             outcomes: Vec::new(),
+            diagnostics: None,
             manifest: crate::load::test_manifest(json!({"train": {
                 "config": {"warmup": warmup, "iterations": 1000},
                 "evidence": {"plateau_loss": 400.0, "untrained_fraction": 0.8},
