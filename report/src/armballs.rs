@@ -33,11 +33,16 @@ pub const INTEREST_FIGURE: &str = "armballs_interest.svg";
 /// Cells of the 30x30 grid over [-1, 1]^2 that meet the unit disk: the denominator of our cell
 /// coverage. The follow-up's "exploration ratio" divides the visited cells by all 900, so it is
 /// our coverage times 756 / 900 (the ball never leaves the disk).
-/// ArmBalls' ball: the cells it can reach, of all cells of its grid (the registry's).
-fn ball_cells() -> (f64, f64) {
-    let grid = ugl_types::EnvSpec::by_name("armballs")
+/// ArmBalls' ball's KL-coverage grid (the registry's).
+fn ball_grid() -> ugl_types::KlcGrid {
+    ugl_types::EnvSpec::by_name("armballs")
         .expect("armballs is registered")
-        .klc;
+        .klc
+}
+
+/// ArmBalls' ball: the cells it can reach, of all cells of its grid.
+fn ball_cells() -> (f64, f64) {
+    let grid = ball_grid();
     (
         grid.achievable_cells as f64,
         (grid.bins as f64).powi(grid.dims as i32),
@@ -428,11 +433,15 @@ pub fn render(
         "## Exploration of the controllable ball\n\n\
          Final values after the last exploration iteration, mean over seeds with a \
          {:.0}% bootstrap interval of the mean. *Ratio* is the follow-up's exploration ratio \
-         (ball cells visited on a 30x30 grid over [-1, 1]², divided by all 900 cells; at most \
-         0.84); *KLC* is the paper's KL-coverage (lower is better). The distractor columns are \
+         (ball cells visited on a {bins}x{bins} grid over [-1, 1]², divided by all {all} \
+         cells; at most {most:.2}); *KLC* is the paper's KL-coverage (lower is better). The \
+         distractor columns are \
          the control: its walk does not depend on the policy, so every algorithm should get \
          the same values there.\n",
-        CONFIDENCE * 100.0
+        CONFIDENCE * 100.0,
+        bins = ball_grid().bins,
+        all = ball_cells().1,
+        most = ball_cells().0 / ball_cells().1,
     );
     p.push_str(
         "| algorithm | seeds | ball ratio | ball KLC | distractor ratio (control) | distractor KLC (control) |\n|---|---|---|---|---|---|\n",

@@ -319,8 +319,8 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
         "Every algorithm of the main campaign, and every learner added with `ugl compare` \
          (campaigns `compare-*`, run on the same cells and seeds), ranked over the {} tasks ({}) \
          with the statistics of Agarwal et al. (2021, *rliable*). Scores are normalised so that \
-         tasks pool: KLC divided by the KLC of outcomes all in one cell (ln 756 on ArmBall, \
-         ln 22680 on ArmArrow), so 0 is a perfect cover and 1 is \"the object never moved\"; \
+         tasks pool: KLC divided by the KLC of outcomes all in one cell ({}), so 0 is a \
+         perfect cover and 1 is \"the object never moved\"; \
          lower is better. *Final*: interquartile mean (IQM) of the normalised final KLC over all \
          runs of all tasks; *speed*: IQM of the normalised area under the KLC curve (the mean \
          KLC during exploration); *P(better than EFR)*: probability that a run beats a run of \
@@ -340,6 +340,7 @@ pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
          with little coverage: read the two together. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *final*; entries missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
+        super::paper_envs(|e| format!("ln {} on {}", e.klc.achievable_cells, e.display)),
         lb.confidence * 100.0,
         lb.n_boot
     );

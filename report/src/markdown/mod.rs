@@ -393,15 +393,21 @@ pub fn render(inp: &Inputs<'_>) -> String {
         "Mean over seeds (line) with the 90% percentile-bootstrap confidence interval of the mean \
          (shaded; {} resamples of the runs, seed {}), as the paper's `seaborn.tsplot(ci=90)`. \
          Lower is better; the y axis spans the data: from just below the lowest value drawn to \
-         the KL-coverage of outcomes all in one cell (ln 756 = 6.63 for ArmBall, ln 22680 = \
-         10.03 for ArmArrow), not from 0. The baselines appear in every \
-         panel of their environment, as in the paper. Hollow stars: the paper's final values \
+         the KL-coverage of outcomes all in one cell ({}), not from 0. The baselines appear in \
+         every panel of their environment, as in the paper. Hollow stars: the paper's final values \
          (single runs, read off its plots at the point labelled 4900), drawn at our last epoch. \
          As in the paper's figure, only KDE goals for the learned spaces: the Gaussian-goal runs \
          are in the Figure 4 section. Colour and marker shape identify the algorithm; the \
          *faithful* variant is solid with filled markers, the *corrected* one dashed with hollow \
          markers. *n* in the legend: seeds.\n",
-        inp.opts.n_boot, inp.opts.bootstrap_seed
+        inp.opts.n_boot,
+        inp.opts.bootstrap_seed,
+        paper_envs(|e| format!(
+            "ln {} = {:.2} for {}",
+            e.klc.achievable_cells,
+            e.klc.max_klc(),
+            e.display
+        ))
     );
     if !inp.campaigns.compare.is_empty() {
         let names: Vec<String> = inp
@@ -589,7 +595,8 @@ pub fn render(inp: &Inputs<'_>) -> String {
         w,
         "- KL-coverage is computed for every algorithm on the engineered outcome (object x, y; and \
          the arrow's angle for ArmArrow), 30 bins per dimension over [-1, 1], against the uniform \
-         distribution on the achievable cells (756 for ArmBall, 22680 for ArmArrow)."
+         distribution on the achievable cells ({}).",
+        paper_envs(|e| format!("{} for {}", e.klc.achievable_cells, e.display))
     );
     if last_epochs.iter().any(|&e| e != 5000) {
         let _ = writeln!(
@@ -738,4 +745,15 @@ fn reproduce(w: &mut String, inp: &Inputs<'_>) {
          this for the `smoke` profile against committed checksums); the bootstrap of this report is \
          seeded too, so rendering the same results gives the same bytes."
     );
+}
+
+/// `f` of each environment of the paper, joined by commas (prose numbers come from the
+/// environment registry).
+pub(crate) fn paper_envs(f: impl Fn(&ugl_types::EnvSpec) -> String) -> String {
+    ugl_types::ENVIRONMENTS
+        .iter()
+        .filter(|e| e.in_paper)
+        .map(f)
+        .collect::<Vec<_>>()
+        .join(", ")
 }

@@ -1,0 +1,349 @@
+//! The command line's grammar (clap): every subcommand, its options and their help, the
+//! lists in the help derived from the registries.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Parser, Subcommand};
+
+use ugl_bench::env::EnvKind;
+use ugl_bench::explore::{Algo, Learner, SamplerKind};
+use ugl_bench::repr::cache::ModelCache;
+use ugl_bench::repr::neural::Variant;
+
+/// ugl-bench: reproduce "Unsupervised Learning of Goal Spaces for Intrinsically Motivated Goal
+/// Exploration" (Péré et al., ICLR 2018) deterministically on a CPU.
+#[derive(Parser, Debug)]
+#[command(name = "ugl", version, about, long_about = None, propagate_version = true)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub(crate) enum Command {
+    /// Run episodes: prints a JSON array with, per parameter vector, the final object state,
+    /// whether the object was caught, and the hand position.
+    Rollout {
+        #[arg(long, help = env_help())]
+        env: EnvKind,
+        /// JSON file: an array of arrays of 21 numbers (motor parameters; clipped to [-1,1]).
+        #[arg(long)]
+        params: PathBuf,
+        /// armballs: the distractor's random walk draws from this seed's `distractor` stream,
+        /// episode after episode (the other environments draw nothing).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+    /// KL-coverage of a set of engineered outcomes (prints the value, or `inf`).
+    Klc {
+        #[arg(long, help = klc_env_help())]
+        env: EnvKind,
+        /// CSV file of outcomes in [-1,1].
+        #[arg(long)]
+        outcomes: PathBuf,
+    },
+    /// Render an object state as the 70x70 image the learners see.
+    Render {
+        #[arg(long, help = env_help())]
+        env: EnvKind,
+        #[arg(long, allow_hyphen_values = true, help = state_help())]
+        state: String,
+        /// Output file: `.npy` (float32 70x70 indexed [x][y]) or `.png` (for people).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// One exploration run; writes DIR/<run-id>.parquet (+ .outcomes.parquet, .json) and prints
+    /// a JSON summary as its last line.
+    Run {
+        #[arg(long, help = env_help())]
+        env: EnvKind,
+        #[arg(long, help = algo_help())]
+        algo: Algo,
+        /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (the
+        /// prior N(0, I); VAE, RFVAE, or an external learner that writes a prior).
+        #[arg(long, default_value = "kde")]
+        sampler: SamplerKind,
+        /// rge-vae / rge-rfvae: `faithful` (the original code, defects included) or `corrected`.
+        #[arg(long)]
+        variant: Option<Variant>,
+        /// Latent size of a learned goal space.
+        #[arg(long, default_value_t = 10)]
+        latents: usize,
+        /// Override the profile's number of UGL training images.
+        #[arg(long)]
+        images: Option<usize>,
+        /// Repetition index; the RNG seed derives from it, the run identity and the campaign seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Override the profile's number of exploration epochs.
+        #[arg(long)]
+        epochs: Option<usize>,
+        /// Budget profile: a name in data/campaigns/ or a path to a .toml file.
+        #[arg(long, default_value = "paper")]
+        profile: String,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// rge-external: the command line of a program speaking the external-learner protocol
+        /// (docs/external-learners.md), run with `sh -c`; replaces the profile's
+        /// [learners.external] command.
+        #[arg(long)]
+        command: Option<String>,
+        /// rge-external: the program's name in results and the report (default: the profile's
+        /// [learners.external] name, else `external`).
+        #[arg(long)]
+        name: Option<String>,
+        #[command(flatten)]
+        cache: CacheArgs,
+    },
+    /// Export a goal space: fit (or load from the model cache) the representation of one cell
+    /// and seed, as a run would, and write the latents of its training images and of a grid of
+    /// object positions as .npy files. Prints a JSON summary (files, latent quality).
+    Embed(EmbedArgs),
+    /// List the run ids of a campaign, one per line.
+    Plan {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+    },
+    /// Run a campaign matrix in parallel; resumable (finished runs are skipped).
+    Campaign {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+        /// Results directory (default: data/results/<campaign name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Runs in parallel (default: the number of cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// No progress bar (also automatic when stderr is not a terminal).
+        #[arg(long)]
+        quiet: bool,
+        /// Run only the deterministic slice i of n (0-based, `0/4` .. `3/4`); the union of the n
+        /// shards is the whole campaign, and runs sharing a trained representation stay together.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Run nothing: bring the goal-space diagnostics of the finished runs up to date: the
+        /// latent quality where a manifest holds an older measure, and the missing goal-space
+        /// figure data of seed 0 (each representation concerned is fitted again, or loaded from
+        /// the model cache, once). Runs are not touched: the new measure goes to
+        /// OUT/diagnostics/<run_id>.json.
+        #[arg(long)]
+        refresh_diagnostics: bool,
+        #[command(flatten)]
+        cache: CacheArgs,
+    },
+    /// List the registered representation learners: name, algorithm, what its goal space
+    /// offers (variants, a prior), whether the paper evaluated it, and a description.
+    Learners,
+    /// Run one more representation learner on the cells and seeds of a campaign (default: the
+    /// paper's), into data/results/compare-NAME; the report ranks it against the paper's
+    /// algorithms with the same statistics.
+    Compare(CompareArgs),
+    /// Write a Slurm array job (one task per shard) and a merge step for a campaign.
+    Slurm {
+        /// Campaign file (data/campaigns/NAME.toml).
+        #[arg(long)]
+        config: PathBuf,
+        /// Number of array tasks (shards).
+        #[arg(long)]
+        shards: usize,
+        /// Results directory the tasks write to (on a shared file system).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Directory for the generated scripts.
+        #[arg(long, default_value = "slurm")]
+        scripts: PathBuf,
+        /// CPUs per task (each task runs that many runs in parallel).
+        #[arg(long, default_value_t = 2)]
+        cpus: usize,
+        /// Wall-time limit per task (Slurm syntax).
+        #[arg(long, default_value = "04:00:00")]
+        time: String,
+    },
+    /// Merge run files from several results directories (e.g. one per machine) into one store.
+    Merge {
+        /// Destination results directory.
+        #[arg(long)]
+        into: PathBuf,
+        /// Source results directories.
+        #[arg(required = true)]
+        sources: Vec<PathBuf>,
+    },
+    /// Render the report (markdown + SVG figures) from a results store.
+    Report {
+        /// Results directory (run files, or one sub-directory per campaign).
+        #[arg(long, default_value = "data/results")]
+        results: PathBuf,
+        /// Output directory for REPORT.md and figures/.
+        #[arg(long, default_value = "report/out")]
+        out: PathBuf,
+        /// The paper's reference values.
+        #[arg(long, default_value = "data/paper")]
+        paper: PathBuf,
+        /// The campaign (sub-directory of --results) the figures and tables are drawn from;
+        /// `budget-*` campaigns feed the training-budget section. `(top level)` or `.`: the
+        /// runs directly in --results.
+        #[arg(long = "main", default_value = "paper")]
+        main_campaign: String,
+    },
+}
+
+#[derive(clap::Args, Debug)]
+pub(crate) struct EmbedArgs {
+    #[arg(long, help = env_help())]
+    pub(crate) env: EnvKind,
+    #[arg(long, help = learner_help())]
+    pub(crate) learner: String,
+    /// External learners: the command line of the program (docs/external-learners.md).
+    #[arg(long)]
+    pub(crate) command: Option<String>,
+    /// vae / rfvae: faithful (default) or corrected.
+    #[arg(long)]
+    pub(crate) variant: Option<Variant>,
+    /// Latent size.
+    #[arg(long, default_value_t = 10)]
+    pub(crate) latents: usize,
+    /// Repetition index (the data set and the learner's stream derive from it).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Override the profile's number of UGL training images.
+    #[arg(long)]
+    pub(crate) images: Option<usize>,
+    /// Budget profile: a name in data/campaigns/ or a path to a .toml file.
+    #[arg(long, default_value = "paper")]
+    pub(crate) profile: String,
+    /// The grid of object positions: GRID x GRID over [-1, 1]^2 (ArmArrow: angle 0).
+    #[arg(long, default_value_t = 21)]
+    pub(crate) grid: usize,
+    /// The training latents' file (.npy, float64, (n, latents)); beside it OUT-stem.states.npy
+    /// (n, state dim), OUT-stem.grid.npy (GRID^2, latents) and OUT-stem.grid_states.npy.
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+    #[command(flatten)]
+    pub(crate) cache: CacheArgs,
+}
+
+#[derive(clap::Args, Debug)]
+pub(crate) struct CompareArgs {
+    #[arg(long, help = learner_help())]
+    pub(crate) learner: String,
+    /// Command line of a program speaking the external-learner protocol
+    /// (docs/external-learners.md), run with `sh -c`.
+    #[arg(long)]
+    pub(crate) command: Option<String>,
+    /// External learners: also run Gaussian-prior goals (the program must write prior.npy).
+    #[arg(long)]
+    pub(crate) gaussian: bool,
+    /// The campaign whose cells, seeds and budgets to use.
+    #[arg(long, default_value = "data/campaigns/paper.toml")]
+    pub(crate) config: PathBuf,
+    /// Results directory (default: data/results/compare-NAME).
+    #[arg(long)]
+    pub(crate) out: Option<PathBuf>,
+    /// Runs in parallel (default: the number of cores).
+    #[arg(long)]
+    pub(crate) jobs: Option<usize>,
+    /// No progress bars.
+    #[arg(long)]
+    pub(crate) quiet: bool,
+    /// Run nothing: bring the goal-space diagnostics of the finished runs up to date (as
+    /// `ugl campaign --refresh-diagnostics`).
+    #[arg(long)]
+    pub(crate) refresh_diagnostics: bool,
+    #[command(flatten)]
+    pub(crate) cache: CacheArgs,
+}
+
+/// Where trained neural models are kept.
+#[derive(clap::Args, Debug)]
+pub(crate) struct CacheArgs {
+    /// Model cache directory for fitted representations that persist: trained networks, PCA
+    /// (default: OUT/models). A model is keyed by the hash of everything it depends on; an
+    /// invalid file is refitted.
+    #[arg(long)]
+    pub(crate) cache: Option<PathBuf>,
+    /// Do not read or write the model cache (always fit).
+    #[arg(long, conflicts_with = "cache")]
+    pub(crate) no_cache: bool,
+    /// Save a checkpoint of each neural training every N iterations in the model cache (0:
+    /// never). A training killed mid-way resumes from its latest checkpoint and ends
+    /// bit-identical to an uninterrupted one.
+    #[arg(long, default_value_t = 1000)]
+    pub(crate) checkpoint_every: usize,
+}
+
+impl CacheArgs {
+    pub(crate) fn resolve(&self, out: &Path) -> Option<ModelCache> {
+        if self.no_cache {
+            return None;
+        }
+        Some(ModelCache::new(
+            self.cache.clone().unwrap_or_else(|| out.join("models")),
+        ))
+    }
+}
+
+/// `--algo`'s help, from the registry.
+pub(crate) fn algo_help() -> String {
+    let algos: Vec<&str> = Learner::all().map(|l| l.entry().algo).collect();
+    format!(
+        "rpe, rge-efr, or a learned goal space rge-NAME: {} (parameters in the profile's \
+         [learners.NAME]; `ugl learners` describes them); the follow-up paper's modular goal \
+         exploration (docs/armballs.md): mge-efr-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one \
+         module), random or lp (learning progress), constants in the profile's [mge]",
+        algos.join(", ")
+    )
+}
+
+/// `--learner`'s help, from the registry.
+/// `--env`: every environment of the registry, with its description.
+pub(crate) fn env_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| format!("{}: {}", e.name, e.description))
+        .collect();
+    format!("The environment: {}", envs.join("; "))
+}
+
+/// `ugl klc --env`: the CSV header of each environment, the measured coordinates.
+pub(crate) fn klc_env_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| {
+            format!(
+                "{} (CSV header `{}`)",
+                e.name,
+                e.outcome_columns[e.metric_dims()].join(",")
+            )
+        })
+        .collect();
+    format!(
+        "The environment: {}; only the controllable object is measured",
+        envs.join(", ")
+    )
+}
+
+/// `ugl render --state`: the engineered state of each environment.
+pub(crate) fn state_help() -> String {
+    let envs: Vec<String> = ugl_types::ENVIRONMENTS
+        .iter()
+        .map(|e| format!("`{}` ({})", e.outcome_columns.join(","), e.name))
+        .collect();
+    format!(
+        "Engineered state, each coordinate in [-1,1]: {}",
+        envs.join(", ")
+    )
+}
+
+pub(crate) fn learner_help() -> String {
+    let names: Vec<&str> = Learner::all()
+        .filter(|l| !l.is_external())
+        .map(Learner::name)
+        .collect();
+    format!(
+        "A registered learner ({}), or with --command the name of an external program",
+        names.join(", ")
+    )
+}

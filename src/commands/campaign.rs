@@ -1,0 +1,221 @@
+//! `ugl campaign` (and `--refresh-diagnostics`), `ugl slurm`, `ugl merge`.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use ugl_bench::campaign::config::CampaignConfig;
+use ugl_bench::campaign::plan::parse_shard;
+use ugl_bench::campaign::{CampaignOptions, Progress, plan, run_campaign};
+
+use crate::cli::CacheArgs;
+use crate::commands::single::check_out_dir;
+use crate::progress::{learner_lines, stop_on_ctrl_c, training_bars};
+
+/// `ugl campaign`: run the campaign, or with `--refresh-diagnostics` refresh its diagnostics.
+pub(crate) fn campaign(
+    config: &Path,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    quiet: bool,
+    shard: Option<&str>,
+    refresh_diagnostics: bool,
+    cache: &CacheArgs,
+) -> Result<()> {
+    let cfg = CampaignConfig::load(config)?;
+    let profile = config
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("custom")
+        .to_string();
+    if refresh_diagnostics {
+        refresh_config(&cfg, &profile, out, jobs, shard, cache)
+    } else {
+        run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
+    }
+}
+
+/// `--refresh-diagnostics` of a loaded campaign (`ugl campaign`, `ugl compare`).
+pub(crate) fn refresh_config(
+    cfg: &CampaignConfig,
+    profile: &str,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    cache: &CacheArgs,
+) -> Result<()> {
+    let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
+    if !out.is_dir() {
+        bail!("--out {}: no results directory to refresh", out.display());
+    }
+    check_out_dir(&out)?;
+    let stop = stop_on_ctrl_c("the representations in flight")?;
+    let t0 = std::time::Instant::now();
+    let model_cache = cache.resolve(&out);
+    let opts = CampaignOptions {
+        jobs,
+        profile,
+        stop: &stop,
+        shard,
+        cache: model_cache.as_ref(),
+        train_progress: None,
+        learner_messages: None,
+        checkpoint_every: cache.checkpoint_every,
+    };
+    let r = ugl_bench::campaign::remeasure::refresh_diagnostics(cfg, &out, &opts, &|label| {
+        eprintln!("refreshed {label} ({:.0} s)", t0.elapsed().as_secs_f64())
+    })?;
+    eprintln!(
+        "goal-space diagnostics: {} representations refreshed: {} runs given the latent \
+         quality measure version {} in diagnostics/ ({} already had it), {} figure samples \
+         written; {} learned-space runs not finished; in {:.1} s -> {}",
+        r.representations,
+        r.runs,
+        ugl_bench::repr::quality::MEASURE_VERSION,
+        r.current,
+        r.samples,
+        r.unfinished,
+        t0.elapsed().as_secs_f64(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// The checked `--shard`, `--out` (default `data/results/<campaign>`) and `--jobs` (default: the
+/// number of cores) of a campaign command.
+pub(crate) fn campaign_args(
+    cfg: &CampaignConfig,
+    shard: Option<&str>,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+) -> Result<(Option<(usize, usize)>, PathBuf, usize)> {
+    let shard = shard
+        .map(parse_shard)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!(e))?;
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let jobs = jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    Ok((shard, out, jobs))
+}
+
+pub(crate) fn run_config(
+    cfg: &CampaignConfig,
+    profile: &str,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    quiet: bool,
+    shard: Option<&str>,
+    cache: &CacheArgs,
+) -> Result<()> {
+    // Every argument is checked before anything touches the disk.
+    let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
+    check_out_dir(&out)?;
+    let stop = stop_on_ctrl_c("the runs in flight")?;
+    let mp = MultiProgress::new();
+    if quiet || !std::io::stderr().is_terminal() {
+        mp.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    let bar = mp.add(ProgressBar::new(0));
+    let checkpoint_every = cache.checkpoint_every;
+    let cache = cache.resolve(&out);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs  {elapsed_precise} elapsed, ETA {eta}  {msg}",
+        )
+        .expect("valid template"),
+    );
+    let t0 = std::time::Instant::now();
+    let on = |p: Progress| match p {
+        Progress::Planned { total, skipped } => {
+            bar.set_length(total as u64);
+            bar.set_position(skipped as u64);
+            if skipped > 0 {
+                bar.println(format!(
+                    "{skipped} of {total} runs already complete in {}; resuming",
+                    out.display()
+                ));
+            }
+        }
+        Progress::Finished(s) => {
+            bar.inc(1);
+            bar.set_message(format!("{} klc={:.3}", s.run, s.final_klc));
+        }
+    };
+    let opts = CampaignOptions {
+        jobs,
+        profile,
+        stop: &stop,
+        shard,
+        cache: cache.as_ref(),
+        train_progress: Some(training_bars(&mp, Some(&bar))),
+        learner_messages: Some(learner_lines(&mp, Some(&bar))),
+        checkpoint_every,
+    };
+    let done = run_campaign(cfg, &out, &opts, &on)?;
+    bar.finish_and_clear();
+    eprintln!(
+        "campaign {}: {} runs executed in {:.1} s ({} jobs) -> {}",
+        cfg.campaign.name,
+        done.len(),
+        t0.elapsed().as_secs_f64(),
+        jobs,
+        out.display()
+    );
+    Ok(())
+}
+
+pub(crate) fn slurm(
+    config: &Path,
+    shards: usize,
+    out: Option<PathBuf>,
+    scripts: &Path,
+    cpus: usize,
+    time: &str,
+) -> Result<()> {
+    use ugl_bench::campaign::slurm::{SlurmJob, scripts as slurm_scripts, write_scripts};
+    let cfg = CampaignConfig::load(config)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    let (config_abs, out_abs) = (cwd.join(config), cwd.join(&out));
+    let job = SlurmJob {
+        name: &cfg.campaign.name,
+        n_runs: plan(&cfg).len(),
+        checkout: &cwd,
+        config: &config_abs,
+        out: &out_abs,
+        shards,
+        cpus,
+        time,
+    };
+    let texts = slurm_scripts(&job)?;
+    check_out_dir(scripts)?;
+    write_scripts(scripts, &texts)?;
+    eprintln!(
+        "wrote {}/{{array,report,submit}}.sh: {} runs in {shards} shards; run {}/submit.sh",
+        scripts.display(),
+        job.n_runs,
+        scripts.display()
+    );
+    Ok(())
+}
+
+pub(crate) fn merge(into: &Path, sources: &[PathBuf]) -> Result<()> {
+    check_out_dir(into)?;
+    let done = ugl_bench::campaign::merge::merge_stores(into, sources)?;
+    eprintln!(
+        "merge: {} runs copied, {} already present and identical -> {}",
+        done.copied,
+        done.already_present,
+        into.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! `ugl learners` and `ugl compare`: the registry, and a new learner on the paper's cells.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use ugl_bench::campaign::config::CampaignConfig;
+use ugl_bench::campaign::single::{self};
+use ugl_bench::explore::Learner;
+
+use crate::cli::CompareArgs;
+use crate::commands::campaign::{refresh_config, run_config};
+
+/// `ugl learners`: the registry as a table.
+pub(crate) fn learners() {
+    println!(
+        "{:<22} {:<26} {:<9} {:<9} {:<6} description",
+        "name", "algorithm", "variants", "prior", "paper"
+    );
+    for l in Learner::all() {
+        let e = l.entry();
+        let prior = match e.prior {
+            ugl_bench::repr::registry::Prior::None => "no",
+            ugl_bench::repr::registry::Prior::Always => "yes",
+            ugl_bench::repr::registry::Prior::Declared => "declared",
+        };
+        println!(
+            "{:<22} {:<26} {:<9} {:<9} {:<6} {}",
+            e.name,
+            e.algo,
+            if e.has_variants { "yes" } else { "no" },
+            prior,
+            if e.in_paper { "yes" } else { "no" },
+            e.description
+        );
+    }
+}
+
+/// `ugl compare`: the paper's matrix cells and seeds for one more learner.
+pub(crate) fn compare(a: CompareArgs) -> Result<()> {
+    let (cfg, base) = single::compare_campaign(
+        CampaignConfig::load(&a.config)?,
+        &a.learner,
+        a.command.as_deref(),
+        a.gaussian,
+    )
+    .map_err(anyhow::Error::msg)?;
+    cfg.validate()
+        .map_err(|m| anyhow::anyhow!("{}: {m}", a.config.display()))?;
+    let out = a
+        .out
+        .unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    if a.refresh_diagnostics {
+        let profile = cfg.campaign.name.clone();
+        return refresh_config(&cfg, &profile, Some(out), a.jobs, None, &a.cache);
+    }
+    run_config(
+        &cfg,
+        &cfg.campaign.name.clone(),
+        Some(out.clone()),
+        a.jobs,
+        a.quiet,
+        None,
+        &a.cache,
+    )?;
+    print_compare_page(&out, &cfg.campaign.name, &base);
+    Ok(())
+}
+
+/// After `ugl compare`: the new learner's one-page summary (what `ugl report` writes as
+/// `compare_<campaign>.md`), from a report rendered into a temporary directory.
+pub(crate) fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) {
+    let results = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = std::env::temp_dir().join(format!("ugl-compare-{}", std::process::id()));
+    let mut opts = ugl_report::ReportOptions::new(results.to_path_buf(), tmp.clone());
+    opts.main_campaign = main_campaign.to_string();
+    let page = ugl_report::render_report(&opts)
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            let p = tmp.join(ugl_report::markdown::compare::file_name(campaign));
+            std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))
+        });
+    let _ = std::fs::remove_dir_all(&tmp);
+    match page {
+        Ok(text) => println!("{text}"),
+        Err(e) => eprintln!(
+            "no summary page ({e}); `ugl report` ranks the learner once the main campaign \
+             `{main_campaign}` is in {}",
+            results.display()
+        ),
+    }
+}

@@ -1,0 +1,6 @@
+//! The subcommands' implementations, one file per family.
+
+pub(crate) mod campaign;
+pub(crate) mod compare;
+pub(crate) mod environment;
+pub(crate) mod single;

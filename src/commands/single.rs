@@ -1,0 +1,128 @@
+//! `ugl run` and `ugl embed`: one run, or one fitted representation, outside a campaign.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use indicatif::MultiProgress;
+
+use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
+use ugl_bench::campaign::single::{self, RunRequest};
+use ugl_bench::campaign::{RunContext, RunSpec};
+use ugl_bench::explore::{Algo, SamplerKind};
+use ugl_bench::repr::cache::ModelCache;
+
+use crate::cli::{CacheArgs, EmbedArgs};
+use crate::progress::{learner_lines, progress_area, training_bars};
+
+pub(crate) fn run(a: RunRequest, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
+    let path = resolve_profile(profile)?;
+    let mut cfg = CampaignConfig::load(&path)?;
+    let spec = a.resolve(&mut cfg, &path).map_err(anyhow::Error::msg)?;
+    check_out_dir(out)?;
+    let model_cache = cache.resolve(out);
+    let mp = progress_area();
+    let ctx = single_context(&cfg, profile, model_cache.as_ref(), cache, out, &mp);
+    let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
+    println!("{}", serde_json::to_string(&summary)?);
+    Ok(())
+}
+
+/// The context of one run or one representation (`ugl run`, `ugl embed`): the whole machine's
+/// threads, training bars and learner lines in `mp`, learner logs and the model cache in `out`.
+pub(crate) fn single_context<'a>(
+    cfg: &'a CampaignConfig,
+    profile: &'a str,
+    model_cache: Option<&'a ModelCache>,
+    cache: &CacheArgs,
+    out: &'a Path,
+    mp: &MultiProgress,
+) -> RunContext<'a> {
+    RunContext {
+        campaign: &cfg.campaign.name,
+        campaign_seed: cfg.campaign.seed,
+        profile,
+        explore: &cfg.explore,
+        env: &cfg.env,
+        ugl: &cfg.ugl,
+        learners: &cfg.learners,
+        mge: &cfg.mge,
+        threads: rayon::current_num_threads(),
+        cache: model_cache,
+        train_progress: Some(training_bars(mp, None)),
+        train_threads: 0,
+        log_dir: Some(out),
+        learner_messages: Some(learner_lines(mp, None)),
+        checkpoint_every: cache.checkpoint_every,
+        role: None,
+    }
+}
+
+/// An output directory must be a directory (created if missing).
+pub(crate) fn check_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        bail!("--out {}: exists and is not a directory", out.display());
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
+}
+
+/// `ugl embed`: the latents of one fitted goal space.
+pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
+    single::check_seed(a.seed).map_err(anyhow::Error::msg)?;
+    let path = resolve_profile(&a.profile)?;
+    let mut cfg = CampaignConfig::load(&path)?;
+    single::set_images(&mut cfg, a.images).map_err(anyhow::Error::msg)?;
+    let learner = single::resolve_learner(&a.learner, a.command.as_deref(), &mut cfg)
+        .map_err(anyhow::Error::msg)?;
+    single::check_learner_variant(learner, a.variant).map_err(anyhow::Error::msg)?;
+    single::check_latents(a.latents, cfg.ugl.images).map_err(anyhow::Error::msg)?;
+    if !(2..=1000).contains(&a.grid) {
+        bail!("--grid must be between 2 and 1000, got {}", a.grid);
+    }
+    if a.out.extension().and_then(|e| e.to_str()) != Some("npy") {
+        bail!("--out {}: the file name must end in .npy", a.out.display());
+    }
+    let dir = a
+        .out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    check_out_dir(dir)?;
+    let spec = RunSpec::learned(
+        a.env,
+        Algo::Rge(learner),
+        SamplerKind::Kde,
+        a.latents,
+        a.variant.unwrap_or_default(),
+        a.seed,
+    );
+    let model_cache = a.cache.resolve(dir);
+    let mp = progress_area();
+    let ctx = single_context(&cfg, &a.profile, model_cache.as_ref(), &a.cache, dir, &mp);
+    let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid)?;
+    let stem = a.out.with_extension("");
+    let sibling = |suffix: &str| PathBuf::from(format!("{}.{suffix}.npy", stem.display()));
+    let files = [
+        (a.out.clone(), e.train.n, e.train.latents, &e.train.data),
+        (sibling("states"), e.train.n, e.state_dim, &e.train_states),
+        (sibling("grid"), e.grid.n, e.grid.latents, &e.grid.data),
+        (
+            sibling("grid_states"),
+            e.grid.n,
+            e.state_dim,
+            &e.grid_states,
+        ),
+    ];
+    for (path, rows, cols, data) in &files {
+        ugl_bench::campaign::embed::write_npy_f64(path, *rows, *cols, data)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    println!(
+        "{}",
+        serde_json::json!({
+            "representation": ugl_bench::campaign::fit::representation_label(&spec),
+            "files": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
+            "latent_quality": e.quality,
+        })
+    );
+    Ok(())
+}
