@@ -232,7 +232,7 @@ impl Campaigns {
 /// The declaration a campaign directory records ([`CampaignRecord`]); None without a record.
 fn record(d: &CampaignDir) -> Result<Option<CampaignDecl>, ReportError> {
     CampaignRecord::read(&d.path)
-        .map(|r| r.map(|r| r.decl()))
+        .map(|r| r.map(|r| r.decl))
         .map_err(|e| ReportError::Invalid {
             path: CampaignRecord::path(&d.path),
             problem: e.to_string(),

@@ -68,19 +68,13 @@ pub struct CampaignDecl {
     pub label: Option<String>,
 }
 
-/// The record of a campaign in its results directory ([`RECORD_FILE`]).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// The record of a campaign in its results directory ([`RECORD_FILE`]): its name and its
+/// declaration, as a TOML table (`name = ...`, then the declaration's keys).
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CampaignRecord {
     /// The campaign's name (`[campaign] name`).
     pub name: String,
-    pub role: CampaignRole,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub variant_of: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tag: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub label: Option<String>,
+    pub decl: CampaignDecl,
 }
 
 /// Errors reading a campaign record or a run's diagnostics.
@@ -100,20 +94,7 @@ impl CampaignRecord {
     pub fn new(name: &str, decl: &CampaignDecl) -> CampaignRecord {
         CampaignRecord {
             name: name.to_string(),
-            role: decl.role,
-            variant_of: decl.variant_of.clone(),
-            tag: decl.tag.clone(),
-            label: decl.label.clone(),
-        }
-    }
-
-    /// The declaration it records.
-    pub fn decl(&self) -> CampaignDecl {
-        CampaignDecl {
-            role: self.role,
-            variant_of: self.variant_of.clone(),
-            tag: self.tag.clone(),
-            label: self.label.clone(),
+            decl: decl.clone(),
         }
     }
 
@@ -130,19 +111,31 @@ impl CampaignRecord {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(source) => return Err(RecordError::Io { path, source }),
         };
-        toml::from_str(&text)
+        CampaignRecord::parse(&text)
             .map(Some)
-            .map_err(|e| RecordError::Parse {
-                path,
-                message: e.message().to_string(),
-            })
+            .map_err(|message| RecordError::Parse { path, message })
+    }
+
+    /// Parses a record's text; the error says what is wrong.
+    pub fn parse(text: &str) -> Result<CampaignRecord, String> {
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        let name = match table.remove("name") {
+            Some(toml::Value::String(name)) => name,
+            Some(_) => return Err("`name` is not a string".into()),
+            None => return Err("missing `name`".into()),
+        };
+        let decl = toml::Value::Table(table)
+            .try_into()
+            .map_err(|e: toml::de::Error| e.message().to_string())?;
+        Ok(CampaignRecord { name, decl })
     }
 
     /// The record's text: a comment line, then the TOML.
     pub fn to_text(&self) -> String {
-        let body = toml::to_string(self).expect("a campaign record serialises");
+        let decl = toml::to_string(&self.decl).expect("a campaign declaration serialises");
         format!(
-            "# What this campaign is, from the [campaign] table of its TOML (written by `ugl campaign`).\n{body}"
+            "# What this campaign is, from the [campaign] table of its TOML (written by `ugl campaign`).\nname = {}\n{decl}",
+            toml::Value::String(self.name.clone())
         )
     }
 }
@@ -160,15 +153,19 @@ mod tests {
             label: Some("still distractor".into()),
         };
         let r = CampaignRecord::new("armballs-still", &decl);
-        assert_eq!(r.decl(), decl);
         let text = r.to_text();
-        assert_eq!(toml::from_str::<CampaignRecord>(&text).unwrap(), r);
-        assert!(text.contains("role = \"followup\""), "{text}");
+        assert_eq!(CampaignRecord::parse(&text).unwrap(), r);
+        assert!(
+            text.contains("\nname = \"armballs-still\"\nrole = \"followup\"\n"),
+            "{text}"
+        );
         let bad = text.replace("followup", "sequel");
-        assert!(toml::from_str::<CampaignRecord>(&bad).is_err());
+        assert!(CampaignRecord::parse(&bad).is_err());
+        assert!(CampaignRecord::parse(&text.replace("tag", "tags")).is_err());
+        assert!(CampaignRecord::parse("role = \"main\"\n").is_err());
         for role in CampaignRole::ALL {
             let t = format!("name = \"x\"\nrole = \"{}\"\n", role.name());
-            assert_eq!(toml::from_str::<CampaignRecord>(&t).unwrap().role, role);
+            assert_eq!(CampaignRecord::parse(&t).unwrap().decl.role, role);
         }
     }
 }

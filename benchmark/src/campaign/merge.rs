@@ -88,8 +88,8 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
                     return Err(MergeError::RecordConflict {
                         source_dir: src.clone(),
                         into: into.to_path_buf(),
-                        theirs: format!("{} ({})", record.name, record.role.name()),
-                        ours: format!("{} ({})", theirs.name, theirs.role.name()),
+                        theirs: format!("{} ({})", record.name, record.decl.role.name()),
+                        ours: format!("{} ({})", theirs.name, theirs.decl.role.name()),
                     });
                 }
                 Some(_) => {}
@@ -160,4 +160,45 @@ fn copy_diagnostics(src: &Path, into: &Path, run_id: &str) -> Result<(), MergeEr
         store::write_diagnostics(into, &d)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ugl_types::{CampaignDecl, CampaignRole};
+
+    fn with_record(dir: &Path, name: &str, role: CampaignRole) {
+        std::fs::create_dir_all(dir).unwrap();
+        let decl = CampaignDecl {
+            role,
+            ..CampaignDecl::default()
+        };
+        let text = CampaignRecord::new(name, &decl).to_text();
+        std::fs::write(CampaignRecord::path(dir), text).unwrap();
+    }
+
+    /// The campaign record travels with the runs, and two different campaigns do not mix.
+    #[test]
+    fn the_record_is_carried_and_a_different_one_refused() {
+        let t = tempfile::tempdir().unwrap();
+        let (a, b, into) = (
+            t.path().join("a"),
+            t.path().join("b"),
+            t.path().join("into"),
+        );
+        with_record(&a, "paper", CampaignRole::Main);
+        merge_stores(&into, std::slice::from_ref(&a)).unwrap();
+        assert_eq!(
+            CampaignRecord::read(&into).unwrap(),
+            CampaignRecord::read(&a).unwrap()
+        );
+        // The same record again is fine; another campaign's is refused, naming both.
+        merge_stores(&into, std::slice::from_ref(&a)).unwrap();
+        with_record(&b, "paper-long", CampaignRole::Recipe);
+        let e = merge_stores(&into, &[b]).unwrap_err().to_string();
+        assert!(
+            e.contains("paper-long (recipe)") && e.contains("paper (main)"),
+            "{e}"
+        );
+    }
 }
