@@ -363,6 +363,7 @@ fn remove_stale_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<(), Repor
         };
         let ours = (name.ends_with(".svg")
             && (name.starts_with("klc_")
+                || name.starts_with("coverage_")
                 || name.starts_with("outcomes_")
                 || name.starts_with("budget_")
                 || name.starts_with("goal_space_")

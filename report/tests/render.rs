@@ -313,9 +313,11 @@ fn stale_figures_are_removed_but_other_files_kept() {
     synthetic_store(&results);
     std::fs::create_dir_all(out.join("figures")).unwrap();
     std::fs::write(out.join("figures/klc_gone.svg"), "x").unwrap();
+    std::fs::write(out.join("figures/coverage_gone.svg"), "x").unwrap();
     std::fs::write(out.join("figures/notes.txt"), "x").unwrap();
     render_report(&opts(&results, &out)).unwrap();
     assert!(!out.join("figures/klc_gone.svg").exists());
+    assert!(!out.join("figures/coverage_gone.svg").exists());
     assert!(out.join("figures/notes.txt").exists());
 }
 
