@@ -27,15 +27,13 @@
 //! - Any other campaign (another `main`, a recipe of another campaign, a store without a record)
 //!   is listed as present but not used (its runs are not even read).
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use ugl_types::{CampaignDecl, CampaignRecord, CampaignRole};
 
 use crate::ReportError;
 use crate::load::{CampaignDir, Store, campaign_display, scan_store};
-
-/// The prefix of the campaigns `ugl compare` writes (`compare-<learner>`).
-pub const COMPARE_PREFIX: &str = "compare-";
 
 /// A campaign that was read.
 #[derive(Debug, Clone)]
@@ -127,12 +125,17 @@ pub fn relabel_external(store: &mut Store) {
     }
 }
 
-/// Reads the main campaign `main` and the budget campaigns of the store `dir`; counts the others.
+/// Reads the main campaign `main` of the store `dir` and the campaigns whose role is `wanted`
+/// (the roles the report's sections read, [`crate::sections::wanted_roles`]); counts the others.
 ///
 /// Errors: the store missing or empty as for [`crate::load::load_store`]; the main campaign
 /// absent ([`ReportError::MissingMainCampaign`], listing the campaigns found) or without a
 /// complete run ([`ReportError::NoCompleteRuns`]); any schema problem in a run that is read.
-pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> {
+pub fn load_campaigns(
+    dir: &Path,
+    main: &str,
+    wanted: &BTreeSet<CampaignRole>,
+) -> Result<Campaigns, ReportError> {
     let dirs = scan_store(dir)?;
     if dirs.is_empty() {
         return Err(ReportError::EmptyResults(dir.to_path_buf()));
@@ -162,7 +165,11 @@ pub fn load_campaigns(dir: &Path, main: &str) -> Result<Campaigns, ReportError> 
             continue;
         }
         let decl = record(d)?;
-        match decl.as_ref().map(|decl| decl.role) {
+        match decl
+            .as_ref()
+            .map(|decl| decl.role)
+            .filter(|r| wanted.contains(r))
+        {
             Some(CampaignRole::Budget) => budget.push(read(d, decl.unwrap_or_default())?),
             Some(CampaignRole::Compare) if decl.as_ref().is_some_and(varies_main) => {
                 let mut c = read(d, decl.unwrap_or_default())?;

@@ -22,6 +22,20 @@ use crate::aggregate::ConditionSummary;
 use crate::load::{ConditionKey, Store};
 use crate::stats::{self, area_under_curve};
 
+/// Where the claims come from, as the report shows it.
+pub enum ClaimsInput<'a> {
+    /// Evaluated from this file.
+    Evaluated {
+        path: &'a std::path::Path,
+        confidence: f64,
+        n_boot: usize,
+        margin: f64,
+        results: &'a [ClaimResult],
+    },
+    /// No claims file where the report looked.
+    Missing(&'a std::path::Path),
+}
+
 /// The claims file name inside the paper directory.
 pub const FILE: &str = "claims.toml";
 

@@ -10,6 +10,7 @@ use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
 use crate::load::Run;
 use crate::markdown::quality::group_r2;
+use crate::output::Output;
 
 /// The directory under the report's output.
 pub const DIR: &str = "data";
@@ -51,11 +52,7 @@ fn runs_in_order(camp: &Campaign) -> Vec<&Run> {
 }
 
 /// Write both files into `dir`; returns their paths.
-pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError> {
-    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+pub fn write(out: &mut Output, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError> {
     let sources: Vec<&Campaign> = std::iter::once(&camps.main)
         .chain(camps.compare.iter())
         .collect();
@@ -116,11 +113,9 @@ pub fn write(dir: &Path, camps: &Campaigns) -> Result<Vec<PathBuf>, ReportError>
             }
         }
     }
-    let mut out = Vec::new();
+    let mut written = Vec::new();
     for (name, text) in [(CURVES_FILE, curves), (FINAL_FILE, finals)] {
-        let path = dir.join(name);
-        crate::write_file(&path, text.as_bytes())?;
-        out.push(path);
+        written.push(out.write(Path::new(DIR).join(name), text.as_bytes())?);
     }
-    Ok(out)
+    Ok(written)
 }

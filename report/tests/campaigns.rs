@@ -579,7 +579,12 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             })
             .map(|(p, b)| (p.rsplit('/').next().unwrap().to_string(), b))
             .collect();
-        for f in ["REPORT.md", "data/final_by_seed.csv", "data/curves.csv"] {
+        for f in [
+            "REPORT.md",
+            "data/final_by_seed.csv",
+            "data/curves.csv",
+            "files.txt",
+        ] {
             v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));
         }
         v.sort();

@@ -217,10 +217,11 @@ fn renders_report_and_figures_with_the_right_numbers() {
         }
     }
     // REPORT.md, 2 KLC and 2 coverage figures, 4 outcome scatters, the paper's 3 illustrations
-    // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 2 CSV files.
+    // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 2 CSV files,
+    // the list of files.
     let env_figures = cfg!(feature = "environment-figures");
     let illustrations = if env_figures { 3 } else { 1 };
-    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 2);
+    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 2 + 1);
     for (name, drawn) in [
         ("fig1_environments.svg", env_figures),
         ("fig5_radial_flow.svg", true),
@@ -307,18 +308,61 @@ fn rendering_twice_gives_identical_bytes() {
 
 #[test]
 fn stale_figures_are_removed_but_other_files_kept() {
+    // A render removes exactly the files of the previous render's list (`files.txt`) that it no
+    // longer writes: here the figures of a condition whose runs left the store.
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     let out = tmp.path().join("out");
     synthetic_store(&results);
-    std::fs::create_dir_all(out.join("figures")).unwrap();
-    std::fs::write(out.join("figures/klc_gone.svg"), "x").unwrap();
-    std::fs::write(out.join("figures/coverage_gone.svg"), "x").unwrap();
-    std::fs::write(out.join("figures/notes.txt"), "x").unwrap();
     render_report(&opts(&results, &out)).unwrap();
-    assert!(!out.join("figures/klc_gone.svg").exists());
-    assert!(!out.join("figures/coverage_gone.svg").exists());
+    let gone = out.join("figures/outcomes_armarrow_rge-efr_uniform_0_none.svg");
+    assert!(gone.is_file());
+    std::fs::write(out.join("figures/notes.txt"), "x").unwrap();
+    std::fs::write(out.join("figures/klc_mine.svg"), "x").unwrap();
+    for e in std::fs::read_dir(results.join("paper")).unwrap() {
+        let p = e.unwrap().path();
+        if p.file_name()
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .starts_with("armarrow.rge-efr.")
+        {
+            std::fs::remove_file(p).unwrap();
+        }
+    }
+    let s = render_report(&opts(&results, &out)).unwrap();
+    assert!(
+        !gone.exists(),
+        "a figure of the previous render that this one did not write"
+    );
     assert!(out.join("figures/notes.txt").exists());
+    assert!(
+        out.join("figures/klc_mine.svg").exists(),
+        "a file no render wrote was removed"
+    );
+    let listed = std::fs::read_to_string(out.join(ugl_report::output::FILE_LIST)).unwrap();
+    assert!(!listed.contains("armarrow_rge-efr"), "{listed}");
+    assert!(s.files.iter().all(|f| f.is_file()));
+}
+
+#[test]
+fn every_file_written_is_recorded() {
+    // Every file under the output directory of a fresh render is in its list (a section that
+    // forgot to record a file would leave it behind forever).
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    let out = tmp.path().join("out");
+    synthetic_store(&results);
+    let s = render_report(&opts(&results, &out)).unwrap();
+    let mut on_disk: Vec<String> = read_all(&out).into_iter().map(|(p, _)| p).collect();
+    on_disk.sort();
+    let mut listed: Vec<String> = s
+        .files
+        .iter()
+        .map(|f| f.strip_prefix(&out).unwrap().display().to_string())
+        .collect();
+    listed.sort();
+    assert_eq!(on_disk, listed);
 }
 
 #[test]

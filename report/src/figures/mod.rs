@@ -16,6 +16,9 @@ pub mod sampler_compare;
 pub mod training_loss;
 pub mod variants;
 
+/// The figures' directory inside the report's output directory (markdown links start with it).
+pub const DIR: &str = "figures";
+
 /// Figure 1: the environments and their rendered images (`environment-figures`).
 pub const FIG1: &str = "fig1_environments.svg";
 /// Figure 6: one DMP episode on ArmBall (`environment-figures`).

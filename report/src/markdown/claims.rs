@@ -2,25 +2,12 @@
 
 use std::fmt::Write as _;
 
-use super::{Inputs, fmt_klc, plural};
-use crate::claims::{ClaimResult, Comparison, Statistic, Verdict};
+use super::{fmt_klc, plural};
+use crate::claims::{ClaimResult, ClaimsInput, Comparison, Statistic, Verdict};
+use crate::context::Context;
 use crate::figures::outcomes::describe_key;
 use crate::figures::{condition_name, env_name, sampler_name};
 use crate::leaderboard::Entry;
-
-/// Where the claims come from, as the report shows it.
-pub enum ClaimsInput<'a> {
-    /// Evaluated from this file.
-    Evaluated {
-        path: &'a std::path::Path,
-        confidence: f64,
-        n_boot: usize,
-        margin: f64,
-        results: &'a [ClaimResult],
-    },
-    /// No claims file where the report looked.
-    Missing(&'a std::path::Path),
-}
 
 /// The symbol of a verdict.
 fn mark(v: Verdict) -> &'static str {
@@ -69,7 +56,7 @@ fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
 }
 
 /// The one-line count of verdicts for the top of the report, if claims were evaluated.
-pub fn summary_line(w: &mut String, inp: &Inputs<'_>) {
+pub fn summary_line(w: &mut String, inp: &Context<'_>) {
     if let ClaimsInput::Evaluated { results, .. } = inp.claims {
         let papers: Vec<_> = results.iter().filter(|r| !r.claim.ours).collect();
         let count = |v: Verdict| papers.iter().filter(|r| r.verdict == v).count();
@@ -92,7 +79,7 @@ pub fn summary_line(w: &mut String, inp: &Inputs<'_>) {
 }
 
 /// The claims section.
-pub fn claims(w: &mut String, inp: &Inputs<'_>) {
+pub fn claims(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "## The paper's claims\n");
     let (path, confidence, n_boot, margin, results) = match inp.claims {
         ClaimsInput::Missing(p) => {
@@ -303,7 +290,7 @@ fn tasks_cell(e: &Entry, all: usize) -> String {
 }
 
 /// The leaderboard section.
-pub fn leaderboard(w: &mut String, inp: &Inputs<'_>) {
+pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
     let lb = inp.leaderboard;
     if lb.entries.is_empty() {
         return;

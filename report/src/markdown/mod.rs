@@ -1,55 +1,23 @@
-//! `REPORT.md`: what was run, the figures, the table of final KL-coverage against the paper, and
-//! the deviations. Pure function of its inputs (sorted iteration everywhere, no clock): rendering
-//! twice gives the same bytes.
+//! The words of `REPORT.md`, one function per part (the sections of [`crate::sections`] call
+//! them in order): what was run, the figures, the table of final KL-coverage against the paper,
+//! the deviations. Pure functions of their inputs (sorted iteration everywhere, no clock):
+//! rendering twice gives the same bytes.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
 use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
-use crate::campaigns::Campaigns;
+use crate::context::Context;
 use crate::figures::outcomes::describe;
 use crate::figures::{FigureFile, env_name};
-use crate::load::{Store, campaign_display};
-use crate::neural::{BudgetAnalysis, VariantPair};
-use crate::paper::PaperTable;
+use crate::load::{Run, campaign_display};
 
 pub mod claims;
 pub mod compare;
 pub mod neural;
 pub mod quality;
 pub mod recipe;
-
-/// Everything the markdown is made of.
-pub struct Inputs<'a> {
-    pub opts: &'a ReportOptions,
-    pub campaigns: &'a Campaigns,
-    /// The main campaign's runs.
-    pub store: &'a Store,
-    pub paper: &'a PaperTable,
-    /// The main campaign's conditions.
-    pub conditions: &'a [ConditionSummary],
-    pub klc_figures: &'a [FigureFile],
-    /// Cell coverage against the epochs, as the KL-coverage figures.
-    pub coverage_figures: &'a [FigureFile],
-    pub outcome_figures: &'a [FigureFile],
-    /// Goal-space lattices and reconstruction grids (seed 0 of each learned cell).
-    pub goal_space_figures: &'a [FigureFile],
-    pub reconstruction_figures: &'a [FigureFile],
-    /// The paper's appendix figures that need no results (Figure 5: a radial flow).
-    pub appendix_figures: &'a [FigureFile],
-    /// KDE-vs-Gaussian figures (the paper's Figure 4 for RGE-VAE first).
-    pub sampler_figures: &'a [FigureFile],
-    pub variant_pairs: &'a [VariantPair<'a>],
-    pub variants_figure: Option<&'a FigureFile>,
-    pub budget: &'a BudgetAnalysis,
-    pub budget_figures: &'a [FigureFile],
-    pub loss_figure: Option<&'a FigureFile>,
-    /// The paper's claims, evaluated on the main campaign.
-    pub claims: &'a claims::ClaimsInput<'a>,
-    /// Main and `compare-*` campaigns, ranked.
-    pub leaderboard: &'a crate::leaderboard::Leaderboard,
-}
 
 /// The text of the epoch-label note (PAPER-NOTES section 4).
 pub const EPOCH_NOTE: &str = "The paper's notebooks labelled the snapshot holding 100i+12 outcomes as \
@@ -160,13 +128,8 @@ fn compute_line(w: &mut String, runs: &[crate::load::Run]) {
     );
 }
 
-pub fn render(inp: &Inputs<'_>) -> String {
-    let mut md = String::new();
-    let store = inp.store;
-    let runs = &store.runs;
-    let main = campaign_name(&inp.campaigns.main.name);
-    let w = &mut md;
-
+/// The title, the reduced-budget warning, the claims' headline and a missing paper table.
+pub fn header(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "# ugl-bench: replication report\n");
     let _ = writeln!(
         w,
@@ -182,20 +145,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
     );
 
     // --- Reduced budget: prominently, before anything else (main and budget campaigns).
-    let used: Vec<&crate::load::Run> = runs
-        .iter()
-        .chain(
-            inp.campaigns
-                .budget
-                .iter()
-                .flat_map(|c| c.store.runs.iter()),
-        )
-        .collect();
-    let reduced: Vec<&crate::load::Run> = used
-        .iter()
-        .copied()
-        .filter(|r| r.manifest.reduced_budget)
-        .collect();
+    let (used, reduced) = budget_runs(inp);
     if !reduced.is_empty() {
         let mut notes: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         for r in &reduced {
@@ -226,20 +176,73 @@ pub fn render(inp: &Inputs<'_>) -> String {
             inp.paper.looked_at.display()
         );
     }
-    let reduced_keys: BTreeSet<_> = reduced
+}
+
+/// The main and budget campaigns' runs, and those of them with a budget reduced from the paper's.
+fn budget_runs<'a>(inp: &'a Context<'_>) -> (Vec<&'a Run>, Vec<&'a Run>) {
+    let used: Vec<&Run> = inp
+        .store
+        .runs
+        .iter()
+        .chain(
+            inp.campaigns
+                .budget
+                .iter()
+                .flat_map(|c| c.store.runs.iter()),
+        )
+        .collect();
+    let reduced = used
+        .iter()
+        .copied()
+        .filter(|r| r.manifest.reduced_budget)
+        .collect();
+    (used, reduced)
+}
+
+/// Slugs of the main campaign's conditions with a reduced-budget run (marked † in the tables).
+fn reduced_keys(inp: &Context<'_>) -> BTreeSet<String> {
+    budget_runs(inp)
+        .1
         .iter()
         .filter(|r| r.campaign == inp.campaigns.main.name)
         .map(|r| r.key.slug())
-        .collect();
-    let dagger = |c: &ConditionSummary| {
-        if reduced_keys.contains(&c.key.slug()) {
-            " †"
-        } else {
-            ""
-        }
-    };
+        .collect()
+}
 
-    // --- What was run.
+fn dagger(reduced_keys: &BTreeSet<String>, c: &ConditionSummary) -> &'static str {
+    if reduced_keys.contains(&c.key.slug()) {
+        " †"
+    } else {
+        ""
+    }
+}
+
+/// The main campaign's environments, in the order of its conditions.
+fn envs<'a>(inp: &'a Context<'_>) -> Vec<&'a str> {
+    let mut envs: Vec<&str> = Vec::new();
+    for c in inp.conditions {
+        if !envs.contains(&c.key.env.as_str()) {
+            envs.push(&c.key.env);
+        }
+    }
+    envs
+}
+
+/// The distinct last epochs of the main campaign's conditions.
+fn last_epochs(inp: &Context<'_>) -> Vec<i64> {
+    let mut last_epochs: BTreeSet<i64> = BTreeSet::new();
+    for c in inp.conditions {
+        last_epochs.extend(c.final_epochs.iter().copied());
+    }
+    last_epochs.into_iter().collect()
+}
+
+/// What was run: campaigns, runs, seeds, epochs, compute and provenance, the table of conditions.
+pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
+    let store = inp.store;
+    let runs = &store.runs;
+    let main = campaign_name(&inp.campaigns.main.name);
+    let reduced_keys = reduced_keys(inp);
     let _ = writeln!(w, "## What was run (main campaign `{main}`)\n");
     neural::campaigns_line(w, inp);
     let _ = writeln!(
@@ -271,15 +274,10 @@ pub fn render(inp: &Inputs<'_>) -> String {
          which).",
         seed_counts.join(", ")
     );
-    let mut last_epochs: BTreeSet<i64> = BTreeSet::new();
-    for c in inp.conditions {
-        last_epochs.extend(c.final_epochs.iter().copied());
-    }
-    let last_epochs: Vec<i64> = last_epochs.into_iter().collect();
     let _ = writeln!(
         w,
         "- **Exploration epochs:** {} (the paper: 5000).",
-        fmt_epochs(&last_epochs)
+        fmt_epochs(&last_epochs(inp))
     );
     let _ = writeln!(
         w,
@@ -369,7 +367,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
             "| {} | {}{} | {} | {} | {} | {} ({}) | {} | {} |",
             env_name(&c.key.env),
             crate::figures::algo_name(&c.key.algo),
-            dagger(c),
+            dagger(&reduced_keys, c),
             c.key.sampler,
             if c.key.latents == 0 {
                 "—".to_string()
@@ -385,8 +383,15 @@ pub fn render(inp: &Inputs<'_>) -> String {
     }
     let _ = writeln!(w);
     neural::training_budgets(w, inp);
+}
 
-    // --- Figures.
+/// The KL-coverage curves (the paper's Figure 2) and the cell-coverage curves.
+pub fn klc_curves(
+    w: &mut String,
+    inp: &Context<'_>,
+    klc_figures: &[FigureFile],
+    coverage_figures: &[FigureFile],
+) {
     let _ = writeln!(w, "## KL-coverage during exploration\n");
     let _ = writeln!(
         w,
@@ -424,10 +429,10 @@ pub fn render(inp: &Inputs<'_>) -> String {
             names.join(", ")
         );
     }
-    for f in inp.klc_figures {
+    for f in klc_figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
     }
-    if !inp.coverage_figures.is_empty() {
+    if !coverage_figures.is_empty() {
         let _ = writeln!(
             w,
             "### Cell coverage during exploration (not in the paper)
@@ -442,12 +447,15 @@ pub fn render(inp: &Inputs<'_>) -> String {
              condition can lower its KL-coverage without reaching new cells; this figure shows \
              the diversity alone.\n"
         );
-        for f in inp.coverage_figures {
+        for f in coverage_figures {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
         }
     }
+}
 
-    // --- Final table.
+/// The table of final KL-coverage against the paper's values.
+pub fn final_table(w: &mut String, inp: &Context<'_>) {
+    let reduced_keys = reduced_keys(inp);
     let _ = writeln!(w, "## Final KL-coverage\n");
     let _ = writeln!(
         w,
@@ -459,12 +467,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
          *paper*: the paper's value (one run, ±0.03) and *Δ* = our mean − paper.\n",
         crate::aggregate::RPE_LEVEL_FACTOR
     );
-    let mut envs: Vec<&str> = Vec::new();
-    for c in inp.conditions {
-        if !envs.contains(&c.key.env.as_str()) {
-            envs.push(&c.key.env);
-        }
-    }
+    let envs = envs(inp);
     for env in &envs {
         let _ = writeln!(w, "### {}\n", env_name(env));
         let _ = writeln!(
@@ -497,7 +500,7 @@ pub fn render(inp: &Inputs<'_>) -> String {
                 w,
                 "| {}{} | {} | {} | {} | [{}, {}] | {:.0} / {:.0} | {:.1} % | {} | {} | {} |",
                 describe(c),
-                dagger(c),
+                dagger(&reduced_keys, c),
                 s.n,
                 fmt_epochs(&c.final_epochs),
                 mean_sd,
@@ -526,17 +529,11 @@ pub fn render(inp: &Inputs<'_>) -> String {
         }
         let _ = writeln!(w);
     }
+}
 
-    claims::claims(w, inp);
-    claims::leaderboard(w, inp);
-    neural::figure4(w, inp);
-    neural::variants(w, inp);
-    neural::budget(w, inp);
-    neural::training_loss(w, inp);
-    quality::section(w, inp);
-    recipe::section(w, inp);
-
-    // --- Outcome scatters.
+/// The outcome scatters (the paper's Figure 3).
+pub fn outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
+    let envs = envs(inp);
     let _ = writeln!(w, "## Object positions reached\n");
     let _ = writeln!(
         w,
@@ -549,13 +546,15 @@ pub fn render(inp: &Inputs<'_>) -> String {
     );
     for env in &envs {
         let _ = writeln!(w, "### {}\n", env_name(env));
-        for f in inp.outcome_figures.iter().filter(|f| f.env == *env) {
+        for f in figures.iter().filter(|f| f.env == *env) {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
         }
     }
+}
 
-    // --- The paper's appendix figures that need no results.
-    if !inp.appendix_figures.is_empty() {
+/// The paper's appendix figures that need no results.
+pub fn illustrations(w: &mut String, figures: &[FigureFile]) {
+    if !figures.is_empty() {
         let _ = writeln!(w, "## The paper's illustrations\n");
         let _ = writeln!(
             w,
@@ -569,12 +568,15 @@ pub fn render(inp: &Inputs<'_>) -> String {
              RPE samples them) that catches the ball: the arm every 7 steps (light to dark), the \
              hand's path (blue), the ball's start (pale) and end, and the joint commands.\n"
         );
-        for f in inp.appendix_figures {
+        for f in figures {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
         }
     }
+}
 
-    // --- Deviations and notes.
+/// Deviations from the paper and notes on the data.
+pub fn deviations(w: &mut String, inp: &Context<'_>) {
+    let store = inp.store;
     let _ = writeln!(w, "## Deviations and notes\n");
     let _ = writeln!(w, "- {EPOCH_NOTE}");
     neural::deviations(w, inp);
@@ -598,12 +600,12 @@ pub fn render(inp: &Inputs<'_>) -> String {
          distribution on the achievable cells ({}).",
         paper_envs(|e| format!("{} for {}", e.klc.achievable_cells, e.display))
     );
-    if last_epochs.iter().any(|&e| e != 5000) {
+    if last_epochs(inp).iter().any(|&e| e != 5000) {
         let _ = writeln!(
             w,
             "- Our last epoch ({}) differs from the paper's 5000 exploration epochs: the paper's \
              stars are placed at our last epoch, but they were reached after ~4812 outcomes.",
-            fmt_epochs(&last_epochs)
+            fmt_epochs(&last_epochs(inp))
         );
     }
     let infinite: Vec<String> = inp
@@ -688,12 +690,10 @@ pub fn render(inp: &Inputs<'_>) -> String {
             let _ = writeln!(w, "  - `{}`: missing {}", rel.display(), missing.join(", "));
         }
     }
-    reproduce(w, inp);
-    md
 }
 
 /// How to regenerate every campaign this report used, then the report.
-fn reproduce(w: &mut String, inp: &Inputs<'_>) {
+pub fn reproduce(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "\n## How to reproduce\n");
     let _ = writeln!(
         w,
@@ -713,7 +713,11 @@ fn reproduce(w: &mut String, inp: &Inputs<'_>) {
         let _ = writeln!(w, "{}", profile(&c.name));
     }
     for c in &inp.campaigns.compare {
-        let learner = c.name.trim_start_matches(crate::campaigns::COMPARE_PREFIX);
+        // The learner its runs recorded (`ugl compare --learner NAME` wrote them).
+        let Some(learner) = c.store.runs.iter().find_map(|r| r.manifest.learner.clone()) else {
+            let _ = writeln!(w, "{}", profile(&c.name));
+            continue;
+        };
         // An external program's command, as its runs' manifests recorded it.
         let command = c.store.runs.iter().find_map(|r| {
             let cmd = r.manifest.external_command()?;

@@ -6,11 +6,12 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::{Inputs, fmt_klc, fmt_seeds, plural};
+use super::{fmt_klc, fmt_seeds, plural};
 use crate::aggregate::ConditionSummary;
+use crate::context::Context;
 use crate::figures::budget::series_title;
 use crate::figures::sampler_compare::{self, SAMPLERS};
-use crate::figures::{algo_name, condition_name, env_name, learner_name, sampler_name};
+use crate::figures::{FigureFile, algo_name, condition_name, env_name, learner_name, sampler_name};
 use crate::load::campaign_display;
 use crate::neural::{self, BudgetPoint, paper_training};
 use crate::stats::{self, Summary};
@@ -30,7 +31,7 @@ fn campaign(name: &str) -> String {
 
 /// `- **Campaigns:** ...`: the main one, the budget and training-recipe ones, and those present
 /// but not used.
-pub fn campaigns_line(w: &mut String, inp: &Inputs<'_>) {
+pub fn campaigns_line(w: &mut String, inp: &Context<'_>) {
     let c = inp.campaigns;
     let n = c.main.store.runs.len();
     let mut parts = vec![format!(
@@ -93,7 +94,7 @@ fn values(m: &BTreeMap<String, usize>) -> String {
 }
 
 /// The training budgets actually used by the main campaign, next to the paper's.
-pub fn training_budgets(w: &mut String, inp: &Inputs<'_>) {
+pub fn training_budgets(w: &mut String, inp: &Context<'_>) {
     let used = neural::budgets_used(inp.store);
     let _ = writeln!(w, "### Neural training budgets\n");
     if used.is_empty() {
@@ -168,7 +169,7 @@ pub fn training_budgets(w: &mut String, inp: &Inputs<'_>) {
 
 /// One-line summary of the budgets for the deviations: `RGE-AE 2000 of the paper's 200000
 /// iterations (1.0%)`, plus the hidden layers where they differ.
-fn budget_deviation(inp: &Inputs<'_>) -> Option<String> {
+fn budget_deviation(inp: &Context<'_>) -> Option<String> {
     let used = neural::budgets_used(inp.store);
     let mut parts = Vec::new();
     let mut hidden = Vec::new();
@@ -265,7 +266,7 @@ fn signed(v: f64) -> String {
 }
 
 /// The paper's Figure 4 (RGE-VAE, KDE vs Gaussian goals), and the same for RGE-RFVAE if drawn.
-pub fn figure4(w: &mut String, inp: &Inputs<'_>) {
+pub fn figure4(w: &mut String, inp: &Context<'_>, sampler_figures: &[FigureFile]) {
     let _ = writeln!(
         w,
         "## RGE-VAE: KDE vs Gaussian goals (the paper's Figure 4)\n"
@@ -281,8 +282,7 @@ pub fn figure4(w: &mut String, inp: &Inputs<'_>) {
          seeds (*n* seeds).\n"
     );
     for (algo, name) in crate::SAMPLER_FIGURES {
-        let fig = inp
-            .sampler_figures
+        let fig = sampler_figures
             .iter()
             .find(|f| f.link == format!("figures/{name}"));
         if algo != "rge-vae" && fig.is_none() {
@@ -344,10 +344,10 @@ pub fn figure4(w: &mut String, inp: &Inputs<'_>) {
 }
 
 /// Faithful vs corrected: the figure and the paired-difference table.
-pub fn variants(w: &mut String, inp: &Inputs<'_>) {
+pub fn variants(w: &mut String, inp: &Context<'_>, figure: Option<&FigureFile>) {
     let _ = writeln!(w, "## Faithful vs corrected variants\n");
     let _ = writeln!(w, "{VARIANT_NOTE}\n");
-    let Some(fig) = inp.variants_figure else {
+    let Some(fig) = figure else {
         let _ = writeln!(
             w,
             "No RGE-VAE or RGE-RFVAE run with a faithful or corrected variant in the main campaign \
@@ -453,7 +453,7 @@ pub fn small_n_warning(n: usize) -> String {
     )
 }
 
-pub fn budget(w: &mut String, inp: &Inputs<'_>) {
+pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
     let _ = writeln!(w, "## Training-budget sensitivity\n");
     let camps = &inp.campaigns.budget;
     if camps.is_empty() {
@@ -492,7 +492,7 @@ pub fn budget(w: &mut String, inp: &Inputs<'_>) {
         list.join(", "),
         campaign(&inp.campaigns.main.name)
     );
-    for f in inp.budget_figures {
+    for f in figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
     }
     let budget_runs: Vec<crate::load::Run> = inp
@@ -587,8 +587,8 @@ pub fn budget(w: &mut String, inp: &Inputs<'_>) {
 }
 
 /// The training-loss figure, if any run recorded its loss.
-pub fn training_loss(w: &mut String, inp: &Inputs<'_>) {
-    let Some(f) = inp.loss_figure else {
+pub fn training_loss(w: &mut String, figure: Option<&FigureFile>) {
+    let Some(f) = figure else {
         return;
     };
     let _ = writeln!(w, "## Training losses\n");
@@ -605,7 +605,7 @@ pub fn training_loss(w: &mut String, inp: &Inputs<'_>) {
 }
 
 /// The neural learners' lines in the deviations.
-pub fn deviations(w: &mut String, inp: &Inputs<'_>) {
+pub fn deviations(w: &mut String, inp: &Context<'_>) {
     if let Some(s) = budget_deviation(inp) {
         let _ = writeln!(w, "- {s}");
     }

@@ -4,7 +4,9 @@
 
 use std::fmt::Write;
 
-use super::{Inputs, env_name, plural};
+use super::{env_name, plural};
+use crate::context::Context;
+use crate::figures::FigureFile;
 use crate::load::Manifest;
 
 /// A condition's row.
@@ -91,7 +93,7 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 /// Rows of the main campaign's learned goal spaces, one per (env, algo, variant, latents): the
 /// KDE and Gaussian runs of a cell share one representation, so the KDE runs are counted (each
 /// representation once).
-fn rows(inp: &Inputs<'_>) -> Vec<Row> {
+fn rows(inp: &Context<'_>) -> Vec<Row> {
     let mut out: Vec<Row> = Vec::new();
     for c in inp.conditions.iter().filter(|c| c.key.latents > 0) {
         if c.key.sampler != "kde" {
@@ -151,7 +153,12 @@ fn rows(inp: &Inputs<'_>) -> Vec<Row> {
 }
 
 /// The section (nothing when the campaign has no learned goal space).
-pub fn section(w: &mut String, inp: &Inputs<'_>) {
+pub fn section(
+    w: &mut String,
+    inp: &Context<'_>,
+    goal_space_figures: &[FigureFile],
+    reconstruction_figures: &[FigureFile],
+) {
     let rows = rows(inp);
     if rows.is_empty() {
         return;
@@ -269,12 +276,16 @@ pub fn section(w: &mut String, inp: &Inputs<'_>) {
         "\n{n_untrained} of {n_evidence} neural representation{} did not leave the plateau.\n",
         plural(n_evidence)
     );
-    figures(w, inp);
+    figures(w, goal_space_figures, reconstruction_figures);
 }
 
 /// The goal-space lattices and the reconstruction grids.
-fn figures(w: &mut String, inp: &Inputs<'_>) {
-    if inp.goal_space_figures.is_empty() && inp.reconstruction_figures.is_empty() {
+fn figures(
+    w: &mut String,
+    goal_space_figures: &[FigureFile],
+    reconstruction_figures: &[FigureFile],
+) {
+    if goal_space_figures.is_empty() && reconstruction_figures.is_empty() {
         let _ = writeln!(
             w,
             "No goal-space figure data in this campaign (`goal_spaces/`): \
@@ -292,10 +303,10 @@ fn figures(w: &mut String, inp: &Inputs<'_>) {
          features do; a folded or collapsed one loses it. The goal spaces' latents are the \
          same `ugl embed --grid 21` writes.\n"
     );
-    for f in inp.goal_space_figures {
+    for f in goal_space_figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
     }
-    if !inp.reconstruction_figures.is_empty() {
+    if !reconstruction_figures.is_empty() {
         let _ = writeln!(
             w,
             "Reconstructions (seed 0): eight held-out images (top row) and what the network \
@@ -303,7 +314,7 @@ fn figures(w: &mut String, inp: &Inputs<'_>) {
         );
         let _ = writeln!(w, "| goal space | held-out images / reconstructions |");
         let _ = writeln!(w, "|---|---|");
-        for f in inp.reconstruction_figures {
+        for f in reconstruction_figures {
             let label = f
                 .caption
                 .split(':')

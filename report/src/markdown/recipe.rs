@@ -12,8 +12,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::quality::{evidence, group_r2, median};
-use super::{Inputs, fmt_klc, plural};
+use super::{fmt_klc, plural};
 use crate::campaigns::Campaign;
+use crate::context::Context;
 use crate::figures::{algo_name, env_name};
 use crate::load::{ConditionKey, Run};
 use crate::neural::{learner, training};
@@ -190,7 +191,7 @@ fn cells<'a>(camp: &'a Campaign, main: &'a Campaign) -> (Vec<Cell<'a>>, usize) {
 }
 
 /// The section (nothing when there is no recipe campaign).
-pub fn section(w: &mut String, inp: &Inputs<'_>) {
+pub fn section(w: &mut String, inp: &Context<'_>) {
     let main = &inp.campaigns.main;
     if inp.campaigns.recipe.is_empty() {
         return;

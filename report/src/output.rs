@@ -1,0 +1,206 @@
+//! The report's output directory: every file a render writes is recorded here, and the list is
+//! kept beside them ([`FILE_LIST`]). A file of the previous render's list that this render did
+//! not write is stale and removed; nothing else in the directory is ever touched.
+
+use std::collections::BTreeSet;
+use std::path::{Component, Path, PathBuf};
+
+use crate::ReportError;
+use crate::figures::FigureFile;
+
+/// The list of the files the last render wrote, relative to the output directory, one per line.
+pub const FILE_LIST: &str = "files.txt";
+
+const HEADER: &str = "# The files the last `ugl report` wrote into this directory, one per line. \
+The next render removes those it no longer writes.\n";
+
+/// Where a render writes, and what it wrote.
+#[derive(Debug)]
+pub struct Output {
+    root: PathBuf,
+    /// Relative paths written by this render.
+    written: BTreeSet<PathBuf>,
+    /// Relative paths the previous render listed.
+    previous: BTreeSet<PathBuf>,
+}
+
+impl Output {
+    /// Creates `root` and `root/figures` if missing, and reads the previous render's list (none:
+    /// a first render, which removes nothing).
+    pub fn open(root: &Path) -> Result<Self, ReportError> {
+        create_dir(root)?;
+        create_dir(&root.join(crate::figures::DIR))?;
+        let list = root.join(FILE_LIST);
+        let previous = match std::fs::read_to_string(&list) {
+            Ok(text) => parse_list(&text),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => BTreeSet::new(),
+            Err(source) => return Err(ReportError::Io { path: list, source }),
+        };
+        Ok(Output {
+            root: root.to_path_buf(),
+            written: BTreeSet::new(),
+            previous,
+        })
+    }
+
+    /// The output directory.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// Where figures are drawn (`<root>/figures`).
+    pub fn figures_dir(&self) -> PathBuf {
+        self.root.join(crate::figures::DIR)
+    }
+
+    /// Writes `bytes` to `rel` (relative to the output directory) and records it.
+    pub fn write(&mut self, rel: impl AsRef<Path>, bytes: &[u8]) -> Result<PathBuf, ReportError> {
+        let path = self.root.join(rel.as_ref());
+        if let Some(dir) = path.parent() {
+            create_dir(dir)?;
+        }
+        std::fs::write(&path, bytes).map_err(|source| ReportError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        self.record(&path)?;
+        Ok(path)
+    }
+
+    /// Records a file a drawing backend wrote itself (`path` under the output directory).
+    pub fn record(&mut self, path: &Path) -> Result<(), ReportError> {
+        let rel = path
+            .strip_prefix(&self.root)
+            .ok()
+            .filter(|rel| is_plain_relative(rel))
+            .ok_or_else(|| ReportError::Invalid {
+                path: path.to_path_buf(),
+                problem: format!(
+                    "not a file under the output directory {}",
+                    self.root.display()
+                ),
+            })?;
+        self.written.insert(rel.to_path_buf());
+        Ok(())
+    }
+
+    /// Records drawn figures and hands them back.
+    pub fn figures(&mut self, figs: Vec<FigureFile>) -> Result<Vec<FigureFile>, ReportError> {
+        for f in &figs {
+            self.record(&f.path)?;
+        }
+        Ok(figs)
+    }
+
+    /// Records an optional figure and hands it back.
+    pub fn figure(&mut self, fig: Option<FigureFile>) -> Result<Option<FigureFile>, ReportError> {
+        if let Some(f) = &fig {
+            self.record(&f.path)?;
+        }
+        Ok(fig)
+    }
+
+    /// Removes the previous render's files this one did not write, writes the new list, and
+    /// returns every file written (the list last), as full paths in sorted order.
+    pub fn finish(mut self) -> Result<Vec<PathBuf>, ReportError> {
+        let stale: Vec<&PathBuf> = self.previous.difference(&self.written).collect();
+        for rel in stale {
+            let path = self.root.join(rel);
+            if path.is_file() {
+                tracing::info!(path = %path.display(), "removing a file the previous render wrote and this one did not");
+                std::fs::remove_file(&path).map_err(|source| ReportError::Io { path, source })?;
+            }
+        }
+        let mut text = HEADER.to_string();
+        for rel in &self.written {
+            text.push_str(&rel.to_string_lossy());
+            text.push('\n');
+        }
+        let list = self.root.join(FILE_LIST);
+        std::fs::write(&list, text).map_err(|source| ReportError::Io {
+            path: list.clone(),
+            source,
+        })?;
+        self.written.insert(PathBuf::from(FILE_LIST));
+        Ok(self.written.iter().map(|rel| self.root.join(rel)).collect())
+    }
+}
+
+/// The entries of a list: comment lines skipped, and only plain relative paths (no `..`, no
+/// absolute path), so that a damaged list can never reach outside the output directory.
+fn parse_list(text: &str) -> BTreeSet<PathBuf> {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(PathBuf::from)
+        .filter(|p| is_plain_relative(p) && p != Path::new(FILE_LIST))
+        .collect()
+}
+
+fn is_plain_relative(p: &Path) -> bool {
+    p.components().count() > 0 && p.components().all(|c| matches!(c, Component::Normal(_)))
+}
+
+fn create_dir(dir: &Path) -> Result<(), ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_files_are_the_previous_list_minus_this_render() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path();
+        let mut out = Output::open(root).unwrap();
+        out.write("a.md", b"a").unwrap();
+        out.write("figures/b.svg", b"b").unwrap();
+        let files = out.finish().unwrap();
+        assert_eq!(
+            files,
+            [
+                root.join("a.md"),
+                root.join("figures/b.svg"),
+                root.join(FILE_LIST)
+            ]
+        );
+        std::fs::write(root.join("notes.txt"), "mine").unwrap();
+        let mut out = Output::open(root).unwrap();
+        out.write("a.md", b"a2").unwrap();
+        out.finish().unwrap();
+        assert!(!root.join("figures/b.svg").exists(), "stale figure kept");
+        assert!(
+            root.join("notes.txt").exists(),
+            "a file never written was removed"
+        );
+        let list = std::fs::read_to_string(root.join(FILE_LIST)).unwrap();
+        assert!(list.ends_with("\na.md\n"), "{list}");
+    }
+
+    #[test]
+    fn a_damaged_list_cannot_reach_outside() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path().join("out");
+        std::fs::create_dir_all(&root).unwrap();
+        let outside = tmp.path().join("precious.txt");
+        std::fs::write(&outside, "keep").unwrap();
+        std::fs::write(
+            root.join(FILE_LIST),
+            format!("../precious.txt\n{}\n/etc/hostname\n", outside.display()),
+        )
+        .unwrap();
+        Output::open(&root).unwrap().finish().unwrap();
+        assert!(outside.exists());
+    }
+
+    #[test]
+    fn recording_a_file_outside_is_an_error() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut out = Output::open(&tmp.path().join("out")).unwrap();
+        assert!(out.record(&tmp.path().join("elsewhere.svg")).is_err());
+    }
+}
