@@ -89,6 +89,66 @@ pub struct Claim {
     /// ("can be beneficial").
     #[serde(default)]
     pub quantifier: Quantifier,
+    /// The margin as a fraction of each comparison's reference mean ("within 10% of"), instead
+    /// of `margin`.
+    #[serde(default)]
+    pub relative_margin: Option<f64>,
+    /// What must hold of the results for the claim to be about them at all (the follow-up's
+    /// claims about a disentangled space); the verdict is shown with it.
+    #[serde(default)]
+    pub premise: Option<Premise>,
+}
+
+/// A condition on the results that a claim presupposes.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Premise {
+    /// At least one network of this learner has a latent that encodes only the controllable
+    /// object and one that encodes only the distractor (ArmBalls).
+    pub disentangled: String,
+}
+
+/// A premise checked on the results.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PremiseCheck {
+    pub met: bool,
+    /// What was counted, in words.
+    pub counted: String,
+}
+
+/// What a claims file is evaluated on: conditions and, per condition, the per-seed values of a
+/// statistic. The main campaign is one ([`CampaignObservations`]); the follow-up's campaigns
+/// are another (`crate::armballs`).
+pub trait Observations {
+    /// The conditions, in report order.
+    fn keys(&self) -> Vec<ConditionKey>;
+    /// The per-seed values of `statistic` for the condition `key` (seed order; empty when the
+    /// statistic is not measured there).
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64>;
+    /// Whether `premise` holds on these results (None: it cannot be checked on them).
+    fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
+        let _ = premise;
+        None
+    }
+}
+
+/// The conditions of one campaign, with the runs of its store.
+pub struct CampaignObservations<'a> {
+    pub conditions: &'a [ConditionSummary],
+    pub store: &'a Store,
+}
+
+impl Observations for CampaignObservations<'_> {
+    fn keys(&self) -> Vec<ConditionKey> {
+        self.conditions.iter().map(|c| c.key.clone()).collect()
+    }
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64> {
+        self.conditions
+            .iter()
+            .find(|c| &c.key == key)
+            .map(|c| values(self.store, c, statistic))
+            .unwrap_or_default()
+    }
 }
 
 /// How a claim's verdict follows from its comparisons' verdicts.
@@ -160,6 +220,13 @@ pub enum Statistic {
     /// Mean distance from the origin (the centre of the disk of reachable positions) of the
     /// object's final positions in the episodes that moved it: larger is nearer the boundary.
     Boundary,
+    /// ArmBalls: the follow-up's exploration ratio of the controllable ball at the last epoch
+    /// (ball cells visited, of all cells of its grid).
+    BallRatio,
+    /// ArmBalls, modular exploration: the share of goals drawn in the module that encodes the
+    /// ball best (engineered features: the ball's module; a learned space: the module with the
+    /// largest ball R² − distractor R²).
+    BallModuleGoals,
 }
 
 impl Statistic {
@@ -170,6 +237,8 @@ impl Statistic {
             Statistic::Moved => "episodes that moved the object",
             Statistic::Boundary => "mean distance of the moved object from the centre",
             Statistic::Coverage => "fraction of the achievable cells reached",
+            Statistic::BallRatio => "final exploration ratio of the ball",
+            Statistic::BallModuleGoals => "share of goals in the ball's module",
         }
     }
 }
@@ -320,6 +389,16 @@ pub fn parse_claims(text: &str, path: &Path) -> Result<ClaimsFile, ReportError> 
         if let Some(m) = c.margin {
             check_margin(m).map_err(|m| invalid(format!("claim `{}`: margin {m}", c.id)))?;
         }
+        if let Some(m) = c.relative_margin {
+            check_margin(m)
+                .map_err(|m| invalid(format!("claim `{}`: relative_margin {m}", c.id)))?;
+            if c.margin.is_some() {
+                return Err(invalid(format!(
+                    "claim `{}`: give `margin` or `relative_margin`, not both",
+                    c.id
+                )));
+            }
+        }
         for (side, sel) in [("subject", &c.subject), ("reference", &c.reference)] {
             if let Some(LatentsSelector::Named(n)) = &sel.latents
                 && n != "true"
@@ -405,6 +484,9 @@ pub struct Comparison {
     pub diff: f64,
     pub lo: f64,
     pub hi: f64,
+    /// The margin of this comparison's relation (the claim's, or its `relative_margin` times
+    /// the reference mean).
+    pub margin: f64,
     pub verdict: Verdict,
 }
 
@@ -418,6 +500,8 @@ pub struct ClaimResult {
     /// The same claim on the paper's own reference values ([`check_on_paper`]); set by
     /// [`attach_paper_checks`].
     pub paper: Option<PaperCheck>,
+    /// The claim's premise, checked on the results (None: it has none).
+    pub premise: Option<PremiseCheck>,
 }
 
 /// One comparison of a claim on the paper's own values (single runs, so no interval).
@@ -519,35 +603,41 @@ pub fn values(store: &Store, cond: &ConditionSummary, statistic: Statistic) -> V
                     let v: Vec<f64> = run.curve.iter().map(|p| p.klc).collect();
                     area_under_curve(&e, &v).ok()
                 }
+                // Measured on the follow-up's campaigns only (`crate::armballs`).
+                Statistic::BallRatio | Statistic::BallModuleGoals => None,
             }
         })
         .collect()
 }
 
-/// Evaluates every claim on the conditions of one campaign (`store` holds their runs). The
-/// bootstrap of each comparison is seeded from `seed`, the claim id and both conditions.
+/// Evaluates every claim on the conditions of one campaign (`store` holds their runs).
 pub fn evaluate(
     file: &ClaimsFile,
     conditions: &[ConditionSummary],
     store: &Store,
     seed: u64,
 ) -> Vec<ClaimResult> {
+    evaluate_on(file, &CampaignObservations { conditions, store }, seed)
+}
+
+/// Evaluates every claim of `file` on `obs`. Each subject condition is compared with every
+/// reference condition that agrees with it on `pair_on`; the bootstrap of each comparison is
+/// seeded from `seed`, the claim id and both conditions.
+pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations, seed: u64) -> Vec<ClaimResult> {
     let alpha = 1.0 - file.settings.confidence;
+    let keys = obs.keys();
     file.claims
         .iter()
         .map(|claim| {
             let margin = claim.margin.unwrap_or(file.settings.margin);
-            let set = claim.relation.interval(margin);
             let mut comparisons = Vec::new();
-            for s in conditions.iter().filter(|c| claim.subject.matches(&c.key)) {
-                let xs = values(store, s, claim.statistic);
-                for r in conditions.iter().filter(|c| {
-                    c.key != s.key
-                        && claim.reference.matches(&c.key)
-                        && same_on(&claim.pair_on, &s.key, &c.key)
+            for s in keys.iter().filter(|k| claim.subject.matches(k)) {
+                let xs = obs.values(s, claim.statistic);
+                for r in keys.iter().filter(|k| {
+                    *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k)
                 }) {
-                    let ys = values(store, r, claim.statistic);
-                    let label = format!("claim|{}|{}|{}", claim.id, s.key.slug(), r.key.slug());
+                    let ys = obs.values(r, claim.statistic);
+                    let label = format!("claim|{}|{}|{}", claim.id, s.slug(), r.slug());
                     let Some((diff, lo, hi)) = stats::difference_of_means_ci(
                         &xs,
                         &ys,
@@ -557,27 +647,43 @@ pub fn evaluate(
                     ) else {
                         continue;
                     };
+                    let reference_mean = stats::mean(&ys);
+                    let margin = match claim.relative_margin {
+                        Some(f) => f * reference_mean.abs(),
+                        None => margin,
+                    };
                     comparisons.push(Comparison {
-                        subject: s.key.clone(),
-                        reference: r.key.clone(),
+                        subject: s.clone(),
+                        reference: r.clone(),
                         n_subject: xs.len(),
                         n_reference: ys.len(),
                         subject_mean: stats::mean(&xs),
-                        reference_mean: stats::mean(&ys),
+                        reference_mean,
                         diff,
                         lo,
                         hi,
-                        verdict: Verdict::of_interval(lo, hi, set),
+                        margin,
+                        verdict: Verdict::of_interval(lo, hi, claim.relation.interval(margin)),
                     });
                 }
             }
             let verdicts: Vec<Verdict> = comparisons.iter().map(|c| c.verdict).collect();
+            let premise = claim.premise.as_ref().map(|p| {
+                obs.premise(p).unwrap_or_else(|| PremiseCheck {
+                    met: false,
+                    counted: format!(
+                        "whether a {} network is disentangled cannot be checked on these results",
+                        p.disentangled
+                    ),
+                })
+            });
             ClaimResult {
                 verdict: claim.quantifier.combine(&verdicts),
                 claim: claim.clone(),
                 margin,
                 comparisons,
                 paper: None,
+                premise,
             }
         })
         .collect()

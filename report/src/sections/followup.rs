@@ -25,6 +25,7 @@ impl Section for Followup {
             lead,
             &variants,
             &out.figures_dir(),
+            &ctx.opts.paper_dir,
             ctx.opts.n_boot,
             ctx.opts.bootstrap_seed,
         )?

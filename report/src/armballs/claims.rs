@@ -1,0 +1,298 @@
+//! The follow-up's claims (`data/paper/followup_claims.toml`), evaluated by the one claims
+//! engine ([`crate::claims`]) on the follow-up's runs: each algorithm of the campaigns is a
+//! condition, its runs' final ball ratio or ball-module share of goals the per-seed values.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+use super::labels::{f3, tag};
+use super::runs::{FollowupRun, algos, display, of, role};
+use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
+use crate::figures::learner_name;
+use crate::load::ConditionKey;
+
+/// The claims file of the follow-up, in the paper directory.
+pub const FILE: &str = "followup_claims.toml";
+
+/// The environment of the follow-up's conditions.
+const ENV: &str = "armballs";
+
+/// The follow-up's runs as the claims engine sees them.
+pub struct FollowupObservations<'a> {
+    pub runs: &'a [FollowupRun],
+}
+
+fn key(algo: &str) -> ConditionKey {
+    ConditionKey {
+        env: ENV.into(),
+        algo: algo.into(),
+        sampler: String::new(),
+        latents: 0,
+        variant: String::new(),
+    }
+}
+
+impl Observations for FollowupObservations<'_> {
+    fn keys(&self) -> Vec<ConditionKey> {
+        algos(self.runs).iter().map(|a| key(a)).collect()
+    }
+
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64> {
+        let runs = of(self.runs, &key.algo);
+        match statistic {
+            Statistic::BallRatio => runs.iter().map(|r| r.final_ratio()).collect(),
+            Statistic::BallModuleGoals => {
+                runs.iter().filter_map(|r| ball_module_goals(r)).collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
+        let (yes, n) = disentangled(self.runs, &premise.disentangled);
+        Some(PremiseCheck {
+            met: yes > 0,
+            counted: format!(
+                "{} networks with a ball-only and a distractor-only latent: {yes} of {n}",
+                learner_name(&premise.disentangled)
+            ),
+        })
+    }
+}
+
+/// The share of a modular run's goals drawn in the module that encodes the ball best: the
+/// module named `ball` (engineered features), else the one with the largest ball R² −
+/// distractor R² (a learned space). None for a run without modules.
+fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
+    let fin = r.final_interest();
+    let total: i64 = fin.values().map(|v| v.1).sum();
+    if total == 0 {
+        return None;
+    }
+    let by_name = r
+        .modules
+        .iter()
+        .find(|(_, (name, _))| name == "ball")
+        .map(|(m, _)| *m);
+    let ball = by_name.or_else(|| {
+        r.modules
+            .keys()
+            .filter_map(|m| r.module_objects(*m).map(|(b, d)| (*m, b - d)))
+            .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
+            .map(|(m, _)| m)
+    })?;
+    Some(fin.get(&ball).map_or(0, |v| v.1) as f64 / total as f64)
+}
+
+/// How many of the learned networks of `learner` have a ball-only and a distractor-only latent
+/// (one network per variant campaign and seed).
+fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
+    let mut seen = BTreeSet::new();
+    let mut n = 0;
+    let mut yes = 0;
+    for r in runs {
+        let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
+            continue;
+        };
+        if l != learner || !seen.insert((tag(&r.algo).to_string(), r.seed)) {
+            continue;
+        }
+        n += 1;
+        let roles: Vec<&str> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
+        if roles.contains(&"ball") && roles.contains(&"distractor") {
+            yes += 1;
+        }
+    }
+    (yes, n)
+}
+
+/// A claim's verdict in words: the engine's, or "premise not met" with it.
+pub fn verdict(r: &ClaimResult) -> String {
+    let v = if r.comparisons.is_empty() {
+        let missing: Vec<String> = r
+            .claim
+            .subject
+            .algo
+            .iter()
+            .chain(r.claim.reference.algo.iter())
+            .flatten()
+            .cloned()
+            .collect();
+        format!("not run ({})", missing.join(", "))
+    } else {
+        r.verdict.label().to_string()
+    };
+    match &r.premise {
+        Some(p) if !p.met => format!("premise not met (difference: {v})"),
+        _ => v,
+    }
+}
+
+/// The claims table: claim, source, our test, what was measured, the verdict.
+pub fn table(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "| claim | source | our test | measured | verdict |\n|---|---|---|---|---|"
+    );
+    for r in results {
+        let several = r.comparisons.len() > 1;
+        let mut measured: Vec<String> = r
+            .comparisons
+            .iter()
+            .map(|c| {
+                let mut m = format!(
+                    "{} {} − {} {} = {} [{}, {}]",
+                    display(runs, &c.subject.algo),
+                    f3(c.subject_mean),
+                    display(runs, &c.reference.algo),
+                    f3(c.reference_mean),
+                    f3(c.diff),
+                    f3(c.lo),
+                    f3(c.hi)
+                );
+                if r.claim.relative_margin.is_some() {
+                    let _ = write!(m, ", margin ±{}", f3(c.margin));
+                }
+                if several {
+                    let _ = write!(m, " ({})", c.verdict.label());
+                }
+                m
+            })
+            .collect();
+        if measured.is_empty() {
+            measured.push("n/a".into());
+        }
+        if let Some(p) = &r.premise {
+            measured.push(p.counted.clone());
+        }
+        let _ = writeln!(
+            t,
+            "| {} | {} | {} | {} | **{}** |",
+            r.claim.id,
+            r.claim.source,
+            r.claim.statement,
+            measured.join("; "),
+            verdict(r)
+        );
+    }
+    t
+}
+
+/// How many claims are reproduced, not reproduced, inconclusive (premise not met counts apart).
+pub fn counts(results: &[ClaimResult]) -> (usize, usize, usize, usize) {
+    let premise_not_met = |r: &&ClaimResult| r.premise.as_ref().is_some_and(|p| !p.met);
+    let n = |v: Verdict| {
+        results
+            .iter()
+            .filter(|r| !premise_not_met(r) && !r.comparisons.is_empty() && r.verdict == v)
+            .count()
+    };
+    (
+        n(Verdict::Reproduced),
+        n(Verdict::NotReproduced),
+        n(Verdict::Inconclusive),
+        results.iter().filter(premise_not_met).count(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::armballs::runs::ball_cells;
+    use crate::claims::{evaluate_on, parse_claims};
+
+    fn run(algo: &str, seed: i64, ratio: f64) -> FollowupRun {
+        FollowupRun {
+            algo: algo.into(),
+            seed,
+            epochs: vec![100],
+            ball_coverage: vec![{
+                let (reachable, all) = ball_cells();
+                ratio * all / reachable
+            }],
+            ball_klc: vec![1.0],
+            distractor_coverage: vec![Some(0.3)],
+            distractor_klc: vec![Some(2.0)],
+            modules: BTreeMap::new(),
+            interest: Vec::new(),
+            learner: None,
+            loss_fraction: None,
+            knn_ball: None,
+            knn_distractor: None,
+            per_latent: None,
+            variant_label: algo.contains('@').then(|| "still distractor".into()),
+        }
+    }
+
+    fn committed() -> crate::claims::ClaimsFile {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../data/paper")
+            .join(FILE);
+        let text = std::fs::read_to_string(&path).unwrap();
+        parse_claims(&text, &path).unwrap()
+    }
+
+    #[test]
+    fn verdicts_follow_the_intervals() {
+        let mut runs = Vec::new();
+        for s in 0..5 {
+            runs.push(run("rpe", s, 0.10 + 0.001 * s as f64));
+            runs.push(run("mge-efr-flat", s, 0.20 + 0.002 * s as f64));
+            runs.push(run("mge-efr-lp", s, 0.30 + 0.002 * s as f64));
+            runs.push(run("mge-efr-flat@still", s, 0.35 + 0.002 * s as f64));
+        }
+        assert_eq!(
+            display(&runs, "mge-efr-flat@still"),
+            "RGE-EFR (flat), still distractor"
+        );
+        let mut file = committed();
+        file.settings.n_boot = 500;
+        let c = evaluate_on(&file, &FollowupObservations { runs: &runs }, 0);
+        let get = |id: &str| c.iter().find(|c| c.claim.id == id).unwrap();
+        assert_eq!(verdict(get("C4")), "reproduced");
+        assert_eq!(get("C4").comparisons.len(), 2);
+        assert_eq!(verdict(get("C6")), "reproduced");
+        // Variant campaigns are not goal explorers of C6.
+        assert!(
+            get("C6")
+                .comparisons
+                .iter()
+                .all(|c| !c.subject.algo.contains('@'))
+        );
+        assert!(
+            verdict(get("C1")).contains("not run"),
+            "{}",
+            verdict(get("C1"))
+        );
+        assert!(verdict(get("C1")).starts_with("premise not met"));
+        // Swap: the flat one wins.
+        for r in &mut runs {
+            if r.algo == "mge-efr-flat" {
+                r.ball_coverage[0] *= 3.0;
+            }
+        }
+        let c = evaluate_on(&file, &FollowupObservations { runs: &runs }, 0);
+        let c4 = c.iter().find(|c| c.claim.id == "C4").unwrap();
+        assert_eq!(verdict(c4), "not reproduced");
+    }
+
+    #[test]
+    fn ball_module_share_picks_the_ball_module() {
+        let mut r = run("mge-efr-lp", 0, 0.3);
+        r.modules.insert(0, ("ball".into(), vec![0, 1]));
+        r.modules.insert(1, ("distractor".into(), vec![2, 3]));
+        r.interest = vec![(100, 0, 0.5, 80), (100, 1, 0.1, 20), (50, 0, 0.5, 1)];
+        assert_eq!(ball_module_goals(&r), Some(0.8));
+        // A learned space: the module whose latents encode the ball best.
+        let mut l = run("mge-bvae-lp", 0, 0.3);
+        l.modules.insert(0, ("0".into(), vec![0]));
+        l.modules.insert(1, ("1".into(), vec![1]));
+        l.per_latent = Some((vec![0.1, 0.9], vec![0.8, 0.0]));
+        l.interest = vec![(100, 0, 0.5, 70), (100, 1, 0.1, 30)];
+        assert_eq!(ball_module_goals(&l), Some(0.3));
+        assert_eq!(ball_module_goals(&run("rpe", 0, 0.1)), None);
+    }
+}

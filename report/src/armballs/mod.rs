@@ -1,0 +1,111 @@
+//! Beyond the paper: the follow-up's question (Laversanne-Finot, Péré & Oudeyer, CoRL 2018,
+//! "Curiosity Driven Exploration of Learned Disentangled Goal Spaces"), on the `followup`
+//! campaigns: exploration of the controllable ball when the scene holds a distractor, the
+//! interest (learning progress) of each goal module over time, how disentangled each learned goal
+//! space is, and the follow-up's claims (`data/paper/followup_claims.toml`, evaluated by the one
+//! claims engine; `docs/armballs.md` says how each is formalised).
+//!
+//! Inputs: the runs of the follow-up campaign and its variants: their curves (ball and distractor
+//! coverage), their `<run>.interest.parquet` (modular runs) and their manifests'
+//! `latent_quality.per_latent`. Output: the page `armballs.md`, two figures, and a summary for
+//! `REPORT.md`. One module per concern: `runs` (reading), `labels` (names and order), `claims`
+//! (the engine's view of the runs, and the claims table), `figures`, `page`.
+
+mod claims;
+mod figures;
+mod labels;
+mod page;
+mod runs;
+
+use std::path::Path;
+
+pub use claims::{FILE as CLAIMS_FILE, FollowupObservations};
+pub use labels::label;
+pub use runs::{FollowupRun, load};
+
+use crate::ReportError;
+use crate::campaigns::Campaign;
+use crate::claims::ClaimResult;
+use crate::figures::FigureFile;
+
+/// The page this section writes.
+pub const PAGE: &str = "armballs.md";
+/// Its figures.
+pub const COVERAGE_FIGURE: &str = "armballs_coverage.svg";
+pub const INTEREST_FIGURE: &str = "armballs_interest.svg";
+
+/// What the section produced.
+pub struct Section {
+    /// The page `armballs.md`.
+    pub page: String,
+    /// The section of `REPORT.md` (claims and a link to the page).
+    pub summary: String,
+    pub figures: Vec<FigureFile>,
+}
+
+/// The follow-up's claims, as the page shows them.
+pub enum FollowupClaims<'a> {
+    /// Evaluated from this file.
+    Evaluated {
+        path: &'a Path,
+        confidence: f64,
+        n_boot: usize,
+        results: Vec<ClaimResult>,
+    },
+    /// No claims file where the report looked.
+    Missing(&'a Path),
+}
+
+/// Renders the section; `None` when the campaigns have no run. `paper_dir` holds the claims
+/// file; `n_boot` and `seed` drive the exploration table's intervals and the claims' bootstrap.
+pub fn render(
+    campaign: &Campaign,
+    variants: &[&Campaign],
+    fig_dir: &Path,
+    paper_dir: &Path,
+    n_boot: usize,
+    seed: u64,
+) -> Result<Option<Section>, ReportError> {
+    let mut runs = load(campaign)?;
+    for v in variants {
+        runs.extend(load(v)?);
+    }
+    runs.sort_by(|a, b| {
+        labels::algo_order(&a.algo)
+            .cmp(&labels::algo_order(&b.algo))
+            .then(a.seed.cmp(&b.seed))
+    });
+    if runs.is_empty() {
+        return Ok(None);
+    }
+    let mut figures = vec![figures::draw_coverage(&runs, fig_dir)?];
+    figures.extend(figures::draw_interest(&runs, fig_dir)?);
+    let path = paper_dir.join(CLAIMS_FILE);
+    let followup_claims = if path.exists() {
+        let file = crate::claims::load_claims(&path)?;
+        let results =
+            crate::claims::evaluate_on(&file, &FollowupObservations { runs: &runs }, seed);
+        FollowupClaims::Evaluated {
+            path: &path,
+            confidence: file.settings.confidence,
+            n_boot: file.settings.n_boot,
+            results,
+        }
+    } else {
+        FollowupClaims::Missing(&path)
+    };
+    let (page, summary) = page::write(
+        campaign,
+        variants,
+        &runs,
+        &figures,
+        &followup_claims,
+        n_boot,
+        seed,
+    );
+    Ok(Some(Section {
+        page,
+        summary,
+        figures,
+    }))
+}

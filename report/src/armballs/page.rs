@@ -1,0 +1,313 @@
+//! The page `armballs.md`: exploration of the ball per algorithm with the distractor control,
+//! the interest of each module, the disentanglement of each network, the claims.
+
+use std::fmt::Write as _;
+
+use super::labels::{f2, f3, parts, tag};
+use super::runs::{
+    ENCODES, FollowupRun, IGNORES, algos, ball_cells, ball_grid, display, of, ratios, role,
+};
+use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
+use crate::campaigns::Campaign;
+use crate::figures::{FigureFile, learner_name};
+use crate::stats::{derive_seed, mean};
+
+/// Level of the intervals of the exploration table.
+const CONFIDENCE: f64 = 0.95;
+
+/// The page, and the section of `REPORT.md` (its claims and a link to the page).
+pub(super) fn write(
+    campaign: &Campaign,
+    variants: &[&Campaign],
+    runs: &[FollowupRun],
+    figures: &[FigureFile],
+    followup_claims: &FollowupClaims<'_>,
+    n_boot: usize,
+    seed: u64,
+) -> (String, String) {
+    let mut p = String::new();
+    let name = std::iter::once(campaign.name.as_str())
+        .chain(variants.iter().map(|v| v.name.as_str()))
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(" and ");
+    let n_seeds = {
+        let mut s: Vec<i64> = runs.iter().map(|r| r.seed).collect();
+        s.sort();
+        s.dedup();
+        s.len()
+    };
+    let _ = writeln!(
+        p,
+        "# Beyond the paper: a distractor (ArmBalls)\n\n\
+         The follow-up of the same authors (Laversanne-Finot, Péré & Oudeyer, CoRL 2018, \
+         *Curiosity Driven Exploration of Learned Disentangled Goal Spaces*) asks what happens \
+         when the scene holds an object the agent cannot control. Campaigns {name} \
+         ({} runs, {n_seeds} seeds): ArmBall's arm and ball plus a **distractor** ball that \
+         follows a seeded random walk (`docs/armballs.md`); random parameters (RPE) and goal \
+         exploration with engineered features (EFR: ball and distractor positions) or in goal \
+         spaces learned from images of both balls (VAE, β-VAE, 10 latents), each **flat** (one \
+         module, the follow-up's RGE) or **modular** (MGE: one module per object, or pairs of \
+         latents), the module chosen at random or by **learning progress** (LP, curiosity). \
+         Exploration is measured on the controllable ball; the distractor, which no policy \
+         can move, is measured the same way as a control.\n",
+        runs.len()
+    );
+
+    // 1. Exploration of the ball.
+    let _ = writeln!(
+        p,
+        "## Exploration of the controllable ball\n\n\
+         Final values after the last exploration iteration, mean over seeds with a \
+         {:.0}% bootstrap interval of the mean. *Ratio* is the follow-up's exploration ratio \
+         (ball cells visited on a {bins}x{bins} grid over [-1, 1]², divided by all {all} \
+         cells; at most {most:.2}); *KLC* is the paper's KL-coverage (lower is better). The \
+         distractor columns are \
+         the control: its walk does not depend on the policy, so every algorithm should get \
+         the same values there.\n",
+        CONFIDENCE * 100.0,
+        bins = ball_grid().bins,
+        all = ball_cells().1,
+        most = ball_cells().0 / ball_cells().1,
+    );
+    p.push_str(
+        "| algorithm | seeds | ball ratio | ball KLC | distractor ratio (control) | distractor KLC (control) |\n|---|---|---|---|---|---|\n",
+    );
+    for a in algos(runs) {
+        let rs = of(runs, &a);
+        let r = ratios(runs, &a);
+        let s = summarize_at(&r, n_boot, derive_seed(seed, &format!("armballs/{a}")));
+        let klc: Vec<f64> = rs
+            .iter()
+            .map(|r| r.ball_klc.last().copied().unwrap_or(f64::NAN))
+            .collect();
+        // The distractor's measure counts all 900 cells: its coverage is the ratio.
+        let dratio: Vec<f64> = rs
+            .iter()
+            .filter_map(|r| r.distractor_coverage.last().copied().flatten())
+            .collect();
+        let dklc: Vec<f64> = rs
+            .iter()
+            .filter_map(|r| r.distractor_klc.last().copied().flatten())
+            .collect();
+        let _ = writeln!(
+            p,
+            "| {} | {} | {} [{}, {}] | {} | {} | {} |",
+            display(runs, &a),
+            rs.len(),
+            f3(s.0),
+            f3(s.1),
+            f3(s.2),
+            f3(mean(&klc)),
+            if dratio.is_empty() {
+                "n/a".into()
+            } else {
+                f3(mean(&dratio))
+            },
+            if dklc.is_empty() {
+                "n/a".into()
+            } else {
+                f3(mean(&dklc))
+            },
+        );
+    }
+    let _ = writeln!(
+        p,
+        "\n![Ball and distractor exploration](figures/{COVERAGE_FIGURE})\n"
+    );
+
+    // 2. Interest per module.
+    let lp: Vec<String> = algos(runs)
+        .into_iter()
+        .filter(|a| parts(a).1 == "lp" || parts(a).1 == "random")
+        .collect();
+    if !lp.is_empty() {
+        let _ = writeln!(
+            p,
+            "## Interest per module\n\n\
+             The follow-up's key figure: with learning-progress choice, interest (|learning \
+             progress|, `docs/learning-progress.md`) should concentrate on the modules that \
+             encode the controllable ball. Modules of a learned space are pairs of latents in \
+             decreasing order of their variance over the training images (module 0 holds the \
+             two most spread latents), so a module's latents differ between seeds; its *ball \
+             R²* and *distractor R²* are the mean, over its latents and the seeds, of the \
+             held-out k-NN R² of each latent from that object's position (section \
+             *Disentanglement*). Values at the last iteration, mean over seeds; *goals* is the \
+             share of goals drawn in the module.\n"
+        );
+        p.push_str(
+            "| algorithm | module | final interest | goals | ball R² | distractor R² |\n|---|---|---|---|---|---|\n",
+        );
+        for a in &lp {
+            let rs = of(runs, a);
+            let modules: Vec<i64> = {
+                let mut m: Vec<i64> = rs.iter().flat_map(|r| r.modules.keys().copied()).collect();
+                m.sort();
+                m.dedup();
+                m
+            };
+            for m in modules {
+                let mut interest = Vec::new();
+                let mut share = Vec::new();
+                let mut objects = Vec::new();
+                let mut name = String::new();
+                for r in &rs {
+                    let fin = r.final_interest();
+                    let total: i64 = fin.values().map(|v| v.1).sum();
+                    if let Some(&(i, n)) = fin.get(&m) {
+                        interest.push(i);
+                        share.push(if total > 0 {
+                            n as f64 / total as f64
+                        } else {
+                            0.0
+                        });
+                    }
+                    if let Some(o) = r.module_objects(m) {
+                        objects.push(o);
+                    }
+                    if let Some((n, _)) = r.modules.get(&m)
+                        && parts(a).0 == "efr"
+                    {
+                        name = n.clone();
+                    }
+                }
+                let module = if name.is_empty() {
+                    format!("{m}")
+                } else {
+                    format!("{m} ({name})")
+                };
+                let (b, d) = if objects.is_empty() {
+                    ("n/a".to_string(), "n/a".to_string())
+                } else {
+                    (
+                        f2(mean(&objects.iter().map(|o| o.0).collect::<Vec<_>>())),
+                        f2(mean(&objects.iter().map(|o| o.1).collect::<Vec<_>>())),
+                    )
+                };
+                let _ = writeln!(
+                    p,
+                    "| {} | {module} | {:.2e} | {} | {b} | {d} |",
+                    display(runs, a),
+                    mean(&interest),
+                    f2(mean(&share)),
+                );
+            }
+        }
+        if figures.iter().any(|f| f.link.ends_with(INTEREST_FIGURE)) {
+            let _ = writeln!(p, "\n![Interest per module](figures/{INTEREST_FIGURE})\n");
+        }
+    }
+
+    // 3. Disentanglement.
+    let learned: Vec<&FollowupRun> = {
+        let mut seen = std::collections::BTreeSet::new();
+        runs.iter()
+            .filter(|r| r.per_latent.is_some())
+            .filter(|r| seen.insert((tag(&r.algo).to_string(), r.learner.clone(), r.seed)))
+            .collect()
+    };
+    if !learned.is_empty() {
+        let _ = writeln!(
+            p,
+            "## Disentanglement of the learned goal spaces\n\n\
+             One network per learner and seed (shared by its flat and modular runs). *Loss* is \
+             the reconstruction loss against the mean-image plateau (below 1: the network \
+             learned); *ball* / *distractor* k-NN R² say whether each object's position can be \
+             read off the latents (held-out images). Per latent, the k-NN R² of the latent from \
+             each object's position classifies it: **ball** (ball R² ≥ {ENCODES}, distractor \
+             < {IGNORES}), **distractor** (the reverse), **both** (entangled: both ≥ {IGNORES}), \
+             **none** (both below {IGNORES}; collapsed), otherwise *mostly* one. A \
+             disentangled space in the follow-up's sense has ball-only and distractor-only \
+             latents.\n"
+        );
+        p.push_str(
+            "| learner | seed | loss / plateau | ball k-NN R² | distractor k-NN R² | ball-only latents | distractor-only | both | none | per latent: ball R² / distractor R² |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in &learned {
+            let (b, d) = r.per_latent.as_ref().expect("filtered");
+            let roles: Vec<&str> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
+            let count = |x: &str| roles.iter().filter(|r| **r == x).count();
+            let per: Vec<String> = b
+                .iter()
+                .zip(d)
+                .map(|(b, d)| format!("{b:.2}/{d:.2}"))
+                .collect();
+            let _ = writeln!(
+                p,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                match (r.learner.as_deref().map(learner_name), tag(&r.algo)) {
+                    (Some(l), "") => l,
+                    (Some(l), t) => format!("{l}, {t}"),
+                    (None, _) => String::new(),
+                },
+                r.seed,
+                r.loss_fraction.map(f2).unwrap_or_else(|| "n/a".into()),
+                r.knn_ball.map(f2).unwrap_or_else(|| "n/a".into()),
+                r.knn_distractor.map(f2).unwrap_or_else(|| "n/a".into()),
+                count("ball"),
+                count("distractor"),
+                count("both"),
+                count("none"),
+                per.join(" "),
+            );
+        }
+        p.push('\n');
+    }
+
+    // 4. Claims.
+    let (intro, table) = match followup_claims {
+        FollowupClaims::Evaluated {
+            path,
+            confidence,
+            n_boot,
+            results,
+        } => {
+            let (yes, no, open, premise) = claims::counts(results);
+            (
+                format!(
+                    "The follow-up's text gives no number we could read \
+                     (`docs/followup-paper-sources.md` section 5), so each claim is formalised \
+                     here (our choice, `{}`, explained in `docs/armballs.md`) and evaluated by \
+                     the same engine as the paper's claims: differences of means over seeds with \
+                     a {:.0}% percentile-bootstrap interval ({n_boot} resamples); **reproduced** \
+                     when the interval lies inside the claimed set, **not reproduced** when it \
+                     lies outside, **inconclusive** otherwise; **premise not met** when the \
+                     claim is about a disentangled space and no network here is one. Of {} \
+                     claims: {yes} reproduced, {no} not reproduced, {open} inconclusive, \
+                     {premise} with the premise not met.",
+                    path.display(),
+                    confidence * 100.0,
+                    results.len()
+                ),
+                claims::table(runs, results),
+            )
+        }
+        FollowupClaims::Missing(path) => (
+            format!(
+                "No claims file at `{}`: the follow-up's claims are not evaluated.",
+                path.display()
+            ),
+            String::new(),
+        ),
+    };
+    let _ = writeln!(p, "## The follow-up's claims\n\n{intro}\n\n{table}");
+    let summary = format!(
+        "## Beyond the paper: a distractor (ArmBalls)\n\n\
+         The follow-up paper's setting (a distractor ball, modular goal exploration, learning \
+         progress, β-VAE) on campaigns {name} ({} runs): exploration, interest curves, \
+         disentanglement and figures in [{PAGE}]({PAGE}). Its claims:\n\n{table}",
+        runs.len()
+    );
+    (p, summary)
+}
+
+/// Mean and bootstrap interval at [`CONFIDENCE`].
+fn summarize_at(xs: &[f64], n_boot: usize, seed: u64) -> (f64, f64, f64) {
+    if xs.is_empty() {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    use rand::SeedableRng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (lo, hi) = crate::stats::bootstrap_mean_ci(xs, CONFIDENCE, n_boot, &mut rng);
+    (mean(xs), lo, hi)
+}

@@ -1,0 +1,285 @@
+//! The follow-up campaigns' runs, as the ArmBalls page reads them: the ball's and the
+//! distractor's curves, the interest of each goal module, and how each latent of a learned space
+//! relates to the two objects.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde_json::Value;
+
+use super::labels::label;
+use crate::ReportError;
+use crate::campaigns::Campaign;
+use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
+use crate::stats::mean;
+
+/// ArmBalls' ball's KL-coverage grid (the registry's).
+pub(super) fn ball_grid() -> ugl_types::KlcGrid {
+    ugl_types::EnvSpec::by_name("armballs")
+        .expect("armballs is registered")
+        .klc
+}
+
+/// ArmBalls' ball: the cells it can reach, of all cells of its grid.
+pub(super) fn ball_cells() -> (f64, f64) {
+    let grid = ball_grid();
+    (
+        grid.achievable_cells as f64,
+        (grid.bins as f64).powi(grid.dims as i32),
+    )
+}
+
+/// A latent "encodes" an object when the object's position explains at least this much of its
+/// variance (k-NN R²), and "ignores" it below [`IGNORES`].
+pub(super) const ENCODES: f64 = 0.5;
+pub(super) const IGNORES: f64 = 0.1;
+
+/// One run of the campaign, as this section reads it.
+#[derive(Debug, Clone)]
+pub struct FollowupRun {
+    pub algo: String,
+    pub seed: i64,
+    pub epochs: Vec<i64>,
+    /// The controllable ball: cell coverage (of the 756 reachable cells) and KL-coverage.
+    pub ball_coverage: Vec<f64>,
+    pub ball_klc: Vec<f64>,
+    /// The distractor (control): cell coverage (of all 900 cells) and KL-coverage.
+    pub distractor_coverage: Vec<Option<f64>>,
+    pub distractor_klc: Vec<Option<f64>>,
+    /// Modular runs: per module, its name and goal-space coordinates.
+    pub modules: BTreeMap<i64, (String, Vec<usize>)>,
+    /// Modular runs: (epoch, module, interest, goals chosen so far).
+    pub interest: Vec<(i64, i64, f64, i64)>,
+    /// Learned goal spaces: the learner, its loss against the plateau, the held-out k-NN R² of
+    /// the ball's and the distractor's positions, and per latent the R² of each object.
+    pub learner: Option<String>,
+    pub loss_fraction: Option<f64>,
+    pub knn_ball: Option<f64>,
+    pub knn_distractor: Option<f64>,
+    pub per_latent: Option<(Vec<f64>, Vec<f64>)>,
+    /// A variant campaign's declared label (`[campaign] label`).
+    pub variant_label: Option<String>,
+}
+
+impl FollowupRun {
+    pub(super) fn final_ratio(&self) -> f64 {
+        {
+            let (reachable, all) = ball_cells();
+            self.ball_coverage.last().copied().unwrap_or(f64::NAN) * reachable / all
+        }
+    }
+
+    /// Per module: (ball R², distractor R²), the means over the module's latents.
+    pub(super) fn module_objects(&self, module: i64) -> Option<(f64, f64)> {
+        let (_, dims) = self.modules.get(&module)?;
+        let (b, d) = self.per_latent.as_ref()?;
+        let pick = |v: &Vec<f64>| mean(&dims.iter().map(|&k| v[k]).collect::<Vec<_>>());
+        Some((pick(b), pick(d)))
+    }
+
+    /// Final interest and goals chosen, per module.
+    pub(super) fn final_interest(&self) -> BTreeMap<i64, (f64, i64)> {
+        let last = self.interest.iter().map(|p| p.0).max();
+        self.interest
+            .iter()
+            .filter(|p| Some(p.0) == last)
+            .map(|p| (p.1, (p.2, p.3)))
+            .collect()
+    }
+}
+
+/// Reads the campaign's runs. The runs of a variant campaign (`[campaign] variant_of`, e.g.
+/// `armballs-still`, a distractor that does not move, tag `still`) get the algorithm
+/// `ALGO@TAG`, and the label the campaign declares.
+pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
+    let mut out = Vec::new();
+    let decl = &campaign.decl;
+    let tag = decl
+        .variant_of
+        .as_ref()
+        .map(|_| decl.tag.clone().unwrap_or_else(|| campaign.name.clone()));
+    let tag = tag.as_deref();
+    for run in &campaign.store.runs {
+        let df = read_parquet(&run.curve_path)?;
+        let c = Cols {
+            df: &df,
+            path: &run.curve_path,
+        };
+        let has = |name: &str| df.get_column_names().iter().any(|n| n.as_str() == name);
+        let (dcov, dklc) = if has("control_coverage") {
+            (
+                c.f64s_nullable("control_coverage")?,
+                c.f64s_nullable("control_klc")?,
+            )
+        } else {
+            (vec![None; df.height()], vec![None; df.height()])
+        };
+        let epochs = c.i64s("epoch")?;
+        let mut order: Vec<usize> = (0..epochs.len()).collect();
+        order.sort_by_key(|&i| epochs[i]);
+        let quality = run.manifest.latent_quality.as_ref();
+        let group = |name: &str| {
+            quality
+                .and_then(|q| q.get("groups"))
+                .and_then(Value::as_array)
+                .and_then(|g| {
+                    g.iter()
+                        .find(|x| x.get("group").and_then(Value::as_str) == Some(name))
+                })
+                .and_then(|x| x.get("knn_r2"))
+                .and_then(Value::as_f64)
+        };
+        let per_latent = quality
+            .and_then(|q| q.get("per_latent"))
+            .and_then(Value::as_array)
+            .and_then(|objects| {
+                let r2 = |name: &str| -> Option<Vec<f64>> {
+                    let o = objects
+                        .iter()
+                        .find(|o| o.get("object").and_then(Value::as_str) == Some(name))?;
+                    Some(
+                        o.get("r2")?
+                            .as_array()?
+                            .iter()
+                            // A constant latent explains nothing.
+                            .map(|v| v.as_f64().unwrap_or(0.0))
+                            .collect(),
+                    )
+                };
+                Some((r2("ball")?, r2("distractor")?))
+            });
+        let (modules, interest) = load_interest(&run.curve_path)?;
+        out.push(FollowupRun {
+            algo: match tag {
+                Some(t) => format!("{}@{t}", run.key.algo),
+                None => run.key.algo.clone(),
+            },
+            seed: run.seed,
+            epochs: order.iter().map(|&i| epochs[i]).collect(),
+            ball_coverage: run.curve.iter().map(|p| p.coverage).collect(),
+            ball_klc: run.curve.iter().map(|p| p.klc).collect(),
+            distractor_coverage: order.iter().map(|&i| dcov[i]).collect(),
+            distractor_klc: order.iter().map(|&i| dklc[i]).collect(),
+            modules,
+            interest,
+            learner: run.manifest.learner.clone(),
+            loss_fraction: run
+                .manifest
+                .train_field("evidence")
+                .and_then(|e| e.get("loss_fraction"))
+                .and_then(Value::as_f64),
+            knn_ball: group("position"),
+            knn_distractor: group("distractor"),
+            per_latent,
+            variant_label: decl.label.clone(),
+        });
+    }
+    Ok(out)
+}
+
+type Interest = (
+    BTreeMap<i64, (String, Vec<usize>)>,
+    Vec<(i64, i64, f64, i64)>,
+);
+
+/// `<run>.interest.parquet` next to the curve file, if any.
+pub(super) fn load_interest(curve: &Path) -> Result<Interest, ReportError> {
+    let name = curve
+        .file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.strip_suffix(".parquet"))
+        .unwrap_or_default();
+    let path = curve.with_file_name(format!("{name}{INTEREST_SUFFIX}"));
+    if !path.is_file() {
+        return Ok((BTreeMap::new(), Vec::new()));
+    }
+    let df = read_parquet(&path)?;
+    let c = Cols {
+        df: &df,
+        path: &path,
+    };
+    let (epoch, module, interest, chosen) = (
+        c.i64s("epoch")?,
+        c.i64s("module")?,
+        c.f64s("interest")?,
+        c.i64s("n_chosen")?,
+    );
+    let (names, dims) = (c.strs("module_name")?, c.strs("dims")?);
+    let mut modules = BTreeMap::new();
+    for i in 0..df.height() {
+        let d: Vec<usize> = dims[i]
+            .split(',')
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse())
+            .collect::<Result<_, _>>()
+            .map_err(|_| ReportError::Invalid {
+                path: path.clone(),
+                problem: format!("column `dims`: `{}` is not a list of indices", dims[i]),
+            })?;
+        modules.insert(module[i], (names[i].clone(), d));
+    }
+    let points = (0..df.height())
+        .map(|i| (epoch[i], module[i], interest[i], chosen[i]))
+        .collect();
+    Ok((modules, points))
+}
+
+/// The name of `algo` among `runs`: [`label`], with a variant campaign's tag replaced by the
+/// label its campaign declares (`[campaign] label`: `still distractor`).
+pub(super) fn display(runs: &[FollowupRun], algo: &str) -> String {
+    match algo.split_once('@') {
+        Some((base, tag)) => {
+            let declared = runs
+                .iter()
+                .find(|r| r.algo == algo)
+                .and_then(|r| r.variant_label.clone());
+            format!("{}, {}", label(base), declared.as_deref().unwrap_or(tag))
+        }
+        None => label(algo),
+    }
+}
+
+/// The algorithms of `runs`, each once, in the order of their first run.
+pub(super) fn algos(runs: &[FollowupRun]) -> Vec<String> {
+    let mut v: Vec<String> = Vec::new();
+    for r in runs {
+        if !v.contains(&r.algo) {
+            v.push(r.algo.clone());
+        }
+    }
+    v
+}
+
+pub(super) fn of<'a>(runs: &'a [FollowupRun], algo: &str) -> Vec<&'a FollowupRun> {
+    runs.iter().filter(|r| r.algo == algo).collect()
+}
+
+pub(super) fn ratios(runs: &[FollowupRun], algo: &str) -> Vec<f64> {
+    of(runs, algo).iter().map(|r| r.final_ratio()).collect()
+}
+
+/// A latent's role from its two R²: `ball`, `distractor`, `both` (entangled) or `none`.
+pub(super) fn role(b: f64, d: f64) -> &'static str {
+    match (b >= ENCODES && d < IGNORES, d >= ENCODES && b < IGNORES) {
+        (true, _) => "ball",
+        (_, true) => "distractor",
+        _ if b >= IGNORES && d >= IGNORES => "both",
+        _ if b < IGNORES && d < IGNORES => "none",
+        _ if b > d => "mostly ball",
+        _ => "mostly distractor",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latent_roles() {
+        assert_eq!(role(0.9, 0.01), "ball");
+        assert_eq!(role(0.02, 0.8), "distractor");
+        assert_eq!(role(0.5, 0.2), "both");
+        assert_eq!(role(0.01, 0.05), "none");
+        assert_eq!(role(0.3, 0.05), "mostly ball");
+    }
+}
