@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use super::labels::{f3, tag};
-use super::runs::{FollowupRun, algos, display, of, role};
+use super::runs::{FollowupRun, display, role};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::figures::learner_name;
 use crate::load::ConditionKey;
@@ -22,23 +22,40 @@ pub struct FollowupObservations<'a> {
     pub runs: &'a [FollowupRun],
 }
 
-fn key(algo: &str) -> ConditionKey {
+/// A run's condition as the engine sees it: the algorithm with its campaign's tag, the goal
+/// sampler and the latent size (selectors and `pair_on` work on these).
+fn key(r: &FollowupRun) -> ConditionKey {
     ConditionKey {
         env: ENV.into(),
-        algo: algo.into(),
-        sampler: String::new(),
-        latents: 0,
+        algo: r.base.clone(),
+        sampler: r.sampler.clone(),
+        latents: r.latents,
         variant: String::new(),
     }
 }
 
+/// The page's name of the condition `k`.
+fn name(runs: &[FollowupRun], k: &ConditionKey) -> String {
+    runs.iter()
+        .find(|r| key(r) == *k)
+        .map(|r| display(runs, &r.algo))
+        .unwrap_or_else(|| k.algo.clone())
+}
+
 impl Observations for FollowupObservations<'_> {
     fn keys(&self) -> Vec<ConditionKey> {
-        algos(self.runs).iter().map(|a| key(a)).collect()
+        let mut keys: Vec<ConditionKey> = Vec::new();
+        for r in self.runs {
+            let k = key(r);
+            if !keys.contains(&k) {
+                keys.push(k);
+            }
+        }
+        keys
     }
 
-    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64> {
-        let runs = of(self.runs, &key.algo);
+    fn values(&self, k: &ConditionKey, statistic: Statistic) -> Vec<f64> {
+        let runs: Vec<&FollowupRun> = self.runs.iter().filter(|r| key(r) == *k).collect();
         match statistic {
             Statistic::BallRatio => runs.iter().map(|r| r.final_ratio()).collect(),
             Statistic::BallModuleGoals => {
@@ -85,7 +102,7 @@ fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
 }
 
 /// How many of the learned networks of `learner` have a ball-only and a distractor-only latent
-/// (one network per variant campaign and seed).
+/// (one network per variant campaign, seed and latent size).
 fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
     let mut seen = BTreeSet::new();
     let mut n = 0;
@@ -94,7 +111,7 @@ fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
         let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
             continue;
         };
-        if l != learner || !seen.insert((tag(&r.algo).to_string(), r.seed)) {
+        if l != learner || !seen.insert((tag(&r.algo).to_string(), r.seed, r.latents)) {
             continue;
         }
         n += 1;
@@ -143,9 +160,9 @@ pub fn table(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
             .map(|c| {
                 let mut m = format!(
                     "{} {} − {} {} = {} [{}, {}]",
-                    display(runs, &c.subject.algo),
+                    name(runs, &c.subject),
                     f3(c.subject_mean),
-                    display(runs, &c.reference.algo),
+                    name(runs, &c.reference),
                     f3(c.reference_mean),
                     f3(c.diff),
                     f3(c.lo),
@@ -207,6 +224,13 @@ mod tests {
     fn run(algo: &str, seed: i64, ratio: f64) -> FollowupRun {
         FollowupRun {
             algo: algo.into(),
+            base: algo.into(),
+            sampler: if algo == "rpe" { "none" } else { "gaussian" }.into(),
+            latents: if algo.contains("efr") || algo == "rpe" {
+                0
+            } else {
+                10
+            },
             seed,
             epochs: vec![100],
             ball_coverage: vec![{

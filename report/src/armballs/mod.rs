@@ -70,6 +70,7 @@ pub fn render(
     for v in variants {
         runs.extend(load(v)?);
     }
+    runs::separate_conditions(&mut runs);
     runs.sort_by(|a, b| {
         labels::algo_order(&a.algo)
             .cmp(&labels::algo_order(&b.algo))
@@ -108,4 +109,87 @@ pub fn render(
         summary,
         figures,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::load::Store;
+
+    fn run(algo: &str, sampler: &str, latents: i64, seed: i64, ratio: f64) -> FollowupRun {
+        let (reachable, all) = runs::ball_cells();
+        FollowupRun {
+            algo: algo.into(),
+            base: algo.into(),
+            sampler: sampler.into(),
+            latents,
+            seed,
+            epochs: vec![100],
+            ball_coverage: vec![ratio * all / reachable],
+            ball_klc: vec![1.0],
+            distractor_coverage: vec![Some(0.3)],
+            distractor_klc: vec![Some(2.0)],
+            modules: BTreeMap::new(),
+            interest: Vec::new(),
+            learner: (latents > 0).then(|| "vae".into()),
+            loss_fraction: None,
+            knn_ball: None,
+            knn_distractor: None,
+            per_latent: None,
+            variant_label: None,
+        }
+    }
+
+    /// One algorithm run with two goal samplers and two latent sizes is four conditions of the
+    /// page, never one pooled row (the page used to average them and count 4 seeds).
+    #[test]
+    fn samplers_and_latent_sizes_are_never_pooled() {
+        let mut rs = Vec::new();
+        for seed in 0..2 {
+            rs.push(run("rpe", "none", 0, seed, 0.05));
+            for (sampler, latents, ratio) in [
+                ("kde", 4, 0.1),
+                ("kde", 10, 0.2),
+                ("gaussian", 4, 0.3),
+                ("gaussian", 10, 0.4),
+            ] {
+                rs.push(run("mge-vae-lp", sampler, latents, seed, ratio));
+            }
+        }
+        runs::separate_conditions(&mut rs);
+        rs.sort_by(|a, b| labels::algo_order(&a.algo).cmp(&labels::algo_order(&b.algo)));
+        assert_eq!(runs::algos(&rs).len(), 5, "{:?}", runs::algos(&rs));
+        assert!(
+            rs.iter().any(|r| r.algo == "rpe"),
+            "an algorithm run one way keeps its name"
+        );
+        let campaign = Campaign {
+            name: "armballs".into(),
+            path: "armballs".into(),
+            decl: Default::default(),
+            store: Store {
+                runs: Vec::new(),
+                incomplete: Vec::new(),
+            },
+        };
+        let claims = FollowupClaims::Missing(Path::new("none.toml"));
+        let (page, _) = page::write(&campaign, &[], &rs, &[], &claims, 200, 0);
+        assert!(page.contains("(10 runs, 2 seeds)"), "{page}");
+        assert!(page.contains("VAE, 4 and 10 latents"), "{page}");
+        let row = |name: &str| {
+            page.lines()
+                .find(|l| l.starts_with(&format!("| {name} |")))
+                .unwrap_or_else(|| panic!("no row {name} in\n{page}"))
+                .to_string()
+        };
+        let r = row("MGE-VAE (LP), Gaussian goals, 10 latents");
+        assert!(
+            r.starts_with("| MGE-VAE (LP), Gaussian goals, 10 latents | 2 | 0.400"),
+            "{r}"
+        );
+        let r = row("MGE-VAE (LP), KDE goals, 4 latents");
+        assert!(r.contains("| 2 | 0.100"), "{r}");
+    }
 }

@@ -37,6 +37,28 @@ pub(super) fn write(
         s.dedup();
         s.len()
     };
+    // The learned spaces as run: their learners and latent sizes.
+    let mut learners: Vec<String> = Vec::new();
+    let mut sizes: Vec<i64> = Vec::new();
+    for r in runs {
+        if let Some(l) = &r.learner {
+            let l = learner_name(l);
+            if !learners.contains(&l) {
+                learners.push(l);
+            }
+            if !sizes.contains(&r.latents) {
+                sizes.push(r.latents);
+            }
+        }
+    }
+    sizes.sort();
+    let several_sizes = sizes.len() > 1;
+    let spaces = if learners.is_empty() {
+        "none run here".to_string()
+    } else {
+        let sizes: Vec<String> = sizes.iter().map(|s| s.to_string()).collect();
+        format!("{}, {} latents", learners.join(", "), sizes.join(" and "))
+    };
     let _ = writeln!(
         p,
         "# Beyond the paper: a distractor (ArmBalls)\n\n\
@@ -46,7 +68,7 @@ pub(super) fn write(
          ({} runs, {n_seeds} seeds): ArmBall's arm and ball plus a **distractor** ball that \
          follows a seeded random walk (`docs/armballs.md`); random parameters (RPE) and goal \
          exploration with engineered features (EFR: ball and distractor positions) or in goal \
-         spaces learned from images of both balls (VAE, β-VAE, 10 latents), each **flat** (one \
+         spaces learned from images of both balls ({spaces}), each **flat** (one \
          module, the follow-up's RGE) or **modular** (MGE: one module per object, or pairs of \
          latents), the module chosen at random or by **learning progress** (LP, curiosity). \
          Exploration is measured on the controllable ball; the distractor, which no policy \
@@ -203,7 +225,14 @@ pub(super) fn write(
         let mut seen = std::collections::BTreeSet::new();
         runs.iter()
             .filter(|r| r.per_latent.is_some())
-            .filter(|r| seen.insert((tag(&r.algo).to_string(), r.learner.clone(), r.seed)))
+            .filter(|r| {
+                seen.insert((
+                    tag(&r.algo).to_string(),
+                    r.learner.clone(),
+                    r.seed,
+                    r.latents,
+                ))
+            })
             .collect()
     };
     if !learned.is_empty() {
@@ -239,6 +268,10 @@ pub(super) fn write(
                     (Some(l), "") => l,
                     (Some(l), t) => format!("{l}, {t}"),
                     (None, _) => String::new(),
+                } + &if several_sizes {
+                    format!(", {} latents", r.latents)
+                } else {
+                    String::new()
                 },
                 r.seed,
                 r.loss_fraction.map(f2).unwrap_or_else(|| "n/a".into()),

@@ -2,12 +2,12 @@
 //! distractor's curves, the interest of each goal module, and how each latent of a learned space
 //! relates to the two objects.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use serde_json::Value;
 
-use super::labels::label;
+use super::labels::{label, split_condition, suffix_label};
 use crate::ReportError;
 use crate::campaigns::Campaign;
 use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
@@ -37,7 +37,14 @@ pub(super) const IGNORES: f64 = 0.1;
 /// One run of the campaign, as this section reads it.
 #[derive(Debug, Clone)]
 pub struct FollowupRun {
+    /// The page's condition (`labels`): `ALGO[@TAG]`, with `~SAMPLER~LATENTS` when the
+    /// campaigns ran this algorithm with several samplers or latent sizes
+    /// ([`separate_conditions`]).
     pub algo: String,
+    /// `ALGO[@TAG]`.
+    pub base: String,
+    pub sampler: String,
+    pub latents: i64,
     pub seed: i64,
     pub epochs: Vec<i64>,
     /// The controllable ball: cell coverage (of the 756 reachable cells) and KL-coverage.
@@ -149,11 +156,15 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
                 Some((r2("ball")?, r2("distractor")?))
             });
         let (modules, interest) = load_interest(&run.curve_path)?;
+        let base = match tag {
+            Some(t) => format!("{}@{t}", run.key.algo),
+            None => run.key.algo.clone(),
+        };
         out.push(FollowupRun {
-            algo: match tag {
-                Some(t) => format!("{}@{t}", run.key.algo),
-                None => run.key.algo.clone(),
-            },
+            algo: base.clone(),
+            base,
+            sampler: run.key.sampler.clone(),
+            latents: run.key.latents,
             seed: run.seed,
             epochs: order.iter().map(|&i| epochs[i]).collect(),
             ball_coverage: run.curve.iter().map(|p| p.coverage).collect(),
@@ -224,18 +235,37 @@ pub(super) fn load_interest(curve: &Path) -> Result<Interest, ReportError> {
     Ok((modules, points))
 }
 
-/// The name of `algo` among `runs`: [`label`], with a variant campaign's tag replaced by the
-/// label its campaign declares (`[campaign] label`: `still distractor`).
+/// The name of the condition `algo` among `runs`: [`label`], with a variant campaign's tag
+/// replaced by the label its campaign declares (`[campaign] label`: `still distractor`).
 pub(super) fn display(runs: &[FollowupRun], algo: &str) -> String {
-    match algo.split_once('@') {
-        Some((base, tag)) => {
+    let (base, _) = split_condition(algo);
+    let name = match base.split_once('@') {
+        Some((b, tag)) => {
             let declared = runs
                 .iter()
                 .find(|r| r.algo == algo)
                 .and_then(|r| r.variant_label.clone());
-            format!("{}, {}", label(base), declared.as_deref().unwrap_or(tag))
+            format!("{}, {}", label(b), declared.as_deref().unwrap_or(tag))
         }
-        None => label(algo),
+        None => label(base),
+    };
+    format!("{name}{}", suffix_label(algo))
+}
+
+/// Runs of one algorithm (and campaign) with several goal samplers or latent sizes are separate
+/// conditions, never pooled: their condition gets the suffix `~SAMPLER~LATENTS`.
+pub(super) fn separate_conditions(runs: &mut [FollowupRun]) {
+    let mut variants: BTreeMap<String, BTreeSet<(String, i64)>> = BTreeMap::new();
+    for r in runs.iter() {
+        variants
+            .entry(r.base.clone())
+            .or_default()
+            .insert((r.sampler.clone(), r.latents));
+    }
+    for r in runs.iter_mut() {
+        if variants[&r.base].len() > 1 {
+            r.algo = format!("{}~{}~{}", r.base, r.sampler, r.latents);
+        }
     }
 }
 
