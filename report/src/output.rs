@@ -1,6 +1,10 @@
 //! The report's output directory: every file a render writes is recorded here, and the list is
 //! kept beside them ([`FILE_LIST`]). A file of the previous render's list that this render did
 //! not write is stale and removed; nothing else in the directory is ever touched.
+//!
+//! A render writes into a staging directory inside the output directory and moves its files into
+//! place only when every section has succeeded ([`Output::finish`]): a render that fails (a full
+//! disk, a damaged run file) leaves the previous render as it was, never a mixture of two.
 
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
@@ -18,6 +22,8 @@ The next render removes those it no longer writes.\n";
 #[derive(Debug)]
 pub struct Output {
     root: PathBuf,
+    /// Where this render writes until [`Output::finish`] (removed when dropped).
+    staging: PathBuf,
     /// Relative paths written by this render.
     written: BTreeSet<PathBuf>,
     /// Relative paths the previous render listed.
@@ -29,7 +35,14 @@ impl Output {
     /// a first render, which removes nothing).
     pub fn open(root: &Path) -> Result<Self, ReportError> {
         create_dir(root)?;
-        create_dir(&root.join(crate::figures::DIR))?;
+        let staging = root.join(format!("{STAGING_PREFIX}{}", std::process::id()));
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).map_err(|source| ReportError::Io {
+                path: staging.clone(),
+                source,
+            })?;
+        }
+        create_dir(&staging.join(crate::figures::DIR))?;
         let list = root.join(FILE_LIST);
         let previous = match std::fs::read_to_string(&list) {
             Ok(text) => parse_list(&text),
@@ -38,6 +51,7 @@ impl Output {
         };
         Ok(Output {
             root: root.to_path_buf(),
+            staging,
             written: BTreeSet::new(),
             previous,
         })
@@ -48,14 +62,15 @@ impl Output {
         &self.root
     }
 
-    /// Where figures are drawn (`<root>/figures`).
+    /// Where figures are drawn (`figures/` of the staging directory).
     pub fn figures_dir(&self) -> PathBuf {
-        self.root.join(crate::figures::DIR)
+        self.staging.join(crate::figures::DIR)
     }
 
-    /// Writes `bytes` to `rel` (relative to the output directory) and records it.
+    /// Writes `bytes` to `rel` (relative to the output directory; staged until
+    /// [`Output::finish`]) and records it. Returns the path it will have after `finish`.
     pub fn write(&mut self, rel: impl AsRef<Path>, bytes: &[u8]) -> Result<PathBuf, ReportError> {
-        let path = self.root.join(rel.as_ref());
+        let path = self.staging.join(rel.as_ref());
         if let Some(dir) = path.parent() {
             create_dir(dir)?;
         }
@@ -64,13 +79,13 @@ impl Output {
             source,
         })?;
         self.record(&path)?;
-        Ok(path)
+        Ok(self.root.join(rel.as_ref()))
     }
 
-    /// Records a file a drawing backend wrote itself (`path` under the output directory).
+    /// Records a file a drawing backend wrote itself (`path` under [`Output::figures_dir`]).
     pub fn record(&mut self, path: &Path) -> Result<(), ReportError> {
         let rel = path
-            .strip_prefix(&self.root)
+            .strip_prefix(&self.staging)
             .ok()
             .filter(|rel| is_plain_relative(rel))
             .ok_or_else(|| ReportError::Invalid {
@@ -100,9 +115,17 @@ impl Output {
         Ok(fig)
     }
 
-    /// Removes the previous render's files this one did not write, writes the new list, and
-    /// returns every file written (the list last), as full paths in sorted order.
+    /// Moves the staged files into place (one rename each), removes the previous render's files
+    /// this one did not write, writes the new list, and returns every file written (the list
+    /// included), as full paths in sorted order.
     pub fn finish(mut self) -> Result<Vec<PathBuf>, ReportError> {
+        for rel in &self.written {
+            let (from, to) = (self.staging.join(rel), self.root.join(rel));
+            if let Some(dir) = to.parent() {
+                create_dir(dir)?;
+            }
+            std::fs::rename(&from, &to).map_err(|source| ReportError::Io { path: to, source })?;
+        }
         let stale: Vec<&PathBuf> = self.previous.difference(&self.written).collect();
         for rel in stale {
             let path = self.root.join(rel);
@@ -116,8 +139,12 @@ impl Output {
             text.push_str(&rel.to_string_lossy());
             text.push('\n');
         }
-        let list = self.root.join(FILE_LIST);
-        std::fs::write(&list, text).map_err(|source| ReportError::Io {
+        let (staged, list) = (self.staging.join(FILE_LIST), self.root.join(FILE_LIST));
+        std::fs::write(&staged, text).map_err(|source| ReportError::Io {
+            path: staged.clone(),
+            source,
+        })?;
+        std::fs::rename(&staged, &list).map_err(|source| ReportError::Io {
             path: list.clone(),
             source,
         })?;
@@ -125,6 +152,16 @@ impl Output {
         Ok(self.written.iter().map(|rel| self.root.join(rel)).collect())
     }
 }
+
+impl Drop for Output {
+    /// A render that did not finish leaves nothing behind.
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
+}
+
+/// The staging directory's name, before the process id.
+pub const STAGING_PREFIX: &str = ".rendering-";
 
 /// The entries of a list: comment lines skipped, and only plain relative paths (no `..`, no
 /// absolute path), so that a damaged list can never reach outside the output directory.
@@ -195,6 +232,29 @@ mod tests {
         .unwrap();
         Output::open(&root).unwrap().finish().unwrap();
         assert!(outside.exists());
+    }
+
+    #[test]
+    fn a_failed_render_leaves_the_previous_one_intact() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path();
+        let mut out = Output::open(root).unwrap();
+        out.write("REPORT.md", b"old").unwrap();
+        out.write("figures/a.svg", b"old a").unwrap();
+        out.finish().unwrap();
+        let mut out = Output::open(root).unwrap();
+        out.write("REPORT.md", b"new").unwrap();
+        out.write("figures/b.svg", b"new b").unwrap();
+        drop(out); // a section failed: no finish
+        assert_eq!(std::fs::read(root.join("REPORT.md")).unwrap(), b"old");
+        assert_eq!(std::fs::read(root.join("figures/a.svg")).unwrap(), b"old a");
+        assert!(!root.join("figures/b.svg").exists());
+        let left: Vec<_> = std::fs::read_dir(root)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.starts_with(STAGING_PREFIX))
+            .collect();
+        assert!(left.is_empty(), "staging left behind: {left:?}");
     }
 
     #[test]
