@@ -356,6 +356,12 @@ fn read_manifest(manifest_path: &Path) -> Result<Manifest, ReportError> {
         path: manifest_path.to_path_buf(),
         source,
     })?;
+    manifest
+        .check_results_version()
+        .map_err(|e| ReportError::Invalid {
+            path: manifest_path.to_path_buf(),
+            problem: e.to_string(),
+        })?;
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     ugl_types::verify_files(dir, &manifest).map_err(|e| match e {
         ugl_types::DigestError::Io { path, source } => ReportError::Io { path, source },

@@ -366,6 +366,25 @@ fn every_file_written_is_recorded() {
 }
 
 #[test]
+fn a_manifest_of_a_future_results_version_is_an_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    synthetic_store(&results);
+    let path = results.join("paper/armball.rpe.s1.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    m["crate_versions"]["results_version"] = 99.into();
+    std::fs::write(&path, m.to_string()).unwrap();
+    let err = render_report(&opts(&results, &tmp.path().join("out")))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("armball.rpe.s1.json") && err.contains("newer ugl-bench"),
+        "{err}"
+    );
+}
+
+#[test]
 fn missing_column_names_the_file_and_column() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");

@@ -37,7 +37,7 @@ pub mod learners {
         AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
     };
 }
-pub use manifest::{CpuInfo, FileDigest, Manifest, RESULTS_VERSION, Summary};
+pub use manifest::{CpuInfo, FileDigest, FutureResults, Manifest, RESULTS_VERSION, Summary};
 pub use paths::{
     CURVE_SUFFIX, DigestError, INTEREST_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX, RunPaths,
     run_paths, verify_files,

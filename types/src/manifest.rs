@@ -116,6 +116,16 @@ pub struct Manifest {
     pub files: Option<Vec<FileDigest>>,
 }
 
+/// A manifest written by a newer ugl-bench than this one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "written by a newer ugl-bench (results version {found}; this build reads up to \
+     {RESULTS_VERSION}): update ugl-bench to read it"
+)]
+pub struct FutureResults {
+    pub found: u64,
+}
+
 impl Manifest {
     /// Parses a manifest; the error is serde's, with line and column.
     pub fn from_json(text: &str) -> Result<Manifest, serde_json::Error> {
@@ -125,6 +135,15 @@ impl Manifest {
     /// The results version the run was written with (`crate_versions.results_version`).
     pub fn results_version(&self) -> Option<u64> {
         self.crate_versions.get("results_version")?.as_u64()
+    }
+
+    /// Refuses a manifest written by a newer build (a results version above
+    /// [`RESULTS_VERSION`]): its fields may mean what this build does not know.
+    pub fn check_results_version(&self) -> Result<(), FutureResults> {
+        match self.results_version() {
+            Some(found) if found > u64::from(RESULTS_VERSION) => Err(FutureResults { found }),
+            _ => Ok(()),
+        }
     }
 
     /// A field of the `train` object (neural learners).

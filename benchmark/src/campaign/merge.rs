@@ -39,6 +39,11 @@ pub enum MergeError {
         /// `config hash` or `data`.
         what: &'static str,
     },
+    #[error("{path}: {source}")]
+    Future {
+        path: PathBuf,
+        source: ugl_types::FutureResults,
+    },
     #[error(transparent)]
     Store(#[from] StoreError),
     #[error(transparent)]
@@ -104,6 +109,12 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
         }
         for m in manifests {
             let manifest = store::read_manifest(&m)?;
+            manifest
+                .check_results_version()
+                .map_err(|source| MergeError::Future {
+                    path: m.clone(),
+                    source,
+                })?;
             let from = store::run_paths(src, &manifest.run_id);
             if let Err(why) = store::verify_files(src, &manifest) {
                 return Err(MergeError::Damaged {
@@ -175,6 +186,25 @@ mod tests {
         };
         let text = CampaignRecord::new(name, &decl).to_text();
         std::fs::write(CampaignRecord::path(dir), text).unwrap();
+    }
+
+    /// A run written by a newer build is refused, not merged silently.
+    #[test]
+    fn a_manifest_of_a_future_results_version_is_refused() {
+        let t = tempfile::tempdir().unwrap();
+        let (src, into) = (t.path().join("src"), t.path().join("into"));
+        std::fs::create_dir_all(&src).unwrap();
+        let committed =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/results/paper/armball.rpe.s0.json");
+        let mut m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(committed).unwrap()).unwrap();
+        m["crate_versions"]["results_version"] = 99.into();
+        std::fs::write(src.join("armball.rpe.s0.json"), m.to_string()).unwrap();
+        let e = merge_stores(&into, &[src]).unwrap_err().to_string();
+        assert!(
+            e.contains("armball.rpe.s0.json") && e.contains("newer ugl-bench"),
+            "{e}"
+        );
     }
 
     /// The campaign record travels with the runs, and two different campaigns do not mix.
