@@ -36,7 +36,7 @@ pub enum MergeError {
     Conflict {
         run_id: String,
         into: PathBuf,
-        /// `config hash` or `data`.
+        /// `config hash`, `data` or `goal-space sample`.
         what: &'static str,
     },
     #[error("{path}: {source}")]
@@ -159,8 +159,74 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
             copy_diagnostics(src, into, &manifest.run_id)?;
             done.copied += 1;
         }
+        copy_beside_runs(src, into)?;
     }
     Ok(done)
+}
+
+/// What a store holds beside its runs travels too: the goal-space samples of the figures
+/// (`goal_spaces/`; the same name with other bytes is a conflict) and external learners' logs
+/// (`*.learner.log`; the destination's copy is kept).
+fn copy_beside_runs(src: &Path, into: &Path) -> Result<(), MergeError> {
+    let files = |dir: &Path| -> Result<Vec<PathBuf>, MergeError> {
+        if !dir.is_dir() {
+            return Ok(Vec::new());
+        }
+        let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|source| MergeError::Read {
+                path: dir.to_path_buf(),
+                source,
+            })?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_file())
+            .collect();
+        v.sort();
+        Ok(v)
+    };
+    let read = |p: &Path| {
+        std::fs::read(p).map_err(|source| MergeError::Read {
+            path: p.to_path_buf(),
+            source,
+        })
+    };
+    let samples = files(&src.join(ugl_types::GOAL_SPACE_DIR))?;
+    if !samples.is_empty() {
+        let to_dir = into.join(ugl_types::GOAL_SPACE_DIR);
+        std::fs::create_dir_all(&to_dir).map_err(|source| MergeError::Read {
+            path: to_dir.clone(),
+            source,
+        })?;
+        for a in samples {
+            let b = to_dir.join(a.file_name().expect("a listed file has a name"));
+            let bytes = read(&a)?;
+            if b.exists() {
+                if read(&b)? != bytes {
+                    return Err(MergeError::Conflict {
+                        run_id: format!(
+                            "{}/{}",
+                            ugl_types::GOAL_SPACE_DIR,
+                            b.file_name().unwrap_or_default().to_string_lossy()
+                        ),
+                        into: into.to_path_buf(),
+                        what: "goal-space sample",
+                    });
+                }
+            } else {
+                store::write_atomic(&b, &bytes)?;
+            }
+        }
+    }
+    for a in files(src)? {
+        let name = a
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        if name.ends_with(".learner.log") && !into.join(&name).exists() {
+            store::write_atomic(&into.join(&name), &read(&a)?)?;
+        }
+    }
+    Ok(())
 }
 
 /// A run's diagnostics sidecar travels with it (where the destination has none).
@@ -186,6 +252,35 @@ mod tests {
         };
         let text = CampaignRecord::new(name, &decl).to_text();
         std::fs::write(CampaignRecord::path(dir), text).unwrap();
+    }
+
+    /// Goal-space samples and learner logs travel with the runs (they were dropped, and the
+    /// merged store's report lost its goal-space figures without a word).
+    #[test]
+    fn goal_space_samples_and_learner_logs_are_carried() {
+        let t = tempfile::tempdir().unwrap();
+        let (src, into) = (t.path().join("src"), t.path().join("into"));
+        std::fs::create_dir_all(src.join(ugl_types::GOAL_SPACE_DIR)).unwrap();
+        std::fs::write(src.join("goal_spaces/armball.rge-vae.l2.s0.json"), "{}").unwrap();
+        std::fs::write(src.join("armball.rge-external.l2.s0.learner.log"), "hello").unwrap();
+        merge_stores(&into, std::slice::from_ref(&src)).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(into.join("goal_spaces/armball.rge-vae.l2.s0.json")).unwrap(),
+            "{}"
+        );
+        assert!(
+            into.join("armball.rge-external.l2.s0.learner.log")
+                .is_file()
+        );
+        // Merging again is fine; another sample under the same name is a conflict.
+        merge_stores(&into, std::slice::from_ref(&src)).unwrap();
+        std::fs::write(
+            src.join("goal_spaces/armball.rge-vae.l2.s0.json"),
+            "{\"x\":1}",
+        )
+        .unwrap();
+        let e = merge_stores(&into, &[src]).unwrap_err().to_string();
+        assert!(e.contains("goal-space sample"), "{e}");
     }
 
     /// A run written by a newer build is refused, not merged silently.
