@@ -426,3 +426,104 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
         "{log}"
     );
 }
+
+fn small_config(dir: &Path, file: &str, name: &str, epochs: usize) -> PathBuf {
+    let cfg = dir.join(file);
+    std::fs::write(
+        &cfg,
+        format!(
+            "[campaign]\nname = \"{name}\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+             algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = {epochs}\neval_every = 100\n"
+        ),
+    )
+    .unwrap();
+    cfg
+}
+
+/// One store holds one campaign with one configuration: another configuration (or another
+/// campaign) is refused before any run, also when the record predates the configuration hash,
+/// and of two campaigns started together on one store exactly one runs.
+#[test]
+fn a_store_refuses_another_configuration_or_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("store");
+    let a = small_config(dir.path(), "a.toml", "small", 200);
+    let b = small_config(dir.path(), "b.toml", "small", 300);
+    let other = small_config(dir.path(), "c.toml", "other", 200);
+    let campaign =
+        |cfg: &Path, out: &Path| run(&["campaign", "--config", p(cfg), "--out", p(out), "--quiet"]);
+    assert!(campaign(&a, &out).status.success());
+    assert!(
+        campaign(&a, &out).status.success(),
+        "the same campaign again resumes"
+    );
+    let before = common::parquet_files(&out);
+    let o = campaign(&b, &out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("another configuration"),
+        "{err}"
+    );
+    let o = campaign(&other, &out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("holds campaign `small`"),
+        "{err}"
+    );
+    assert_eq!(
+        common::parquet_files(&out),
+        before,
+        "a refused campaign touched the store"
+    );
+    // A record written before the configuration hash: the manifests decide.
+    let record = out.join("campaign.toml");
+    let text = std::fs::read_to_string(&record).unwrap();
+    let legacy: String = text
+        .lines()
+        .filter(|l| !l.starts_with("configuration"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_ne!(legacy, text);
+    std::fs::write(&record, &legacy).unwrap();
+    let o = campaign(&b, &out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("[explore]"), "{err}");
+    assert!(
+        campaign(&a, &out).status.success(),
+        "the matching configuration upgrades the record"
+    );
+    assert!(
+        std::fs::read_to_string(&record)
+            .unwrap()
+            .contains("configuration = ")
+    );
+    // Two campaigns of different configurations started together: one runs, one is refused.
+    let fresh = dir.path().join("fresh");
+    let start = |cfg: &Path| {
+        ugl()
+            .args([
+                "campaign",
+                "--config",
+                p(cfg),
+                "--out",
+                p(&fresh),
+                "--quiet",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (x, y) = (start(&a), start(&b));
+    let (x, y) = (x.wait_with_output().unwrap(), y.wait_with_output().unwrap());
+    assert_eq!(
+        [x.status.success(), y.status.success()]
+            .iter()
+            .filter(|s| **s)
+            .count(),
+        1,
+        "{} / {}",
+        String::from_utf8_lossy(&x.stderr),
+        String::from_utf8_lossy(&y.stderr)
+    );
+}

@@ -45,6 +45,29 @@ pub struct Campaign {
     pub decl: CampaignDecl,
     /// Its runs; may be empty (only incomplete runs so far) for a budget campaign.
     pub store: Store,
+    /// How many configurations its runs were run with ([`configurations`]): 1 for a sound
+    /// campaign; more is flagged at the top of the report.
+    pub configurations: usize,
+}
+
+/// The configurations of a campaign's runs: distinct (campaign seed, `[explore]`, `[env]`) of
+/// its runs, and distinct `[ugl]` of those in a learned goal space; the larger count. The
+/// runner refuses to mix configurations in one store; a store assembled by hand (or by an
+/// older build) can still hold several, and its statistics would pool them.
+pub fn configurations(store: &Store) -> usize {
+    let mut base = BTreeSet::new();
+    let mut ugl = BTreeSet::new();
+    for r in &store.runs {
+        let m = &r.manifest;
+        base.insert(format!(
+            "{}|{}|{}",
+            m.campaign_seed, m.explore, m.env_config
+        ));
+        if let Some(u) = &m.ugl {
+            ugl.insert(u.to_string());
+        }
+    }
+    base.len().max(ugl.len())
 }
 
 /// A campaign present in the store that the report does not use.
@@ -74,6 +97,15 @@ pub struct Campaigns {
 }
 
 impl Campaigns {
+    /// Every campaign the report reads: the main one first, then by role.
+    pub fn used(&self) -> impl Iterator<Item = &Campaign> {
+        std::iter::once(&self.main)
+            .chain(&self.budget)
+            .chain(&self.compare)
+            .chain(&self.recipe)
+            .chain(&self.followup)
+    }
+
     /// Runs the report uses (main, budget and compare campaigns).
     pub fn n_used_runs(&self) -> usize {
         self.main.store.runs.len()
@@ -248,11 +280,13 @@ fn record(d: &CampaignDir) -> Result<Option<CampaignDecl>, ReportError> {
 
 /// Reads a campaign's runs.
 fn read(d: &CampaignDir, decl: CampaignDecl) -> Result<Campaign, ReportError> {
+    let store = d.load()?;
     Ok(Campaign {
         name: d.name.clone(),
         path: d.path.clone(),
         decl,
-        store: d.load()?,
+        configurations: configurations(&store),
+        store,
     })
 }
 

@@ -385,6 +385,29 @@ fn a_manifest_of_a_future_results_version_is_an_error() {
 }
 
 #[test]
+fn a_campaign_of_two_configurations_is_flagged() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    synthetic_store(&results);
+    let out = tmp.path().join("out");
+    render_report(&opts(&results, &out)).unwrap();
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(!md.contains("Mixed configurations"), "{md}");
+    // One run explored with another budget: the campaign now pools two configurations.
+    let path = results.join("paper/armball.rpe.s1.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    m["explore"]["noise_sigma"] = 0.3.into();
+    std::fs::write(&path, m.to_string()).unwrap();
+    render_report(&opts(&results, &out)).unwrap();
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("**⚠ Mixed configurations.** The runs of `paper` (2 configurations)"),
+        "{md}"
+    );
+}
+
+#[test]
 fn missing_column_names_the_file_and_column() {
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");

@@ -75,6 +75,10 @@ pub struct CampaignRecord {
     /// The campaign's name (`[campaign] name`).
     pub name: String,
     pub decl: CampaignDecl,
+    /// The hash of the configuration its runs were run with (every constant of the campaign
+    /// TOML but its matrix: seeds, exploration, environment, learners); a campaign with another
+    /// configuration does not write into this store. None in records written before it was kept.
+    pub configuration: Option<String>,
 }
 
 /// Errors reading a campaign record or a run's diagnostics.
@@ -95,7 +99,25 @@ impl CampaignRecord {
         CampaignRecord {
             name: name.to_string(),
             decl: decl.clone(),
+            configuration: None,
         }
+    }
+
+    /// The same record, with its configuration hash.
+    pub fn with_configuration(mut self, hash: &str) -> CampaignRecord {
+        self.configuration = Some(hash.to_string());
+        self
+    }
+
+    /// Whether two records describe one campaign: the same name and declaration, and the same
+    /// configuration where both record one.
+    pub fn same_campaign(&self, other: &CampaignRecord) -> bool {
+        self.name == other.name
+            && self.decl == other.decl
+            && match (&self.configuration, &other.configuration) {
+                (Some(a), Some(b)) => a == b,
+                _ => true,
+            }
     }
 
     /// The record file of the campaign directory `dir`.
@@ -124,17 +146,30 @@ impl CampaignRecord {
             Some(_) => return Err("`name` is not a string".into()),
             None => return Err("missing `name`".into()),
         };
+        let configuration = match table.remove("configuration") {
+            Some(toml::Value::String(c)) => Some(c),
+            Some(_) => return Err("`configuration` is not a string".into()),
+            None => None,
+        };
         let decl = toml::Value::Table(table)
             .try_into()
             .map_err(|e: toml::de::Error| e.message().to_string())?;
-        Ok(CampaignRecord { name, decl })
+        Ok(CampaignRecord {
+            name,
+            decl,
+            configuration,
+        })
     }
 
     /// The record's text: a comment line, then the TOML.
     pub fn to_text(&self) -> String {
         let decl = toml::to_string(&self.decl).expect("a campaign declaration serialises");
+        let configuration = match &self.configuration {
+            Some(c) => format!("configuration = {}\n", toml::Value::String(c.clone())),
+            None => String::new(),
+        };
         format!(
-            "# What this campaign is, from the [campaign] table of its TOML (written by `ugl campaign`).\nname = {}\n{decl}",
+            "# What this campaign is, from the [campaign] table of its TOML (written by `ugl campaign`).\nname = {}\n{configuration}{decl}",
             toml::Value::String(self.name.clone())
         )
     }
@@ -159,6 +194,10 @@ mod tests {
             text.contains("\nname = \"armballs-still\"\nrole = \"followup\"\n"),
             "{text}"
         );
+        let with = r.clone().with_configuration("abc");
+        assert_eq!(CampaignRecord::parse(&with.to_text()).unwrap(), with);
+        assert!(with.same_campaign(&r) && r.same_campaign(&with));
+        assert!(!with.same_campaign(&r.clone().with_configuration("abd")));
         let bad = text.replace("followup", "sequel");
         assert!(CampaignRecord::parse(&bad).is_err());
         assert!(CampaignRecord::parse(&text.replace("tag", "tags")).is_err());

@@ -251,6 +251,24 @@ pub struct CampaignConfig {
 }
 
 impl CampaignConfig {
+    /// The hash of the campaign's configuration: every constant but the matrix (the results
+    /// version, campaign seed, `[explore]`, `[env]`, `[ugl]`, `[learners]`, `[mge]`). Runs of two
+    /// configurations never share a store ([`super::runner::write_campaign_record`]); adding
+    /// seeds or cells to the matrix keeps it.
+    pub fn configuration_hash(&self) -> String {
+        let input = serde_json::json!({
+            "results_version": ugl_types::RESULTS_VERSION,
+            "campaign_seed": self.campaign.seed,
+            "explore": self.explore,
+            "env": self.env,
+            "ugl": self.ugl,
+            "learners": self.learners,
+            "mge": self.mge,
+        });
+        let json = serde_json::to_vec(&input).expect("a campaign config serialises");
+        blake3::hash(&json).to_hex().to_string()
+    }
+
     /// Parse and validate TOML text; `path` is only used in error messages.
     pub fn from_toml(text: &str, path: &Path) -> Result<Self, ConfigError> {
         let cfg: CampaignConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {

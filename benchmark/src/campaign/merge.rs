@@ -89,16 +89,18 @@ pub fn merge_stores(into: &Path, sources: &[PathBuf]) -> Result<MergeSummary, Me
         // The campaign record travels with the runs; two different records do not mix.
         if let Some(record) = CampaignRecord::read(src)? {
             match CampaignRecord::read(into)? {
-                Some(theirs) if theirs != record => {
+                Some(theirs) if !theirs.same_campaign(&record) => {
                     return Err(MergeError::RecordConflict {
                         source_dir: src.clone(),
                         into: into.to_path_buf(),
-                        theirs: format!("{} ({})", record.name, record.decl.role.name()),
-                        ours: format!("{} ({})", theirs.name, theirs.decl.role.name()),
+                        theirs: describe(&record),
+                        ours: describe(&theirs),
                     });
                 }
-                Some(_) => {}
-                None => {
+                Some(theirs)
+                    if theirs.configuration.is_some() || record.configuration.is_none() => {}
+                // A record without its configuration (older) learns it from the source's.
+                _ => {
                     std::fs::create_dir_all(into).map_err(|source| MergeError::Read {
                         path: into.to_path_buf(),
                         source,
@@ -227,6 +229,19 @@ fn copy_beside_runs(src: &Path, into: &Path) -> Result<(), MergeError> {
         }
     }
     Ok(())
+}
+
+/// A record in an error message: `paper (main)`, with its configuration hash's first digits.
+fn describe(r: &CampaignRecord) -> String {
+    match &r.configuration {
+        Some(c) => format!(
+            "{} ({}, configuration {})",
+            r.name,
+            r.decl.role.name(),
+            &c[..c.len().min(12)]
+        ),
+        None => format!("{} ({})", r.name, r.decl.role.name()),
+    }
 }
 
 /// A run's diagnostics sidecar travels with it (where the destination has none).

@@ -2,7 +2,7 @@
 //! pool of workers; the failure and interruption policy.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -82,16 +82,106 @@ pub(crate) fn campaign_context<'a>(
     }
 }
 
-/// Record what the campaign is ([`CampaignRecord`]) in its results directory `out`, where the
-/// report reads its role. Written at every start (the declaration is not part of any run's
-/// identity, so a changed declaration changes no result).
+/// The lock file that serialises campaigns starting on one results directory.
+pub const STORE_LOCK: &str = ".ugl-store.lock";
+
+/// Claims the results directory `out` for this campaign and records what it is
+/// ([`CampaignRecord`]: its name, role and configuration hash), where the report reads its
+/// role. One store holds one campaign run with one configuration: a campaign of another name,
+/// or of the same name with another configuration (`CampaignConfig::configuration_hash`), is
+/// refused, so that the runs of two configurations never mix (shards of one campaign share it).
+/// The check and the write happen under an exclusive lock on `out/.ugl-store.lock`, so two
+/// campaigns started together cannot both pass. A store whose record predates the configuration
+/// hash is checked against its manifests of the current results version instead.
 pub fn write_campaign_record(cfg: &CampaignConfig, out: &Path) -> Result<(), StoreError> {
-    std::fs::create_dir_all(out).map_err(|source| StoreError::Io {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| StoreError::Io { path, source }
+    };
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let lock_path = out.join(STORE_LOCK);
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(io(&lock_path))?;
+    lock.lock().map_err(io(&lock_path))?;
+    let configuration = cfg.configuration_hash();
+    let refused = |message: String| StoreError::Refused {
         path: out.to_path_buf(),
-        source,
+        message,
+    };
+    let advice = "use another --out (or remove that store to start over)";
+    let ours = CampaignRecord::read(out).map_err(|e| StoreError::Read {
+        path: CampaignRecord::path(out),
+        message: e.to_string(),
     })?;
-    let record = CampaignRecord::new(&cfg.campaign.name, &cfg.campaign.decl());
+    if let Some(theirs) = &ours {
+        if theirs.name != cfg.campaign.name {
+            return Err(refused(format!(
+                "holds campaign `{}`, not `{}`: {advice}",
+                theirs.name, cfg.campaign.name
+            )));
+        }
+        match &theirs.configuration {
+            Some(c) if *c != configuration => {
+                return Err(refused(format!(
+                    "holds the runs of campaign `{}` with another configuration (recorded {}, this one {}): the results of two configurations would mix; {advice}",
+                    theirs.name,
+                    &c[..12.min(c.len())],
+                    &configuration[..12]
+                )));
+            }
+            Some(_) => {}
+            None => {
+                check_legacy_manifests(cfg, out).map_err(|m| refused(format!("{m}; {advice}")))?
+            }
+        }
+    } else {
+        check_legacy_manifests(cfg, out).map_err(|m| refused(format!("{m}; {advice}")))?;
+    }
+    let record = CampaignRecord::new(&cfg.campaign.name, &cfg.campaign.decl())
+        .with_configuration(&configuration);
     store::write_atomic(&CampaignRecord::path(out), record.to_text().as_bytes())
+}
+
+/// A store without a configuration hash: its runs of the current results version must have
+/// been run with this campaign's seed, `[explore]` and `[env]` (older versions are superseded
+/// and rerun anyway).
+fn check_legacy_manifests(cfg: &CampaignConfig, out: &Path) -> Result<(), String> {
+    let explore = serde_json::to_value(&cfg.explore).expect("explore serialises");
+    let env = serde_json::to_value(&cfg.env).expect("env serialises");
+    let entries = std::fs::read_dir(out).map_err(|e| format!("cannot list it: {e}"))?;
+    let mut names: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    names.sort();
+    for path in names {
+        let Ok(m) = store::read_manifest(&path) else {
+            continue;
+        };
+        if m.results_version() != Some(u64::from(ugl_types::RESULTS_VERSION)) {
+            continue;
+        }
+        let differs = if m.campaign_seed != cfg.campaign.seed {
+            Some("the campaign seed")
+        } else if m.explore != explore {
+            Some("[explore]")
+        } else if m.env_config != env {
+            Some("[env]")
+        } else {
+            None
+        };
+        if let Some(what) = differs {
+            return Err(format!(
+                "holds runs of another configuration ({what} of {} differs from this campaign's)",
+                path.file_name().unwrap_or_default().to_string_lossy()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Run `work(g)` for every group index `g < n`: `jobs` plain worker threads pull indexes from a

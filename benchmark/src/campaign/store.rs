@@ -29,6 +29,9 @@ pub enum StoreError {
     Encode { path: PathBuf, message: String },
     #[error("cannot read {path}: {message}")]
     Read { path: PathBuf, message: String },
+    /// The store belongs to another campaign or configuration.
+    #[error("{path}: {message}")]
+    Refused { path: PathBuf, message: String },
 }
 
 /// The curve table of a run. Where the scene has an object the agent cannot control

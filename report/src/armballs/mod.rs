@@ -169,6 +169,7 @@ mod tests {
             name: "armballs".into(),
             path: "armballs".into(),
             decl: Default::default(),
+            configurations: 1,
             store: Store {
                 runs: Vec::new(),
                 incomplete: Vec::new(),

@@ -168,6 +168,28 @@ pub fn header(w: &mut String, inp: &Context<'_>) {
         }
         let _ = writeln!(w);
     }
+    let mixed: Vec<String> = inp
+        .campaigns
+        .used()
+        .filter(|c| c.configurations > 1)
+        .map(|c| {
+            format!(
+                "`{}` ({} configurations)",
+                campaign_name(&c.name),
+                c.configurations
+            )
+        })
+        .collect();
+    if !mixed.is_empty() {
+        let _ = writeln!(
+            w,
+            "> **⚠ Mixed configurations.** The runs of {} were run with different \
+             configurations (campaign seed, `[explore]`, `[env]` or `[ugl]` differ between \
+             their manifests), and the statistics below pool them. Rerun such a campaign into \
+             a store of its own.\n",
+            mixed.join(", ")
+        );
+    }
     claims::summary_line(w, inp);
     if inp.paper.path.is_none() {
         let _ = writeln!(
