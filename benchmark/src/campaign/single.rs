@@ -207,11 +207,13 @@ pub fn resolve_learner(
             if cmd.trim().is_empty() {
                 return Err("--command must not be empty".into());
             }
+            // The profile's timeouts still apply to the program given here.
+            let configured = cfg.learners.external();
             cfg.learners.set_external(&ExternalConfig {
                 name: name.to_string(),
                 command: cmd.to_string(),
-                ready_timeout_s: None,
-                answer_timeout_s: None,
+                ready_timeout_s: configured.as_ref().and_then(|e| e.ready_timeout_s),
+                answer_timeout_s: configured.as_ref().and_then(|e| e.answer_timeout_s),
             });
             Learner::all()
                 .find(|l| l.is_external())
@@ -355,6 +357,27 @@ mod tests {
         .resolve(&mut c, Path::new("base.toml"))
         .unwrap();
         assert_eq!(c.learners.external().unwrap().name, "external");
+    }
+
+    /// `--command` replaces the program, not the profile's timeouts (compare and embed dropped
+    /// them, and waited on a hanging learner past the configured limit).
+    #[test]
+    fn a_command_keeps_the_profiles_external_timeouts() {
+        let text = format!(
+            "{PROFILE}[learners.external]\nname = \"slow\"\ncommand = \"false\"\n\
+             ready_timeout_s = 3.0\nanswer_timeout_s = 2.0\n"
+        );
+        let mut c = CampaignConfig::from_toml(&text, Path::new("base.toml")).unwrap();
+        resolve_learner("mine", Some("python3 m.py"), &mut c).unwrap();
+        let e = c.learners.external().unwrap();
+        assert_eq!(
+            (e.name.as_str(), e.command.as_str()),
+            ("mine", "python3 m.py")
+        );
+        assert_eq!(
+            (e.ready_timeout_s, e.answer_timeout_s),
+            (Some(3.0), Some(2.0))
+        );
     }
 
     #[test]
