@@ -456,3 +456,18 @@ fn measure_fit_10k_arrows() {
     z.data.iter().for_each(|v| v.to_bits().hash(&mut h));
     println!("embedding fingerprint: {:016x}", h.finish());
 }
+
+/// More latents than the geodesic kernel has positive eigenvalues: an error naming how many
+/// carry variance (it used to return the extra dimensions as constant zeros).
+#[test]
+fn more_latents_than_positive_eigenvalues_is_an_error() {
+    let (set, _) = balls(100, 4);
+    let r = Isomap::default().fit(&set, 99, &mut stream_named(1, "l"));
+    match r {
+        Err(ReprError::Numerical(m)) => {
+            assert!(m.contains("same for all 100 training images"), "{m}")
+        }
+        Err(e) => panic!("unexpected error {e}"),
+        Ok(_) => panic!("99 latents of 100 images fitted without a word"),
+    }
+}

@@ -43,7 +43,7 @@ use super::neural_model::Variant;
 use super::params::{LearnerParams, ParamGuard};
 use super::{
     Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
-    check_latents,
+    check_latents, check_no_constant_latent,
 };
 use crate::seed::Stream;
 
@@ -278,10 +278,8 @@ impl ExternalLearner {
             },
             Err(e) => return Err(session.fail(format!("after READY: {e}"), false)),
         };
-        if let Err(e) = check_latents(
-            &z,
-            &format!("external learner '{}' (train_latents.npy)", self.name),
-        ) {
+        let who = format!("external learner '{}' (train_latents.npy)", self.name);
+        if let Err(e) = check_latents(&z, &who).and_then(|()| check_no_constant_latent(&z, &who)) {
             let _ = session.fail(e.to_string(), false);
             return Err(e);
         }

@@ -284,6 +284,39 @@ pub fn check_fit_input(images: &ImageSet, latents: usize) -> Result<(), ReprErro
 }
 
 /// Check an encoder's output: right shape, finite.
+/// Refuses training latents with a dimension that is the same for every training image: the
+/// goal space has fewer dimensions than asked, and a KDE of the goals degenerates in it (an
+/// external program's constant output; Isomap asked for more dimensions than its geodesic
+/// kernel has positive eigenvalues).
+pub fn check_no_constant_latent(z: &Latents, who: &str) -> Result<(), ReprError> {
+    if z.n < 2 {
+        return Ok(());
+    }
+    let constant: Vec<usize> = (0..z.latents)
+        .filter(|&c| {
+            let first = z.data[c];
+            (1..z.n).all(|i| z.data[i * z.latents + c] == first)
+        })
+        .collect();
+    if constant.is_empty() {
+        return Ok(());
+    }
+    Err(ReprError::Numerical(format!(
+        "{who}: {} of the {} latents are the same for all {} training images (dimension{} {}): \
+         the goal space has only {} dimensions; ask for fewer latents",
+        constant.len(),
+        z.latents,
+        z.n,
+        if constant.len() == 1 { "" } else { "s" },
+        constant
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        z.latents - constant.len()
+    )))
+}
+
 pub fn check_latents(z: &Latents, who: &str) -> Result<(), ReprError> {
     if z.data.len() != z.n * z.latents {
         return Err(ReprError::Numerical(format!(
@@ -301,4 +334,31 @@ pub fn check_latents(z: &Latents, who: &str) -> Result<(), ReprError> {
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_constant_latent_is_refused_and_named() {
+        let varying = Latents {
+            n: 3,
+            latents: 2,
+            data: vec![0.0, 1.0, 0.5, 2.0, 1.0, 3.0],
+        };
+        assert!(check_no_constant_latent(&varying, "x").is_ok());
+        let constant = Latents {
+            n: 3,
+            latents: 2,
+            data: vec![0.0, 7.0, 0.5, 7.0, 1.0, 7.0],
+        };
+        let e = check_no_constant_latent(&constant, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("1 of the 2 latents") && e.contains("dimension 1"),
+            "{e}"
+        );
+    }
 }

@@ -75,6 +75,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
+    check_no_constant_latent,
 };
 use crate::repr::neural_model::Variant;
 use crate::repr::params::{LearnerParams, ParamGuard};
@@ -360,6 +361,7 @@ impl Isomap {
             data: z,
         };
         check_latents(&z, "isomap")?;
+        check_no_constant_latent(&z, "isomap")?;
         let enc = IsomapEncoder {
             n_neighbors: k,
             latents,
