@@ -121,13 +121,18 @@ pub struct EnvConfig {
     /// Catch radius: the object is caught when the squared hand-object distance is below its square.
     pub object_size: f64,
     /// Initial ball position.
+    #[serde(deserialize_with = "ball_initial")]
     pub ball_initial: [f64; 2],
     /// Initial arrow pose (x, y, angle in units of pi).
+    #[serde(deserialize_with = "arrow_initial")]
     pub arrow_initial: [f64; 3],
     /// ArmBalls: the distractor's position at the start of every episode (CDGE
     /// `distract_initial_pose`). Serialised only when it differs from the default, so that
     /// the other environments' config hashes do not depend on it.
-    #[serde(skip_serializing_if = "is_default_distractor_initial")]
+    #[serde(
+        skip_serializing_if = "is_default_distractor_initial",
+        deserialize_with = "distractor_initial"
+    )]
     pub distractor_initial: [f64; 2],
     /// ArmBalls: standard deviation of the distractor's step per time step (CDGE
     /// `distract_noise`; 0 keeps it still). Serialised only when it differs from the default.
@@ -139,6 +144,30 @@ pub struct EnvConfig {
 const DISTRACTOR_INITIAL: [f64; 2] = [0.7, -0.45];
 /// The follow-up's distractor step (CDGE `--distract_noise`, committed configs).
 const DISTRACTOR_NOISE: f64 = 0.1;
+
+/// Exactly `N` numbers for the key `env.KEY`: serde's fixed-size arrays read the first `N`
+/// elements of a longer TOML array and silently drop the rest.
+pub(crate) fn exactly<'de, D, const N: usize>(d: D, key: &str) -> Result<[f64; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let v = Vec::<f64>::deserialize(d)?;
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| serde::de::Error::custom(format!("env.{key} must have {N} numbers, got {n}")))
+}
+
+fn ball_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly(d, "ball_initial")
+}
+
+fn arrow_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    exactly(d, "arrow_initial")
+}
+
+fn distractor_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly(d, "distractor_initial")
+}
 
 fn is_default_distractor_initial(v: &[f64; 2]) -> bool {
     *v == DISTRACTOR_INITIAL
