@@ -379,7 +379,7 @@ impl CampaignConfig {
             ));
         }
         self.explore.validate()?;
-        validate_env(&self.env)
+        self.env.validate()
     }
 }
 
@@ -388,38 +388,6 @@ fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
         .enumerate()
         .find(|(i, a)| v[..*i].contains(a))
         .map(|(_, a)| a.to_string())
-}
-
-fn validate_env(e: &EnvConfig) -> Result<(), String> {
-    if e.arm.lengths.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
-        return Err("env.arm.lengths must be finite and >= 0".into());
-    }
-    if !(e.object_size.is_finite() && e.object_size > 0.0) {
-        return Err(format!(
-            "env.object_size must be > 0, got {}",
-            e.object_size
-        ));
-    }
-    if e.dmp.timesteps == 0 {
-        return Err("env.dmp.timesteps must be at least 1".into());
-    }
-    if !(e.dmp.run_time.is_finite() && e.dmp.run_time > 0.0) {
-        return Err("env.dmp.run_time must be > 0".into());
-    }
-    for (k, v) in [
-        ("env.dmp.ay", e.dmp.ay),
-        ("env.dmp.ax", e.dmp.ax),
-        ("env.dmp.max_params", e.dmp.max_params),
-    ] {
-        if !v.is_finite() {
-            return Err(format!("{k} must be finite"));
-        }
-    }
-    let inside = |p: &[f64]| p.iter().all(|v| (-1.0..=1.0).contains(v));
-    if !inside(&e.ball_initial) || !inside(&e.arrow_initial) {
-        return Err("env.ball_initial / env.arrow_initial must lie in [-1,1]".into());
-    }
-    Ok(())
 }
 
 /// A (possibly multi-line) TOML error as one line: the reason, the position and the offending
