@@ -1798,3 +1798,56 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     assert!(report.join("figures/armballs_coverage.svg").is_file());
     assert!(report.join("figures/armballs_interest.svg").is_file());
 }
+
+/// A closed stdout ends a command quietly with exit 0, as `ls | head` does (the reader has what
+/// it wanted); a full one (`/dev/full`) is one line on stderr and exit 2. Both used to panic
+/// ("failed printing to stdout", exit 101).
+#[test]
+fn a_closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let commands: [&[&str]; 4] = [
+        &["learners"],
+        &["plan", "--config", "data/campaigns/paper.toml"],
+        &[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--epochs",
+            "20",
+            "--profile",
+            "smoke",
+            "--out",
+            p(&out),
+        ],
+        &["--help"],
+    ];
+    let with_stdout = |args: &[&str], stdout: std::process::Stdio| {
+        Command::new(env!("CARGO_BIN_EXE_ugl"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(stdout)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .expect("ugl runs")
+    };
+    for args in commands {
+        // The reading end is closed before the command starts: its first write fails.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = with_stdout(args, writer.into());
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o), "", "{args:?}: quiet");
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = with_stdout(args, full.into());
+        assert_one_line_error(&o, "No space left on device");
+        assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    }
+    // The run itself was done and stored before its summary could not be printed.
+    assert!(out.join("armball.rpe.s0.json").is_file());
+}
