@@ -1851,3 +1851,46 @@ fn a_closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
     // The run itself was done and stored before its summary could not be printed.
     assert!(out.join("armball.rpe.s0.json").is_file());
 }
+
+/// `ugl embed --grid N` is checked against the machine's memory before anything is fitted, as
+/// `--images` is: `--grid 1000` allocated 19.6 GB of images after the fit and aborted.
+#[test]
+fn embed_grid_is_checked_against_memory_before_fitting() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("emb").join("pca.npy");
+    let embed = |grid: &str| {
+        ugl(&[
+            "embed",
+            "--env",
+            "armball",
+            "--learner",
+            "pca",
+            "--latents",
+            "2",
+            "--images",
+            "300",
+            "--profile",
+            "smoke",
+            "--grid",
+            grid,
+            "--out",
+            p(&out),
+        ])
+    };
+    assert_one_line_error(&embed("100000"), "--grid = 100000 needs about");
+    let mem_gib = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|m| {
+            let kib: f64 = m.lines().next()?.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib / (1024.0 * 1024.0))
+        })
+        .unwrap_or(f64::INFINITY);
+    // 10^6 images of 70x70: about 55 GiB with an encoder's f64 copy.
+    if mem_gib < 50.0 {
+        assert_one_line_error(&embed("1000"), "--grid = 1000 needs about");
+    }
+    assert!(
+        !dir.path().join("emb").exists(),
+        "nothing was fitted or written"
+    );
+}

@@ -76,9 +76,11 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
         .map_err(anyhow::Error::msg)?;
     single::check_learner_variant(learner, a.variant).map_err(anyhow::Error::msg)?;
     single::check_latents(a.latents, cfg.ugl.images).map_err(anyhow::Error::msg)?;
-    if !(2..=1000).contains(&a.grid) {
-        bail!("--grid must be between 2 and 1000, got {}", a.grid);
+    if a.grid < 2 {
+        bail!("--grid must be at least 2, got {}", a.grid);
     }
+    // Before anything is fitted or allocated: GRID^2 images must fit in memory.
+    ugl_bench::limits::check_grid(a.grid, cfg.ugl.images).map_err(anyhow::Error::msg)?;
     if a.out.extension().and_then(|e| e.to_str()) != Some("npy") {
         bail!("--out {}: the file name must end in .npy", a.out.display());
     }
