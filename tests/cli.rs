@@ -1894,3 +1894,30 @@ fn embed_grid_is_checked_against_memory_before_fitting() {
         "nothing was fitted or written"
     );
 }
+
+/// A modular exploration of a learned goal space whose latents do not split into modules of
+/// `mge.module_size` is refused before any training: `ugl run --algo mge-vae-lp --latents 3`
+/// trained for seconds and then failed.
+#[test]
+fn modular_latent_sizes_are_checked_before_training() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armarrow",
+        "--algo",
+        "mge-vae-lp",
+        "--latents",
+        "3",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&out),
+    ]);
+    assert_one_line_error(
+        &o,
+        "--latents 3: mge-vae-lp splits its latents into modules of mge.module_size = 2",
+    );
+    assert!(!out.exists(), "nothing was trained or written");
+}

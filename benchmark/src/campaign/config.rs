@@ -121,6 +121,16 @@ pub enum LatentSize {
     TrueDim,
 }
 
+impl LatentSize {
+    /// The number of latents in `env`.
+    pub fn size(self, env: EnvKind) -> usize {
+        match self {
+            LatentSize::N(n) => n,
+            LatentSize::TrueDim => env.spec().true_latents,
+        }
+    }
+}
+
 impl Serialize for LatentSize {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
@@ -337,17 +347,28 @@ impl CampaignConfig {
         }
         self.learners.validate()?;
         self.mge.validate()?;
+        // Every size, "true" resolved per environment, before anything is trained.
         for a in self.matrix.algos.iter().filter(|a| a.modules().is_some()) {
             if a.learner().is_some()
                 && a.modules() != Some(crate::explore::Modules::Flat)
-                && let Some(n) = self.matrix.latents.iter().find_map(|l| match l {
-                    LatentSize::N(n) if n % self.mge.module_size != 0 => Some(*n),
-                    _ => None,
+                && let Some((l, env)) = self.matrix.latents.iter().find_map(|l| {
+                    let env = self
+                        .matrix
+                        .envs
+                        .iter()
+                        .find(|e| l.size(**e) % self.mge.module_size != 0)?;
+                    Some((*l, *env))
                 })
             {
+                let has = match l {
+                    LatentSize::N(n) => n.to_string(),
+                    LatentSize::TrueDim => {
+                        format!("\"true\" ({} latents in {env})", l.size(env))
+                    }
+                };
                 return Err(format!(
                     "matrix.algos has {a}, whose modules take mge.module_size = {} latents, \
-                     but matrix.latents has {n}",
+                     but matrix.latents has {has}",
                     self.mge.module_size
                 ));
             }
