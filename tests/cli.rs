@@ -1921,3 +1921,47 @@ fn modular_latent_sizes_are_checked_before_training() {
     );
     assert!(!out.exists(), "nothing was trained or written");
 }
+
+/// Messages name what the user wrote: the algorithm given, the command-line flag (not the
+/// library's option), the key of a learner's table and its line.
+#[test]
+fn messages_name_the_algorithm_the_flag_and_the_key_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "mge-external-lp",
+        "--latents",
+        "2",
+        "--out",
+        p(&dir.path().join("run")),
+    ]);
+    assert_one_line_error(&o, "--algo mge-external-lp needs --command");
+    let o = ugl(&[
+        "report",
+        "--results",
+        "data/results",
+        "--main",
+        "nosuch",
+        "--out",
+        p(&dir.path().join("report")),
+    ]);
+    assert_one_line_error(&o, "choose one with --main NAME");
+    assert!(!stderr(&o).contains("ReportOptions"), "{}", stderr(&o));
+    let cfg = dir.path().join("bvae.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rge-bvae\"]\n[learners.bvae]\nbeta = 4.0\ninit = 1\n",
+    )
+    .unwrap();
+    let o = ugl(&["plan", "--config", p(&cfg)]);
+    assert_one_line_error(&o, "learners.bvae.init: invalid type");
+    assert!(
+        stderr(&o).contains("(line 9: `init = 1`)"),
+        "{}",
+        stderr(&o)
+    );
+}

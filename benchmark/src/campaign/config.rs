@@ -269,7 +269,7 @@ impl CampaignConfig {
         })?;
         cfg.validate().map_err(|message| ConfigError::Invalid {
             path: path.to_path_buf(),
-            message,
+            message: with_learner_line(text, message),
         })?;
         Ok(cfg)
     }
@@ -409,6 +409,44 @@ fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
         .enumerate()
         .find(|(i, a)| v[..*i].contains(a))
         .map(|(_, a)| a.to_string())
+}
+
+/// A message about `learners.NAME.KEY` (the learners' tables are checked after parsing, without
+/// positions) with the line of `text` that sets the key: `... (line 9: `init = 1`)`.
+fn with_learner_line(text: &str, message: String) -> String {
+    let Some((path, _)) = message.split_once(": ") else {
+        return message;
+    };
+    let Some((name, key)) = path
+        .strip_prefix("learners.")
+        .and_then(|p| p.split_once('.'))
+    else {
+        return message;
+    };
+    let key = key.split(['.', '[']).next().unwrap_or(key);
+    match learner_key_line(text, name, key) {
+        Some(at) if !message.contains("(line ") => format!("{message} ({at})"),
+        _ => message,
+    }
+}
+
+/// Where `learners.NAME.KEY` is set in `text`: `line N: `the line``.
+fn learner_key_line(text: &str, name: &str, key: &str) -> Option<String> {
+    use toml::de::{DeTable, DeValue};
+    fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t toml::Spanned<DeValue<'i>>> {
+        t.iter().find(|(n, _)| n.get_ref() == k).map(|(_, v)| v)
+    }
+    let root = DeTable::parse(text).ok()?;
+    let DeValue::Table(learners) = get(root.get_ref(), "learners")?.get_ref() else {
+        return None;
+    };
+    let DeValue::Table(table) = get(learners, name)?.get_ref() else {
+        return None;
+    };
+    let (k, _) = table.iter().find(|(n, _)| n.get_ref() == key)?;
+    let line = text[..k.span().start].matches('\n').count() + 1;
+    let source = text.lines().nth(line - 1)?.trim();
+    Some(format!("line {line}: `{source}`"))
 }
 
 /// A (possibly multi-line) TOML error as one line: the reason, the position and the offending

@@ -80,7 +80,8 @@ impl RunRequest {
         let external = self.algo.learner().is_some_and(Learner::is_external);
         if !external && (self.command.is_some() || self.name.is_some()) {
             return Err(format!(
-                "--command and --name apply to --algo rge-external only, not {}",
+                "--command and --name apply to the external learner's algorithms only \
+                 (rge-external, mge-external-*), not {}",
                 self.algo
             ));
         }
@@ -114,7 +115,8 @@ impl RunRequest {
         }
         if cfg.learners.external().is_none() {
             return Err(format!(
-                "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                "--algo {} needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                self.algo,
                 profile.display()
             ));
         }
