@@ -4,6 +4,7 @@
 
 mod cli;
 mod commands;
+mod output;
 mod progress;
 
 use std::process::ExitCode;
@@ -36,7 +37,9 @@ fn main() -> ExitCode {
                     | ErrorKind::DisplayVersion
                     | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
             ) {
-                let _ = e.print();
+                if let Err(err) = e.print() {
+                    return stdout_failed(output::StdoutError(err));
+                }
                 return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
                     ExitCode::from(2)
                 } else {
@@ -54,10 +57,25 @@ fn main() -> ExitCode {
     };
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<output::StdoutError>().is_some() => {
+            let e = e.downcast::<output::StdoutError>().expect("checked");
+            stdout_failed(e)
+        }
         Err(e) => {
             eprintln!("error: {}", one_line(&e));
             ExitCode::from(2)
         }
+    }
+}
+
+/// Standard output failed: a closed pipe ends quietly (exit 0: the reader has what it wanted,
+/// as with `ls | head`), any other failure (a full disk) is one line and exit 2.
+fn stdout_failed(e: output::StdoutError) -> ExitCode {
+    if e.is_closed_pipe() {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
     }
 }
 
@@ -118,7 +136,7 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Plan { config } => {
             let cfg = CampaignConfig::load(&config)?;
             for spec in plan(&cfg) {
-                println!("{}", spec.run_id());
+                output::outln!("{}", spec.run_id())?;
             }
             Ok(())
         }
@@ -148,10 +166,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             time,
         } => slurm(&config, shards, out, &scripts, cpus, &time),
         Command::Merge { into, sources } => merge(&into, &sources),
-        Command::Learners => {
-            learners();
-            Ok(())
-        }
+        Command::Learners => learners(),
         Command::Compare(a) => compare(a),
         Command::Embed(a) => embed(a),
         Command::Report {

@@ -41,10 +41,23 @@ fn every_bad_config_gives_a_one_line_error_naming_the_key_and_touches_nothing() 
             .next()
             .and_then(|l| l.strip_prefix("# expect: "))
             .unwrap_or_else(|| panic!("{} lacks '# expect:'", f.display()));
-        for cmd in ["plan", "campaign"] {
-            let o =
-                run(&[cmd, "--config", p(&f), "--out", p(&out)]
-                    [..if cmd == "plan" { 3 } else { 5 }]);
+        // `ugl run` reads the same file as a profile and checks all of it first.
+        for cmd in ["plan", "campaign", "run"] {
+            let o = match cmd {
+                "plan" => run(&[cmd, "--config", p(&f)]),
+                "campaign" => run(&[cmd, "--config", p(&f), "--out", p(&out)]),
+                _ => run(&[
+                    cmd,
+                    "--profile",
+                    p(&f),
+                    "--env",
+                    "armball",
+                    "--algo",
+                    "rpe",
+                    "--out",
+                    p(&out),
+                ]),
+            };
             let err = String::from_utf8_lossy(&o.stderr);
             assert_eq!(o.status.code(), Some(2), "{} ({cmd}): {err}", f.display());
             assert_eq!(

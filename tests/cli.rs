@@ -1798,3 +1798,170 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     assert!(report.join("figures/armballs_coverage.svg").is_file());
     assert!(report.join("figures/armballs_interest.svg").is_file());
 }
+
+/// A closed stdout ends a command quietly with exit 0, as `ls | head` does (the reader has what
+/// it wanted); a full one (`/dev/full`) is one line on stderr and exit 2. Both used to panic
+/// ("failed printing to stdout", exit 101).
+#[test]
+fn a_closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let commands: [&[&str]; 4] = [
+        &["learners"],
+        &["plan", "--config", "data/campaigns/paper.toml"],
+        &[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--epochs",
+            "20",
+            "--profile",
+            "smoke",
+            "--out",
+            p(&out),
+        ],
+        &["--help"],
+    ];
+    let with_stdout = |args: &[&str], stdout: std::process::Stdio| {
+        Command::new(env!("CARGO_BIN_EXE_ugl"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(stdout)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .expect("ugl runs")
+    };
+    for args in commands {
+        // The reading end is closed before the command starts: its first write fails.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = with_stdout(args, writer.into());
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o), "", "{args:?}: quiet");
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = with_stdout(args, full.into());
+        assert_one_line_error(&o, "No space left on device");
+        assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    }
+    // The run itself was done and stored before its summary could not be printed.
+    assert!(out.join("armball.rpe.s0.json").is_file());
+}
+
+/// `ugl embed --grid N` is checked against the machine's memory before anything is fitted, as
+/// `--images` is: `--grid 1000` allocated 19.6 GB of images after the fit and aborted.
+#[test]
+fn embed_grid_is_checked_against_memory_before_fitting() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("emb").join("pca.npy");
+    let embed = |grid: &str| {
+        ugl(&[
+            "embed",
+            "--env",
+            "armball",
+            "--learner",
+            "pca",
+            "--latents",
+            "2",
+            "--images",
+            "300",
+            "--profile",
+            "smoke",
+            "--grid",
+            grid,
+            "--out",
+            p(&out),
+        ])
+    };
+    assert_one_line_error(&embed("100000"), "--grid = 100000 needs about");
+    let mem_gib = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|m| {
+            let kib: f64 = m.lines().next()?.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib / (1024.0 * 1024.0))
+        })
+        .unwrap_or(f64::INFINITY);
+    // 10^6 images of 70x70: about 55 GiB with an encoder's f64 copy.
+    if mem_gib < 50.0 {
+        assert_one_line_error(&embed("1000"), "--grid = 1000 needs about");
+    }
+    assert!(
+        !dir.path().join("emb").exists(),
+        "nothing was fitted or written"
+    );
+}
+
+/// A modular exploration of a learned goal space whose latents do not split into modules of
+/// `mge.module_size` is refused before any training: `ugl run --algo mge-vae-lp --latents 3`
+/// trained for seconds and then failed.
+#[test]
+fn modular_latent_sizes_are_checked_before_training() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armarrow",
+        "--algo",
+        "mge-vae-lp",
+        "--latents",
+        "3",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&out),
+    ]);
+    assert_one_line_error(
+        &o,
+        "--latents 3: mge-vae-lp splits its latents into modules of mge.module_size = 2",
+    );
+    assert!(!out.exists(), "nothing was trained or written");
+}
+
+/// Messages name what the user wrote: the algorithm given, the command-line flag (not the
+/// library's option), the key of a learner's table and its line.
+#[test]
+fn messages_name_the_algorithm_the_flag_and_the_key_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "mge-external-lp",
+        "--latents",
+        "2",
+        "--out",
+        p(&dir.path().join("run")),
+    ]);
+    assert_one_line_error(&o, "--algo mge-external-lp needs --command");
+    let o = ugl(&[
+        "report",
+        "--results",
+        "data/results",
+        "--main",
+        "nosuch",
+        "--out",
+        p(&dir.path().join("report")),
+    ]);
+    assert_one_line_error(&o, "choose one with --main NAME");
+    assert!(!stderr(&o).contains("ReportOptions"), "{}", stderr(&o));
+    let cfg = dir.path().join("bvae.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rge-bvae\"]\n[learners.bvae]\nbeta = 4.0\ninit = 1\n",
+    )
+    .unwrap();
+    let o = ugl(&["plan", "--config", p(&cfg)]);
+    assert_one_line_error(&o, "learners.bvae.init: invalid type");
+    assert!(
+        stderr(&o).contains("(line 9: `init = 1`)"),
+        "{}",
+        stderr(&o)
+    );
+}

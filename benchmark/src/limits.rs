@@ -46,6 +46,15 @@ pub fn check_images(n: usize) -> Result<(), String> {
     check_fits("ugl.images", n, n as f64 * PIXELS as f64 * 4.0 * 2.0)
 }
 
+/// `ugl embed --grid N` (`N x N` rendered images of 70x70 f32, held with the `images` training
+/// images while they are encoded; the encoders work on an f64 copy of a set). Computed in
+/// floating point, so that no size overflows.
+pub fn check_grid(grid: usize, images: usize) -> Result<(), String> {
+    let grid_images = grid as f64 * grid as f64;
+    let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * PIXELS as f64;
+    check_fits("--grid", grid, bytes)
+}
+
 /// `explore.epochs` (the exploration's per-epoch records).
 pub fn check_epochs(n: usize) -> Result<(), String> {
     check_fits("explore.epochs", n, n as f64 * BYTES_PER_EPOCH)
@@ -89,6 +98,10 @@ mod tests {
             "{e}"
         );
         assert!(check_epochs(1 << 63).is_err());
+        assert!(check_grid(21, 10_000).is_ok());
+        let e = check_grid(100_000, 300).unwrap_err();
+        assert!(e.starts_with("--grid = 100000 needs about"), "{e}");
+        assert!(check_grid(usize::MAX, 300).is_err());
         assert!(check_epochs(usize::MAX).is_err());
         assert!(check_hidden("learners.ae.hidden", [100_000_000, 10]).is_err());
         assert!(check_runs(&[("envs", 2), ("algos", 7), ("reps", 5)]).is_ok());

@@ -832,6 +832,152 @@ fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
     }
 }
 
+/// A checkpoint whose `state.json` was changed (one value of the batch permutation, the
+/// iteration count, the stream's position or the loss curve; an entry out of range; the digest
+/// gone; the file cut short) is ignored with a warning: the training starts over, or resumes
+/// from an older valid checkpoint, and ends bit-identical to an uninterrupted one. Before the
+/// state was sealed, a swapped pair in `perm` resumed silently into another network, and an
+/// out-of-range entry panicked on every rerun.
+#[test]
+fn a_damaged_or_inconsistent_checkpoint_state_is_ignored() {
+    use serde_json::Value;
+    use ugl_bench::repr::neural::{CheckpointSpec, Engine, train, train_with_checkpoints};
+    let model = Model::Vae;
+    let set = images(EnvKind::ArmBall, 120);
+    let cfg = NeuralConfig {
+        log_every: 5,
+        engine: Engine::Host,
+        ..tiny(model, Variant::Faithful, 60)
+    };
+    let learner_stream = || stream_named(9, "checkpoint-state");
+    let reference = train(model, &cfg, &set, 3, &mut learner_stream(), None).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let spec = CheckpointSpec {
+        dir: dir.path().to_path_buf(),
+        key: "state-test".into(),
+        every: 20,
+    };
+    let ckpt = |step: usize| dir.path().join(format!("state-test.ckpt.{step}"));
+    // Train, killed after iteration `at`; returns the first iteration it ran (1-based).
+    let train_until = |at: Option<usize>| {
+        let first = Arc::new(AtomicUsize::new(usize::MAX));
+        let seen = first.clone();
+        let watch: ugl_bench::repr::neural::ProgressFn = Arc::new(move |p| {
+            seen.fetch_min(p.iteration, Ordering::SeqCst);
+            if Some(p.iteration) == at {
+                panic!("killed at iteration {}", p.iteration);
+            }
+        });
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            train_with_checkpoints(
+                model,
+                &cfg,
+                &set,
+                3,
+                &mut learner_stream(),
+                Some(&watch),
+                Some(&spec),
+            )
+        }));
+        (r, first.load(Ordering::SeqCst))
+    };
+    let copy = |from: &std::path::Path, to: &std::path::Path| {
+        let _ = std::fs::remove_dir_all(to);
+        std::fs::create_dir_all(to).unwrap();
+        for e in std::fs::read_dir(from).unwrap() {
+            let e = e.unwrap();
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    };
+    let saved = tempfile::tempdir().unwrap();
+    let (saved20, saved40) = (saved.path().join("20"), saved.path().join("40"));
+    assert!(train_until(Some(27)).0.is_err());
+    copy(&ckpt(20), &saved20);
+    assert!(train_until(Some(47)).0.is_err());
+    assert!(!ckpt(20).exists(), "the older checkpoint was replaced");
+    copy(&ckpt(40), &saved40);
+
+    // The object holding the state's fields (the whole file, or its `state`).
+    fn fields(v: &mut Value) -> &mut serde_json::Map<String, Value> {
+        if v.get("perm").is_some() {
+            v.as_object_mut().unwrap()
+        } else {
+            v["state"].as_object_mut().unwrap()
+        }
+    }
+    let edit = |change: fn(&mut Value)| {
+        move |path: &std::path::Path| {
+            let mut v: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+            change(&mut v);
+            std::fs::write(path, serde_json::to_vec(&v).unwrap()).unwrap();
+        }
+    };
+    let damages: Vec<(&str, Box<dyn Fn(&std::path::Path)>)> = vec![
+        (
+            "two entries of perm swapped",
+            Box::new(edit(|v| {
+                fields(v)["perm"].as_array_mut().unwrap().swap(0, 1)
+            })),
+        ),
+        (
+            "an entry of perm out of range",
+            Box::new(edit(|v| fields(v)["perm"][0] = 5000.into())),
+        ),
+        ("step", Box::new(edit(|v| fields(v)["step"] = 39.into()))),
+        (
+            "rng_word_pos",
+            Box::new(edit(|v| {
+                let f = fields(v);
+                let pos: u128 = f["rng_word_pos"].as_str().unwrap().parse().unwrap();
+                f["rng_word_pos"] = (pos + 1).to_string().into();
+            })),
+        ),
+        (
+            "a loss",
+            Box::new(edit(|v| fields(v)["losses"][0][1] = 0.5.into())),
+        ),
+        (
+            "the digest removed",
+            Box::new(edit(|v| {
+                if let Some(s) = v.get("state").cloned() {
+                    *v = s;
+                }
+            })),
+        ),
+        (
+            "cut short",
+            Box::new(|p: &std::path::Path| {
+                let b = std::fs::read(p).unwrap();
+                std::fs::write(p, &b[..b.len() / 2]).unwrap();
+            }),
+        ),
+    ];
+    for (what, damage) in &damages {
+        for older in [false, true] {
+            for s in [20, 40] {
+                let _ = std::fs::remove_dir_all(ckpt(s));
+            }
+            copy(&saved40, &ckpt(40));
+            if older {
+                copy(&saved20, &ckpt(20));
+            }
+            damage(&ckpt(40).join("state.json"));
+            let (r, first) = train_until(None);
+            let enc = r
+                .unwrap_or_else(|_| panic!("{what}: the training panicked"))
+                .unwrap();
+            assert_eq!(
+                first,
+                if older { 21 } else { 1 },
+                "{what}: resumed from the right place (older: {older})"
+            );
+            assert_eq!(enc.net, reference.net, "{what}: weights differ");
+            assert_eq!(enc.losses, reference.losses, "{what}: loss curve differs");
+            assert_eq!(enc.encode_seed, reference.encode_seed, "{what}");
+        }
+    }
+}
+
 /// The β-VAE (`bvae.rs`) with β = 1 is the corrected VAE, bit for bit, on both engines: same
 /// loss curve, same encodings. β = 4 weighs the KL more: another training.
 #[test]

@@ -48,7 +48,7 @@ pub enum ReportError {
 
     #[error(
         "main campaign `{main}` not found in {dir}: campaigns found: {}; choose one with \
-         `ugl report --main NAME`",
+         --main NAME",
         if found.is_empty() { "none".to_string() } else { found.join(", ") }
     )]
     MissingMainCampaign {

@@ -10,13 +10,18 @@ use ugl_bench::explore::Learner;
 
 use crate::cli::CompareArgs;
 use crate::commands::campaign::{refresh_config, run_config};
+use crate::output::outln;
 
 /// `ugl learners`: the registry as a table.
-pub(crate) fn learners() {
-    println!(
+pub(crate) fn learners() -> Result<()> {
+    outln!(
         "{:<22} {:<26} {:<9} {:<9} {:<6} description",
-        "name", "algorithm", "variants", "prior", "paper"
-    );
+        "name",
+        "algorithm",
+        "variants",
+        "prior",
+        "paper"
+    )?;
     for l in Learner::all() {
         let e = l.entry();
         let prior = match e.prior {
@@ -24,7 +29,7 @@ pub(crate) fn learners() {
             ugl_bench::repr::registry::Prior::Always => "yes",
             ugl_bench::repr::registry::Prior::Declared => "declared",
         };
-        println!(
+        outln!(
             "{:<22} {:<26} {:<9} {:<9} {:<6} {}",
             e.name,
             e.algo,
@@ -32,8 +37,9 @@ pub(crate) fn learners() {
             prior,
             if e.in_paper { "yes" } else { "no" },
             e.description
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// `ugl compare`: the paper's matrix cells and seeds for one more learner.
@@ -63,13 +69,12 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
         None,
         &a.cache,
     )?;
-    print_compare_page(&out, &cfg.campaign.name, &base);
-    Ok(())
+    print_compare_page(&out, &cfg.campaign.name, &base)
 }
 
 /// After `ugl compare`: the new learner's one-page summary (what `ugl report` writes as
 /// `compare_<campaign>.md`), from a report rendered into a temporary directory.
-pub(crate) fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) {
+pub(crate) fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) -> Result<()> {
     let results = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -85,11 +90,12 @@ pub(crate) fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str
         });
     let _ = std::fs::remove_dir_all(&tmp);
     match page {
-        Ok(text) => println!("{text}"),
+        Ok(text) => outln!("{text}")?,
         Err(e) => eprintln!(
             "no summary page ({e}); `ugl report` ranks the learner once the main campaign \
              `{main_campaign}` is in {}",
             results.display()
         ),
     }
+    Ok(())
 }

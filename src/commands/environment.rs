@@ -10,6 +10,8 @@ use ugl_bench::env::{EnvConfig, EnvKind, PARAMS, make_env};
 use ugl_bench::metrics::KlCoverage;
 use ugl_bench::metrics::csv::read_outcomes_csv;
 
+use crate::output::outln;
+
 #[derive(Serialize)]
 pub(crate) struct RolloutOut {
     object: Vec<f64>,
@@ -47,7 +49,7 @@ pub(crate) fn rollout(kind: EnvKind, params: &Path, seed: u64) -> Result<()> {
             hand: r.hand,
         });
     }
-    println!("{}", serde_json::to_string(&out)?);
+    outln!("{}", serde_json::to_string(&out)?)?;
     Ok(())
 }
 
@@ -58,9 +60,9 @@ pub(crate) fn klc(kind: EnvKind, path: &Path) -> Result<()> {
     let k = KlCoverage::new(dim)?;
     let v = k.evaluate(pts.iter().map(|p| &p[..]))?;
     if v.is_infinite() {
-        println!("inf")
+        outln!("inf")?
     } else {
-        println!("{v}")
+        outln!("{v}")?
     }
     Ok(())
 }

@@ -12,6 +12,7 @@ use ugl_bench::explore::{Algo, SamplerKind};
 use ugl_bench::repr::cache::ModelCache;
 
 use crate::cli::{CacheArgs, EmbedArgs};
+use crate::output::outln;
 use crate::progress::{learner_lines, progress_area, training_bars};
 
 pub(crate) fn run(a: RunRequest, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
@@ -23,7 +24,7 @@ pub(crate) fn run(a: RunRequest, profile: &str, out: &Path, cache: &CacheArgs) -
     let mp = progress_area();
     let ctx = single_context(&cfg, profile, model_cache.as_ref(), cache, out, &mp);
     let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
-    println!("{}", serde_json::to_string(&summary)?);
+    outln!("{}", serde_json::to_string(&summary)?)?;
     Ok(())
 }
 
@@ -75,9 +76,11 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
         .map_err(anyhow::Error::msg)?;
     single::check_learner_variant(learner, a.variant).map_err(anyhow::Error::msg)?;
     single::check_latents(a.latents, cfg.ugl.images).map_err(anyhow::Error::msg)?;
-    if !(2..=1000).contains(&a.grid) {
-        bail!("--grid must be between 2 and 1000, got {}", a.grid);
+    if a.grid < 2 {
+        bail!("--grid must be at least 2, got {}", a.grid);
     }
+    // Before anything is fitted or allocated: GRID^2 images must fit in memory.
+    ugl_bench::limits::check_grid(a.grid, cfg.ugl.images).map_err(anyhow::Error::msg)?;
     if a.out.extension().and_then(|e| e.to_str()) != Some("npy") {
         bail!("--out {}: the file name must end in .npy", a.out.display());
     }
@@ -116,13 +119,13 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
         ugl_bench::campaign::embed::write_npy_f64(path, *rows, *cols, data)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    println!(
+    outln!(
         "{}",
         serde_json::json!({
             "representation": ugl_bench::campaign::fit::representation_label(&spec),
             "files": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
             "latent_quality": e.quality,
         })
-    );
+    )?;
     Ok(())
 }

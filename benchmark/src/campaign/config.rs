@@ -121,6 +121,16 @@ pub enum LatentSize {
     TrueDim,
 }
 
+impl LatentSize {
+    /// The number of latents in `env`.
+    pub fn size(self, env: EnvKind) -> usize {
+        match self {
+            LatentSize::N(n) => n,
+            LatentSize::TrueDim => env.spec().true_latents,
+        }
+    }
+}
+
 impl Serialize for LatentSize {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
@@ -277,7 +287,7 @@ impl CampaignConfig {
         })?;
         cfg.validate().map_err(|message| ConfigError::Invalid {
             path: path.to_path_buf(),
-            message,
+            message: with_learner_line(text, message),
         })?;
         Ok(cfg)
     }
@@ -355,17 +365,28 @@ impl CampaignConfig {
         }
         self.learners.validate()?;
         self.mge.validate()?;
+        // Every size, "true" resolved per environment, before anything is trained.
         for a in self.matrix.algos.iter().filter(|a| a.modules().is_some()) {
             if a.learner().is_some()
                 && a.modules() != Some(crate::explore::Modules::Flat)
-                && let Some(n) = self.matrix.latents.iter().find_map(|l| match l {
-                    LatentSize::N(n) if n % self.mge.module_size != 0 => Some(*n),
-                    _ => None,
+                && let Some((l, env)) = self.matrix.latents.iter().find_map(|l| {
+                    let env = self
+                        .matrix
+                        .envs
+                        .iter()
+                        .find(|e| l.size(**e) % self.mge.module_size != 0)?;
+                    Some((*l, *env))
                 })
             {
+                let has = match l {
+                    LatentSize::N(n) => n.to_string(),
+                    LatentSize::TrueDim => {
+                        format!("\"true\" ({} latents in {env})", l.size(env))
+                    }
+                };
                 return Err(format!(
                     "matrix.algos has {a}, whose modules take mge.module_size = {} latents, \
-                     but matrix.latents has {n}",
+                     but matrix.latents has {has}",
                     self.mge.module_size
                 ));
             }
@@ -397,7 +418,7 @@ impl CampaignConfig {
             ));
         }
         self.explore.validate()?;
-        validate_env(&self.env)
+        self.env.validate()
     }
 }
 
@@ -408,36 +429,42 @@ fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
         .map(|(_, a)| a.to_string())
 }
 
-fn validate_env(e: &EnvConfig) -> Result<(), String> {
-    if e.arm.lengths.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
-        return Err("env.arm.lengths must be finite and >= 0".into());
+/// A message about `learners.NAME.KEY` (the learners' tables are checked after parsing, without
+/// positions) with the line of `text` that sets the key: `... (line 9: `init = 1`)`.
+fn with_learner_line(text: &str, message: String) -> String {
+    let Some((path, _)) = message.split_once(": ") else {
+        return message;
+    };
+    let Some((name, key)) = path
+        .strip_prefix("learners.")
+        .and_then(|p| p.split_once('.'))
+    else {
+        return message;
+    };
+    let key = key.split(['.', '[']).next().unwrap_or(key);
+    match learner_key_line(text, name, key) {
+        Some(at) if !message.contains("(line ") => format!("{message} ({at})"),
+        _ => message,
     }
-    if !(e.object_size.is_finite() && e.object_size > 0.0) {
-        return Err(format!(
-            "env.object_size must be > 0, got {}",
-            e.object_size
-        ));
+}
+
+/// Where `learners.NAME.KEY` is set in `text`: `line N: `the line``.
+fn learner_key_line(text: &str, name: &str, key: &str) -> Option<String> {
+    use toml::de::{DeTable, DeValue};
+    fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t toml::Spanned<DeValue<'i>>> {
+        t.iter().find(|(n, _)| n.get_ref() == k).map(|(_, v)| v)
     }
-    if e.dmp.timesteps == 0 {
-        return Err("env.dmp.timesteps must be at least 1".into());
-    }
-    if !(e.dmp.run_time.is_finite() && e.dmp.run_time > 0.0) {
-        return Err("env.dmp.run_time must be > 0".into());
-    }
-    for (k, v) in [
-        ("env.dmp.ay", e.dmp.ay),
-        ("env.dmp.ax", e.dmp.ax),
-        ("env.dmp.max_params", e.dmp.max_params),
-    ] {
-        if !v.is_finite() {
-            return Err(format!("{k} must be finite"));
-        }
-    }
-    let inside = |p: &[f64]| p.iter().all(|v| (-1.0..=1.0).contains(v));
-    if !inside(&e.ball_initial) || !inside(&e.arrow_initial) {
-        return Err("env.ball_initial / env.arrow_initial must lie in [-1,1]".into());
-    }
-    Ok(())
+    let root = DeTable::parse(text).ok()?;
+    let DeValue::Table(learners) = get(root.get_ref(), "learners")?.get_ref() else {
+        return None;
+    };
+    let DeValue::Table(table) = get(learners, name)?.get_ref() else {
+        return None;
+    };
+    let (k, _) = table.iter().find(|(n, _)| n.get_ref() == key)?;
+    let line = text[..k.span().start].matches('\n').count() + 1;
+    let source = text.lines().nth(line - 1)?.trim();
+    Some(format!("line {line}: `{source}`"))
 }
 
 /// A (possibly multi-line) TOML error as one line: the reason, the position and the offending

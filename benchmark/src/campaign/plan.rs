@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::config::{CampaignConfig, LatentSize};
+use super::config::CampaignConfig;
 use crate::env::EnvKind;
 use crate::explore::{Algo, SamplerKind};
 use crate::repr::neural::Variant;
@@ -171,10 +171,7 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
                         continue;
                     }
                     for l in &cfg.matrix.latents {
-                        let latents = match l {
-                            LatentSize::N(n) => *n,
-                            LatentSize::TrueDim => env.state_dim(),
-                        };
+                        let latents = l.size(env);
                         for seed in 0..cfg.campaign.reps as u64 {
                             runs.push(RunSpec::learned(env, algo, sampler, latents, variant, seed));
                         }

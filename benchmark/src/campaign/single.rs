@@ -52,6 +52,7 @@ impl RunRequest {
                     ));
                 }
                 check_latents(self.latents, cfg.ugl.images)?;
+                check_modules(self.algo, self.latents, cfg.mge.module_size)?;
                 RunSpec::learned(
                     self.env,
                     self.algo,
@@ -79,7 +80,8 @@ impl RunRequest {
         let external = self.algo.learner().is_some_and(Learner::is_external);
         if !external && (self.command.is_some() || self.name.is_some()) {
             return Err(format!(
-                "--command and --name apply to --algo rge-external only, not {}",
+                "--command and --name apply to the external learner's algorithms only \
+                 (rge-external, mge-external-*), not {}",
                 self.algo
             ));
         }
@@ -113,7 +115,8 @@ impl RunRequest {
         }
         if cfg.learners.external().is_none() {
             return Err(format!(
-                "--algo rge-external needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                "--algo {} needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                self.algo,
                 profile.display()
             ));
         }
@@ -150,6 +153,22 @@ pub fn check_latents(latents: usize, images: usize) -> Result<(), String> {
         return Err(format!(
             "--latents must be between 1 and the number of images - 1 ({}), got {latents}",
             images - 1
+        ));
+    }
+    Ok(())
+}
+
+/// `--latents` of a modular exploration of a learned goal space: its modules take
+/// `module_size` latents each (`[mge] module_size`), checked before anything is trained.
+pub fn check_modules(algo: Algo, latents: usize, module_size: usize) -> Result<(), String> {
+    let modular = algo.learner().is_some()
+        && algo
+            .modules()
+            .is_some_and(|m| m != crate::explore::Modules::Flat);
+    if modular && module_size > 0 && latents % module_size != 0 {
+        return Err(format!(
+            "--latents {latents}: {algo} splits its latents into modules of \
+             mge.module_size = {module_size}, and {latents} is not a multiple of {module_size}"
         ));
     }
     Ok(())

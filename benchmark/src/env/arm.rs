@@ -11,9 +11,16 @@ pub const JOINTS: usize = 7;
 #[serde(deny_unknown_fields)]
 pub struct ArmConfig {
     /// Link lengths, base to hand (they sum to 1, so the reachable set is the closed unit disk).
+    /// Each finite and >= 0, their sum in (0, 1] (the arm's reach fits in the scene).
+    #[serde(deserialize_with = "lengths")]
     pub lengths: [f64; JOINTS],
     /// Offset added to the first joint, in units of pi (0.5: the arm points straight up at q = 0).
+    /// In [-2, 2].
     pub angle_shift: f64,
+}
+
+fn lengths<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; JOINTS], D::Error> {
+    super::exactly(d, "arm.lengths")
 }
 
 impl Default for ArmConfig {

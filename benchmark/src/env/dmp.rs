@@ -29,15 +29,17 @@ pub enum DmpWidths {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DmpConfig {
-    /// Number of integration steps (joint commands per episode).
+    /// Number of integration steps (joint commands per episode), 1 to 10,000.
     pub timesteps: usize,
-    /// Duration of the movement in seconds (dt = run_time / timesteps).
+    /// Duration of the movement in seconds (dt = run_time / timesteps), in (0, 1000].
     pub run_time: f64,
-    /// Spring gain a_y (b_y = a_y / 4).
+    /// Spring gain a_y (b_y = a_y / 4), in (0, 1e4].
     pub ay: f64,
-    /// Canonical system decay a_x.
+    /// Canonical system decay a_x, in (0, 1e4].
     pub ax: f64,
-    /// Parameters in [-1,1] are multiplied by this to give the DMP weights.
+    /// Parameters in [-1,1] are multiplied by this to give the DMP weights; in [0, 1e6]. The
+    /// campaign check also runs the extreme commands and refuses constants whose movement is
+    /// not finite (a step too coarse for the gain).
     pub max_params: f64,
     /// Basis widths.
     pub widths: DmpWidths,

@@ -119,18 +119,27 @@ pub struct EnvConfig {
     /// Motor primitive.
     pub dmp: DmpConfig,
     /// Catch radius: the object is caught when the squared hand-object distance is below its square.
+    /// In (0, 1].
     pub object_size: f64,
-    /// Initial ball position.
+    /// Initial ball position, in [-1, 1]² (the scene).
+    #[serde(deserialize_with = "ball_initial")]
     pub ball_initial: [f64; 2],
-    /// Initial arrow pose (x, y, angle in units of pi).
+    /// Initial arrow pose (x, y, angle in units of pi), each in [-1, 1].
+    #[serde(deserialize_with = "arrow_initial")]
     pub arrow_initial: [f64; 3],
     /// ArmBalls: the distractor's position at the start of every episode (CDGE
-    /// `distract_initial_pose`). Serialised only when it differs from the default, so that
-    /// the other environments' config hashes do not depend on it.
-    #[serde(skip_serializing_if = "is_default_distractor_initial")]
+    /// `distract_initial_pose`), inside the square [-0.95, 0.95]² it walks in. Serialised only
+    /// when it differs from the default, so that the other environments' config hashes do not
+    /// depend on it.
+    #[serde(
+        skip_serializing_if = "is_default_distractor_initial",
+        deserialize_with = "distractor_initial"
+    )]
     pub distractor_initial: [f64; 2],
     /// ArmBalls: standard deviation of the distractor's step per time step (CDGE
-    /// `distract_noise`; 0 keeps it still). Serialised only when it differs from the default.
+    /// `distract_noise`; 0 keeps it still), in [0, 1] (a step the size of the scene's half-width
+    /// already jumps across the distractor's square). Serialised only when it differs from the
+    /// default.
     #[serde(skip_serializing_if = "is_default_distractor_noise")]
     pub distractor_noise: f64,
 }
@@ -139,6 +148,30 @@ pub struct EnvConfig {
 const DISTRACTOR_INITIAL: [f64; 2] = [0.7, -0.45];
 /// The follow-up's distractor step (CDGE `--distract_noise`, committed configs).
 const DISTRACTOR_NOISE: f64 = 0.1;
+
+/// Exactly `N` numbers for the key `env.KEY`: serde's fixed-size arrays read the first `N`
+/// elements of a longer TOML array and silently drop the rest.
+pub(crate) fn exactly<'de, D, const N: usize>(d: D, key: &str) -> Result<[f64; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let v = Vec::<f64>::deserialize(d)?;
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| serde::de::Error::custom(format!("env.{key} must have {N} numbers, got {n}")))
+}
+
+fn ball_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly(d, "ball_initial")
+}
+
+fn arrow_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    exactly(d, "arrow_initial")
+}
+
+fn distractor_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly(d, "distractor_initial")
+}
 
 fn is_default_distractor_initial(v: &[f64; 2]) -> bool {
     *v == DISTRACTOR_INITIAL
@@ -161,6 +194,103 @@ impl Default for EnvConfig {
         }
     }
 }
+
+impl EnvConfig {
+    /// Check every value of the `[env]` table against its range (the fields' documentation);
+    /// the message names the key. Ranges keep each value finite and meaningful: an object
+    /// starts in the scene, the arm's reach fits in it, and the motor primitive's movement is
+    /// finite for every motor command (checked on the extreme commands, where a linear
+    /// movement is largest).
+    pub fn validate(&self) -> Result<(), String> {
+        let within = |key: &str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{key} must be a finite number in [{lo}, {hi}], got {}",
+                    num(v)
+                ))
+            }
+        };
+        let a = &self.arm;
+        if let Some(l) = a.lengths.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
+            return Err(format!("env.arm.lengths must be finite and >= 0, got {l}"));
+        }
+        let reach: f64 = a.lengths.iter().sum();
+        if !(reach > 0.0 && reach <= 1.0 + 1e-9) {
+            return Err(format!(
+                "env.arm.lengths must add up to a reach in (0, 1] (the scene), got {reach}"
+            ));
+        }
+        within("env.arm.angle_shift", a.angle_shift, -2.0, 2.0)?;
+        let d = &self.dmp;
+        if !(1..=MAX_TIMESTEPS).contains(&d.timesteps) {
+            return Err(format!(
+                "env.dmp.timesteps must be between 1 and {MAX_TIMESTEPS}, got {}",
+                d.timesteps
+            ));
+        }
+        for (k, v, lo, hi) in [
+            ("env.dmp.run_time", d.run_time, f64::MIN_POSITIVE, 1e3),
+            ("env.dmp.ay", d.ay, f64::MIN_POSITIVE, 1e4),
+            ("env.dmp.ax", d.ax, f64::MIN_POSITIVE, 1e4),
+            ("env.dmp.max_params", d.max_params, 0.0, 1e6),
+            ("env.object_size", self.object_size, f64::MIN_POSITIVE, 1.0),
+        ] {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                let lo = if lo > 0.0 {
+                    "(0".to_string()
+                } else {
+                    format!("[{lo}")
+                };
+                return Err(format!(
+                    "{k} must be a finite number in {lo}, {hi}], got {}",
+                    num(v)
+                ));
+            }
+        }
+        // The joint angles are linear in the 3 weights of their joint, so their largest
+        // magnitude over [-1, 1]^21 is reached at a vertex: the 8 sign patterns, shared by all
+        // joints, cover every vertex of every joint.
+        for signs in 0..8u32 {
+            let theta: [f64; PARAMS] =
+                std::array::from_fn(|k| if signs >> (k % 3) & 1 == 1 { 1.0 } else { -1.0 });
+            if dmp::trajectory(d, &theta)
+                .iter()
+                .any(|q| q.iter().any(|v| !v.is_finite()))
+            {
+                return Err(format!(
+                    "env.dmp: the movement is not finite with these constants (timesteps = {}, \
+                     run_time = {}, ay = {}, ax = {}, max_params = {})",
+                    d.timesteps, d.run_time, d.ay, d.ax, d.max_params
+                ));
+            }
+        }
+        for (i, v) in self.ball_initial.iter().enumerate() {
+            within(&format!("env.ball_initial[{i}]"), *v, -1.0, 1.0)?;
+        }
+        for (i, v) in self.arrow_initial.iter().enumerate() {
+            within(&format!("env.arrow_initial[{i}]"), *v, -1.0, 1.0)?;
+        }
+        let b = armballs::DISTRACTOR_BOUND;
+        for (i, v) in self.distractor_initial.iter().enumerate() {
+            within(&format!("env.distractor_initial[{i}]"), *v, -b, b)?;
+        }
+        within("env.distractor_noise", self.distractor_noise, 0.0, 1.0)
+    }
+}
+
+/// A number as a person writes it: `1e300`, not three hundred digits.
+fn num(v: f64) -> String {
+    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
+/// At most this many DMP steps per episode (the paper: 50).
+pub const MAX_TIMESTEPS: usize = 10_000;
 
 /// The result of one episode.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -297,6 +427,47 @@ impl Body {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_paper_constants_pass_the_checks_and_each_range_is_enforced() {
+        let ok = EnvConfig::default();
+        ok.validate().unwrap();
+        let head = EnvConfig {
+            dmp: DmpConfig {
+                widths: DmpWidths::ExplautoHead,
+                ..DmpConfig::default()
+            },
+            ..EnvConfig::default()
+        };
+        head.validate().unwrap();
+        let still = EnvConfig {
+            distractor_noise: 0.0,
+            ..EnvConfig::default()
+        };
+        still.validate().unwrap();
+        let bad: [(fn(&mut EnvConfig), &str); 8] = [
+            (|e| e.distractor_noise = -0.1, "env.distractor_noise"),
+            (|e| e.distractor_noise = f64::NAN, "env.distractor_noise"),
+            (
+                |e| e.distractor_initial = [0.0, 0.96],
+                "env.distractor_initial[1]",
+            ),
+            (
+                |e| e.ball_initial = [f64::INFINITY, 0.0],
+                "env.ball_initial[0]",
+            ),
+            (|e| e.arm.lengths[6] = 0.5, "env.arm.lengths"),
+            (|e| e.dmp.timesteps = MAX_TIMESTEPS + 1, "env.dmp.timesteps"),
+            (|e| e.dmp.ay = -1.0, "env.dmp.ay"),
+            (|e| e.object_size = 2.0, "env.object_size"),
+        ];
+        for (change, key) in bad {
+            let mut e = EnvConfig::default();
+            change(&mut e);
+            let m = e.validate().unwrap_err();
+            assert!(m.starts_with(key), "{m} should start with {key}");
+        }
+    }
 
     #[test]
     fn env_names_round_trip() {

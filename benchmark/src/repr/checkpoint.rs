@@ -7,11 +7,16 @@
 //!   parameter ids): the optimiser's state;
 //! - `state.json`, written last (atomically): the iteration count, the loss curve so far, the
 //!   learner stream's seed and word position, the batch permutation, the parameter ids, and the
-//!   BLAKE3 hashes of the two other files.
+//!   BLAKE3 hashes of the two other files; sealed by the BLAKE3 digest of all of it
+//!   (`{"state": ..., "blake3": ...}`, the digest over the state's JSON as this module writes
+//!   it), so that the state is as trusted as the weights and the optimiser.
 //!
-//! On start, the latest checkpoint whose `state.json` parses and whose files match their hashes
-//! is resumed; a damaged one is ignored (and an older one used). Resuming restores everything
-//! the next iterations depend on, so the result is bit-identical to an uninterrupted training.
+//! On start, the latest checkpoint whose `state.json` parses, matches its digest, fits the
+//! training (a permutation of its images, an iteration inside it, a loss curve before it) and
+//! whose files match their hashes is resumed; a damaged or inconsistent one is reported (one
+//! warning) and ignored, and an older one used or the training started over. Resuming restores
+//! everything the next iterations depend on, so the result is bit-identical to an
+//! uninterrupted training (tested, with damaged checkpoints too).
 
 use std::path::{Path, PathBuf};
 
@@ -32,7 +37,14 @@ pub struct CheckpointSpec {
     pub every: usize,
 }
 
+/// `state.json`: the state and the BLAKE3 digest of its JSON ([`digest`]).
 #[derive(Serialize, Deserialize)]
+struct Sealed {
+    state: State,
+    blake3: String,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct State {
     key: String,
     step: usize,
@@ -52,6 +64,46 @@ fn optim_file(cfg: &NeuralConfig) -> &'static str {
         Engine::Burn => "optim.bpk",
         Engine::Host => "optim.bin",
     }
+}
+
+/// The digest sealing a state: BLAKE3 of its JSON (field order of [`State`], floats written
+/// shortest-round-trip, so a state read back gives the same bytes).
+fn digest(state: &State) -> String {
+    let json = serde_json::to_vec(state).expect("state serialises");
+    blake3::hash(&json).to_hex().to_string()
+}
+
+/// The state of a `state.json`, if it matches its digest and fits a training of `iterations`
+/// iterations on `images` images; `Err` says why it cannot be trusted.
+fn verify(bytes: &[u8], iterations: usize, images: usize) -> Result<State, String> {
+    let sealed: Sealed = serde_json::from_slice(bytes).map_err(|e| e.to_string())?;
+    let state = sealed.state;
+    if digest(&state) != sealed.blake3 {
+        return Err("state.json does not match its digest".into());
+    }
+    if state.step == 0 || state.step >= iterations {
+        return Err(format!("iteration {} out of range", state.step));
+    }
+    let mut seen = vec![false; images];
+    if state.perm.len() != images
+        || !state
+            .perm
+            .iter()
+            .all(|&i| i < images && !std::mem::replace(&mut seen[i], true))
+    {
+        return Err(format!(
+            "the batch permutation is not one of the {images} images"
+        ));
+    }
+    if !state.losses.windows(2).all(|w| w[0].0 < w[1].0)
+        || state
+            .losses
+            .iter()
+            .any(|&(i, l)| i >= state.step || !l.is_finite())
+    {
+        return Err("the loss curve does not fit the iterations done".into());
+    }
+    Ok(state)
 }
 
 fn hex(b: &[u8]) -> String {
@@ -118,7 +170,11 @@ pub fn save(
         net_blake3: blake3::hash(&net_bytes).to_hex().to_string(),
         optim_blake3: blake3::hash(&optim_bytes).to_hex().to_string(),
     };
-    let json = serde_json::to_vec(&state).expect("state serialises");
+    let sealed = Sealed {
+        blake3: digest(&state),
+        state,
+    };
+    let json = serde_json::to_vec(&sealed).expect("state serialises");
     let state_path = dir.join("state.json");
     crate::fsio::write_atomic(&state_path, &json).map_err(|e| io("write", &state_path, e))?;
     for (step, old) in existing(c) {
@@ -168,12 +224,9 @@ fn try_load<'a>(
     rng: &mut Stream,
 ) -> Result<(Trainer<'a>, Vec<(usize, f64)>), String> {
     let text = std::fs::read(dir.join("state.json")).map_err(|e| e.to_string())?;
-    let state: State = serde_json::from_slice(&text).map_err(|e| e.to_string())?;
+    let state = verify(&text, cfg.iterations, images.n)?;
     if state.key != c.key || state.rng_seed != hex(&rng.get_seed()) {
         return Err("written for another training".into());
-    }
-    if state.step == 0 || state.step >= cfg.iterations {
-        return Err(format!("iteration {} out of range", state.step));
     }
     let net_bytes = std::fs::read(dir.join("net.model")).map_err(|e| e.to_string())?;
     if blake3::hash(&net_bytes).to_hex().as_str() != state.net_blake3 {
@@ -205,4 +258,72 @@ fn try_load<'a>(
     .map_err(|e| e.to_string())?;
     rng.set_word_pos(word_pos);
     Ok((trainer, state.losses))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state() -> State {
+        State {
+            key: "k".into(),
+            step: 40,
+            losses: vec![(0, 3.5), (5, 0.1 + 0.2), (39, 1e-300)],
+            rng_seed: "00".into(),
+            rng_word_pos: "340282366920938463463374607431768211455".into(),
+            perm: vec![2, 0, 3, 1],
+            param_ids: [7; 12],
+            net_blake3: "n".into(),
+            optim_blake3: "o".into(),
+        }
+    }
+
+    fn seal(state: State) -> Vec<u8> {
+        serde_json::to_vec(&Sealed {
+            blake3: digest(&state),
+            state,
+        })
+        .unwrap()
+    }
+
+    /// A sealed state reads back (its digest survives the round trip through JSON); one whose
+    /// digest is stale, or that is consistently sealed but does not fit the training (a
+    /// hand-made or buggy writer), is refused with the reason.
+    #[test]
+    fn the_state_is_sealed_and_checked_against_the_training() {
+        let good = seal(state());
+        assert_eq!(verify(&good, 60, 4).unwrap().perm, [2, 0, 3, 1]);
+        let stale = String::from_utf8(good)
+            .unwrap()
+            .replace("\"step\":40", "\"step\":39");
+        assert!(
+            verify(stale.as_bytes(), 60, 4)
+                .unwrap_err()
+                .contains("digest")
+        );
+        let bad: [(fn(&mut State), &str); 6] = [
+            (|s| s.perm[0] = 4, "permutation"),
+            (|s| s.perm[0] = 0, "permutation"),
+            (
+                |s| {
+                    s.perm.pop();
+                },
+                "permutation",
+            ),
+            (|s| s.step = 60, "out of range"),
+            (|s| s.step = 0, "out of range"),
+            (|s| s.losses[1].0 = 45, "loss curve"),
+        ];
+        for (damage, why) in bad {
+            let mut s = state();
+            damage(&mut s);
+            let e = verify(&seal(s), 60, 4).unwrap_err();
+            assert!(e.contains(why), "{e} should say {why}");
+        }
+        let unsealed = serde_json::to_vec(&state()).unwrap();
+        assert!(
+            verify(&unsealed, 60, 4).is_err(),
+            "a state without its digest"
+        );
+    }
 }

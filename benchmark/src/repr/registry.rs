@@ -198,7 +198,7 @@ where
 {
     let unchecked: U = match table {
         None => U::default(),
-        Some(t) => t.clone().try_into().map_err(|e| one_line(&e))?,
+        Some(t) => typed(t)?,
     };
     Ok(Box::new(unchecked.check()?))
 }
@@ -227,7 +227,7 @@ impl ModelOf for RFVAE {
 fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String> {
     let section: NeuralSection = match table {
         None => NeuralSection::default(),
-        Some(t) => t.clone().try_into().map_err(|e| one_line(&e))?,
+        Some(t) => typed(t)?,
     };
     Ok(Box::new((M::MODEL, section).check()?))
 }
@@ -236,8 +236,31 @@ fn external(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, Strin
     let Some(t) = table else {
         return Err("there is no [learners.external] section (name, command)".into());
     };
-    let unchecked: ExternalConfig = t.clone().try_into().map_err(|e| one_line(&e))?;
+    let unchecked: ExternalConfig = typed(t)?;
     Ok(Box::new(unchecked.check()?))
+}
+
+/// A `[learners.NAME]` table as `U`. The table was parsed before its learner's type was known,
+/// so serde's message (`invalid type: integer `1`, expected ...`) names no key: the key is the
+/// first one that, alone in a table, fails with the same message, and the message becomes
+/// `KEY: message` (the campaign file's reader adds the table's path and the line).
+fn typed<U: DeserializeOwned>(t: &toml::Value) -> Result<U, String> {
+    t.clone().try_into().map_err(|e| {
+        let message = one_line(&e);
+        let alone = |k: &String, v: &toml::Value| {
+            let one = toml::Table::from_iter([(k.clone(), v.clone())]);
+            toml::Value::Table(one)
+                .try_into::<U>()
+                .is_err_and(|e| one_line(&e) == message)
+        };
+        match t
+            .as_table()
+            .and_then(|t| t.iter().find(|(k, v)| alone(k, v)))
+        {
+            Some((k, _)) => format!("{k}: {message}"),
+            _ => message,
+        }
+    })
 }
 
 fn one_line(e: &toml::de::Error) -> String {
