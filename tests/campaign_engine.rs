@@ -247,12 +247,31 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
         common::parquet_files(&out) == expected,
         "resumed campaign differs from the uninterrupted one"
     );
-    // A changed configuration reruns the runs whose config hash changed, never reuses them.
+    // A changed configuration never reuses (nor mixes with) the stored runs: it is refused
+    // here, and runs in a store of its own.
     let text = std::fs::read_to_string(&cfg)
         .unwrap()
         .replace("epochs = 1500", "epochs = 1400");
     std::fs::write(&cfg, text).unwrap();
     let o = run(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("another configuration"),
+        "{err}"
+    );
+    assert!(
+        common::parquet_files(&out) == expected,
+        "a refused campaign touched the store"
+    );
+    let elsewhere = dir.path().join("elsewhere");
+    let o = run(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&elsewhere),
+        "--quiet",
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         err.contains(&format!("{} runs executed", expected.len() / 2)),

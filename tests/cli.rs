@@ -320,8 +320,9 @@ fn campaign_plan_and_resume() {
         "2",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    // Three files for each of the four runs, and the campaign's record.
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 13);
+    // Three files for each of the four runs, the campaign's record and the store's lock file.
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 14);
+    assert!(out.join(".ugl-store.lock").is_file());
     let record = std::fs::read_to_string(out.join("campaign.toml")).unwrap();
     assert!(record.contains("role = \"main\""), "{record}");
     // The campaign's run equals the single run with the same seed.

@@ -215,6 +215,30 @@ fn scripted(dir: &Path, train: &[u8], after: &str) -> String {
     )
 }
 
+/// A program whose training latents are constant in a dimension is refused, naming it (its goal
+/// space has fewer dimensions than asked; it was accepted).
+#[test]
+fn constant_train_latents_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = sh(
+        "flat",
+        &scripted(
+            dir.path(),
+            &npy_f64(3, 2, &[0.0, 5.0, 1.0, 5.0, 2.0, 5.0]),
+            "cat > /dev/null",
+        ),
+    );
+    let m = match l.fit(&images(3), 2, &mut stream_named(0, "learner")) {
+        Err(ReprError::Numerical(m)) => m,
+        Err(e) => panic!("expected a Numerical error, got {e:?}"),
+        Ok(_) => panic!("constant latents accepted"),
+    };
+    assert!(
+        m.contains("1 of the 2 latents are the same") && m.contains("dimension 1"),
+        "{m}"
+    );
+}
+
 #[test]
 fn exit_with_message_before_ready() {
     let l = sh(
@@ -320,13 +344,13 @@ fn wrong_answer_shape_breaks_the_encoder_and_reaps_the_process() {
     std::fs::write(&wrong, npy_f64(1, 3, &[1.0, 2.0, 3.0])).unwrap();
     let cmd = scripted(
         dir.path(),
-        &npy_f64(3, 2, &[0.0; 6]),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
         &format!("cat '{}'; cat > /dev/null", wrong.display()),
     );
     let (mut enc, z) = sh("wrong-shape", &cmd)
         .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
         .unwrap();
-    assert_eq!(z.data, vec![0.0; 6]);
+    assert_eq!(z.data, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
     let pid = enc.process_id();
     let mut out = [0.0; 2];
     let m = external_msg(enc.encode_one(images(1).row(0), &mut out));
@@ -343,7 +367,7 @@ fn non_finite_answer() {
     std::fs::write(&nan, npy_f64(1, 2, &[0.5, f64::INFINITY])).unwrap();
     let cmd = scripted(
         dir.path(),
-        &npy_f64(3, 2, &[0.0; 6]),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
         &format!("cat '{}'; cat > /dev/null", nan.display()),
     );
     let (mut enc, _) = sh("inf", &cmd)
@@ -358,7 +382,7 @@ fn crash_during_encode_reports_status_and_stderr() {
     let dir = tempfile::tempdir().unwrap();
     let cmd = scripted(
         dir.path(),
-        &npy_f64(3, 2, &[0.0; 6]),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
         "head -c 10 > /dev/null; echo 'Segmentation fault in encoder' >&2; exit 3",
     );
     let (mut enc, _) = sh("crash", &cmd)
@@ -374,7 +398,11 @@ fn crash_during_encode_reports_status_and_stderr() {
 #[test]
 fn answer_timeout() {
     let dir = tempfile::tempdir().unwrap();
-    let cmd = scripted(dir.path(), &npy_f64(3, 2, &[0.0; 6]), "sleep 30");
+    let cmd = scripted(
+        dir.path(),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
+        "sleep 30",
+    );
     let mut l = sh("mute", &cmd);
     l.answer_timeout = Duration::from_millis(300);
     let (mut enc, _) = l
@@ -391,7 +419,7 @@ fn shutdown_reports_non_zero_exit() {
     let dir = tempfile::tempdir().unwrap();
     let cmd = scripted(
         dir.path(),
-        &npy_f64(3, 2, &[0.0; 6]),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
         "cat > /dev/null; echo 'bye' >&2; exit 4",
     );
     let (enc, _) = sh("bad-exit", &cmd)
@@ -407,7 +435,7 @@ fn the_environment_of_the_program() {
     let env = dir.path().join("env.txt");
     let cmd = scripted(
         dir.path(),
-        &npy_f64(3, 2, &[0.0; 6]),
+        &npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]),
         &format!(
             "echo \"$UGL_PROTOCOL $UGL_LATENTS $UGL_SEED $(basename \"$UGL_TRAIN\") $(basename \"$UGL_PRIOR\") $UGL_HARNESS_PID $(test -d \"$UGL_WORKDIR\" && echo dir) $(head -c 6 \"$UGL_TRAIN\" | tail -c 5)\" > '{}'; cat > /dev/null",
             env.display()
@@ -506,7 +534,7 @@ fn identical_images_are_sent_once_per_run() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let z = npy_f64(3, 1, &[0.0, 0.0, 0.0]);
+    let z = npy_f64(3, 1, &[0.0, 1.0, 2.0]);
     let t = dir.path().join("z.npy");
     std::fs::write(&t, &z).unwrap();
     let script = dir.path().join("count.py");

@@ -115,10 +115,13 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
             &e.grid_states,
         ),
     ];
-    for (path, rows, cols, data) in &files {
-        ugl_bench::campaign::embed::write_npy_f64(path, *rows, *cols, data)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
+    // All four files or none: the latents and their states never come from two embeddings.
+    let paths: Vec<&std::path::Path> = files.iter().map(|f| f.0.as_path()).collect();
+    ugl_bench::fsio::write_set_atomic(&paths, &|i, tmp| {
+        let (_, rows, cols, data) = &files[i];
+        ugl_bench::campaign::embed::write_npy_f64(tmp, *rows, *cols, data)
+    })
+    .with_context(|| format!("cannot write {}", a.out.display()))?;
     outln!(
         "{}",
         serde_json::json!({

@@ -261,13 +261,13 @@ pub struct CampaignConfig {
 }
 
 impl CampaignConfig {
-    /// The hash of the campaign's configuration: every constant but the matrix (the results
-    /// version, campaign seed, `[explore]`, `[env]`, `[ugl]`, `[learners]`, `[mge]`). Runs of two
-    /// configurations never share a store ([`super::runner::write_campaign_record`]); adding
-    /// seeds or cells to the matrix keeps it.
+    /// The hash of the campaign's configuration: every constant but the matrix (campaign seed,
+    /// `[explore]`, `[env]`, `[ugl]`, `[learners]`, `[mge]`). Runs of two configurations never
+    /// share a store ([`super::runner::write_campaign_record`]); adding seeds or cells to the
+    /// matrix keeps it, and so does a new results version (its runs supersede the older ones:
+    /// their config hashes differ, so a resumed campaign recomputes them).
     pub fn configuration_hash(&self) -> String {
         let input = serde_json::json!({
-            "results_version": ugl_types::RESULTS_VERSION,
             "campaign_seed": self.campaign.seed,
             "explore": self.explore,
             "env": self.env,
