@@ -10,7 +10,7 @@ use super::plan::RunSpec;
 use super::store::{self, Manifest, Summary};
 use crate::env::{Environment, make_env};
 use crate::explore::{
-    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
+    EngineeredSpace, ExplorationLog, ExploreConfig, GoalSpaceKind, LearnedSpace, Learner, SamplerKind, Strategy,
     goal_modules, run_mge, run_rge, run_rpe,
 };
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
@@ -44,16 +44,16 @@ pub fn explore(
         source,
     };
     let mge_err = |m: String| run_err(ReprError::InvalidInput(m));
-    let log = match spec.algo {
-        Algo::Rpe => run_rpe(env, ctx.explore, seed),
-        Algo::RgeEfr => run_rge(
+    let log = match (spec.algo.strategy(), spec.algo.space()) {
+        (Strategy::Rpe, _) => run_rpe(env, ctx.explore, seed),
+        (Strategy::Rge, GoalSpaceKind::Engineered) => run_rge(
             env,
             &mut EngineeredSpace::new(d),
             &mut UniformGoals::unit(d),
             ctx.explore,
             seed,
         ),
-        Algo::MgeEfr(m) => {
+        (Strategy::Mge(m), GoalSpaceKind::Engineered) => {
             let objects = spec.env.objects();
             let modules =
                 goal_modules(m, d, Some(&objects), &[], ctx.mge.module_size).map_err(mge_err)?;
@@ -73,7 +73,7 @@ pub fn explore(
             )
             .map_err(mge_err)?
         }
-        Algo::Rge(_) | Algo::Mge(..) => {
+        (_, GoalSpaceKind::Learned(_) | GoalSpaceKind::None) => {
             let repr = repr.ok_or_else(|| {
                 run_err(ReprError::InvalidInput(
                     "no representation was fitted".into(),
