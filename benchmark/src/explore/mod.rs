@@ -2,7 +2,12 @@
 //! random parameter exploration (RPE) and random goal exploration (RGE) with a nearest-neighbour
 //! meta-policy, in an engineered (EFR) or learned goal space; and the follow-up paper's modular
 //! goal exploration (MGE, `mge.rs`) with curiosity-driven module choice (`interest.rs`).
+//!
+//! An [`Algo`] is a [`Strategy`] in a [`GoalSpaceKind`]; the strategy builds the run's
+//! [`Explorer`] from the goal space's outcome encoding ([`OutcomeSpace`]) and goals
+//! ([`GoalSource`]).
 
+pub mod goal_source;
 pub mod history;
 pub mod imgep;
 pub mod interest;
@@ -15,11 +20,26 @@ use std::borrow::Cow;
 
 use serde::{Deserialize, Serialize};
 
+use crate::env::Environment;
+use crate::repr::ReprError;
+
 pub use crate::repr::registry::Learner;
 pub use history::{Checkpoint, ExplorationLog};
-pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, run_rge};
-pub use mge::{GoalModule, MgeConfig, Modules, goal_modules, run_mge};
-pub use rpe::run_rpe;
+pub use goal_source::{EngineeredGoals, GoalSource};
+pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, Rge, run_rge};
+pub use mge::{GoalModule, Mge, MgeConfig, Modules, goal_modules, run_mge};
+pub use rpe::{Rpe, run_rpe};
+
+/// An exploration loop (RPE, RGE or MGE), built for one run ([`Strategy::explorer`]).
+pub trait Explorer {
+    /// Explore `env` for `cfg.epochs` iterations, drawing from the streams of `run_seed`.
+    fn explore(
+        &mut self,
+        env: &dyn Environment,
+        cfg: &ExploreConfig,
+        run_seed: u64,
+    ) -> Result<ExplorationLog, String>;
+}
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -99,6 +119,37 @@ pub enum Strategy {
 }
 
 impl Strategy {
+    /// The explorer of this strategy, encoding outcomes in `space` and drawing goals from
+    /// `goals` (RPE uses neither).
+    pub fn explorer<'a>(
+        self,
+        space: &'a mut dyn OutcomeSpace,
+        goals: &dyn GoalSource,
+        mge: &'a MgeConfig,
+    ) -> Result<Box<dyn Explorer + 'a>, ReprError> {
+        Ok(match self {
+            Strategy::Rpe => Box::new(Rpe),
+            Strategy::Rge => Box::new(Rge {
+                space,
+                sampler: goals.sampler(None)?,
+            }),
+            Strategy::Mge(choice) => {
+                let modules = goals.modules(choice, mge.module_size)?;
+                let samplers = modules
+                    .iter()
+                    .map(|m| goals.sampler(Some(&m.dims)))
+                    .collect::<Result<_, _>>()?;
+                Box::new(Mge {
+                    space,
+                    modules,
+                    samplers,
+                    choice,
+                    config: mge,
+                })
+            }
+        })
+    }
+
     /// Rank in [`Algo`]'s order: RPE, RGE, MGE.
     fn rank(self) -> u8 {
         match self {
