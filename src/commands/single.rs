@@ -92,7 +92,7 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
     check_out_dir(dir)?;
     let spec = RunSpec::learned(
         a.env,
-        Algo::Rge(learner),
+        Algo::rge(learner),
         SamplerKind::Kde,
         a.latents,
         a.variant.unwrap_or_default(),

@@ -10,11 +10,11 @@ use super::plan::RunSpec;
 use super::store::{self, Manifest, Summary};
 use crate::env::{Environment, make_env};
 use crate::explore::{
-    Algo, EngineeredSpace, ExplorationLog, ExploreConfig, LearnedSpace, Learner, SamplerKind,
-    goal_modules, run_mge, run_rge, run_rpe,
+    Algo, EngineeredGoals, EngineeredSpace, ExplorationLog, ExploreConfig, Explorer, GoalModule,
+    GoalSource, GoalSpaceKind, LearnedSpace, Learner, Modules, Rpe, SamplerKind, goal_modules,
 };
-use crate::goals::{GaussianGoals, GoalSampler, KdeGoals, UniformGoals};
-use crate::repr::{Latents, ReprError};
+use crate::goals::{GaussianGoals, GoalSampler, KdeGoals};
+use crate::repr::{GaussianPrior, Latents, ReprError};
 use crate::seed::{Component, run_seed, stream};
 
 use super::context::RunContext;
@@ -43,93 +43,109 @@ pub fn explore(
         run: spec.run_id(),
         source,
     };
-    let mge_err = |m: String| run_err(ReprError::InvalidInput(m));
-    let log = match spec.algo {
-        Algo::Rpe => run_rpe(env, ctx.explore, seed),
-        Algo::RgeEfr => run_rge(
-            env,
-            &mut EngineeredSpace::new(d),
-            &mut UniformGoals::unit(d),
-            ctx.explore,
-            seed,
-        ),
-        Algo::MgeEfr(m) => {
-            let objects = spec.env.objects();
-            let modules =
-                goal_modules(m, d, Some(&objects), &[], ctx.mge.module_size).map_err(mge_err)?;
-            let mut samplers: Vec<Box<dyn GoalSampler>> = modules
-                .iter()
-                .map(|g| Box::new(UniformGoals::unit(g.dims.len())) as Box<dyn GoalSampler>)
-                .collect();
-            run_mge(
-                env,
-                &mut EngineeredSpace::new(d),
-                &modules,
-                &mut samplers,
-                m,
-                ctx.explore,
-                ctx.mge,
-                seed,
-            )
-            .map_err(mge_err)?
+    let explore_err = |m: String| run_err(ReprError::InvalidInput(m));
+    let strategy = spec.algo.strategy();
+    match spec.algo.space() {
+        GoalSpaceKind::None => Ok(Explored {
+            log: Rpe.explore(env, ctx.explore, seed).map_err(explore_err)?,
+            encode_s: None,
+        }),
+        GoalSpaceKind::Engineered => {
+            let goals = EngineeredGoals::new(d, spec.env.objects());
+            let log = strategy
+                .explorer(&mut EngineeredSpace::new(d), &goals, ctx.mge)
+                .map_err(run_err)?
+                .explore(env, ctx.explore, seed)
+                .map_err(explore_err)?;
+            Ok(Explored {
+                log,
+                encode_s: None,
+            })
         }
-        Algo::Rge(_) | Algo::Mge(..) => {
+        GoalSpaceKind::Learned(_) => {
             let repr = repr.ok_or_else(|| {
                 run_err(ReprError::InvalidInput(
                     "no representation was fitted".into(),
                 ))
             })?;
-            let dim = repr.encoder.latents();
-            let modules = match spec.algo.modules() {
-                None => None,
-                Some(m) => Some(
-                    goal_modules(
-                        m,
-                        dim,
-                        None,
-                        &latent_spread(&repr.train),
-                        ctx.mge.module_size,
-                    )
-                    .map_err(mge_err)?,
-                ),
-            };
-            let mut samplers: Vec<Box<dyn GoalSampler>> = match &modules {
-                None => vec![goal_sampler(spec, repr, None).map_err(run_err)?],
-                Some(ms) => ms
-                    .iter()
-                    .map(|g| goal_sampler(spec, repr, Some(&g.dims)))
-                    .collect::<Result<_, _>>()
-                    .map_err(run_err)?,
+            let goals = LearnedGoals {
+                dim: repr.encoder.latents(),
+                train: &repr.train,
+                prior: repr.encoder.prior(),
+                sampler: spec.sampler,
+                algo: spec.algo,
             };
             repr.encoder.begin_run(stream(seed, Component::Encoding));
             let mut space = LearnedSpace::new(env, repr.encoder.as_mut());
-            let log = match (&modules, spec.algo.modules()) {
-                (Some(ms), Some(m)) => run_mge(
-                    env,
-                    &mut space,
-                    ms,
-                    &mut samplers,
-                    m,
-                    ctx.explore,
-                    ctx.mge,
-                    seed,
-                )
-                .map_err(mge_err)?,
-                _ => run_rge(env, &mut space, samplers[0].as_mut(), ctx.explore, seed),
-            };
+            let log = strategy
+                .explorer(&mut space, &goals, ctx.mge)
+                .map_err(run_err)?
+                .explore(env, ctx.explore, seed)
+                .map_err(explore_err)?;
             if let Some(e) = space.error.take() {
                 return Err(run_err(e));
             }
-            return Ok(Explored {
+            Ok(Explored {
                 log,
                 encode_s: Some(space.encode_s),
-            });
+            })
         }
-    };
-    Ok(Explored {
-        log,
-        encode_s: None,
-    })
+    }
+}
+
+/// The goals of a learned goal space: the KDE of the training encodings or the model's prior
+/// (`sampler`), and modules of latents ordered by their spread.
+struct LearnedGoals<'r> {
+    dim: usize,
+    train: &'r Latents,
+    prior: Option<GaussianPrior>,
+    sampler: SamplerKind,
+    algo: Algo,
+}
+
+impl GoalSource for LearnedGoals<'_> {
+    fn modules(&self, choice: Modules, module_size: usize) -> Result<Vec<GoalModule>, ReprError> {
+        goal_modules(choice, self.dim, None, &latent_spread(self.train), module_size)
+            .map_err(ReprError::InvalidInput)
+    }
+
+    /// Over every latent (`dims` None) or over one module's latents (the KDE of those latents
+    /// of the training encodings; the prior's marginal).
+    fn sampler(&self, dims: Option<&[usize]>) -> Result<Box<dyn GoalSampler>, ReprError> {
+        let train = self.train;
+        Ok(match self.sampler {
+            SamplerKind::Kde => Box::new(match dims {
+                None => KdeGoals::fit(train)?,
+                Some(dims) => KdeGoals::fit(&Latents {
+                    n: train.n,
+                    latents: dims.len(),
+                    data: (0..train.n)
+                        .flat_map(|i| dims.iter().map(move |&k| train.row(i)[k]))
+                        .collect(),
+                })?,
+            }),
+            SamplerKind::Gaussian => match &self.prior {
+                Some(prior) => Box::new(GaussianGoals::from_prior(&match dims {
+                    None => prior.clone(),
+                    Some(dims) => GaussianPrior {
+                        mean: dims.iter().map(|&k| prior.mean[k]).collect(),
+                        std: dims.iter().map(|&k| prior.std[k]).collect(),
+                    },
+                })),
+                None => {
+                    return Err(ReprError::InvalidInput(format!(
+                        "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
+                        self.algo
+                    )));
+                }
+            },
+            other => {
+                return Err(ReprError::InvalidInput(format!(
+                    "sampler {other} is not for learned goal spaces"
+                )));
+            }
+        })
+    }
 }
 
 /// The spread of each latent over the training encodings (its variance), which orders the
@@ -145,47 +161,6 @@ fn latent_spread(train: &Latents) -> Vec<f64> {
                 / n
         })
         .collect()
-}
-
-/// The goal sampler of a learned goal space, over every latent (`dims` None) or over one
-/// module's latents (the KDE of those latents of the training encodings; the prior's marginal).
-fn goal_sampler(
-    spec: &RunSpec,
-    repr: &Representation,
-    dims: Option<&[usize]>,
-) -> Result<Box<dyn GoalSampler>, ReprError> {
-    Ok(match spec.sampler {
-        SamplerKind::Kde => Box::new(match dims {
-            None => KdeGoals::fit(&repr.train)?,
-            Some(dims) => KdeGoals::fit(&Latents {
-                n: repr.train.n,
-                latents: dims.len(),
-                data: (0..repr.train.n)
-                    .flat_map(|i| dims.iter().map(move |&k| repr.train.row(i)[k]))
-                    .collect(),
-            })?,
-        }),
-        SamplerKind::Gaussian => match repr.encoder.prior() {
-            Some(prior) => Box::new(GaussianGoals::from_prior(&match dims {
-                None => prior,
-                Some(dims) => crate::repr::GaussianPrior {
-                    mean: dims.iter().map(|&k| prior.mean[k]).collect(),
-                    std: dims.iter().map(|&k| prior.std[k]).collect(),
-                },
-            })),
-            None => {
-                return Err(ReprError::InvalidInput(format!(
-                    "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
-                    spec.algo
-                )));
-            }
-        },
-        other => {
-            return Err(ReprError::InvalidInput(format!(
-                "sampler {other} is not for learned goal spaces"
-            )));
-        }
-    })
 }
 
 /// The summary of a finished log.

@@ -25,7 +25,7 @@ pub struct RunSpec {
 impl RunSpec {
     /// A baseline run (RPE or RGE-EFR).
     pub fn baseline(env: EnvKind, algo: Algo, seed: u64) -> Self {
-        let sampler = if algo == Algo::Rpe {
+        let sampler = if algo == Algo::RPE {
             SamplerKind::None
         } else {
             SamplerKind::Uniform
@@ -234,13 +234,13 @@ mod tests {
 
     #[test]
     fn identities() {
-        let r = RunSpec::baseline(EnvKind::ArmArrow, Algo::RgeEfr, 3);
+        let r = RunSpec::baseline(EnvKind::ArmArrow, Algo::RGE_EFR, 3);
         assert_eq!(r.identity(), "env=armarrow/algo=rge-efr/seed=3");
         assert_eq!(r.run_id(), "armarrow.rge-efr.s3");
         assert_eq!(r.representation_identity(10), None);
         let r = RunSpec::learned(
             EnvKind::ArmBall,
-            Algo::Rge(Learner::by_name("pca").unwrap()),
+            Algo::rge(Learner::by_name("pca").unwrap()),
             SamplerKind::Kde,
             10,
             Variant::Corrected,
@@ -262,7 +262,7 @@ mod tests {
         );
         let v = RunSpec::learned(
             EnvKind::ArmBall,
-            Algo::Rge(Learner::by_name("vae").unwrap()),
+            Algo::rge(Learner::by_name("vae").unwrap()),
             SamplerKind::Gaussian,
             2,
             Variant::Corrected,
@@ -286,7 +286,7 @@ mod tests {
         assert_eq!(
             RunSpec::learned(
                 EnvKind::ArmBall,
-                Algo::Rge(Learner::by_name("ae").unwrap()),
+                Algo::rge(Learner::by_name("ae").unwrap()),
                 SamplerKind::Kde,
                 2,
                 Variant::Corrected,

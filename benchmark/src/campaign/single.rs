@@ -268,7 +268,7 @@ pub fn compare_campaign(
             "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
         ));
     }
-    let algo = Algo::Rge(resolve_learner(&name, command, &mut cfg)?);
+    let algo = Algo::rge(resolve_learner(&name, command, &mut cfg)?);
     let base = std::mem::replace(&mut cfg.campaign.name, format!("compare-{name}"));
     cfg.campaign.description = format!("{name} on the cells and seeds of campaign '{base}'");
     cfg.campaign.role = ugl_types::CampaignRole::Compare;

@@ -42,7 +42,7 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
     let mut df = df!(
         "run_id" => vec![spec.run_id(); n],
         "env" => vec![spec.env.name(); n],
-        "algo" => vec![spec.algo.name(); n],
+        "algo" => vec![spec.algo.to_string(); n],
         "sampler" => vec![spec.sampler.name(); n],
         "latents" => vec![spec.latents as i64; n],
         "variant" => vec![spec.variant.map(|v| v.name()).unwrap_or("none"); n],

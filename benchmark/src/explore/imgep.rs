@@ -8,8 +8,8 @@
 //! `or` as in the original); otherwise it samples a goal, takes the parameters of the nearest
 //! stored outcome encoding, and perturbs them.
 
-use super::ExploreConfig;
 use super::history::{ExplorationLog, Metrics, Recorder};
+use super::{ExploreConfig, Explorer};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use crate::env::render::PIXELS;
@@ -151,6 +151,29 @@ pub fn run_rge(
         rec.end_epoch(epoch);
     }
     rec.finish()
+}
+
+/// RGE as an [`Explorer`]: in `space`, with goals from `sampler`.
+pub struct Rge<'a> {
+    pub space: &'a mut dyn OutcomeSpace,
+    pub sampler: Box<dyn GoalSampler>,
+}
+
+impl Explorer for Rge<'_> {
+    fn explore(
+        &mut self,
+        env: &dyn Environment,
+        cfg: &ExploreConfig,
+        run_seed: u64,
+    ) -> Result<ExplorationLog, String> {
+        Ok(run_rge(
+            env,
+            self.space,
+            self.sampler.as_mut(),
+            cfg,
+            run_seed,
+        ))
+    }
 }
 
 /// The explorer's memory: parameters and outcome encodings, with the nearest-neighbour index

@@ -27,12 +27,12 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::ExploreConfig;
 use super::history::{ExplorationLog, InterestPoint, Metrics, Recorder};
 use super::imgep::{History, OutcomeSpace};
 use super::interest::{ModuleInterest, choose_module};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
+use super::{ExploreConfig, Explorer};
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;
 use crate::seed::{Component, stream};
@@ -342,6 +342,35 @@ pub fn run_mge(
         }
     }
     Ok(rec.finish())
+}
+
+/// MGE as an [`Explorer`]: in `space`, with its modules and one goal sampler per module.
+pub struct Mge<'a> {
+    pub space: &'a mut dyn OutcomeSpace,
+    pub modules: Vec<GoalModule>,
+    pub samplers: Vec<Box<dyn GoalSampler>>,
+    pub choice: Modules,
+    pub config: &'a MgeConfig,
+}
+
+impl Explorer for Mge<'_> {
+    fn explore(
+        &mut self,
+        env: &dyn Environment,
+        cfg: &ExploreConfig,
+        run_seed: u64,
+    ) -> Result<ExplorationLog, String> {
+        run_mge(
+            env,
+            self.space,
+            &self.modules,
+            &mut self.samplers,
+            self.choice,
+            cfg,
+            self.config,
+            run_seed,
+        )
+    }
 }
 
 #[cfg(test)]

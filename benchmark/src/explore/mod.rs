@@ -2,7 +2,12 @@
 //! random parameter exploration (RPE) and random goal exploration (RGE) with a nearest-neighbour
 //! meta-policy, in an engineered (EFR) or learned goal space; and the follow-up paper's modular
 //! goal exploration (MGE, `mge.rs`) with curiosity-driven module choice (`interest.rs`).
+//!
+//! An [`Algo`] is a [`Strategy`] in a [`GoalSpaceKind`]; the strategy builds the run's
+//! [`Explorer`] from the goal space's outcome encoding ([`OutcomeSpace`]) and goals
+//! ([`GoalSource`]).
 
+pub mod goal_source;
 pub mod history;
 pub mod imgep;
 pub mod interest;
@@ -11,13 +16,30 @@ pub mod mge;
 pub mod nn;
 pub mod rpe;
 
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
+
+use crate::env::Environment;
+use crate::repr::ReprError;
 
 pub use crate::repr::registry::Learner;
 pub use history::{Checkpoint, ExplorationLog};
-pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, run_rge};
-pub use mge::{GoalModule, MgeConfig, Modules, goal_modules, run_mge};
-pub use rpe::run_rpe;
+pub use goal_source::{EngineeredGoals, GoalSource};
+pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, Rge, run_rge};
+pub use mge::{GoalModule, Mge, MgeConfig, Modules, goal_modules, run_mge};
+pub use rpe::{Rpe, run_rpe};
+
+/// An exploration loop (RPE, RGE or MGE), built for one run ([`Strategy::explorer`]).
+pub trait Explorer {
+    /// Explore `env` for `cfg.epochs` iterations, drawing from the streams of `run_seed`.
+    fn explore(
+        &mut self,
+        env: &dyn Environment,
+        cfg: &ExploreConfig,
+        run_seed: u64,
+    ) -> Result<ExplorationLog, String>;
+}
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -85,89 +107,185 @@ impl ExploreConfig {
     }
 }
 
-/// Which exploration algorithm.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Algo {
-    /// Random parameter exploration.
+/// How an explorer chooses the next parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Strategy {
+    /// Random parameter exploration (RPE): no goals.
     Rpe,
-    /// Random goal exploration with engineered features.
-    RgeEfr,
-    /// Random goal exploration in a goal space learned from images (IMGEP-UGL, RGE-REP).
-    Rge(Learner),
-    /// Modular goal exploration (follow-up paper, `mge.rs`) with engineered features, one
-    /// module per object (`mge-efr-lp`, `mge-efr-random`; `mge-efr-flat`: one module).
-    MgeEfr(Modules),
-    /// Modular goal exploration in a learned goal space (`mge-vae-lp`, ...).
-    Mge(Learner, Modules),
+    /// Random goal exploration (RGE; paper Appendix D, Algorithm 3).
+    Rge,
+    /// Modular goal exploration (follow-up paper, `mge.rs`) with this module choice.
+    Mge(Modules),
+}
+
+impl Strategy {
+    /// The explorer of this strategy, encoding outcomes in `space` and drawing goals from
+    /// `goals` (RPE uses neither).
+    pub fn explorer<'a>(
+        self,
+        space: &'a mut dyn OutcomeSpace,
+        goals: &dyn GoalSource,
+        mge: &'a MgeConfig,
+    ) -> Result<Box<dyn Explorer + 'a>, ReprError> {
+        Ok(match self {
+            Strategy::Rpe => Box::new(Rpe),
+            Strategy::Rge => Box::new(Rge {
+                space,
+                sampler: goals.sampler(None)?,
+            }),
+            Strategy::Mge(choice) => {
+                let modules = goals.modules(choice, mge.module_size)?;
+                let samplers = modules
+                    .iter()
+                    .map(|m| goals.sampler(Some(&m.dims)))
+                    .collect::<Result<_, _>>()?;
+                Box::new(Mge {
+                    space,
+                    modules,
+                    samplers,
+                    choice,
+                    config: mge,
+                })
+            }
+        })
+    }
+
+    /// Rank in [`Algo`]'s order: RPE, RGE, MGE.
+    fn rank(self) -> u8 {
+        match self {
+            Strategy::Rpe => 0,
+            Strategy::Rge => 1,
+            Strategy::Mge(_) => 2,
+        }
+    }
+}
+
+/// The goal space an explorer draws its goals in (paper Section 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum GoalSpaceKind {
+    /// No goal space (RPE only).
+    None,
+    /// Engineered features (EFR): the scene's object state.
+    Engineered,
+    /// A space learned from images (IMGEP-UGL, RGE-REP).
+    Learned(Learner),
+}
+
+/// An exploration algorithm: a strategy in a goal space. Only the valid pairs exist (RPE has no
+/// goal space, goal exploration has one; [`Algo::new`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Algo {
+    strategy: Strategy,
+    space: GoalSpaceKind,
 }
 
 impl Algo {
-    /// All algorithms known to this build.
+    /// Random parameter exploration (`rpe`).
+    pub const RPE: Algo = Algo {
+        strategy: Strategy::Rpe,
+        space: GoalSpaceKind::None,
+    };
+
+    /// Random goal exploration with engineered features (`rge-efr`).
+    pub const RGE_EFR: Algo = Algo {
+        strategy: Strategy::Rge,
+        space: GoalSpaceKind::Engineered,
+    };
+
+    /// `strategy` in `space`; `Err` for RPE in a goal space or goal exploration without one.
+    pub fn new(strategy: Strategy, space: GoalSpaceKind) -> Result<Algo, String> {
+        match (strategy, space) {
+            (Strategy::Rpe, GoalSpaceKind::None) => Ok(Algo::RPE),
+            (Strategy::Rpe, _) => Err("random parameter exploration has no goal space".into()),
+            (_, GoalSpaceKind::None) => Err("goal exploration needs a goal space".into()),
+            _ => Ok(Algo { strategy, space }),
+        }
+    }
+
+    /// Random goal exploration in the goal space `learner` learns (`rge-vae`).
+    pub const fn rge(learner: Learner) -> Algo {
+        Algo {
+            strategy: Strategy::Rge,
+            space: GoalSpaceKind::Learned(learner),
+        }
+    }
+
+    /// How it chooses parameters.
+    pub fn strategy(self) -> Strategy {
+        self.strategy
+    }
+
+    /// Where its goals are drawn.
+    pub fn space(self) -> GoalSpaceKind {
+        self.space
+    }
+
+    /// All algorithms known to this build, in their order (`Ord`).
     pub fn all() -> Vec<Algo> {
-        let mut v = vec![Algo::Rpe, Algo::RgeEfr];
-        v.extend(Learner::all().map(Algo::Rge));
-        v.extend(Modules::ALL.map(Algo::MgeEfr));
+        let goal = |strategy, space| Algo { strategy, space };
+        let mut v = vec![Algo::RPE, Algo::RGE_EFR];
+        v.extend(Learner::all().map(Algo::rge));
+        v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::Engineered)));
         for l in Learner::all() {
-            v.extend(Modules::ALL.map(|m| Algo::Mge(l, m)));
+            v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::Learned(l))));
         }
         v
     }
 
     /// Name on the command line and in results (`rpe`, `rge-efr`, `rge-pca`, `mge-efr-lp`,
     /// `mge-vae-random`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            Algo::Rpe => "rpe",
-            Algo::RgeEfr => "rge-efr",
-            Algo::Rge(l) => l.entry().algo,
-            Algo::MgeEfr(m) => match m {
-                Modules::Flat => "mge-efr-flat",
-                Modules::Random => "mge-efr-random",
-                Modules::Progress => "mge-efr-lp",
-            },
-            Algo::Mge(l, m) => mge_name(l, m),
+    pub fn name(self) -> Cow<'static, str> {
+        let space = match self.space {
+            GoalSpaceKind::None => "",
+            GoalSpaceKind::Engineered => "efr",
+            GoalSpaceKind::Learned(l) => l.name(),
+        };
+        match (self.strategy, self.space) {
+            (Strategy::Rpe, _) => "rpe".into(),
+            (Strategy::Rge, GoalSpaceKind::Learned(l)) => l.entry().algo.into(),
+            (Strategy::Rge, _) => "rge-efr".into(),
+            (Strategy::Mge(m), _) => format!("mge-{space}-{}", m.name()).into(),
         }
     }
 
     /// The learner, for algorithms in a learned goal space.
     pub fn learner(self) -> Option<Learner> {
-        match self {
-            Algo::Rge(l) | Algo::Mge(l, _) => Some(l),
+        match self.space {
+            GoalSpaceKind::Learned(l) => Some(l),
             _ => None,
         }
     }
 
     /// The module choice of a modular exploration.
     pub fn modules(self) -> Option<Modules> {
-        match self {
-            Algo::MgeEfr(m) | Algo::Mge(_, m) => Some(m),
+        match self.strategy {
+            Strategy::Mge(m) => Some(m),
             _ => None,
         }
     }
+
+    /// The order of [`Algo::all`]: RPE, RGE (engineered, then each learner), MGE (engineered,
+    /// then each learner; each with every module choice).
+    fn order_key(self) -> (u8, GoalSpaceKind, Option<Modules>) {
+        (self.strategy.rank(), self.space, self.modules())
+    }
 }
 
-/// `mge-<learner>-<modules>`, built once per learner (names must live as long as the registry).
-fn mge_name(l: Learner, m: Modules) -> &'static str {
-    use std::sync::OnceLock;
-    static NAMES: OnceLock<Vec<[&'static str; 3]>> = OnceLock::new();
-    let names = NAMES.get_or_init(|| {
-        Learner::all()
-            .map(|l| {
-                Modules::ALL
-                    .map(|m| &*Box::leak(format!("mge-{}-{}", l.name(), m.name()).into_boxed_str()))
-            })
-            .collect()
-    });
-    let k = Modules::ALL
-        .iter()
-        .position(|x| *x == m)
-        .expect("every module choice is in ALL");
-    names[l.index()][k]
+impl Ord for Algo {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.order_key().cmp(&other.order_key())
+    }
+}
+
+impl PartialOrd for Algo {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
 }
 
 impl Serialize for Algo {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
+        s.serialize_str(&self.name())
     }
 }
 
@@ -180,7 +298,7 @@ impl<'de> Deserialize<'de> for Algo {
 
 impl std::fmt::Display for Algo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+        f.write_str(&self.name())
     }
 }
 
@@ -244,5 +362,44 @@ impl std::str::FromStr for SamplerKind {
                 "unknown goal sampler '{s}' (expected kde or gaussian)"
             )),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn algorithm_names_order_and_parsing_are_stable() {
+        let mut names = vec!["rpe".to_string(), "rge-efr".into()];
+        names.extend(Learner::all().map(|l| format!("rge-{}", l.name())));
+        names.extend(["mge-efr-flat", "mge-efr-random", "mge-efr-lp"].map(String::from));
+        for l in Learner::all() {
+            for m in ["flat", "random", "lp"] {
+                names.push(format!("mge-{}-{m}", l.name()));
+            }
+        }
+        let all = Algo::all();
+        assert_eq!(all.iter().map(|a| a.to_string()).collect::<Vec<_>>(), names);
+        // `Ord` is the order of `all` (the order of the former enum's variants).
+        assert!(all.windows(2).all(|w| w[0] < w[1]));
+        for a in &all {
+            assert_eq!(a.name().parse::<Algo>(), Ok(*a));
+            assert_eq!(Algo::new(a.strategy(), a.space()), Ok(*a));
+            assert_eq!(serde_json::to_string(a).unwrap(), format!("\"{a}\""));
+        }
+        assert!("mge-efr".parse::<Algo>().is_err());
+    }
+
+    #[test]
+    fn only_valid_strategy_and_space_pairs_are_built() {
+        let vae = Learner::by_name("vae").unwrap();
+        assert!(Algo::new(Strategy::Rpe, GoalSpaceKind::Learned(vae)).is_err());
+        assert!(Algo::new(Strategy::Rpe, GoalSpaceKind::Engineered).is_err());
+        assert!(Algo::new(Strategy::Rge, GoalSpaceKind::None).is_err());
+        assert!(Algo::new(Strategy::Mge(Modules::Progress), GoalSpaceKind::None).is_err());
+        let a = Algo::new(Strategy::Mge(Modules::Random), GoalSpaceKind::Learned(vae)).unwrap();
+        assert_eq!(a.to_string(), "mge-vae-random");
+        assert_eq!((a.learner(), a.modules()), (Some(vae), Some(Modules::Random)));
     }
 }

@@ -1,7 +1,7 @@
 //! Random parameter exploration (RPE; PAPER-NOTES.md section 3): `epochs` uniformly random
 //! parameter vectors, no warm-up.
 
-use super::ExploreConfig;
+use super::{ExploreConfig, Explorer};
 use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::random_params;
 use crate::env::Environment;
@@ -20,4 +20,18 @@ pub fn run_rpe(env: &dyn Environment, cfg: &ExploreConfig, run_seed: u64) -> Exp
         rec.end_epoch(epoch);
     }
     rec.finish()
+}
+
+/// RPE as an [`Explorer`].
+pub struct Rpe;
+
+impl Explorer for Rpe {
+    fn explore(
+        &mut self,
+        env: &dyn Environment,
+        cfg: &ExploreConfig,
+        run_seed: u64,
+    ) -> Result<ExplorationLog, String> {
+        Ok(run_rpe(env, cfg, run_seed))
+    }
 }
