@@ -559,3 +559,43 @@ fn a_store_refuses_another_configuration_or_campaign() {
         String::from_utf8_lossy(&y.stderr)
     );
 }
+
+/// The distractor's constants enter the config hash of ArmBalls runs only: an ArmBall run's
+/// bytes do not depend on them, so neither does its hash (it used to change, and the run was
+/// recomputed for nothing).
+#[test]
+fn distractor_constants_enter_only_the_hash_of_armballs_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let hash = |env: &str, noise: &str| {
+        let name = format!("{env}-{noise}");
+        let profile = dir.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &profile,
+            format!(
+                "[campaign]\nname = \"h\"\nreps = 1\n[matrix]\nenvs = [\"{env}\"]\nalgos = [\"rpe\"]\n\
+                 [explore]\nepochs = 120\neval_every = 60\n[env]\ndistractor_noise = {noise}\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join(&name);
+        let o = run(&[
+            "run",
+            "--env",
+            env,
+            "--algo",
+            "rpe",
+            "--profile",
+            p(&profile),
+            "--out",
+            p(&out),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let m: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("{env}.rpe.s0.json"))).unwrap(),
+        )
+        .unwrap();
+        m["config_hash"].as_str().unwrap().to_string()
+    };
+    assert_eq!(hash("armball", "0.1"), hash("armball", "0.2"));
+    assert_ne!(hash("armballs", "0.1"), hash("armballs", "0.2"));
+}

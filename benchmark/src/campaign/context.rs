@@ -23,7 +23,8 @@ struct HashInput<'a> {
     identity: &'a str,
     campaign_seed: u64,
     explore: &'a ExploreConfig,
-    env: &'a EnvConfig,
+    /// Only the constants the run's environment uses ([`EnvConfig::relevant_to`]).
+    env: EnvConfig,
     #[serde(skip_serializing_if = "Option::is_none")]
     ugl: Option<&'a UglConfig>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -83,7 +84,7 @@ impl RunContext<'_> {
             identity: &identity,
             campaign_seed: self.campaign_seed,
             explore: self.explore,
-            env: self.env,
+            env: self.env.relevant_to(spec.env),
             // Learned goal spaces also depend on the UGL stage; baseline hashes do not.
             ugl: spec.algo.learner().map(|_| self.ugl),
             learner: spec

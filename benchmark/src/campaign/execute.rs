@@ -105,8 +105,14 @@ struct LearnedGoals<'r> {
 
 impl GoalSource for LearnedGoals<'_> {
     fn modules(&self, choice: Modules, module_size: usize) -> Result<Vec<GoalModule>, ReprError> {
-        goal_modules(choice, self.dim, None, &latent_spread(self.train), module_size)
-            .map_err(ReprError::InvalidInput)
+        goal_modules(
+            choice,
+            self.dim,
+            None,
+            &latent_spread(self.train),
+            module_size,
+        )
+        .map_err(ReprError::InvalidInput)
     }
 
     /// Over every latent (`dims` None) or over one module's latents (the KDE of those latents

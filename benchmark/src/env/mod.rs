@@ -181,6 +181,20 @@ fn is_default_distractor_noise(v: &f64) -> bool {
     *v == DISTRACTOR_NOISE
 }
 
+impl EnvConfig {
+    /// The constants a run in `kind` depends on: the distractor's are reset to their defaults
+    /// (which are not serialised) in scenes without a distractor, so that they never enter the
+    /// config hash of, say, an ArmBall run (its bytes do not depend on them).
+    pub fn relevant_to(&self, kind: EnvKind) -> EnvConfig {
+        let mut c = self.clone();
+        if kind.control_dims().is_none() {
+            c.distractor_initial = DISTRACTOR_INITIAL;
+            c.distractor_noise = DISTRACTOR_NOISE;
+        }
+        c
+    }
+}
+
 impl Default for EnvConfig {
     fn default() -> Self {
         EnvConfig {

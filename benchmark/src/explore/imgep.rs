@@ -9,9 +9,9 @@
 //! stored outcome encoding, and perturbs them.
 
 use super::history::{ExplorationLog, Metrics, Recorder};
-use super::{ExploreConfig, Explorer};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
+use super::{ExploreConfig, Explorer};
 use crate::env::render::PIXELS;
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;

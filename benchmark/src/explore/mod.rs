@@ -24,8 +24,8 @@ use crate::env::Environment;
 use crate::repr::ReprError;
 
 pub use crate::repr::registry::Learner;
-pub use history::{Checkpoint, ExplorationLog};
 pub use goal_source::{EngineeredGoals, GoalSource};
+pub use history::{Checkpoint, ExplorationLog};
 pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, Rge, run_rge};
 pub use mge::{GoalModule, Mge, MgeConfig, Modules, goal_modules, run_mge};
 pub use rpe::{Rpe, run_rpe};
@@ -400,6 +400,9 @@ mod tests {
         assert!(Algo::new(Strategy::Mge(Modules::Progress), GoalSpaceKind::None).is_err());
         let a = Algo::new(Strategy::Mge(Modules::Random), GoalSpaceKind::Learned(vae)).unwrap();
         assert_eq!(a.to_string(), "mge-vae-random");
-        assert_eq!((a.learner(), a.modules()), (Some(vae), Some(Modules::Random)));
+        assert_eq!(
+            (a.learner(), a.modules()),
+            (Some(vae), Some(Modules::Random))
+        );
     }
 }

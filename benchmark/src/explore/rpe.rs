@@ -1,9 +1,9 @@
 //! Random parameter exploration (RPE; PAPER-NOTES.md section 3): `epochs` uniformly random
 //! parameter vectors, no warm-up.
 
-use super::{ExploreConfig, Explorer};
 use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::random_params;
+use super::{ExploreConfig, Explorer};
 use crate::env::Environment;
 use crate::seed::{Component, stream};
 
