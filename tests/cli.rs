@@ -490,7 +490,7 @@ fn run_with_an_external_learner() {
         "--out",
         p(&out),
     ]);
-    assert_one_line_error(&o, "rge-external only");
+    assert_one_line_error(&o, "apply to the external learner's algorithms only");
     let o = ugl(&[
         "run",
         "--env",
