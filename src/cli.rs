@@ -75,6 +75,10 @@ pub(crate) enum Command {
         /// Repetition index; the RNG seed derives from it, the run identity and the campaign seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Exploration replicate of the repetition (`[campaign] explorations`): replicate J > 0
+        /// explores the repetition's fitted goal space with its own streams.
+        #[arg(long, default_value_t = 0)]
+        exploration: u32,
         /// Override the profile's number of exploration epochs.
         #[arg(long)]
         epochs: Option<usize>,
@@ -289,7 +293,9 @@ impl CacheArgs {
 pub(crate) fn algo_help() -> String {
     let algos: Vec<&str> = Learner::all().map(|l| l.entry().algo).collect();
     format!(
-        "rpe, rge-efr, or a learned goal space rge-NAME: {} (parameters in the profile's \
+        "rpe, rge-efr, rge-efr-position (the engineered features without the angle, paired \
+         with rge-efr: a control on ArmArrow), or a learned goal space rge-NAME: {} \
+         (parameters in the profile's \
          [learners.NAME]; `ugl learners` describes them); the follow-up paper's modular goal \
          exploration (docs/armballs.md): mge-efr-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one \
          module), random or lp (learning progress), constants in the profile's [mge]",
@@ -297,11 +303,10 @@ pub(crate) fn algo_help() -> String {
     )
 }
 
-/// `--learner`'s help, from the registry.
 /// `--env`: every environment of the registry, with its description.
 pub(crate) fn env_help() -> String {
-    let envs: Vec<String> = ugl_types::ENVIRONMENTS
-        .iter()
+    let envs: Vec<String> = ugl_types::environments()
+        .into_iter()
         .map(|e| format!("{}: {}", e.name, e.description))
         .collect();
     format!("The environment: {}", envs.join("; "))
@@ -309,8 +314,8 @@ pub(crate) fn env_help() -> String {
 
 /// `ugl klc --env`: the CSV header of each environment, the measured coordinates.
 pub(crate) fn klc_env_help() -> String {
-    let envs: Vec<String> = ugl_types::ENVIRONMENTS
-        .iter()
+    let envs: Vec<String> = ugl_types::environments()
+        .into_iter()
         .map(|e| {
             format!(
                 "{} (CSV header `{}`)",
@@ -327,8 +332,8 @@ pub(crate) fn klc_env_help() -> String {
 
 /// `ugl render --state`: the engineered state of each environment.
 pub(crate) fn state_help() -> String {
-    let envs: Vec<String> = ugl_types::ENVIRONMENTS
-        .iter()
+    let envs: Vec<String> = ugl_types::environments()
+        .into_iter()
         .map(|e| format!("`{}` ({})", e.outcome_columns.join(","), e.name))
         .collect();
     format!(

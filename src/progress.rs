@@ -2,8 +2,8 @@
 //! Ctrl-C stop flag of long commands.
 
 use std::io::IsTerminal;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use anyhow::{Context, Result};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -97,17 +97,30 @@ pub(crate) fn progress_area() -> MultiProgress {
 
 /// The stop flag of a campaign command: the first Ctrl-C sets it (and stops external learners
 /// still fitting), so the work in flight (`what`) finishes and is stored; a second one exits.
+/// The handler is installed once per process; a later command (of a program that runs the
+/// command line several times) gets the same flag, cleared.
 pub(crate) fn stop_on_ctrl_c(what: &'static str) -> Result<Arc<AtomicBool>> {
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
+    static HANDLER: OnceLock<(Arc<AtomicBool>, Arc<Mutex<&'static str>>)> = OnceLock::new();
+    let (stop, doing) = match HANDLER.get() {
+        Some(h) => h.clone(),
+        None => {
+            let stop = Arc::new(AtomicBool::new(false));
+            let doing = Arc::new(Mutex::new(what));
+            let (flag, label) = (stop.clone(), doing.clone());
+            ctrlc::set_handler(move || {
+                if flag.swap(true, Ordering::SeqCst) {
+                    std::process::exit(130);
+                }
+                // External learners still fitting are stopped now, not waited for.
+                ugl_bench::repr::external::interrupt();
+                let what = *label.lock().unwrap_or_else(|e| e.into_inner());
+                eprintln!("\ninterrupt: finishing {what} (Ctrl-C again to abort now)");
+            })
+            .context("cannot install the Ctrl-C handler")?;
+            HANDLER.get_or_init(|| (stop, doing)).clone()
         }
-        // External learners still fitting are stopped now, not waited for.
-        ugl_bench::repr::external::interrupt();
-        eprintln!("\ninterrupt: finishing {what} (Ctrl-C again to abort now)");
-    })
-    .context("cannot install the Ctrl-C handler")?;
+    };
+    stop.store(false, Ordering::SeqCst);
+    *doing.lock().unwrap_or_else(|e| e.into_inner()) = what;
     Ok(stop)
 }

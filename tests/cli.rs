@@ -1966,3 +1966,43 @@ fn messages_name_the_algorithm_the_flag_and_the_key_given() {
         stderr(&o)
     );
 }
+
+/// The position-only EFR draws RGE-EFR's exploration streams (paired): on ArmBall, whose
+/// outcome is the position, it is RGE-EFR itself; on ArmArrow it explores without the angle
+/// and the runs differ.
+#[test]
+fn the_position_only_efr_is_paired_with_efr_and_drops_only_the_angle() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("runs");
+    for env in ["armball", "armarrow"] {
+        for algo in ["rge-efr", "rge-efr-position"] {
+            let o = ugl(&[
+                "run",
+                "--env",
+                env,
+                "--algo",
+                algo,
+                "--epochs",
+                "300",
+                "--profile",
+                "smoke",
+                "--out",
+                p(&out),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+    }
+    let m = |id: &str| manifest(&out.join(format!("{id}.json")));
+    let (ball, ball_pos) = (m("armball.rge-efr.s0"), m("armball.rge-efr-position.s0"));
+    assert_eq!(ball["run_seed"], ball_pos["run_seed"]);
+    for k in ["final_klc", "n_moved", "coverage"] {
+        assert_eq!(ball["summary"][k], ball_pos["summary"][k], "{k}");
+    }
+    let (arrow, arrow_pos) = (m("armarrow.rge-efr.s0"), m("armarrow.rge-efr-position.s0"));
+    assert_eq!(arrow["run_seed"], arrow_pos["run_seed"]);
+    assert_ne!(
+        arrow["summary"]["final_klc"],
+        arrow_pos["summary"]["final_klc"]
+    );
+    assert_ne!(arrow["config_hash"], arrow_pos["config_hash"]);
+}

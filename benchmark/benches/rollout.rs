@@ -11,7 +11,7 @@ fn bench(c: &mut Criterion) {
     let thetas: Vec<_> = (0..1024).map(|_| random_params(&mut rng)).collect();
     let mut g = c.benchmark_group("rollout");
     g.throughput(Throughput::Elements(thetas.len() as u64));
-    for kind in EnvKind::PAPER {
+    for kind in EnvKind::paper() {
         let env = make_env(kind, &EnvConfig::default());
         let mut noise = stream(0, Component::Distractor);
         g.bench_function(format!("{kind}_x1024"), |b| {

@@ -429,6 +429,88 @@ fn shutdown_reports_non_zero_exit() {
     assert!(m.contains("exit status: 4") && m.contains("bye"), "{m}");
 }
 
+/// The WARN (and higher) events `f` logs on this thread, formatted.
+fn warnings_of(f: impl FnOnce()) -> String {
+    use std::sync::{Arc, Mutex};
+    #[derive(Clone, Default)]
+    struct Buf(Arc<Mutex<Vec<u8>>>);
+    impl std::io::Write for Buf {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0.lock().unwrap().extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let buf = Buf::default();
+    let writer = buf.clone();
+    let subscriber = tracing_subscriber::fmt()
+        .with_max_level(tracing::Level::WARN)
+        .with_ansi(false)
+        .with_writer(move || writer.clone())
+        .finish();
+    tracing::subscriber::with_default(subscriber, f);
+    String::from_utf8(buf.0.lock().unwrap().clone()).unwrap()
+}
+
+/// A dropped encoder whose program ends badly after stdin is closed (exit 3, a signal, no exit
+/// within the grace period) is reported once, as a warning naming the learner, the status and
+/// its log file (it was silent); a clean exit, a shutdown() or an earlier failure add nothing.
+#[test]
+fn a_bad_end_on_drop_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let z = npy_f64(3, 2, &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+    let fitted = |name: &str, after: &str, log: Option<PathBuf>| {
+        let mut l = sh(name, &scripted(dir.path(), &z, after));
+        l.log_file = log;
+        let (mut enc, _) = fit_external(&l, &images(3), 2, 0).unwrap();
+        enc.begin_run(stream_named(0, "encoding"));
+        enc
+    };
+    let log = dir.path().join("x.learner.log");
+    let w = warnings_of(|| {
+        drop(fitted(
+            "exit-3",
+            "cat > /dev/null; echo 'bye, crashing' >&2; exit 3",
+            Some(log.clone()),
+        ))
+    });
+    assert_eq!(w.matches("ended badly").count(), 1, "{w}");
+    assert!(
+        w.contains("learner 'exit-3'") && w.contains("exit status: 3"),
+        "{w}"
+    );
+    assert!(w.contains("bye, crashing"), "{w}");
+    assert!(w.contains(&log.display().to_string()), "{w}");
+
+    let w = warnings_of(|| drop(fitted("signal", "cat > /dev/null; kill -9 $$", None)));
+    assert!(
+        w.contains("learner 'signal'") && w.contains("SIGKILL"),
+        "{w}"
+    );
+
+    let t = Instant::now();
+    let w = warnings_of(|| drop(fitted("deaf", "sleep 30", None)));
+    assert!(t.elapsed() < Duration::from_secs(15), "{:?}", t.elapsed());
+    assert!(w.contains("learner 'deaf'") && w.contains("killed"), "{w}");
+
+    let w = warnings_of(|| drop(fitted("clean", "cat > /dev/null", None)));
+    assert!(w.is_empty(), "{w}");
+    let w = warnings_of(|| {
+        let m = external_msg(fitted("explicit", "cat > /dev/null; exit 3", None).shutdown());
+        assert!(m.contains("exit status: 3"), "{m}");
+    });
+    assert!(!w.contains("ended badly"), "reported twice: {w}");
+    let w = warnings_of(|| {
+        let mut enc = fitted("broken", "head -c 10 > /dev/null; exit 3", None);
+        let _ = external_msg(enc.encode(&images(2)));
+        drop(enc);
+    });
+    // The failure is reported once, by the error `encode` returned; dropping adds nothing.
+    assert!(w.is_empty(), "reported twice: {w}");
+}
+
 #[test]
 fn the_environment_of_the_program() {
     let dir = tempfile::tempdir().unwrap();

@@ -63,7 +63,7 @@ fn every_registered_learner_conforms() {
             eprintln!("SKIPPED: external learner conformance (python3 with numpy not found)");
             continue;
         }
-        for (kind, latents) in [(EnvKind::ArmBall, 2), (EnvKind::ArmArrow, 10)] {
+        for (kind, latents) in [(EnvKind::ARMBALL, 2), (EnvKind::ARMARROW, 10)] {
             let set = images(kind, 300);
             let l = make_learner(learner, &cfg, Some(Variant::Corrected)).unwrap();
             let who = format!("{} on {kind} with {latents} latents", learner.name());

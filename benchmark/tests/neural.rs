@@ -56,7 +56,7 @@ fn mean(v: &[(usize, f64)]) -> f64 {
 
 #[test]
 fn loss_decreases_for_every_model_and_variant() {
-    let set = images(EnvKind::ArmBall, 200);
+    let set = images(EnvKind::ARMBALL, 200);
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
             let cfg = NeuralConfig {
@@ -83,7 +83,7 @@ fn loss_decreases_for_every_model_and_variant() {
 
 #[test]
 fn encoders_have_the_right_shapes_and_priors() {
-    let set = images(EnvKind::ArmArrow, 120);
+    let set = images(EnvKind::ARMARROW, 120);
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
             let l = learner(model, tiny(model, variant, 5));
@@ -114,7 +114,7 @@ fn encoders_have_the_right_shapes_and_priors() {
 
 #[test]
 fn training_is_deterministic_for_a_stream() {
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
             let cfg = tiny(model, variant, 12);
@@ -239,7 +239,7 @@ fn radial_flow_logdet_matches_the_jacobian() {
 
 #[test]
 fn variants_differ_exactly_where_documented() {
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     let d = 2;
     // Initial weights are a function of the stream only.
     for model in Model::ALL {
@@ -335,7 +335,7 @@ fn variants_differ_exactly_where_documented() {
 
 #[test]
 fn invalid_configurations_are_rejected() {
-    let set = images(EnvKind::ArmBall, 30);
+    let set = images(EnvKind::ARMBALL, 30);
     let base = tiny(Model::Vae, Variant::Faithful, 2);
     let cases: Vec<(&str, NeuralConfig)> = vec![
         (
@@ -421,7 +421,7 @@ fn invalid_configurations_are_rejected() {
 
 #[test]
 fn divergence_is_reported() {
-    let set = images(EnvKind::ArmBall, 50);
+    let set = images(EnvKind::ARMBALL, 50);
     let cfg = NeuralConfig {
         lr: 1e30,
         ..tiny(Model::Vae, Variant::Corrected, 50)
@@ -438,7 +438,7 @@ fn divergence_is_reported() {
 
 #[test]
 fn progress_is_reported_every_iteration() {
-    let set = images(EnvKind::ArmBall, 50);
+    let set = images(EnvKind::ARMBALL, 50);
     let calls = Arc::new(AtomicUsize::new(0));
     let seen = calls.clone();
     let l = NeuralLearner::new(
@@ -503,7 +503,7 @@ fn configuration_serde() {
 /// shape, determinism-of-fit and bad-input checks.
 #[test]
 fn neural_learners_conform() {
-    for (kind, latents) in [(EnvKind::ArmBall, 2), (EnvKind::ArmArrow, 10)] {
+    for (kind, latents) in [(EnvKind::ARMBALL, 2), (EnvKind::ARMARROW, 10)] {
         let set = images(kind, 150);
         for model in Model::ALL {
             for variant in [Variant::Faithful, Variant::Corrected] {
@@ -569,7 +569,7 @@ fn host_engine_gradients_match_burn_autodiff() {
     use burn::optim::GradientsParams;
     use ugl_bench::repr::host_train::{HostOptimizer, HostTrainer};
     use ugl_bench::repr::neural::{Init, LatentInput, StepInput, tensor2, training_device};
-    let set = images(EnvKind::ArmBall, 60);
+    let set = images(EnvKind::ARMBALL, 60);
     let (rows, d, step) = (40, 3, 3);
     let x: Vec<f32> = (0..rows).flat_map(|i| set.row(i).to_vec()).collect();
     for model in Model::ALL {
@@ -639,7 +639,7 @@ fn host_engine_gradients_match_burn_autodiff() {
 #[test]
 fn host_engine_is_bit_identical_across_thread_counts() {
     use ugl_bench::repr::neural::{Engine, Init, train};
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     for model in Model::ALL {
         let cfg = NeuralConfig {
             hidden: [256, 128],
@@ -667,7 +667,7 @@ fn host_engine_is_bit_identical_across_thread_counts() {
 /// `UGL_FINGERPRINT_ARCH=H1,H2,iterations` sets the size (default `64,48,20`).
 #[test]
 fn fingerprint_for_thread_count_comparison() {
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     let arch: Vec<usize> = std::env::var("UGL_FINGERPRINT_ARCH")
         .unwrap_or_else(|_| "64,48,20".into())
         .split(',')
@@ -716,7 +716,7 @@ fn fingerprint_for_thread_count_comparison() {
 #[test]
 fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
     use ugl_bench::repr::neural::{CheckpointSpec, Engine, train, train_with_checkpoints};
-    let set = images(EnvKind::ArmBall, 120);
+    let set = images(EnvKind::ARMBALL, 120);
     for (model, engine) in Model::ALL
         .into_iter()
         .flat_map(|m| Engine::ALL.map(|e| (m, e)))
@@ -843,7 +843,7 @@ fn a_damaged_or_inconsistent_checkpoint_state_is_ignored() {
     use serde_json::Value;
     use ugl_bench::repr::neural::{CheckpointSpec, Engine, train, train_with_checkpoints};
     let model = Model::Vae;
-    let set = images(EnvKind::ArmBall, 120);
+    let set = images(EnvKind::ARMBALL, 120);
     let cfg = NeuralConfig {
         log_every: 5,
         engine: Engine::Host,
@@ -983,7 +983,7 @@ fn a_damaged_or_inconsistent_checkpoint_state_is_ignored() {
 #[test]
 fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
     use ugl_bench::repr::neural::Engine;
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     for engine in [Engine::Host, Engine::Burn] {
         let vae = NeuralConfig {
             engine,
@@ -1007,7 +1007,7 @@ fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
 #[test]
 fn capacity_annealing_is_the_beta_kl_against_a_rising_target() {
     use ugl_bench::repr::neural::Engine;
-    let set = images(EnvKind::ArmBall, 150);
+    let set = images(EnvKind::ARMBALL, 150);
     let cfg = |capacity: Option<f64>| NeuralConfig {
         engine: Engine::Host,
         beta: Some(4.0),

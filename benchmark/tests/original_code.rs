@@ -28,7 +28,7 @@ fn theta(v: &Value) -> [f64; PARAMS] {
 #[test]
 fn rollouts_match_the_original_to_1e12() {
     let fx = load("orig_rollouts.json");
-    for kind in EnvKind::PAPER {
+    for kind in EnvKind::paper() {
         let env = make_env(kind, &EnvConfig::default());
         let cases = fx[kind.name()].as_array().unwrap();
         assert!(cases.len() > 300);

@@ -1,5 +1,5 @@
-//! From runs to conditions: the mean KL-coverage curve over seeds with its 90% bootstrap band,
-//! and the final values of the table.
+//! From runs to conditions: the mean KL-coverage curve over seeds with its t-interval band
+//! ([`stats::CONFIDENCE`]), and the final values of the table.
 
 use std::collections::BTreeMap;
 
@@ -15,9 +15,9 @@ pub struct CurveStat {
     pub mean: f64,
     /// Sample standard deviation over the runs (`None` with one run or an infinite value).
     pub std: Option<f64>,
-    /// 90% percentile-bootstrap CI of the mean.
-    pub lo: f64,
-    pub hi: f64,
+    /// Student's t interval of the mean at [`stats::CONFIDENCE`]; `None` with one run or an
+    /// infinite value (no band drawn there).
+    pub ci: Option<(f64, f64)>,
 }
 
 /// One condition (env, algo, sampler, latents, variant) over its seeds.
@@ -60,19 +60,14 @@ impl ConditionSummary {
 }
 
 /// Groups the runs by condition (in the report's condition order) and computes the statistics.
-pub fn aggregate(
-    store: &Store,
-    paper: &PaperTable,
-    bootstrap_seed: u64,
-    n_boot: usize,
-) -> Vec<ConditionSummary> {
+pub fn aggregate(store: &Store, paper: &PaperTable) -> Vec<ConditionSummary> {
     let mut groups: BTreeMap<ConditionKey, Vec<usize>> = BTreeMap::new();
     for (i, run) in store.runs.iter().enumerate() {
         groups.entry(run.key.clone()).or_default().push(i);
     }
     let mut out: Vec<ConditionSummary> = groups
         .into_iter()
-        .map(|(key, runs)| summarize_condition(store, paper, key, runs, bootstrap_seed, n_boot))
+        .map(|(key, runs)| summarize_condition(store, paper, key, runs))
         .collect();
     out.sort_by_key(|c| c.key.order_key());
     mark_rpe_level(store, &mut out);
@@ -133,15 +128,11 @@ fn summarize_condition(
     paper: &PaperTable,
     key: ConditionKey,
     runs: Vec<usize>,
-    bootstrap_seed: u64,
-    n_boot: usize,
 ) -> ConditionSummary {
-    let slug = key.slug();
     let rs: Vec<&crate::load::Run> = runs.iter().map(|&i| &store.runs[i]).collect();
 
-    // Per epoch over the runs: a value of each run's curve, summarised with the bootstrap
-    // stream `seed(epoch)`.
-    let curve_of = |value: fn(&crate::load::CurvePoint) -> f64, seed: &dyn Fn(i64) -> u64| {
+    // Per epoch over the runs: a value of each run's curve, summarised.
+    let curve_of = |value: fn(&crate::load::CurvePoint) -> f64| {
         let mut by_epoch: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
         for r in &rs {
             for p in &r.curve {
@@ -151,22 +142,19 @@ fn summarize_condition(
         by_epoch
             .iter()
             .map(|(&epoch, xs)| {
-                let s = stats::summarize(xs, n_boot, seed(epoch));
+                let s = stats::summarize(xs);
                 CurveStat {
                     epoch,
                     n: s.n,
                     mean: s.mean,
                     std: s.std,
-                    lo: s.ci_lo,
-                    hi: s.ci_hi,
+                    ci: s.ci,
                 }
             })
             .collect::<Vec<_>>()
     };
-    let curve = curve_of(|p| p.klc, &|e| epoch_seed(bootstrap_seed, &slug, e));
-    let coverage_curve = curve_of(|p| p.coverage, &|e| {
-        stats::derive_seed(bootstrap_seed, &format!("{slug}|coverage|epoch={e}"))
-    });
+    let curve = curve_of(|p| p.klc);
+    let coverage_curve = curve_of(|p| p.coverage);
 
     let finals: Vec<_> = rs.iter().map(|r| r.final_point()).collect();
     let final_by_seed = rs
@@ -177,14 +165,9 @@ fn summarize_condition(
     let mut final_epochs: Vec<i64> = finals.iter().map(|p| p.epoch).collect();
     final_epochs.sort_unstable();
     final_epochs.dedup();
-    let final_seed = if final_epochs.len() == 1 {
-        // The same stream as the curve's last point: figure and table agree exactly.
-        epoch_seed(bootstrap_seed, &slug, final_epochs[0])
-    } else {
-        stats::derive_seed(bootstrap_seed, &format!("{slug}|final"))
-    };
+    // With one last epoch, the same values as the curve's last point: figure and table agree.
     let klcs: Vec<f64> = finals.iter().map(|p| p.klc).collect();
-    let final_klc = stats::summarize(&klcs, n_boot, final_seed);
+    let final_klc = stats::summarize(&klcs);
     let n = finals.len() as f64;
     let final_moved_mean = finals.iter().map(|p| p.n_moved as f64).sum::<f64>() / n;
     let final_outcomes_mean = finals.iter().map(|p| p.n_outcomes as f64).sum::<f64>() / n;
@@ -210,8 +193,4 @@ fn summarize_condition(
         final_coverage_mean,
         at_rpe_level: None,
     }
-}
-
-fn epoch_seed(base: u64, slug: &str, epoch: i64) -> u64 {
-    stats::derive_seed(base, &format!("{slug}|epoch={epoch}"))
 }

@@ -1,14 +1,34 @@
 //! The paper's claims (`data/paper/claims.toml`) as testable statements, evaluated on the
-//! main campaign's results with the bootstrap of [`crate::stats`].
+//! main campaign's results with the intervals of [`crate::stats`].
 //!
 //! A claim compares *subject* conditions with *reference* conditions, paired on some fields (the
 //! same environment, say). Each comparison is the difference `subject - reference` of the mean
 //! over seeds of a statistic (final KLC, area under the KLC curve, episodes that moved the
-//! object), with a percentile-bootstrap confidence interval resampling the seeds of each side
-//! independently. The claim's relation is a set of differences (`d < 0`, `|d| < margin`, ...):
-//! a comparison is reproduced when its whole interval lies inside the set, not reproduced when it
-//! lies entirely outside, inconclusive otherwise. A claim is reproduced when every comparison is,
-//! not reproduced when any is not, inconclusive otherwise (and when nothing matched).
+//! object), with Welch's t interval (Welch 1947; the seeds of the two sides are independent
+//! samples; [`stats::interval`] shows by simulation that it covers at 5 and 20 seeds, where the
+//! percentile bootstrap does not). Fewer than two seeds on a side, or an infinite value, give no
+//! interval and an inconclusive comparison. The claim's relation is a set of differences
+//! (`d < 0`, `|d| < margin`, ...): a comparison is reproduced when its whole interval lies inside
+//! the set, not reproduced when it lies entirely outside, inconclusive otherwise.
+//!
+//! **Multiple comparisons.** A claim's verdict combines its comparisons by its [`Quantifier`].
+//! Where a verdict follows from *some* of them holding or failing (a union of tests), one
+//! comparison in `k` would reach it by chance far more often than the level says; there the
+//! comparisons' tests are corrected with Holm's step-down procedure (Holm 1979), which keeps the
+//! family-wise error of the claim's verdict at `1 − confidence`:
+//!
+//! | quantifier | *not reproduced* when | correction | *reproduced* when | correction |
+//! |---|---|---|---|---|
+//! | `all` | any comparison is not | Holm | every comparison is | none needed |
+//! | `most` | at least half are not | Holm | more than half are | Holm |
+//! | `any` | every comparison is not | none needed | at least one is | Holm |
+//!
+//! "Every comparison" is an intersection-union test: each at level α makes the whole one at
+//! level α, with no correction (Berger 1982). Each comparison's test is the interval's: its
+//! p-value `p` is at most α exactly when the `1 − α` interval lies outside (or inside) the set
+//! ([`p_outside`], [`p_inside`]); Holm compares the `j`-th smallest of the `k` p-values with
+//! `α / (k − j + 1)`. A comparison whose interval lies outside the set but does not survive the
+//! correction is inconclusive, and shown so ([`Comparison::uncorrected`]).
 //!
 //! The file format is documented at the top of `data/paper/claims.toml`.
 
@@ -20,7 +40,7 @@ use serde::Deserialize;
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
 use crate::load::{ConditionKey, Store};
-use crate::stats::{self, area_under_curve};
+use crate::stats::{self, TInterval, area_under_curve};
 
 /// Where the claims come from, as the report shows it.
 pub enum ClaimsInput<'a> {
@@ -28,7 +48,6 @@ pub enum ClaimsInput<'a> {
     Evaluated {
         path: &'a std::path::Path,
         confidence: f64,
-        n_boot: usize,
         margin: f64,
         results: &'a [ClaimResult],
     },
@@ -52,10 +71,9 @@ pub struct ClaimsFile {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Settings {
-    /// Level of the bootstrap confidence intervals, in (0, 1).
+    /// Level of the comparisons' intervals, in (0, 1); `1 −` it is the family-wise error of
+    /// a claim's verdict.
     pub confidence: f64,
-    /// Bootstrap resamples per comparison (at least 1).
-    pub n_boot: usize,
     /// Default margin of `much_less`, `at_most`, `at_least` and `similar`.
     pub margin: f64,
 }
@@ -374,9 +392,6 @@ pub fn parse_claims(text: &str, path: &Path) -> Result<ClaimsFile, ReportError> 
             s.confidence
         )));
     }
-    if s.n_boot == 0 {
-        return Err(invalid("settings.n_boot must be at least 1".into()));
-    }
     check_margin(s.margin).map_err(|m| invalid(format!("settings.margin {m}")))?;
     let mut ids = BTreeSet::new();
     for c in &file.claims {
@@ -480,14 +495,111 @@ pub struct Comparison {
     pub n_reference: usize,
     pub subject_mean: f64,
     pub reference_mean: f64,
-    /// `subject_mean - reference_mean`, and its bootstrap interval.
+    /// `subject_mean - reference_mean`.
     pub diff: f64,
-    pub lo: f64,
-    pub hi: f64,
+    /// Its Welch interval at the claims' confidence; `None` (no interval) with fewer than two
+    /// seeds on a side or an infinite value.
+    pub interval: Option<TInterval>,
     /// The margin of this comparison's relation (the claim's, or its `relative_margin` times
     /// the reference mean).
     pub margin: f64,
+    /// Where the interval lies relative to the relation's set, before any correction for the
+    /// claim's other comparisons.
+    pub uncorrected: Verdict,
+    /// The verdict the claim's verdict is formed from: [`Comparison::uncorrected`] where it survives
+    /// Holm's correction (or needs none; see the module docs), inconclusive otherwise.
     pub verdict: Verdict,
+}
+
+impl Comparison {
+    /// Bounds of the interval, if any.
+    pub fn bounds(&self) -> Option<(f64, f64)> {
+        self.interval.map(|i| (i.lo, i.hi))
+    }
+}
+
+/// p-value of the test "the difference lies outside the open set `(a, b)`" (null: it lies
+/// inside): twice the smaller one-sided p-value, `d ≥ b` or `d ≤ a`, capped at 1. It is at most
+/// `α` exactly when the two-sided `1 − α` interval lies outside the set.
+pub fn p_outside(i: &TInterval, (a, b): (f64, f64)) -> f64 {
+    (2.0 * i.p_above(b).min(i.p_below(a))).min(1.0)
+}
+
+/// p-value of the test "the difference lies inside the open set `(a, b)`" (null: outside): twice
+/// the larger one-sided p-value, `d > a` and `d < b` (an intersection-union test, as for
+/// equivalence), capped at 1. It is at most `α` exactly when the `1 − α` interval lies inside.
+pub fn p_inside(i: &TInterval, (a, b): (f64, f64)) -> f64 {
+    (2.0 * i.p_above(a).max(i.p_below(b))).min(1.0)
+}
+
+/// Holm's step-down procedure (Holm 1979) at family-wise level `alpha`: which of the hypotheses
+/// with p-values `ps` are rejected. The `j`-th smallest p-value (1-based) is compared with
+/// `alpha / (k − j + 1)`; the first that fails stops the procedure (ties keep input order).
+/// NaN p-values are never rejected and count in `k`.
+pub fn holm(ps: &[f64], alpha: f64) -> Vec<bool> {
+    let k = ps.len();
+    let mut order: Vec<usize> = (0..k).collect();
+    order.sort_by(|&i, &j| ps[i].total_cmp(&ps[j]).then(i.cmp(&j)));
+    let mut rejected = vec![false; k];
+    for (j, &i) in order.iter().enumerate() {
+        if ps[i] <= alpha / (k - j) as f64 {
+            rejected[i] = true;
+        } else {
+            break;
+        }
+    }
+    rejected
+}
+
+impl Quantifier {
+    /// Whether this quantifier's *reproduced* and *not reproduced* verdicts are union tests
+    /// (some comparisons suffice), which need Holm's correction: `(reproduced, not_reproduced)`.
+    pub fn corrected(self) -> (bool, bool) {
+        match self {
+            Quantifier::All => (false, true),
+            Quantifier::Most => (true, true),
+            Quantifier::Any => (true, false),
+        }
+    }
+}
+
+/// Applies Holm's correction to the comparisons of one claim where its quantifier needs it
+/// (module docs): sets each [`Comparison::verdict`] from [`Comparison::uncorrected`] at level
+/// `alpha`, the family being the claim's comparisons that have an interval.
+pub fn correct(
+    comparisons: &mut [Comparison],
+    quantifier: Quantifier,
+    relation: Relation,
+    alpha: f64,
+) {
+    let (yes_corrected, no_corrected) = quantifier.corrected();
+    // The family: (index, p inside, p outside) of every comparison with an interval.
+    let tested: Vec<(usize, f64, f64)> = comparisons
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| {
+            let set = relation.interval(c.margin);
+            c.interval
+                .as_ref()
+                .map(|iv| (i, p_inside(iv, set), p_outside(iv, set)))
+        })
+        .collect();
+    let yes = holm(&tested.iter().map(|t| t.1).collect::<Vec<_>>(), alpha);
+    let no = holm(&tested.iter().map(|t| t.2).collect::<Vec<_>>(), alpha);
+    for c in comparisons.iter_mut() {
+        c.verdict = c.uncorrected;
+    }
+    for (t, &(i, _, _)) in tested.iter().enumerate() {
+        let c = &mut comparisons[i];
+        let survives = match c.uncorrected {
+            Verdict::Reproduced => !yes_corrected || yes[t],
+            Verdict::NotReproduced => !no_corrected || no[t],
+            Verdict::Inconclusive => true,
+        };
+        if !survives {
+            c.verdict = Verdict::Inconclusive;
+        }
+    }
 }
 
 /// A claim with its comparisons.
@@ -615,15 +727,14 @@ pub fn evaluate(
     file: &ClaimsFile,
     conditions: &[ConditionSummary],
     store: &Store,
-    seed: u64,
 ) -> Vec<ClaimResult> {
-    evaluate_on(file, &CampaignObservations { conditions, store }, seed)
+    evaluate_on(file, &CampaignObservations { conditions, store })
 }
 
 /// Evaluates every claim of `file` on `obs`. Each subject condition is compared with every
-/// reference condition that agrees with it on `pair_on`; the bootstrap of each comparison is
-/// seeded from `seed`, the claim id and both conditions.
-pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations, seed: u64) -> Vec<ClaimResult> {
+/// reference condition that agrees with it on `pair_on` (a side without values, or with a NaN,
+/// gives no comparison); the comparisons of a claim are then corrected ([`correct`]).
+pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult> {
     let alpha = 1.0 - file.settings.confidence;
     let keys = obs.keys();
     file.claims
@@ -637,36 +748,38 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations, seed: u64) -> Vec<
                     *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k)
                 }) {
                     let ys = obs.values(r, claim.statistic);
-                    let label = format!("claim|{}|{}|{}", claim.id, s.slug(), r.slug());
-                    let Some((diff, lo, hi)) = stats::difference_of_means_ci(
-                        &xs,
-                        &ys,
-                        file.settings.n_boot,
-                        alpha,
-                        stats::derive_seed(seed, &label),
-                    ) else {
+                    let unusable = |v: &[f64]| v.is_empty() || v.iter().any(|x| x.is_nan());
+                    if unusable(&xs) || unusable(&ys) {
                         continue;
-                    };
-                    let reference_mean = stats::mean(&ys);
+                    }
+                    let (subject_mean, reference_mean) = (stats::mean(&xs), stats::mean(&ys));
                     let margin = match claim.relative_margin {
                         Some(f) => f * reference_mean.abs(),
                         None => margin,
+                    };
+                    let interval = stats::welch_interval(&xs, &ys, file.settings.confidence).ok();
+                    let uncorrected = match interval {
+                        Some(i) => {
+                            Verdict::of_interval(i.lo, i.hi, claim.relation.interval(margin))
+                        }
+                        None => Verdict::Inconclusive,
                     };
                     comparisons.push(Comparison {
                         subject: s.clone(),
                         reference: r.clone(),
                         n_subject: xs.len(),
                         n_reference: ys.len(),
-                        subject_mean: stats::mean(&xs),
+                        subject_mean,
                         reference_mean,
-                        diff,
-                        lo,
-                        hi,
+                        diff: subject_mean - reference_mean,
+                        interval,
                         margin,
-                        verdict: Verdict::of_interval(lo, hi, claim.relation.interval(margin)),
+                        uncorrected,
+                        verdict: uncorrected,
                     });
                 }
             }
+            correct(&mut comparisons, claim.quantifier, claim.relation, alpha);
             let verdicts: Vec<Verdict> = comparisons.iter().map(|c| c.verdict).collect();
             let premise = claim.premise.as_ref().map(|p| {
                 obs.premise(p).unwrap_or_else(|| PremiseCheck {
@@ -858,7 +971,6 @@ pub(crate) mod tests {
     const GOOD: &str = r#"
 [settings]
 confidence = 0.95
-n_boot = 100
 margin = 0.2
 
 [[claim]]
@@ -885,7 +997,10 @@ pair_on = ["env"]
     fn bad_claims_files_name_the_problem() {
         let cases = [
             (GOOD.replace("0.95", "1.5"), "settings.confidence"),
-            (GOOD.replace("n_boot = 100", "n_boot = 0"), "n_boot"),
+            (
+                GOOD.replace("margin = 0.2", "margin = 0.2\nn_boot = 100"),
+                "n_boot",
+            ),
             (GOOD.replace("margin = 0.2", "margin = -1.0"), "margin"),
             (GOOD.replace("\"less\"", "\"smaller\""), "smaller"),
             (GOOD.replace("\"true\"", "\"ten\""), "latents"),
@@ -957,14 +1072,13 @@ pair_on = ["env"]
             runs,
             incomplete: Vec::new(),
         };
-        let conditions =
-            crate::aggregate::aggregate(&store, &crate::paper::PaperTable::default(), 0, 100);
+        let conditions = crate::aggregate::aggregate(&store, &crate::paper::PaperTable::default());
         (store, conditions)
     }
 
     fn claim(relation: &str, subject: &str, reference: &str, pair_on: &str) -> String {
         format!(
-            "[settings]\nconfidence = 0.95\nn_boot = 2000\nmargin = 0.2\n\n[[claim]]\n\
+            "[settings]\nconfidence = 0.95\nmargin = 0.2\n\n[[claim]]\n\
              id = \"c\"\nsource = \"s\"\nquote = \"q\"\nstatement = \"t\"\n\
              statistic = \"final_klc\"\nrelation = \"{relation}\"\nsubject = {subject}\n\
              reference = {reference}\npair_on = {pair_on}\n"
@@ -973,7 +1087,7 @@ pair_on = ["env"]
 
     fn verdict_of(text: &str, store: &Store, conds: &[ConditionSummary]) -> ClaimResult {
         let f = parse_claims(text, Path::new("c.toml")).unwrap();
-        evaluate(&f, conds, store, 0).remove(0)
+        evaluate(&f, conds, store).remove(0)
     }
 
     #[test]
@@ -1040,8 +1154,154 @@ pair_on = ["env"]
         );
         assert!(r.comparisons.is_empty());
         assert_eq!(r.verdict, Verdict::Inconclusive);
-        // Same inputs, same result (seeded bootstrap).
+        // Same inputs, same result (no resampling).
         assert_eq!(v("less", "rge-vae"), v("less", "rge-vae"));
+    }
+
+    #[test]
+    fn holm_step_down_known_case() {
+        // Sorted: 0.005 <= 0.05/4, 0.01 <= 0.05/3, 0.03 > 0.05/2: stop.
+        assert_eq!(
+            holm(&[0.01, 0.04, 0.03, 0.005], 0.05),
+            vec![true, false, false, true]
+        );
+        // One hypothesis: the uncorrected test.
+        assert_eq!(holm(&[0.05], 0.05), vec![true]);
+        assert_eq!(holm(&[0.02, 0.04], 0.05), vec![true, true]);
+        assert_eq!(holm(&[f64::NAN, 0.001], 0.05), vec![false, true]);
+        assert!(holm(&[], 0.05).is_empty());
+    }
+
+    #[test]
+    fn p_values_agree_with_the_interval() {
+        let i =
+            stats::welch_interval(&[1.0, 1.4, 1.2, 1.5], &[0.2, 0.5, 0.1, 0.3, 0.4], 0.95).unwrap();
+        // The 95% interval's bounds are where the tests' p-values reach 0.05.
+        assert!((p_outside(&i, (f64::NEG_INFINITY, i.lo)) - 0.05).abs() < 1e-9);
+        assert!((p_inside(&i, (i.lo, f64::INFINITY)) - 0.05).abs() < 1e-9);
+        assert!((p_inside(&i, (i.lo, i.hi + 1.0)) - 0.05).abs() < 1e-9);
+        assert_eq!(p_outside(&i, (f64::NEG_INFINITY, f64::INFINITY)), 1.0);
+    }
+
+    /// A constructed case: one of three comparisons has its 95% interval just above 0 (p ≈ 0.03)
+    /// and the other two are undecided. Uncorrected, "every subject is lower than RGE-EFR"
+    /// would be *not reproduced*; Holm's threshold for the smallest of three p-values is
+    /// 0.05 / 3, so it is inconclusive. Alone, the same comparison decides.
+    #[test]
+    fn holm_correction_changes_a_verdict() {
+        let efr: &[f64] = &[4.5, 4.6, 4.4, 4.55, 4.45];
+        let shifted: Vec<f64> = efr.iter().map(|v| v + 0.13).collect();
+        let (store, conds) = synthetic(&[
+            ("rge-efr", 0, efr),
+            ("rge-pca", 10, &shifted),
+            ("rge-ae", 10, &[4.3, 4.7, 4.5, 4.6, 4.4]),
+            ("rge-isomap", 10, &[4.35, 4.65, 4.5, 4.55, 4.45]),
+        ]);
+        let efr_sel = "{ algo = [\"rge-efr\"] }";
+        let three = "{ algo = [\"rge-pca\", \"rge-ae\", \"rge-isomap\"] }";
+        let r = verdict_of(&claim("less", three, efr_sel, "[\"env\"]"), &store, &conds);
+        assert_eq!(r.comparisons.len(), 3);
+        let pca = r
+            .comparisons
+            .iter()
+            .find(|c| c.subject.algo == "rge-pca")
+            .unwrap();
+        let (lo, _) = pca.bounds().unwrap();
+        assert!(lo > 0.0, "the interval lies above 0: {lo}");
+        let p = p_outside(pca.interval.as_ref().unwrap(), Relation::Less.interval(0.2));
+        assert!(p > 0.05 / 3.0 && p < 0.05, "p = {p}");
+        assert_eq!(pca.uncorrected, Verdict::NotReproduced);
+        assert_eq!(pca.verdict, Verdict::Inconclusive);
+        let uncorrected: Vec<Verdict> = r.comparisons.iter().map(|c| c.uncorrected).collect();
+        assert_eq!(
+            Quantifier::All.combine(&uncorrected),
+            Verdict::NotReproduced
+        );
+        assert_eq!(r.verdict, Verdict::Inconclusive);
+        // The same comparison alone: one test, nothing to correct.
+        let one = "{ algo = [\"rge-pca\"] }";
+        let r = verdict_of(&claim("less", one, efr_sel, "[\"env\"]"), &store, &conds);
+        assert_eq!(r.verdict, Verdict::NotReproduced);
+    }
+
+    /// Which direction is corrected follows the quantifier: "any" corrects *reproduced* (one
+    /// success of k is a union test) but not *not reproduced* (all k must fail).
+    #[test]
+    fn correction_follows_the_quantifier() {
+        let iv = |estimate: f64| TInterval {
+            estimate,
+            se: 0.2,
+            df: 8.0,
+            level: 0.95,
+            lo: estimate - 2.306_004_135_204 * 0.2,
+            hi: estimate + 2.306_004_135_204 * 0.2,
+        };
+        let k = |algo: &str| key("armball", algo, "kde", 10, "none");
+        let comparison = |algo: &str, estimate: f64| {
+            let i = iv(estimate);
+            let v = Verdict::of_interval(i.lo, i.hi, Relation::Less.interval(0.2));
+            Comparison {
+                subject: k(algo),
+                reference: k("rge-efr"),
+                n_subject: 5,
+                n_reference: 5,
+                subject_mean: 0.0,
+                reference_mean: 0.0,
+                diff: estimate,
+                interval: Some(i),
+                margin: 0.2,
+                uncorrected: v,
+                verdict: v,
+            }
+        };
+        // Δ = −0.5 with se 0.2: below 0 with p ≈ 0.037; the others undecided.
+        let mut cs = vec![
+            comparison("a", -0.5),
+            comparison("b", 0.0),
+            comparison("c", 0.05),
+        ];
+        assert_eq!(cs[0].uncorrected, Verdict::Reproduced);
+        correct(&mut cs, Quantifier::All, Relation::Less, 0.05);
+        assert_eq!(
+            cs[0].verdict,
+            Verdict::Reproduced,
+            "all: reproduced needs every one"
+        );
+        correct(&mut cs, Quantifier::Any, Relation::Less, 0.05);
+        assert_eq!(
+            cs[0].verdict,
+            Verdict::Inconclusive,
+            "any: one of three is a union"
+        );
+        // Every comparison fails: "any" is not reproduced without correction.
+        let mut fail = vec![comparison("a", 0.5), comparison("b", 0.5)];
+        correct(&mut fail, Quantifier::Any, Relation::Less, 0.05);
+        assert!(fail.iter().all(|c| c.verdict == Verdict::NotReproduced));
+        let vs: Vec<Verdict> = fail.iter().map(|c| c.verdict).collect();
+        assert_eq!(Quantifier::Any.combine(&vs), Verdict::NotReproduced);
+        // ...while "all" corrects them (two at p ≈ 0.037 > 0.05 / 2 for the first).
+        correct(&mut fail, Quantifier::All, Relation::Less, 0.05);
+        assert!(fail.iter().all(|c| c.verdict == Verdict::Inconclusive));
+    }
+
+    #[test]
+    fn one_seed_on_a_side_gives_no_interval() {
+        let (store, conds) =
+            synthetic(&[("rge-efr", 0, &[4.5, 4.6, 4.4]), ("rge-pca", 10, &[3.0])]);
+        let r = verdict_of(
+            &claim(
+                "less",
+                "{ algo = [\"rge-pca\"] }",
+                "{ algo = [\"rge-efr\"] }",
+                "[\"env\"]",
+            ),
+            &store,
+            &conds,
+        );
+        assert_eq!(r.comparisons.len(), 1);
+        assert_eq!(r.comparisons[0].interval, None);
+        assert!((r.comparisons[0].diff - -1.5).abs() < 1e-12);
+        assert_eq!(r.verdict, Verdict::Inconclusive);
     }
 
     #[test]

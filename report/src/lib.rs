@@ -12,6 +12,7 @@ pub mod campaigns;
 pub mod claims;
 pub mod context;
 pub mod data;
+pub mod discovery;
 pub mod error;
 pub mod figures;
 pub mod leaderboard;
@@ -42,9 +43,11 @@ pub struct ReportOptions {
     pub out: PathBuf,
     /// The paper's reference values (`klc_final.csv`); a missing directory is reported, not fatal.
     pub paper_dir: PathBuf,
-    /// Seed of the bootstrap (each condition and epoch derives its own stream from it).
+    /// Seed of the leaderboard's and the comparison pages' stratified bootstrap (each
+    /// statistic derives its own stream from it). The intervals over one condition's seeds
+    /// (tables, bands, claims) are t intervals and draw nothing.
     pub bootstrap_seed: u64,
-    /// Bootstrap resamples per confidence interval.
+    /// Resamples per stratified-bootstrap interval.
     pub n_boot: usize,
 }
 
@@ -98,15 +101,9 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     )?;
     let store = &camps.main.store;
     let paper = paper::load_paper(&opts.paper_dir)?;
-    let conditions = aggregate::aggregate(store, &paper, opts.bootstrap_seed, opts.n_boot);
-    let pairs = neural::variant_pairs(&conditions, opts.bootstrap_seed, opts.n_boot);
-    let budget = neural::budget_analysis(
-        &camps.budget,
-        store,
-        &conditions,
-        opts.bootstrap_seed,
-        opts.n_boot,
-    );
+    let conditions = aggregate::aggregate(store, &paper);
+    let pairs = neural::variant_pairs(&conditions);
+    let budget = neural::budget_analysis(&camps.budget, store, &conditions);
     let losses = neural::loss_curves(store);
 
     let claims_path = opts.paper_dir.join(claims::FILE);
@@ -117,7 +114,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     };
     let mut claim_results = claims_file
         .as_ref()
-        .map(|f| claims::evaluate(f, &conditions, store, opts.bootstrap_seed))
+        .map(|f| claims::evaluate(f, &conditions, store))
         .unwrap_or_default();
     let keys: Vec<_> = conditions.iter().map(|c| c.key.clone()).collect();
     claims::attach_paper_checks(&mut claim_results, &keys, &paper);
@@ -125,7 +122,6 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         Some(f) => claims::ClaimsInput::Evaluated {
             path: &claims_path,
             confidence: f.settings.confidence,
-            n_boot: f.settings.n_boot,
             margin: f.settings.margin,
             results: &claim_results,
         },
@@ -138,8 +134,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         .compare
         .iter()
         .map(|c| {
-            let mut conds =
-                aggregate::aggregate(&c.store, &paper, opts.bootstrap_seed, opts.n_boot);
+            let mut conds = aggregate::aggregate(&c.store, &paper);
             aggregate::mark_rpe_level_against(&c.store, &mut conds, &conditions);
             conds
         })
@@ -205,8 +200,9 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
 /// The report's main page inside the output directory.
 pub const REPORT_FILE: &str = "REPORT.md";
 
-/// Level of the leaderboard's stratified bootstrap intervals (rliable's default).
-pub const LEADERBOARD_CONFIDENCE: f64 = 0.95;
+/// Level of the leaderboard's stratified bootstrap intervals: the report's one level
+/// ([`stats::CONFIDENCE`], also rliable's default).
+pub const LEADERBOARD_CONFIDENCE: f64 = stats::CONFIDENCE;
 
 /// The KDE-vs-Gaussian figures: the paper's Figure 4 (RGE-VAE), and the same for RGE-RFVAE,
 /// which the paper did not plot (drawn when its Gaussian-goal runs exist).

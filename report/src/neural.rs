@@ -222,16 +222,13 @@ pub struct VariantPair<'a> {
     pub corrected: Option<&'a ConditionSummary>,
     /// corrected − faithful per seed, for the seeds both have.
     pub differences: Vec<(i64, f64)>,
-    /// Mean paired difference with its 90% bootstrap CI; `None` without a pair.
+    /// Mean paired difference with its paired t interval ([`stats::paired_summary`]); `None`
+    /// without a pair.
     pub diff: Option<Summary>,
 }
 
 /// Every cell of [`variant_algos`] with a faithful or corrected condition, in the report's order.
-pub fn variant_pairs<'a>(
-    conditions: &'a [ConditionSummary],
-    bootstrap_seed: u64,
-    n_boot: usize,
-) -> Vec<VariantPair<'a>> {
+pub fn variant_pairs(conditions: &[ConditionSummary]) -> Vec<VariantPair<'_>> {
     type Cell = (String, String, String, i64);
     let mut cells: BTreeMap<Cell, (Option<&ConditionSummary>, Option<&ConditionSummary>)> =
         BTreeMap::new();
@@ -248,20 +245,15 @@ pub fn variant_pairs<'a>(
             _ => {}
         }
     }
-    let mut out: Vec<VariantPair<'a>> = cells
+    let mut out: Vec<VariantPair<'_>> = cells
         .into_iter()
         .filter(|(_, (f, c))| f.is_some() || c.is_some())
         .map(|((env, algo, sampler, latents), (f, c))| {
             let (differences, diff) = match (f, c) {
-                (Some(f), Some(c)) => {
-                    let label =
-                        format!("variants|{env}_{algo}_{sampler}_{latents}|corrected-faithful");
-                    let seed = stats::derive_seed(bootstrap_seed, &label);
-                    (
-                        stats::paired_differences(&f.final_by_seed, &c.final_by_seed),
-                        stats::paired_summary(&f.final_by_seed, &c.final_by_seed, n_boot, seed),
-                    )
-                }
+                (Some(f), Some(c)) => (
+                    stats::paired_differences(&f.final_by_seed, &c.final_by_seed),
+                    stats::paired_summary(&f.final_by_seed, &c.final_by_seed),
+                ),
                 _ => (Vec::new(), None),
             };
             VariantPair {
@@ -328,13 +320,7 @@ pub struct BudgetAnalysis {
     pub unrecorded: Vec<String>,
 }
 
-fn point(
-    iterations: i64,
-    runs: &[&Run],
-    label: &str,
-    bootstrap_seed: u64,
-    n_boot: usize,
-) -> BudgetPoint {
+fn point(iterations: i64, runs: &[&Run]) -> BudgetPoint {
     let mut values: Vec<(i64, f64)> = runs.iter().map(|r| (r.seed, r.final_point().klc)).collect();
     values.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let xs: Vec<f64> = values.iter().map(|v| v.1).collect();
@@ -343,11 +329,7 @@ fn point(
         iterations,
         campaigns: campaigns.into_iter().collect(),
         values,
-        summary: stats::summarize(
-            &xs,
-            n_boot,
-            stats::derive_seed(bootstrap_seed, &format!("budget|{label}|it={iterations}")),
-        ),
+        summary: stats::summarize(&xs),
     }
 }
 
@@ -357,8 +339,6 @@ pub fn budget_analysis(
     budget: &[Campaign],
     main: &Store,
     main_conditions: &[ConditionSummary],
-    bootstrap_seed: u64,
-    n_boot: usize,
 ) -> BudgetAnalysis {
     let mut groups: BTreeMap<ConditionKey, BTreeMap<i64, Vec<&Run>>> = BTreeMap::new();
     let mut unrecorded = Vec::new();
@@ -378,13 +358,7 @@ pub fn budget_analysis(
     let mut series: Vec<BudgetSeries> = groups
         .into_iter()
         .map(|(key, by_it)| {
-            let slug = key.slug();
-            let points = by_it
-                .iter()
-                .map(|(&it, runs)| {
-                    point(it, runs, &format!("{slug}|budget"), bootstrap_seed, n_boot)
-                })
-                .collect();
+            let points = by_it.iter().map(|(&it, runs)| point(it, runs)).collect();
             let mut main_by_it: BTreeMap<i64, Vec<&Run>> = BTreeMap::new();
             for r in main.runs.iter().filter(|r| r.key == key) {
                 if let Some(it) = iterations(r) {
@@ -393,7 +367,7 @@ pub fn budget_analysis(
             }
             let main_points = main_by_it
                 .iter()
-                .map(|(&it, runs)| point(it, runs, &format!("{slug}|main"), bootstrap_seed, n_boot))
+                .map(|(&it, runs)| point(it, runs))
                 .collect();
             let references = ["rge-efr", "rpe"]
                 .iter()

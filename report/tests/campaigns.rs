@@ -486,7 +486,7 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     assert_eq!(
         row,
         "| ArmBall | RGE-VAE | kde | faithful | 10 | 3 | 1/3 / 1/3 | 0.20 / 0.20 | never (3) / \
-         never (3) | 0.90 / 0.90 | 4.578 / 4.878 | -0.300 [-0.300, -0.300] | 3/3 |",
+         never (3) | 0.90 / 0.90 | 4.578 / 4.878 | -0.300 (-0.300 to -0.300) | 3/3 |",
         "final KLC: ln 756 minus the mean over seeds 0-2 of vae_drop (+ 0.3)"
     );
     assert!(recipe.contains("Over all 3 pairs: untrained 1 of 3 `paper-long` runs against 1 of 3 `paper` runs; mean paired Δ final KLC -0.300; the `paper-long` run ends with the lower (better) KL-coverage in 3 of 3."), "{recipe}");
@@ -583,6 +583,7 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             "REPORT.md",
             "data/final_by_seed.csv",
             "data/curves.csv",
+            "data/discovery_by_run.csv",
             "files.txt",
         ] {
             v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));
@@ -783,7 +784,7 @@ fn a_malformed_claims_file_is_an_error_naming_it() {
     std::fs::create_dir_all(&paper).unwrap();
     std::fs::write(
         paper.join("claims.toml"),
-        "[settings]\nconfidence = 2.0\nn_boot = 10\nmargin = 0.2\n",
+        "[settings]\nconfidence = 2.0\nmargin = 0.2\n",
     )
     .unwrap();
     let mut o = opts(&results, &tmp.path().join("out"));

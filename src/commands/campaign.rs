@@ -8,7 +8,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use ugl_bench::campaign::config::CampaignConfig;
 use ugl_bench::campaign::plan::parse_shard;
-use ugl_bench::campaign::{CampaignOptions, Progress, plan, run_campaign};
+use ugl_bench::campaign::{CampaignOptions, Harness, Progress, plan, run_campaign};
 
 use crate::cli::CacheArgs;
 use crate::commands::single::check_out_dir;
@@ -56,13 +56,14 @@ pub(crate) fn refresh_config(
     let model_cache = cache.resolve(&out);
     let opts = CampaignOptions {
         jobs,
-        profile,
         stop: &stop,
         shard,
-        cache: model_cache.as_ref(),
-        train_progress: None,
-        learner_messages: None,
-        checkpoint_every: cache.checkpoint_every,
+        harness: Harness {
+            profile,
+            cache: model_cache.as_ref(),
+            checkpoint_every: cache.checkpoint_every,
+            ..Harness::default()
+        },
     };
     let r = ugl_bench::campaign::remeasure::refresh_diagnostics(cfg, &out, &opts, &|label| {
         eprintln!("refreshed {label} ({:.0} s)", t0.elapsed().as_secs_f64())
@@ -152,13 +153,16 @@ pub(crate) fn run_config(
     };
     let opts = CampaignOptions {
         jobs,
-        profile,
         stop: &stop,
         shard,
-        cache: cache.as_ref(),
-        train_progress: Some(training_bars(&mp, Some(&bar))),
-        learner_messages: Some(learner_lines(&mp, Some(&bar))),
-        checkpoint_every,
+        harness: Harness {
+            profile,
+            cache: cache.as_ref(),
+            checkpoint_every,
+            train_progress: Some(training_bars(&mp, Some(&bar))),
+            learner_messages: Some(learner_lines(&mp, Some(&bar))),
+            ..Harness::default()
+        },
     };
     let done = run_campaign(cfg, &out, &opts, &on)?;
     bar.finish_and_clear();

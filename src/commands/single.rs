@@ -7,7 +7,7 @@ use indicatif::MultiProgress;
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::single::{self, RunRequest};
-use ugl_bench::campaign::{RunContext, RunSpec};
+use ugl_bench::campaign::{Harness, RunContext, RunSpec};
 use ugl_bench::explore::{Algo, SamplerKind};
 use ugl_bench::repr::cache::ModelCache;
 
@@ -38,24 +38,16 @@ pub(crate) fn single_context<'a>(
     out: &'a Path,
     mp: &MultiProgress,
 ) -> RunContext<'a> {
-    RunContext {
-        campaign: &cfg.campaign.name,
-        campaign_seed: cfg.campaign.seed,
+    let harness = Harness {
         profile,
-        explore: &cfg.explore,
-        env: &cfg.env,
-        ugl: &cfg.ugl,
-        learners: &cfg.learners,
-        mge: &cfg.mge,
-        threads: rayon::current_num_threads(),
         cache: model_cache,
-        train_progress: Some(training_bars(mp, None)),
-        train_threads: 0,
-        log_dir: Some(out),
-        learner_messages: Some(learner_lines(mp, None)),
         checkpoint_every: cache.checkpoint_every,
-        role: None,
-    }
+        train_progress: Some(training_bars(mp, None)),
+        learner_messages: Some(learner_lines(mp, None)),
+        log_dir: Some(out),
+        train_threads: 0,
+    };
+    RunContext::new(cfg, rayon::current_num_threads(), harness)
 }
 
 /// An output directory must be a directory (created if missing).

@@ -28,7 +28,10 @@ mod paths;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
-pub use env::{ENVIRONMENTS, EnvSpec, KlcGrid, ObjectSpec};
+pub use env::{
+    ARMARROW, ARMBALL, ARMBALLS, BUILT_IN, DISK, EnvSpec, EnvSpecError, KlcGrid, ObjectSpec,
+    environments,
+};
 pub use goal_space::{GOAL_SPACE_DIR, GoalSpaceSample};
 pub use learner::{LEARNERS, LearnerInfo, PaperTraining, Prior};
 /// Each learner's entry, by name (`ugl_types::learners::VAE`).

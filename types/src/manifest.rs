@@ -13,7 +13,10 @@ use crate::campaign::CampaignDecl;
 /// symmetric eigen-solver (was: cyclic Jacobi).
 /// 3: the neural learners train on the host engine by default (`engine = "host"`: other
 /// summation orders than burn's), and gemm/faer use their AVX-512 kernels where the CPU has them.
-pub const RESULTS_VERSION: u32 = 3;
+/// 4: the corrected RFVAE puts its prior N(0, I) on `z_K`, the space its outcomes are encoded
+/// in, so that its Gaussian goals are drawn where the outcomes live (its KDE runs change too:
+/// the fitted network differs).
+pub const RESULTS_VERSION: u32 = 4;
 
 /// The final numbers of a run, also printed by `ugl run` as its last line.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -54,6 +57,10 @@ pub struct Manifest {
     #[serde(default)]
     pub learner: Option<String>,
     pub seed: u64,
+    /// Exploration replicate of the repetition (0 in campaigns without replicates, and then
+    /// not written).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub exploration: u32,
     /// The seed of the run's exploration streams, derived from (campaign seed, the run's
     /// exploration identity).
     pub run_seed: u64,
@@ -264,4 +271,8 @@ mod tests {
         assert_eq!(serde_json::from_str::<Summary>(&j).unwrap(), s);
         assert!(serde_json::from_str::<Summary>(&j.replace("inf", "nan")).is_err());
     }
+}
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
 }

@@ -36,6 +36,14 @@ pub enum ConfigError {
     UnknownProfile { name: String, tried: PathBuf },
 }
 
+fn one() -> usize {
+    1
+}
+
+fn is_one(n: &usize) -> bool {
+    *n == 1
+}
+
 /// The `[campaign]` section.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -45,8 +53,14 @@ pub struct CampaignSection {
     /// The campaign seed; every run seed derives from it and the run identity.
     #[serde(default)]
     pub seed: u64,
-    /// Repetitions (seeds) per cell of the matrix.
+    /// Repetitions (seeds) per cell of the matrix: each has its own data set, fitted goal
+    /// space and exploration streams.
     pub reps: usize,
+    /// Exploration runs per repetition (default 1): each explores the repetition's fitted goal
+    /// space with its own streams, so that the spread due to the fit and the spread due to
+    /// exploration can be told apart. Not part of any run's identity beyond its replicate index.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub explorations: usize,
     /// Free text shown in the report.
     #[serde(default)]
     pub description: String,
@@ -318,6 +332,12 @@ impl CampaignConfig {
         if self.campaign.reps == 0 {
             return Err("campaign.reps must be at least 1".into());
         }
+        if self.campaign.explorations == 0 || self.campaign.explorations > u32::MAX as usize {
+            return Err(format!(
+                "campaign.explorations must be at least 1, got {}",
+                self.campaign.explorations
+            ));
+        }
         if self.matrix.envs.is_empty() {
             return Err("matrix.envs must name at least one environment".into());
         }
@@ -357,6 +377,7 @@ impl CampaignConfig {
             ("latent sizes", self.matrix.latents.len()),
             ("variants", self.matrix.variants.len()),
             ("reps", self.campaign.reps),
+            ("explorations", self.campaign.explorations),
         ])?;
         if self.matrix.variants.is_empty() {
             return Err(

@@ -1,17 +1,19 @@
 //! The context of a run: everything a run depends on besides its identity, and the config
-//! hash that fingerprints it.
+//! hash that fingerprints it; and the harness, the services of an execution declared once.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::config::{LearnersConfig, UglConfig};
+use super::config::{CampaignConfig, LearnersConfig, UglConfig};
 use super::plan::RunSpec;
 use crate::env::EnvConfig;
 use crate::explore::{ExploreConfig, MgeConfig};
+use crate::repr::FitContext;
 use crate::repr::cache::ModelCache;
-use crate::repr::neural::TrainProgress;
+use crate::repr::external::LineSink;
+use crate::repr::neural::{self, TrainProgress};
 use ugl_types::CampaignDecl;
 
 use ugl_types::RESULTS_VERSION;
@@ -42,37 +44,95 @@ pub type TrainSink = dyn Fn(&str, TrainProgress) + Send + Sync;
 /// then `Some(line)` for each line and `None` when the fit is over.
 pub type MessageSink = dyn Fn(&str, Option<&str>) + Send + Sync;
 
-/// Everything needed to execute one run.
+/// The services of an execution, declared once for a single run (`ugl run`, `ugl embed`), a
+/// campaign and a diagnostics refresh: the model cache and its checkpoints, where training
+/// progress, learner messages and logs go. A learner sees its part through
+/// [`Harness::fit_context`].
+#[derive(Clone, Default)]
+pub struct Harness<'a> {
+    /// Profile name recorded in manifests.
+    pub profile: &'a str,
+    /// Where trained neural models are kept (None: always train).
+    pub cache: Option<&'a ModelCache>,
+    /// Neural trainings save a checkpoint in the model cache every this many iterations
+    /// (0: never); a killed training resumes from its latest one, bit-identically.
+    pub checkpoint_every: usize,
+    /// Training progress of neural representations.
+    pub train_progress: Option<Arc<TrainSink>>,
+    /// External learners' stderr lines, as they come.
+    pub learner_messages: Option<Arc<MessageSink>>,
+    /// Where an external learner's stderr is kept: `<log_dir>/<representation label>.learner.log`
+    /// (None: not kept; a campaign's is its results directory).
+    pub log_dir: Option<&'a Path>,
+    /// Threads of a neural training: 0 = the calling pool's (a campaign's workers each have a
+    /// pool of `cores / jobs` threads: two 1-thread trainings side by side beat one 2-thread
+    /// training on 2 cores; STACK-NOTES.md).
+    pub train_threads: usize,
+}
+
+impl Harness<'_> {
+    /// What the fit of the representation `label` gets: its progress and messages under the
+    /// label, its log file, checkpoints in the model cache under `key` when the learner's
+    /// encoders are kept there (`persists`), the training's threads.
+    pub fn fit_context(&self, label: &str, key: &str, persists: bool) -> FitContext {
+        FitContext {
+            progress: self.train_progress.as_ref().map(|sink| {
+                let (sink, label) = (sink.clone(), label.to_string());
+                Arc::new(move |p: TrainProgress| sink(&label, p)) as neural::ProgressFn
+            }),
+            checkpoint: self
+                .cache
+                .filter(|_| persists && self.checkpoint_every > 0)
+                .map(|c| neural::CheckpointSpec {
+                    dir: c.dir.clone(),
+                    key: key.to_string(),
+                    every: self.checkpoint_every,
+                }),
+            threads: self.train_threads,
+            log_file: self.log_dir.map(|d| d.join(format!("{label}.learner.log"))),
+            messages: self.learner_messages.as_ref().map(|sink| {
+                let (sink, label) = (sink.clone(), label.to_string());
+                LineSink(Arc::new(move |line| sink(&label, Some(line))))
+            }),
+        }
+    }
+}
+
+/// Everything needed to execute one run: the configuration it depends on and the harness.
 #[derive(Clone)]
 pub struct RunContext<'a> {
     pub campaign: &'a str,
     pub campaign_seed: u64,
-    pub profile: &'a str,
     pub explore: &'a ExploreConfig,
     pub env: &'a EnvConfig,
     pub ugl: &'a UglConfig,
     pub learners: &'a LearnersConfig,
     /// Modular goal exploration's constants (`mge-*` algorithms).
     pub mge: &'a MgeConfig,
+    /// Threads recorded in manifests: a campaign's jobs, the machine's for a single run.
     pub threads: usize,
-    /// Where trained neural models are kept (None: always train).
-    pub cache: Option<&'a ModelCache>,
-    /// Training progress of neural representations.
-    pub train_progress: Option<Arc<TrainSink>>,
-    /// Threads of a neural training: 0 = the calling pool's (a campaign's workers each have a
-    /// pool of `cores / jobs` threads: two 1-thread trainings side by side beat one 2-thread
-    /// training on 2 cores; STACK-NOTES.md).
-    pub train_threads: usize,
-    /// Where an external learner's stderr is kept: `<log_dir>/<representation label>.learner.log`
-    /// (the results directory; None: not kept).
-    pub log_dir: Option<&'a Path>,
-    /// External learners' stderr lines, as they come.
-    pub learner_messages: Option<Arc<MessageSink>>,
-    /// Neural trainings save a checkpoint in the model cache every this many iterations
-    /// (0: never); a killed training resumes from its latest one, bit-identically.
-    pub checkpoint_every: usize,
     /// The campaign's declared role, recorded in every manifest (None: a single `ugl run`).
     pub role: Option<CampaignDecl>,
+    /// The services the run uses.
+    pub harness: Harness<'a>,
+}
+
+impl<'a> RunContext<'a> {
+    /// The context of a single run of `cfg` (no role) with `threads` and `harness`.
+    pub fn new(cfg: &'a CampaignConfig, threads: usize, harness: Harness<'a>) -> Self {
+        RunContext {
+            campaign: &cfg.campaign.name,
+            campaign_seed: cfg.campaign.seed,
+            explore: &cfg.explore,
+            env: &cfg.env,
+            ugl: &cfg.ugl,
+            learners: &cfg.learners,
+            mge: &cfg.mge,
+            threads,
+            role: None,
+            harness,
+        }
+    }
 }
 
 impl RunContext<'_> {

@@ -50,10 +50,22 @@ pub fn explore(
             log: Rpe.explore(env, ctx.explore, seed).map_err(explore_err)?,
             encode_s: None,
         }),
-        GoalSpaceKind::Engineered => {
-            let goals = EngineeredGoals::new(d, spec.env.objects());
+        GoalSpaceKind::Engineered | GoalSpaceKind::EngineeredPosition => {
+            let (mut space, goals) = if spec.algo.space() == GoalSpaceKind::Engineered {
+                (
+                    EngineeredSpace::new(d),
+                    EngineeredGoals::new(d, spec.env.objects()),
+                )
+            } else {
+                let dims = spec.env.spec().position_dims();
+                let n = dims.len();
+                (
+                    EngineeredSpace::of(dims),
+                    EngineeredGoals::new(n, Vec::new()),
+                )
+            };
             let log = strategy
-                .explorer(&mut EngineeredSpace::new(d), &goals, ctx.mge)
+                .explorer(&mut space, &goals, ctx.mge)
                 .map_err(run_err)?
                 .explore(env, ctx.explore, seed)
                 .map_err(explore_err)?;
@@ -240,11 +252,12 @@ pub fn execute(
         variant: spec.variant.map(|v| v.name()).unwrap_or("none").into(),
         learner: learner_name,
         seed: spec.seed,
+        exploration: spec.exploration,
         run_seed: run_seed(ctx.campaign_seed, &spec.exploration_identity()),
         campaign: ctx.campaign.into(),
         role: ctx.role.clone(),
         campaign_seed: ctx.campaign_seed,
-        profile: ctx.profile.into(),
+        profile: ctx.harness.profile.into(),
         config_hash: ctx.config_hash(spec),
         explore: serde_json::to_value(ctx.explore).expect("serialisable"),
         env_config: serde_json::to_value(ctx.env).expect("serialisable"),

@@ -1,7 +1,6 @@
 //! Fitting a run's representation: the UGL data set, the learner, the model cache and the
 //! training evidence and latent quality recorded in the manifest.
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -10,13 +9,12 @@ use super::config::LearnersConfig;
 use super::plan::RunSpec;
 use crate::env::{Environment, make_env};
 use crate::explore::Learner;
-use crate::repr::cache::{CacheEntry, ModelCache};
+use crate::repr::cache::CacheEntry;
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::repr::evidence::TrainingEvidence;
-use crate::repr::external::LineSink;
-use crate::repr::neural::{self, TrainProgress, Variant};
+use crate::repr::neural::{self, Variant};
 use crate::repr::quality::{self, LatentQuality};
-use crate::repr::{Encoder, FitContext, ImageSet, Latents, ReprError, RepresentationLearner};
+use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 use super::context::RunContext;
@@ -129,37 +127,6 @@ pub fn model_key(spec: &RunSpec, ctx: &RunContext, identity: &serde_json::Value)
     blake3::hash(&json).to_hex().to_string()
 }
 
-/// What the harness offers the fit of `spec`'s representation: progress bars and messages
-/// under its label, checkpoints in the model cache under `key`, the training's threads.
-fn fit_context(
-    spec: &RunSpec,
-    ctx: &RunContext,
-    key: &str,
-    cache: Option<&ModelCache>,
-) -> FitContext {
-    let label = representation_label(spec);
-    FitContext {
-        progress: ctx.train_progress.as_ref().map(|sink| {
-            let (sink, label) = (sink.clone(), label.clone());
-            Arc::new(move |p: TrainProgress| sink(&label, p)) as neural::ProgressFn
-        }),
-        checkpoint: cache
-            .filter(|_| ctx.checkpoint_every > 0)
-            .map(|c| neural::CheckpointSpec {
-                dir: c.dir.clone(),
-                key: key.to_string(),
-                every: ctx.checkpoint_every,
-            }),
-        threads: ctx.train_threads,
-        // An external program's stderr: a log file beside the runs, and its lines to the caller.
-        log_file: ctx.log_dir.map(|d| d.join(format!("{label}.learner.log"))),
-        messages: ctx.learner_messages.as_ref().map(|sink| {
-            let (sink, label) = (sink.clone(), label.clone());
-            LineSink(Arc::new(move |line| sink(&label, Some(line))))
-        }),
-    }
-}
-
 /// Fit `spec`'s representation on `images`, or load it from the model cache (learners whose
 /// encoders persist): the one fit path of every learner. Returns the encoder, the training
 /// latents, for a trained network how it was obtained, and the learner's name in results (an
@@ -178,7 +145,7 @@ fn fit_or_load(
     let identity = params.identity(spec.variant);
     let fitter = params.build(spec.variant);
     let key = model_key(spec, ctx, &identity);
-    let cache = ctx.cache.filter(|_| fitter.persists());
+    let cache = ctx.harness.cache.filter(|_| fitter.persists());
     let mut status = "off";
     let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
         Some(CacheEntry::Hit(enc)) => {
@@ -205,10 +172,11 @@ fn fit_or_load(
             if let Some(c) = cache {
                 c.check_writable()?;
             }
-            let fit_ctx = fit_context(spec, ctx, &key, cache);
+            let label = representation_label(spec);
+            let fit_ctx = ctx.harness.fit_context(&label, &key, cache.is_some());
             let fitted = fitter.fit_in(images, spec.latents, rng, &fit_ctx);
-            if let Some(sink) = &ctx.learner_messages {
-                sink(&representation_label(spec), None);
+            if let Some(sink) = &ctx.harness.learner_messages {
+                sink(&label, None);
             }
             let (enc, z) = fitted?;
             if let Some(c) = cache

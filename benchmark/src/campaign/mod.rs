@@ -19,7 +19,7 @@ pub mod slurm;
 pub mod store;
 
 pub use config::{CampaignConfig, ConfigError};
-pub use context::RunContext;
+pub use context::{Harness, RunContext};
 pub use error::RunError;
 pub use execute::{execute, explore};
 pub use plan::{RunSpec, plan};

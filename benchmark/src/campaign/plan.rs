@@ -18,8 +18,13 @@ pub struct RunSpec {
     pub latents: usize,
     /// Faithful or corrected, for the learners that have both (VAE, RFVAE); None otherwise.
     pub variant: Option<Variant>,
-    /// Repetition index (`--seed` of `ugl run`).
+    /// Repetition index (`--seed` of `ugl run`): the data set, the fitted goal space and the
+    /// exploration streams.
     pub seed: u64,
+    /// Exploration replicate of the repetition (`--exploration`; `[campaign] explorations`):
+    /// replicate `j > 0` explores the same fitted goal space with its own streams. Replicate 0
+    /// is the run of a campaign without replicates (same identity, id and bytes).
+    pub exploration: u32,
 }
 
 impl RunSpec {
@@ -37,6 +42,7 @@ impl RunSpec {
             latents: 0,
             variant: None,
             seed,
+            exploration: 0,
         }
     }
 
@@ -58,6 +64,22 @@ impl RunSpec {
             latents,
             variant,
             seed,
+            exploration: 0,
+        }
+    }
+
+    /// The same run as exploration replicate `j` of its repetition.
+    pub fn with_exploration(mut self, j: u32) -> Self {
+        self.exploration = j;
+        self
+    }
+
+    /// `/exploration=J` (or `.eJ` with `sep` `.`, key `e`) for a replicate above 0, else nothing.
+    fn exploration_part(&self, sep: &str, key: &str) -> String {
+        if self.exploration == 0 {
+            String::new()
+        } else {
+            format!("{sep}{key}{}", self.exploration)
         }
     }
 
@@ -74,15 +96,22 @@ impl RunSpec {
     /// enters the run-seed hash, so it is part of the results' specification.
     pub fn identity(&self) -> String {
         match self.algo.learner() {
-            None => format!("env={}/algo={}/seed={}", self.env, self.algo, self.seed),
+            None => format!(
+                "env={}/algo={}/seed={}{}",
+                self.env,
+                self.algo,
+                self.seed,
+                self.exploration_part("/", "exploration=")
+            ),
             Some(_) => format!(
-                "env={}/algo={}{}/sampler={}/latents={}/seed={}",
+                "env={}/algo={}{}/sampler={}/latents={}/seed={}{}",
                 self.env,
                 self.algo,
                 self.variant_part("/", "variant="),
                 self.sampler,
                 self.latents,
-                self.seed
+                self.seed,
+                self.exploration_part("/", "exploration=")
             ),
         }
     }
@@ -91,30 +120,49 @@ impl RunSpec {
     /// parameters, goals, meta-policy noise, encoding noise): for a learned goal space
     /// `explore/env=armball/sampler=kde/latents=10/seed=3`, without the learner and the
     /// variant, so that every learner of a cell draws the same streams and runs pair across
-    /// learners (`ugl compare`, probability of improvement). Baselines use [`Self::identity`].
+    /// learners (`ugl compare`, probability of improvement). Baselines use [`Self::identity`],
+    /// of the algorithm whose streams they draw ([`Algo::stream_algo`]: the position-only EFR
+    /// draws RGE-EFR's).
     pub fn exploration_identity(&self) -> String {
         match self.algo.learner() {
+            None if self.algo.stream_algo() != self.algo => RunSpec {
+                algo: self.algo.stream_algo(),
+                ..self.clone()
+            }
+            .identity(),
             None => self.identity(),
             Some(_) => format!(
-                "explore/env={}/sampler={}/latents={}/seed={}",
-                self.env, self.sampler, self.latents, self.seed
+                "explore/env={}/sampler={}/latents={}/seed={}{}",
+                self.env,
+                self.sampler,
+                self.latents,
+                self.seed,
+                self.exploration_part("/", "exploration=")
             ),
         }
     }
 
     /// File-name-safe identity: `armball.rge-efr.s3`, `armball.rge-pca.kde.l10.s3`,
-    /// `armball.rge-vae.corrected.kde.l10.s3`.
+    /// `armball.rge-vae.corrected.kde.l10.s3`; exploration replicate 2 of the last
+    /// `armball.rge-vae.corrected.kde.l10.s3.e2`.
     pub fn run_id(&self) -> String {
         match self.algo.learner() {
-            None => format!("{}.{}.s{}", self.env, self.algo, self.seed),
+            None => format!(
+                "{}.{}.s{}{}",
+                self.env,
+                self.algo,
+                self.seed,
+                self.exploration_part(".", "e")
+            ),
             Some(_) => format!(
-                "{}.{}{}.{}.l{}.s{}",
+                "{}.{}{}.{}.l{}.s{}{}",
                 self.env,
                 self.algo,
                 self.variant_part(".", ""),
                 self.sampler,
                 self.latents,
-                self.seed
+                self.seed,
+                self.exploration_part(".", "e")
             ),
         }
     }
@@ -146,7 +194,8 @@ impl RunSpec {
     }
 }
 
-/// All runs of a campaign, in a fixed order (env, algo, variant, sampler, latents, seed).
+/// All runs of a campaign, in a fixed order (env, algo, variant, sampler, latents, seed,
+/// exploration replicate).
 /// Learned goal spaces are crossed with `matrix.samplers` and `matrix.latents`; the VAE and
 /// RFVAE also with `matrix.variants`. `gaussian` goals need a prior, so they are planned only
 /// for the learners that may have one (VAE, RFVAE, external), as in the paper.
@@ -156,7 +205,9 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
         for &algo in &cfg.matrix.algos {
             let Some(learner) = algo.learner() else {
                 for seed in 0..cfg.campaign.reps as u64 {
-                    runs.push(RunSpec::baseline(env, algo, seed));
+                    for j in 0..cfg.campaign.explorations as u32 {
+                        runs.push(RunSpec::baseline(env, algo, seed).with_exploration(j));
+                    }
                 }
                 continue;
             };
@@ -173,7 +224,12 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
                     for l in &cfg.matrix.latents {
                         let latents = l.size(env);
                         for seed in 0..cfg.campaign.reps as u64 {
-                            runs.push(RunSpec::learned(env, algo, sampler, latents, variant, seed));
+                            for j in 0..cfg.campaign.explorations as u32 {
+                                runs.push(
+                                    RunSpec::learned(env, algo, sampler, latents, variant, seed)
+                                        .with_exploration(j),
+                                );
+                            }
                         }
                     }
                 }
@@ -234,12 +290,12 @@ mod tests {
 
     #[test]
     fn identities() {
-        let r = RunSpec::baseline(EnvKind::ArmArrow, Algo::RGE_EFR, 3);
+        let r = RunSpec::baseline(EnvKind::ARMARROW, Algo::RGE_EFR, 3);
         assert_eq!(r.identity(), "env=armarrow/algo=rge-efr/seed=3");
         assert_eq!(r.run_id(), "armarrow.rge-efr.s3");
         assert_eq!(r.representation_identity(10), None);
         let r = RunSpec::learned(
-            EnvKind::ArmBall,
+            EnvKind::ARMBALL,
             Algo::rge(Learner::by_name("pca").unwrap()),
             SamplerKind::Kde,
             10,
@@ -261,7 +317,7 @@ mod tests {
             g.representation_identity(100)
         );
         let v = RunSpec::learned(
-            EnvKind::ArmBall,
+            EnvKind::ARMBALL,
             Algo::rge(Learner::by_name("vae").unwrap()),
             SamplerKind::Gaussian,
             2,
@@ -285,7 +341,7 @@ mod tests {
         );
         assert_eq!(
             RunSpec::learned(
-                EnvKind::ArmBall,
+                EnvKind::ARMBALL,
                 Algo::rge(Learner::by_name("ae").unwrap()),
                 SamplerKind::Kde,
                 2,
@@ -295,6 +351,62 @@ mod tests {
             .run_id(),
             "armball.rge-ae.kde.l2.s0"
         );
+    }
+
+    /// Exploration replicates explore one fitted goal space with their own streams: replicate
+    /// 0 is the run without replicates; the others differ in identity, id and exploration
+    /// streams, never in the fitted representation.
+    #[test]
+    fn exploration_replicates_share_the_fit_and_not_the_streams() {
+        let text = "[campaign]\nname = \"t\"\nreps = 2\nexplorations = 3\n[matrix]\n\
+                    envs = [\"armball\"]\nalgos = [\"rpe\", \"rge-pca\"]\nlatents = [2]\n";
+        let cfg = CampaignConfig::from_toml(text, std::path::Path::new("t.toml")).unwrap();
+        let ids: Vec<String> = plan(&cfg).iter().map(|r| r.run_id()).collect();
+        assert_eq!(
+            ids,
+            [
+                "armball.rpe.s0",
+                "armball.rpe.s0.e1",
+                "armball.rpe.s0.e2",
+                "armball.rpe.s1",
+                "armball.rpe.s1.e1",
+                "armball.rpe.s1.e2",
+                "armball.rge-pca.kde.l2.s0",
+                "armball.rge-pca.kde.l2.s0.e1",
+                "armball.rge-pca.kde.l2.s0.e2",
+                "armball.rge-pca.kde.l2.s1",
+                "armball.rge-pca.kde.l2.s1.e1",
+                "armball.rge-pca.kde.l2.s1.e2",
+            ]
+        );
+        let runs = plan(&cfg);
+        let (a, b) = (&runs[6], &runs[7]);
+        assert_eq!(
+            a.identity(),
+            "env=armball/algo=rge-pca/sampler=kde/latents=2/seed=0"
+        );
+        assert_eq!(
+            b.identity(),
+            "env=armball/algo=rge-pca/sampler=kde/latents=2/seed=0/exploration=1"
+        );
+        assert_ne!(a.exploration_identity(), b.exploration_identity());
+        assert_eq!(a.representation_identity(10), b.representation_identity(10));
+        assert_eq!(a.learner_seed_identity(10), b.learner_seed_identity(10));
+        assert_eq!(
+            runs[1].identity(),
+            "env=armball/algo=rpe/seed=0/exploration=1"
+        );
+        // Shards keep the replicates of a fit together.
+        for i in 0..2 {
+            let s = shard(&runs, 10, i, 2);
+            let fits: Vec<_> = s
+                .iter()
+                .filter_map(|r| r.representation_identity(10))
+                .collect();
+            for f in &fits {
+                assert_eq!(fits.iter().filter(|g| *g == f).count(), 3);
+            }
+        }
     }
 
     #[test]

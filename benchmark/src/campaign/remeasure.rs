@@ -54,8 +54,9 @@ pub fn measure_version(m: &Manifest, sidecar: Option<&Diagnostics>) -> u64 {
 
 /// Re-measure the latent quality of every finished learned-space run of `cfg` in `out` whose
 /// manifest holds an older measure, and write the missing goal-space figure data.
-/// `on_measured` receives each representation's label when it is done. Honours `opts.jobs`, `opts.shard`, `opts.cache` and `opts.stop`
-/// (stops after the representations in flight; rerun to finish).
+/// `on_measured` receives each representation's label when it is done. Honours `opts.jobs`,
+/// `opts.shard`, the harness's model cache and `opts.stop` (stops after the representations in
+/// flight; rerun to finish).
 pub fn refresh_diagnostics(
     cfg: &CampaignConfig,
     out: &Path,

@@ -3,7 +3,6 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -12,10 +11,9 @@ use super::goal_space;
 use super::plan::{RunSpec, plan};
 use super::store::{self, StoreError, Summary};
 use crate::explore::Learner;
-use crate::repr::cache::ModelCache;
 use ugl_types::CampaignRecord;
 
-use super::context::{MessageSink, RunContext, TrainSink};
+use super::context::{Harness, RunContext};
 use super::error::RunError;
 use super::execute::execute;
 use super::fit::fit_representation;
@@ -39,20 +37,13 @@ type GroupResult = Vec<Option<Result<Summary, RunError>>>;
 pub struct CampaignOptions<'a> {
     /// Worker threads (runs in parallel; each run is single-threaded).
     pub jobs: usize,
-    /// Profile name recorded in manifests.
-    pub profile: &'a str,
     /// Set to stop after the runs in flight (Ctrl-C).
     pub stop: &'a AtomicBool,
     /// Run only this slice `(index, count)` of the plan (`--shard i/n`).
     pub shard: Option<(usize, usize)>,
-    /// The model cache of neural representations.
-    pub cache: Option<&'a ModelCache>,
-    /// Training progress of neural representations.
-    pub train_progress: Option<Arc<TrainSink>>,
-    /// External learners' stderr lines.
-    pub learner_messages: Option<Arc<MessageSink>>,
-    /// [`RunContext::checkpoint_every`].
-    pub checkpoint_every: usize,
+    /// The services of its runs; their learner logs go to the results directory and their
+    /// trainings use their worker's pool, whatever `log_dir` and `train_threads` say.
+    pub harness: Harness<'a>,
 }
 
 /// The run context of a campaign's runs.
@@ -61,24 +52,15 @@ pub(crate) fn campaign_context<'a>(
     out: &'a Path,
     opts: &CampaignOptions<'a>,
 ) -> RunContext<'a> {
-    RunContext {
-        campaign: &cfg.campaign.name,
-        campaign_seed: cfg.campaign.seed,
-        profile: opts.profile,
-        explore: &cfg.explore,
-        env: &cfg.env,
-        ugl: &cfg.ugl,
-        learners: &cfg.learners,
-        mge: &cfg.mge,
-        threads: opts.jobs,
-        cache: opts.cache,
-        train_progress: opts.train_progress.clone(),
+    let harness = Harness {
+        log_dir: Some(out),
         // Each worker's own pool is the training's ([`for_each_group`]).
         train_threads: 0,
-        log_dir: Some(out),
-        learner_messages: opts.learner_messages.clone(),
-        checkpoint_every: opts.checkpoint_every,
+        ..opts.harness.clone()
+    };
+    RunContext {
         role: Some(cfg.campaign.decl()),
+        ..RunContext::new(cfg, opts.jobs, harness)
     }
 }
 

@@ -22,6 +22,8 @@ pub struct RunRequest {
     /// Override of the profile's number of UGL training images.
     pub images: Option<usize>,
     pub seed: u64,
+    /// Exploration replicate of the repetition.
+    pub exploration: u32,
     /// Override of the profile's number of exploration epochs.
     pub epochs: Option<usize>,
     /// `rge-external`: the program's command line (replaces the profile's).
@@ -63,6 +65,7 @@ impl RunRequest {
                 )
             }
         };
+        let spec = spec.with_exploration(self.exploration);
         check_variant(self.algo, self.variant)?;
         if self.sampler == SamplerKind::Gaussian
             && !self.algo.learner().is_some_and(|l| l.may_have_prior())
@@ -299,13 +302,14 @@ mod tests {
 
     fn request(algo: &str) -> RunRequest {
         RunRequest {
-            env: EnvKind::ArmBall,
+            env: EnvKind::ARMBALL,
             algo: algo.parse().unwrap(),
             sampler: SamplerKind::Kde,
             variant: None,
             latents: 2,
             images: None,
             seed: 0,
+            exploration: 0,
             epochs: None,
             command: None,
             name: None,

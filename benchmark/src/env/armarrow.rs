@@ -31,7 +31,7 @@ impl ArmArrow {
 
 impl Environment for ArmArrow {
     fn kind(&self) -> EnvKind {
-        EnvKind::ArmArrow
+        EnvKind::ARMARROW
     }
 
     fn initial_state(&self) -> &[f64] {

@@ -22,7 +22,7 @@ impl ArmBall {
 
 impl Environment for ArmBall {
     fn kind(&self) -> EnvKind {
-        EnvKind::ArmBall
+        EnvKind::ARMBALL
     }
 
     fn initial_state(&self) -> &[f64] {

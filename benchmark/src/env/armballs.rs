@@ -56,7 +56,7 @@ impl ArmBalls {
 
 impl Environment for ArmBalls {
     fn kind(&self) -> EnvKind {
-        EnvKind::ArmBalls
+        EnvKind::ARMBALLS
     }
 
     fn initial_state(&self) -> &[f64] {

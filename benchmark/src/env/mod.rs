@@ -14,6 +14,7 @@ pub mod render;
 
 use std::fmt;
 use std::str::FromStr;
+use std::sync::RwLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -26,33 +27,145 @@ pub use armball::ArmBall;
 pub use armballs::ArmBalls;
 pub use dmp::{DmpConfig, DmpTable, DmpWidths, PARAMS};
 
-/// Which environment.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum EnvKind {
-    /// A ball that the arm can catch and move (2-D outcome).
-    ArmBall,
-    /// An arrow that the arm can catch, move and orient (3-D outcome).
-    ArmArrow,
-    /// The ball and a distractor ball that follows a random walk (follow-up paper; 4-D outcome).
-    ArmBalls,
+/// One environment of the registry: its declaration (names, objects, KL-coverage grid; shared
+/// with the report through `ugl-types`) and how to build it from the `[env]` constants.
+///
+/// A new environment is one file holding its [`Environment`] implementation and a
+/// `static` `EnvEntry`, plus one registry entry: a line of [`BUILT_IN`] for this crate's,
+/// or a call of [`register`] before the command line runs for anyone else's.
+#[derive(Debug)]
+pub struct EnvEntry {
+    /// Its declaration.
+    pub spec: &'static EnvSpec,
+    /// Build it.
+    pub build: fn(&EnvConfig) -> Box<dyn Environment>,
 }
 
-impl EnvKind {
-    /// The paper's environments, in the report's order.
-    pub const PAPER: [EnvKind; 2] = [EnvKind::ArmBall, EnvKind::ArmArrow];
-    /// Every environment.
-    pub const ALL: [EnvKind; 3] = [EnvKind::ArmBall, EnvKind::ArmArrow, EnvKind::ArmBalls];
+/// This crate's environments, in the report's order (the registry's built-in declarations).
+pub static BUILT_IN: [EnvEntry; 3] = [
+    EnvEntry {
+        spec: &ugl_types::ARMBALL,
+        build: |cfg| Box::new(ArmBall::new(cfg)),
+    },
+    EnvEntry {
+        spec: &ugl_types::ARMARROW,
+        build: |cfg| Box::new(ArmArrow::new(cfg)),
+    },
+    EnvEntry {
+        spec: &ugl_types::ARMBALLS,
+        build: |cfg| Box::new(ArmBalls::new(cfg)),
+    },
+];
 
-    /// The environment's entry of the registry (`ugl_types::ENVIRONMENTS`): names, objects,
-    /// true latent size and KL-coverage grid are declared there, once.
+/// The environments added with [`register`], in registration order.
+static REGISTERED: RwLock<Vec<&'static EnvEntry>> = RwLock::new(Vec::new());
+
+/// Why an environment cannot be registered.
+#[derive(Debug, thiserror::Error)]
+pub enum RegisterError {
+    /// Its declaration is inconsistent or its name is taken.
+    #[error(transparent)]
+    Spec(#[from] ugl_types::EnvSpecError),
+    /// Its KL-coverage grid is not the measure's (30 bins per dimension, the cells of the arm's
+    /// disk).
+    #[error(
+        "environment '{name}': its KL-coverage grid ({dims} dimensions, {cells} achievable \
+         cells) is not the measure's ({measured})"
+    )]
+    Grid {
+        /// The environment.
+        name: &'static str,
+        /// Its grid's dimensions.
+        dims: usize,
+        /// Its grid's achievable cells.
+        cells: usize,
+        /// What the measure has for that many dimensions.
+        measured: String,
+    },
+    /// Its outcome has more coordinates than a [`Rollout`] holds.
+    #[error("environment '{name}': {dim} outcome coordinates (at most {MAX_STATE_DIM})")]
+    TooLarge {
+        /// The environment.
+        name: &'static str,
+        /// Its outcome's dimension.
+        dim: usize,
+    },
+}
+
+/// Add an environment to the registry: `ugl run --env NAME`, campaigns (`envs = ["NAME"]`),
+/// the command line's help and the report know it from then on. Its declaration is checked
+/// (objects, outcome names, a KL-coverage grid the measure computes); registering the same
+/// entry twice is a no-op.
+pub fn register(entry: &'static EnvEntry) -> Result<EnvKind, RegisterError> {
+    let spec = entry.spec;
+    if spec.state_dim > MAX_STATE_DIM {
+        return Err(RegisterError::TooLarge {
+            name: spec.name,
+            dim: spec.state_dim,
+        });
+    }
+    let measured = crate::metrics::KlCoverage::new(spec.klc.dims).map(|m| m.n_achievable());
+    if spec.klc.bins != crate::metrics::klc::BINS
+        || measured.as_ref().ok() != Some(&spec.klc.achievable_cells)
+    {
+        return Err(RegisterError::Grid {
+            name: spec.name,
+            dims: spec.klc.dims,
+            cells: spec.klc.achievable_cells,
+            measured: match measured {
+                Ok(n) => format!("{n} cells of {} bins", crate::metrics::klc::BINS),
+                Err(e) => e.to_string(),
+            },
+        });
+    }
+    EnvSpec::register(spec)?;
+    let mut registered = REGISTERED.write().unwrap_or_else(|e| e.into_inner());
+    if !registered.iter().any(|e| std::ptr::eq(*e, entry)) {
+        registered.push(entry);
+    }
+    Ok(EnvKind(entry))
+}
+
+/// Which environment: a handle on its registry entry. Compared, hashed and written by name
+/// (`armball`); ordered as the registry lists them (the built-in ones first).
+#[derive(Clone, Copy)]
+pub struct EnvKind(&'static EnvEntry);
+
+impl EnvKind {
+    /// ArmBall (paper Section 4.1).
+    pub const ARMBALL: EnvKind = EnvKind(&BUILT_IN[0]);
+    /// ArmArrow (paper Section 4.1).
+    pub const ARMARROW: EnvKind = EnvKind(&BUILT_IN[1]);
+    /// ArmBalls (the follow-up paper).
+    pub const ARMBALLS: EnvKind = EnvKind(&BUILT_IN[2]);
+
+    /// The handle of an entry; [`register`] it to make it known by name.
+    pub const fn of(entry: &'static EnvEntry) -> EnvKind {
+        EnvKind(entry)
+    }
+
+    /// Every environment of the registry, in the report's order.
+    pub fn all() -> Vec<EnvKind> {
+        let registered = REGISTERED.read().unwrap_or_else(|e| e.into_inner());
+        BUILT_IN
+            .iter()
+            .chain(registered.iter().copied())
+            .map(EnvKind)
+            .collect()
+    }
+
+    /// The paper's environments, in the report's order.
+    pub fn paper() -> Vec<EnvKind> {
+        EnvKind::all()
+            .into_iter()
+            .filter(|k| k.spec().in_paper)
+            .collect()
+    }
+
+    /// The environment's declaration: names, objects, true latent size and KL-coverage grid
+    /// are declared there, once.
     pub fn spec(self) -> &'static EnvSpec {
-        let name = match self {
-            EnvKind::ArmBall => "armball",
-            EnvKind::ArmArrow => "armarrow",
-            EnvKind::ArmBalls => "armballs",
-        };
-        EnvSpec::by_name(name).expect("every EnvKind has a registry entry")
+        self.0.spec
     }
 
     /// The name used on the command line and in results.
@@ -87,6 +200,43 @@ impl EnvKind {
             .map(|o| (o.name, o.dims()))
             .collect()
     }
+
+    /// Its position in the registry.
+    fn position(self) -> usize {
+        EnvSpec::order(self.name())
+    }
+}
+
+impl PartialEq for EnvKind {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for EnvKind {}
+
+impl std::hash::Hash for EnvKind {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.name().hash(state)
+    }
+}
+
+impl PartialOrd for EnvKind {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for EnvKind {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        (self.position(), self.name()).cmp(&(other.position(), other.name()))
+    }
+}
+
+impl fmt::Debug for EnvKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.spec().display)
+    }
 }
 
 impl fmt::Display for EnvKind {
@@ -98,15 +248,28 @@ impl fmt::Display for EnvKind {
 impl FromStr for EnvKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "armball" => Ok(EnvKind::ArmBall),
-            "armarrow" => Ok(EnvKind::ArmArrow),
-            "armballs" => Ok(EnvKind::ArmBalls),
-            other => Err(format!(
-                "unknown environment '{other}' (expected {})",
-                EnvSpec::names_sentence()
-            )),
-        }
+        EnvKind::all()
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown environment '{s}' (expected {})",
+                    EnvSpec::names_sentence()
+                )
+            })
+    }
+}
+
+impl Serialize for EnvKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for EnvKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
     }
 }
 
@@ -306,12 +469,15 @@ fn num(v: f64) -> String {
 /// At most this many DMP steps per episode (the paper: 50).
 pub const MAX_TIMESTEPS: usize = 10_000;
 
+/// The most outcome coordinates an environment has ([`Rollout::state`]).
+pub const MAX_STATE_DIM: usize = 4;
+
 /// The result of one episode.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rollout {
     /// Final object state (engineered outcome), clipped to [-1,1]; only the first
     /// `state_dim` entries are meaningful.
-    pub state: [f64; 4],
+    pub state: [f64; MAX_STATE_DIM],
     /// Number of meaningful entries in `state`.
     pub dim: usize,
     /// The object was caught (and so moved with the hand) during the episode.
@@ -352,11 +518,7 @@ pub trait Environment: Send + Sync {
 
 /// Build an environment.
 pub fn make_env(kind: EnvKind, cfg: &EnvConfig) -> Box<dyn Environment> {
-    match kind {
-        EnvKind::ArmBall => Box::new(ArmBall::new(cfg)),
-        EnvKind::ArmArrow => Box::new(ArmArrow::new(cfg)),
-        EnvKind::ArmBalls => Box::new(ArmBalls::new(cfg)),
-    }
+    (kind.0.build)(cfg)
 }
 
 /// What the arm and its motor primitive share between the two environments.
@@ -485,18 +647,27 @@ mod tests {
 
     #[test]
     fn env_names_round_trip() {
-        for k in EnvKind::ALL {
+        for k in EnvKind::all() {
             assert_eq!(k.name().parse::<EnvKind>().unwrap(), k);
+            let json = serde_json::to_string(&k).unwrap();
+            assert_eq!(json, format!("\"{}\"", k.name()));
+            assert_eq!(serde_json::from_str::<EnvKind>(&json).unwrap(), k);
         }
         assert!("armbal".parse::<EnvKind>().is_err());
-        // Every registry entry is an environment of this build, and the other way round.
-        assert_eq!(EnvKind::ALL.len(), ugl_types::ENVIRONMENTS.len());
+        // Every declaration of the registry is an environment of this build, and the other
+        // way round; the built-in ones keep the order of the closed enumeration they replace.
+        let names = |v: Vec<&'static str>| v;
+        assert_eq!(
+            names(EnvKind::all().iter().map(|k| k.name()).collect()),
+            names(ugl_types::environments().iter().map(|e| e.name).collect())
+        );
+        assert!(EnvKind::ARMBALL < EnvKind::ARMARROW && EnvKind::ARMARROW < EnvKind::ARMBALLS);
     }
 
     /// The registry's KL-coverage grid is the measure's: same dimension, same achievable cells.
     #[test]
     fn registry_klc_grids_are_the_measures() {
-        for k in EnvKind::ALL {
+        for k in EnvKind::all() {
             let grid = k.spec().klc;
             let m = crate::metrics::KlCoverage::new(grid.dims).unwrap();
             assert_eq!(m.n_achievable(), grid.achievable_cells, "{k}");
@@ -544,7 +715,7 @@ mod tests {
 
     #[test]
     fn rest_pose_no_catch() {
-        for k in EnvKind::PAPER {
+        for k in EnvKind::paper() {
             let env = make_env(k, &EnvConfig::default());
             let r = env.rollout(
                 &[0.0; PARAMS],

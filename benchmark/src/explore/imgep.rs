@@ -27,26 +27,33 @@ pub trait OutcomeSpace {
     fn encode(&mut self, state: &[f64], out: &mut [f64]);
 }
 
-/// The engineered goal space of RGE-EFR: z = (s + 1) / 2 in [0,1]^d.
+/// The engineered goal space of RGE-EFR: z = (s + 1) / 2 in [0,1]^d, over every outcome
+/// coordinate or over some of them (the position-only space).
 #[derive(Clone, Debug)]
 pub struct EngineeredSpace {
-    dim: usize,
+    /// The outcome coordinates kept, in order.
+    dims: Vec<usize>,
 }
 
 impl EngineeredSpace {
     /// For outcomes of dimension `dim`.
     pub fn new(dim: usize) -> Self {
-        EngineeredSpace { dim }
+        EngineeredSpace::of((0..dim).collect())
+    }
+
+    /// Over the outcome coordinates `dims` only.
+    pub fn of(dims: Vec<usize>) -> Self {
+        EngineeredSpace { dims }
     }
 }
 
 impl OutcomeSpace for EngineeredSpace {
     fn dim(&self) -> usize {
-        self.dim
+        self.dims.len()
     }
     fn encode(&mut self, state: &[f64], out: &mut [f64]) {
-        for (o, s) in out.iter_mut().zip(state) {
-            *o = (s + 1.0) / 2.0;
+        for (o, &k) in out.iter_mut().zip(&self.dims) {
+            *o = (state[k] + 1.0) / 2.0;
         }
     }
 }

@@ -414,7 +414,7 @@ mod tests {
         assert_eq!(m[0].name, "z1,z3");
         assert_eq!(m[1].dims, vec![0, 2]);
         assert!(goal_modules(Modules::Random, 5, None, &[1.0; 5], 2).is_err());
-        let objects = EnvKind::ArmBalls.objects();
+        let objects = EnvKind::ARMBALLS.objects();
         let m = goal_modules(Modules::Random, 4, Some(&objects), &[], 2).unwrap();
         assert_eq!(
             m.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(),
@@ -427,9 +427,9 @@ mod tests {
 
     #[test]
     fn a_run_is_deterministic_counts_its_episodes_and_records_interest() {
-        let a = efr_run(EnvKind::ArmBalls, Modules::Progress, 3);
-        assert_eq!(a, efr_run(EnvKind::ArmBalls, Modules::Progress, 3));
-        assert_ne!(a, efr_run(EnvKind::ArmBalls, Modules::Progress, 4));
+        let a = efr_run(EnvKind::ARMBALLS, Modules::Progress, 3);
+        assert_eq!(a, efr_run(EnvKind::ARMBALLS, Modules::Progress, 3));
+        assert_ne!(a, efr_run(EnvKind::ARMBALLS, Modules::Progress, 4));
         assert_eq!(a.outcomes.len(), 601);
         assert_eq!(a.n_random + a.n_goal, 600);
         assert!(a.n_random >= 50);
@@ -449,7 +449,7 @@ mod tests {
         // whose "progress" is noise around 0. Over seeds the ball module is chosen more.
         let (mut ball, mut distractor) = (0, 0);
         for seed in 0..4 {
-            let log = efr_run(EnvKind::ArmBalls, Modules::Progress, seed);
+            let log = efr_run(EnvKind::ARMBALLS, Modules::Progress, seed);
             let n = log.interest.len();
             ball += log.interest[n - 2].n_chosen;
             distractor += log.interest[n - 1].n_chosen;
@@ -459,9 +459,9 @@ mod tests {
 
     #[test]
     fn flat_mge_on_armball_explores_like_rge() {
-        let log = efr_run(EnvKind::ArmBall, Modules::Flat, 1);
+        let log = efr_run(EnvKind::ARMBALL, Modules::Flat, 1);
         let rpe = crate::explore::run_rpe(
-            make_env(EnvKind::ArmBall, &EnvConfig::default()).as_ref(),
+            make_env(EnvKind::ARMBALL, &EnvConfig::default()).as_ref(),
             &ExploreConfig {
                 epochs: 600,
                 ..ExploreConfig::default()

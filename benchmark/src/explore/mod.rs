@@ -167,6 +167,10 @@ pub enum GoalSpaceKind {
     None,
     /// Engineered features (EFR): the scene's object state.
     Engineered,
+    /// The engineered features without orientation: each object's position (x, y) only
+    /// ([`ugl_types::EnvSpec::position_dims`]). On ArmArrow it is the control that tells what
+    /// exploring the angle adds; elsewhere it is EFR itself.
+    EngineeredPosition,
     /// A space learned from images (IMGEP-UGL, RGE-REP).
     Learned(Learner),
 }
@@ -192,12 +196,23 @@ impl Algo {
         space: GoalSpaceKind::Engineered,
     };
 
+    /// Random goal exploration in the position-only engineered space (`rge-efr-position`).
+    pub const RGE_EFR_POSITION: Algo = Algo {
+        strategy: Strategy::Rge,
+        space: GoalSpaceKind::EngineeredPosition,
+    };
+
     /// `strategy` in `space`; `Err` for RPE in a goal space or goal exploration without one.
     pub fn new(strategy: Strategy, space: GoalSpaceKind) -> Result<Algo, String> {
         match (strategy, space) {
             (Strategy::Rpe, GoalSpaceKind::None) => Ok(Algo::RPE),
             (Strategy::Rpe, _) => Err("random parameter exploration has no goal space".into()),
             (_, GoalSpaceKind::None) => Err("goal exploration needs a goal space".into()),
+            (Strategy::Mge(_), GoalSpaceKind::EngineeredPosition) => Err(
+                "modular exploration with engineered features already has one module per \
+                 object; the position-only space is for random goal exploration"
+                    .into(),
+            ),
             _ => Ok(Algo { strategy, space }),
         }
     }
@@ -223,7 +238,7 @@ impl Algo {
     /// All algorithms known to this build, in their order (`Ord`).
     pub fn all() -> Vec<Algo> {
         let goal = |strategy, space| Algo { strategy, space };
-        let mut v = vec![Algo::RPE, Algo::RGE_EFR];
+        let mut v = vec![Algo::RPE, Algo::RGE_EFR, Algo::RGE_EFR_POSITION];
         v.extend(Learner::all().map(Algo::rge));
         v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::Engineered)));
         for l in Learner::all() {
@@ -238,13 +253,25 @@ impl Algo {
         let space = match self.space {
             GoalSpaceKind::None => "",
             GoalSpaceKind::Engineered => "efr",
+            GoalSpaceKind::EngineeredPosition => "efr-position",
             GoalSpaceKind::Learned(l) => l.name(),
         };
         match (self.strategy, self.space) {
             (Strategy::Rpe, _) => "rpe".into(),
             (Strategy::Rge, GoalSpaceKind::Learned(l)) => l.entry().algo.into(),
+            (Strategy::Rge, GoalSpaceKind::EngineeredPosition) => "rge-efr-position".into(),
             (Strategy::Rge, _) => "rge-efr".into(),
             (Strategy::Mge(m), _) => format!("mge-{space}-{}", m.name()).into(),
+        }
+    }
+
+    /// The algorithm whose exploration streams a baseline run draws: its own, except the
+    /// position-only EFR, which draws RGE-EFR's (same run seed), so that the two are paired
+    /// and differ only in the goal space.
+    pub fn stream_algo(self) -> Algo {
+        match self.space {
+            GoalSpaceKind::EngineeredPosition => Algo::RGE_EFR,
+            _ => self,
         }
     }
 
@@ -371,7 +398,11 @@ mod tests {
 
     #[test]
     fn algorithm_names_order_and_parsing_are_stable() {
-        let mut names = vec!["rpe".to_string(), "rge-efr".into()];
+        let mut names = vec![
+            "rpe".to_string(),
+            "rge-efr".into(),
+            "rge-efr-position".into(),
+        ];
         names.extend(Learner::all().map(|l| format!("rge-{}", l.name())));
         names.extend(["mge-efr-flat", "mge-efr-random", "mge-efr-lp"].map(String::from));
         for l in Learner::all() {
@@ -397,6 +428,14 @@ mod tests {
         assert!(Algo::new(Strategy::Rpe, GoalSpaceKind::Learned(vae)).is_err());
         assert!(Algo::new(Strategy::Rpe, GoalSpaceKind::Engineered).is_err());
         assert!(Algo::new(Strategy::Rge, GoalSpaceKind::None).is_err());
+        assert!(
+            Algo::new(
+                Strategy::Mge(Modules::Progress),
+                GoalSpaceKind::EngineeredPosition
+            )
+            .is_err()
+        );
+        assert_eq!(Algo::RGE_EFR_POSITION.stream_algo(), Algo::RGE_EFR);
         assert!(Algo::new(Strategy::Mge(Modules::Progress), GoalSpaceKind::None).is_err());
         let a = Algo::new(Strategy::Mge(Modules::Random), GoalSpaceKind::Learned(vae)).unwrap();
         assert_eq!(a.to_string(), "mge-vae-random");

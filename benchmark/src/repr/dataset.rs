@@ -58,7 +58,7 @@ mod tests {
 
     #[test]
     fn deterministic_and_covers_the_square() {
-        let env = make_env(EnvKind::ArmBall, &EnvConfig::default());
+        let env = make_env(EnvKind::ARMBALL, &EnvConfig::default());
         let a = generate(env.as_ref(), 400, &mut stream(1, Component::Dataset)).unwrap();
         let b = generate(env.as_ref(), 400, &mut stream(1, Component::Dataset)).unwrap();
         assert_eq!(a.images, b.images);

@@ -185,7 +185,8 @@ pub struct TrainingRecord {
     pub evidence: TrainingEvidence,
 }
 
-/// What the harness offers one fit: where to report, where to checkpoint, how many threads. A
+/// What the harness offers one fit: where to report, where to checkpoint, how many threads (the
+/// campaign's `Harness::fit_context` derives it from the one declaration of these services). A
 /// learner uses what applies to it and ignores the rest (the default
 /// [`RepresentationLearner::fit_in`] ignores all of it).
 #[derive(Clone, Default)]

@@ -134,7 +134,7 @@ impl Encoder for NeuralEncoder {
     }
 
     fn save(&self, key: &str) -> Option<Vec<u8>> {
-        Some(super::cache::to_bytes(key, self))
+        Some(to_bytes(key, self))
     }
 
     fn training_record(&self, images: &ImageSet) -> Option<super::TrainingRecord> {

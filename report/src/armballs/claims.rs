@@ -159,20 +159,25 @@ pub fn table(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
             .iter()
             .map(|c| {
                 let mut m = format!(
-                    "{} {} − {} {} = {} [{}, {}]",
+                    "{} {} − {} {} = {} {}",
                     name(runs, &c.subject),
                     f3(c.subject_mean),
                     name(runs, &c.reference),
                     f3(c.reference_mean),
                     f3(c.diff),
-                    f3(c.lo),
-                    f3(c.hi)
+                    match c.bounds() {
+                        Some((lo, hi)) => format!("[{}, {}]", f3(lo), f3(hi)),
+                        None => "(no interval)".into(),
+                    }
                 );
                 if r.claim.relative_margin.is_some() {
                     let _ = write!(m, ", margin ±{}", f3(c.margin));
                 }
                 if several {
                     let _ = write!(m, " ({})", c.verdict.label());
+                }
+                if c.verdict != c.uncorrected {
+                    let _ = write!(m, " ({} uncorrected)", c.uncorrected.label());
                 }
                 m
             })
@@ -272,9 +277,8 @@ mod tests {
             display(&runs, "mge-efr-flat@still"),
             "RGE-EFR (flat), still distractor"
         );
-        let mut file = committed();
-        file.settings.n_boot = 500;
-        let c = evaluate_on(&file, &FollowupObservations { runs: &runs }, 0);
+        let file = committed();
+        let c = evaluate_on(&file, &FollowupObservations { runs: &runs });
         let get = |id: &str| c.iter().find(|c| c.claim.id == id).unwrap();
         assert_eq!(verdict(get("C4")), "reproduced");
         assert_eq!(get("C4").comparisons.len(), 2);
@@ -298,7 +302,7 @@ mod tests {
                 r.ball_coverage[0] *= 3.0;
             }
         }
-        let c = evaluate_on(&file, &FollowupObservations { runs: &runs }, 0);
+        let c = evaluate_on(&file, &FollowupObservations { runs: &runs });
         let c4 = c.iter().find(|c| c.claim.id == "C4").unwrap();
         assert_eq!(verdict(c4), "not reproduced");
     }

@@ -49,7 +49,6 @@ pub enum FollowupClaims<'a> {
     Evaluated {
         path: &'a Path,
         confidence: f64,
-        n_boot: usize,
         results: Vec<ClaimResult>,
     },
     /// No claims file where the report looked.
@@ -57,14 +56,12 @@ pub enum FollowupClaims<'a> {
 }
 
 /// Renders the section; `None` when the campaigns have no run. `paper_dir` holds the claims
-/// file; `n_boot` and `seed` drive the exploration table's intervals and the claims' bootstrap.
+/// file.
 pub fn render(
     campaign: &Campaign,
     variants: &[&Campaign],
     fig_dir: &Path,
     paper_dir: &Path,
-    n_boot: usize,
-    seed: u64,
 ) -> Result<Option<Section>, ReportError> {
     let mut runs = load(campaign)?;
     for v in variants {
@@ -84,26 +81,16 @@ pub fn render(
     let path = paper_dir.join(CLAIMS_FILE);
     let followup_claims = if path.exists() {
         let file = crate::claims::load_claims(&path)?;
-        let results =
-            crate::claims::evaluate_on(&file, &FollowupObservations { runs: &runs }, seed);
+        let results = crate::claims::evaluate_on(&file, &FollowupObservations { runs: &runs });
         FollowupClaims::Evaluated {
             path: &path,
             confidence: file.settings.confidence,
-            n_boot: file.settings.n_boot,
             results,
         }
     } else {
         FollowupClaims::Missing(&path)
     };
-    let (page, summary) = page::write(
-        campaign,
-        variants,
-        &runs,
-        &figures,
-        &followup_claims,
-        n_boot,
-        seed,
-    );
+    let (page, summary) = page::write(campaign, variants, &runs, &figures, &followup_claims);
     Ok(Some(Section {
         page,
         summary,
@@ -176,7 +163,7 @@ mod tests {
             },
         };
         let claims = FollowupClaims::Missing(Path::new("none.toml"));
-        let (page, _) = page::write(&campaign, &[], &rs, &[], &claims, 200, 0);
+        let (page, _) = page::write(&campaign, &[], &rs, &[], &claims);
         assert!(page.contains("(10 runs, 2 seeds)"), "{page}");
         assert!(page.contains("VAE, 4 and 10 latents"), "{page}");
         let row = |name: &str| {

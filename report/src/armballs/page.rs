@@ -10,10 +10,7 @@ use super::runs::{
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
 use crate::figures::{FigureFile, learner_name};
-use crate::stats::{derive_seed, mean};
-
-/// Level of the intervals of the exploration table.
-const CONFIDENCE: f64 = 0.95;
+use crate::stats::{CONFIDENCE, mean, t_interval};
 
 /// The page, and the section of `REPORT.md` (its claims and a link to the page).
 pub(super) fn write(
@@ -22,8 +19,6 @@ pub(super) fn write(
     runs: &[FollowupRun],
     figures: &[FigureFile],
     followup_claims: &FollowupClaims<'_>,
-    n_boot: usize,
-    seed: u64,
 ) -> (String, String) {
     let mut p = String::new();
     let name = std::iter::once(campaign.name.as_str())
@@ -80,8 +75,8 @@ pub(super) fn write(
     let _ = writeln!(
         p,
         "## Exploration of the controllable ball\n\n\
-         Final values after the last exploration iteration, mean over seeds with a \
-         {:.0}% bootstrap interval of the mean. *Ratio* is the follow-up's exploration ratio \
+         Final values after the last exploration iteration, mean over seeds with the \
+         {:.0}% t interval of the mean (Student; — with fewer than 2 seeds). *Ratio* is the follow-up's exploration ratio \
          (ball cells visited on a {bins}x{bins} grid over [-1, 1]², divided by all {all} \
          cells; at most {most:.2}); *KLC* is the paper's KL-coverage (lower is better). The \
          distractor columns are \
@@ -98,7 +93,11 @@ pub(super) fn write(
     for a in algos(runs) {
         let rs = of(runs, &a);
         let r = ratios(runs, &a);
-        let s = summarize_at(&r, n_boot, derive_seed(seed, &format!("armballs/{a}")));
+        let ratio = match t_interval(&r, CONFIDENCE) {
+            Ok(i) => format!("{} [{}, {}]", f3(i.estimate), f3(i.lo), f3(i.hi)),
+            Err(_) if r.is_empty() => "n/a".into(),
+            Err(_) => format!("{} (—)", f3(mean(&r))),
+        };
         let klc: Vec<f64> = rs
             .iter()
             .map(|r| r.ball_klc.last().copied().unwrap_or(f64::NAN))
@@ -114,12 +113,9 @@ pub(super) fn write(
             .collect();
         let _ = writeln!(
             p,
-            "| {} | {} | {} [{}, {}] | {} | {} | {} |",
+            "| {} | {} | {ratio} | {} | {} | {} |",
             display(runs, &a),
             rs.len(),
-            f3(s.0),
-            f3(s.1),
-            f3(s.2),
             f3(mean(&klc)),
             if dratio.is_empty() {
                 "n/a".into()
@@ -292,7 +288,6 @@ pub(super) fn write(
         FollowupClaims::Evaluated {
             path,
             confidence,
-            n_boot,
             results,
         } => {
             let (yes, no, open, premise) = claims::counts(results);
@@ -301,15 +296,12 @@ pub(super) fn write(
                     "The follow-up's text gives no number we could read \
                      (`docs/followup-paper-sources.md` section 5), so each claim is formalised \
                      here (our choice, `{}`, explained in `docs/armballs.md`) and evaluated by \
-                     the same engine as the paper's claims: differences of means over seeds with \
-                     a {:.0}% percentile-bootstrap interval ({n_boot} resamples); **reproduced** \
-                     when the interval lies inside the claimed set, **not reproduced** when it \
-                     lies outside, **inconclusive** otherwise; **premise not met** when the \
+                     the same engine as the paper's claims. {} **Premise not met** when the \
                      claim is about a disentangled space and no network here is one. Of {} \
                      claims: {yes} reproduced, {no} not reproduced, {open} inconclusive, \
                      {premise} with the premise not met.",
                     path.display(),
-                    confidence * 100.0,
+                    crate::markdown::claims::method_text(*confidence),
                     results.len()
                 ),
                 claims::table(runs, results),
@@ -332,15 +324,4 @@ pub(super) fn write(
         runs.len()
     );
     (p, summary)
-}
-
-/// Mean and bootstrap interval at [`CONFIDENCE`].
-fn summarize_at(xs: &[f64], n_boot: usize, seed: u64) -> (f64, f64, f64) {
-    if xs.is_empty() {
-        return (f64::NAN, f64::NAN, f64::NAN);
-    }
-    use rand::SeedableRng;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let (lo, hi) = crate::stats::bootstrap_mean_ci(xs, CONFIDENCE, n_boot, &mut rng);
-    (mean(xs), lo, hi)
 }

@@ -1,7 +1,7 @@
 //! Training-budget sensitivity (`budget_<learner>.svg`, e.g. `budget_vae.svg`): the final
 //! KL-coverage of a neural condition against its training iterations (log axis), from the
-//! `budget-*` campaigns. Every seed is a dot; the mean over seeds, with its 90% percentile
-//! bootstrap CI, is a diamond on a line. The main campaign's runs of the same condition are a star
+//! `budget-*` campaigns. Every seed is a dot; the mean over seeds, with its 95% t interval
+//! ([`crate::stats::CONFIDENCE`]; none with one seed), is a diamond on a line. The main campaign's runs of the same condition are a star
 //! at their own budget; RGE-EFR and RPE of the main campaign on the same environment are horizontal
 //! reference lines (their mean final KL-coverage). The paper trained the VAE for 100,000
 //! iterations (PAPER-NOTES section 5), far right of what a CPU campaign affords.
@@ -131,7 +131,7 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
         ),
         (
             Icon::Whisker { colour: col },
-            "budget campaigns: 90% bootstrap CI".to_string(),
+            "budget campaigns: 95% t interval".to_string(),
         ),
     ];
     if let Some(m) = s.main.first() {
@@ -157,7 +157,7 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
             ),
             (
                 Icon::Whisker { colour: BLACK },
-                format!("main campaign {main}: 90% bootstrap CI"),
+                format!("main campaign {main}: 95% t interval"),
             ),
         ]);
     }
@@ -204,7 +204,7 @@ fn draw_panel(
     let mut vals: Vec<f64> = Vec::new();
     for p in &all {
         vals.extend(p.values.iter().map(|v| v.1));
-        vals.extend([p.summary.ci_lo, p.summary.ci_hi]);
+        vals.extend(p.summary.ci.into_iter().flat_map(|(a, b)| [a, b]));
     }
     vals.extend(s.references.iter().map(|r| r.summary.mean));
     vals.retain(|v| v.is_finite());
@@ -283,9 +283,9 @@ fn draw_panel(
         )?;
     }
     // Whiskers, at a small offset to the right of the dots.
-    let whisker = |p: &BudgetPoint, c: RGBColor, offset: f64| {
+    let whisker = |p: &BudgetPoint, (a, b): (f64, f64), c: RGBColor, offset: f64| {
         let x = p.iterations as f64 * 10f64.powf(offset);
-        let (a, b) = (clamp(p.summary.ci_lo), clamp(p.summary.ci_hi));
+        let (a, b) = (clamp(a), clamp(b));
         let cap = 10f64.powf(0.01);
         vec![
             PathElement::new(vec![(x, a), (x, b)], c.stroke_width(2)),
@@ -294,13 +294,13 @@ fn draw_panel(
         ]
     };
     for p in &s.points {
-        if p.summary.ci_lo.is_finite() && p.summary.ci_hi.is_finite() {
-            chart.draw_series(whisker(p, col, 0.04))?;
+        if let Some(ci) = p.summary.ci {
+            chart.draw_series(whisker(p, ci, col, 0.04))?;
         }
     }
     for p in &s.main {
-        if p.summary.ci_lo.is_finite() && p.summary.ci_hi.is_finite() {
-            chart.draw_series(whisker(p, BLACK, 0.075))?;
+        if let Some(ci) = p.summary.ci {
+            chart.draw_series(whisker(p, ci, BLACK, 0.075))?;
         }
     }
     // Means.

@@ -118,7 +118,7 @@ pub fn draw_environments(fig_dir: &Path) -> Result<FigureFile, ReportError> {
 /// The first seeded uniform parameter vector (the distribution RPE samples) whose ArmBall
 /// episode catches the ball, with its seed.
 pub fn catching_parameters(cfg: &EnvConfig) -> Option<(u64, [f64; PARAMS])> {
-    let env = make_env(EnvKind::ArmBall, cfg);
+    let env = make_env(EnvKind::ARMBALL, cfg);
     (0..10_000u64).find_map(|seed| {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let theta: [f64; PARAMS] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
@@ -139,7 +139,7 @@ pub fn draw_dmp_episode(fig_dir: &Path) -> Result<Option<FigureFile>, ReportErro
         return Ok(None);
     };
     let traj = dmp::trajectory(&cfg.dmp, &theta);
-    let end = make_env(EnvKind::ArmBall, &cfg).rollout(
+    let end = make_env(EnvKind::ARMBALL, &cfg).rollout(
         &theta,
         &mut ugl_bench::seed::stream(0, ugl_bench::seed::Component::Distractor),
     );
@@ -238,7 +238,7 @@ mod tests {
     fn the_episode_shown_catches_and_moves_the_ball() {
         let cfg = EnvConfig::default();
         let (_, theta) = catching_parameters(&cfg).expect("a catching episode among 10,000");
-        let r = make_env(EnvKind::ArmBall, &cfg).rollout(
+        let r = make_env(EnvKind::ARMBALL, &cfg).rollout(
             &theta,
             &mut ugl_bench::seed::stream(0, ugl_bench::seed::Component::Distractor),
         );

@@ -1,7 +1,7 @@
 //! KL-coverage against exploration epochs, like the paper's Figure 2: one figure per environment,
 //! one panel per latent size of the learned goal spaces (the baselines RPE and RGE-EFR, which have
 //! no latent size, appear in every panel, as in the paper), one curve per condition: the mean over
-//! seeds with its shaded 90% bootstrap band. The paper's final value is a hollow star at the
+//! seeds with its shaded 95% t-interval band ([`crate::stats::CONFIDENCE`]). The paper's final value is a hollow star at the
 //! condition's last epoch.
 //!
 //! As the paper's figure (its notebook filtered `sampling != 'normal'`), the Gaussian-goal runs are
@@ -128,7 +128,7 @@ pub fn draw_metric(
         let legend_h = legend_height(width, &legend, 13);
         write_svg(&path, (width, PANEL_H + TITLE_H + legend_h), |root| {
             let title = format!(
-                "{}: {}, mean over seeds with 90% bootstrap CI",
+                "{}: {}, mean over seeds with 95% t interval",
                 env_name(env),
                 metric.name()
             );
@@ -281,7 +281,13 @@ fn draw_panel(
         let m = panel
             .members
             .iter()
-            .flat_map(|c| metric.curve(c).iter().map(|p| p.hi).chain(metric.paper(c)))
+            .flat_map(|c| {
+                metric
+                    .curve(c)
+                    .iter()
+                    .map(|p| p.ci.map_or(p.mean, |ci| ci.1))
+                    .chain(metric.paper(c))
+            })
             .filter(|v| v.is_finite())
             .fold(0.0f64, f64::max);
         if m > 0.0 { m * 1.05 } else { 1.0 }
@@ -300,7 +306,7 @@ fn draw_panel(
             metric
                 .curve(c)
                 .iter()
-                .map(|p| p.lo.min(p.mean))
+                .map(|p| p.ci.map_or(p.mean, |ci| ci.0.min(p.mean)))
                 .chain(metric.paper(c))
         })
         .filter(|v| v.is_finite())
@@ -347,16 +353,17 @@ fn draw_panel(
 
     // Bands first, so that every line is drawn over every band.
     for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
-        let pts: Vec<_> = metric
+        // Epochs without an interval (one run, an infinite value) have no band.
+        let pts: Vec<(f64, f64, f64)> = metric
             .curve(c)
             .iter()
-            .filter(|p| !p.lo.is_nan() && !p.hi.is_nan())
+            .filter_map(|p| p.ci.map(|(lo, hi)| (p.epoch as f64, lo, hi)))
             .collect();
-        if pts.len() < 2 || pts.iter().all(|p| p.lo == p.hi) {
+        if pts.len() < 2 || pts.iter().all(|p| p.1 == p.2) {
             continue;
         }
-        let mut poly: Vec<(f64, f64)> = pts.iter().map(|p| (p.epoch as f64, clamp(p.hi))).collect();
-        poly.extend(pts.iter().rev().map(|p| (p.epoch as f64, clamp(p.lo))));
+        let mut poly: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, clamp(p.2))).collect();
+        poly.extend(pts.iter().rev().map(|p| (p.0, clamp(p.1))));
         chart.draw_series(std::iter::once(Polygon::new(
             poly,
             colour(slot).mix(0.14).filled(),

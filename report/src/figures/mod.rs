@@ -88,6 +88,7 @@ pub fn algo_name(algo: &str) -> String {
     match algo {
         "rpe" => "RPE".into(),
         "rge-efr" => "RGE-EFR".into(),
+        "rge-efr-position" => "RGE-EFR (position only)".into(),
         other => match LearnerInfo::by_algo(other) {
             Some(l) => format!("RGE-{}", l.display),
             None => other.to_uppercase(),

@@ -125,13 +125,9 @@ pub fn draw_all(
     Ok(out)
 }
 
-/// What the object is called in titles.
+/// What the object is called in titles (the registry's controllable object).
 fn object_word(env: &str) -> &'static str {
-    match env {
-        "armball" => "ball",
-        "armarrow" => "arrow",
-        _ => "object",
-    }
+    ugl_types::EnvSpec::by_name(env).map_or("object", |e| e.controllable_object())
 }
 
 /// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.

@@ -1,7 +1,7 @@
 //! The paper's Figure 4: RGE-VAE exploring with goals from a KDE of the training latents against
 //! goals from the VAE's isotropic Gaussian prior N(0, I), in four panels (ArmBall 10 / 2 latents,
 //! ArmArrow 10 / 3 latents). As in the paper ("mean and standard deviation over 5 independent
-//! runs"), each curve is the mean over seeds with a ±1 sd band (not the bootstrap CI of the other
+//! runs"), each curve is the mean over seeds with a ±1 sd band (not the t interval of the other
 //! curve figures). Our two variants are both drawn: faithful solid with filled markers, corrected
 //! dashed with hollow markers; KDE blue circles, Gaussian vermillion triangles.
 //!

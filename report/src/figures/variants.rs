@@ -2,8 +2,8 @@
 //! two variants, one panel per environment and latent size. Within a panel, one group per
 //! (algorithm, goal sampler; colour by algorithm as in the curve figures); in a group the faithful
 //! runs on the left (filled circles) and the corrected ones on the right (hollow circles), every seed a dot, a thin grey line joining the two runs
-//! of a seed (they share initial weights and batches), and the mean with its 90% percentile
-//! bootstrap CI as a bar with whiskers.
+//! of a seed (they share initial weights and batches), and the mean with its 95% t interval
+//! ([`crate::stats::CONFIDENCE`]) as a bar with whiskers.
 
 use std::path::Path;
 
@@ -66,7 +66,7 @@ pub fn draw(pairs: &[VariantPair<'_>], fig_dir: &Path) -> Result<Option<FigureFi
         ),
         |root| {
             let area = root.titled(
-                "Final KL-coverage, faithful vs corrected: every seed, mean and 90% bootstrap CI",
+                "Final KL-coverage, faithful vs corrected: every seed, mean and 95% t interval",
                 (FONT, 17),
             )?;
             let (area, strip) = area.split_vertically(PANEL_H * rows as u32);
@@ -82,7 +82,7 @@ pub fn draw(pairs: &[VariantPair<'_>], fig_dir: &Path) -> Result<Option<FigureFi
         path,
         link: format!("figures/{FILE}"),
         caption: "Final KL-coverage of the faithful and corrected variants of RGE-VAE and \
-                  RGE-RFVAE, per seed, with the mean and its 90% bootstrap CI"
+                  RGE-RFVAE, per seed, with the mean and its 95% t interval"
             .into(),
         env: String::new(),
     }))
@@ -113,7 +113,7 @@ fn draw_legend(
         vec![(x + 14, y - 8), (x + 14, y + 8)],
         dark.stroke_width(2),
     ))?;
-    strip.draw(&text("mean (black bar), 90% CI (whiskers)", x + 24))?;
+    strip.draw(&text("mean (black bar), 95% t CI (whiskers)", x + 24))?;
     x += 280;
     strip.draw(&PathElement::new(
         vec![(x - 8, y + 5), (x + 8, y - 5)],
@@ -150,7 +150,7 @@ fn draw_panel(
     for p in pairs {
         for c in sides(p).into_iter().flatten() {
             vals.extend(c.final_by_seed.iter().map(|v| v.1));
-            vals.extend([c.final_klc.ci_lo, c.final_klc.ci_hi]);
+            vals.extend(c.final_klc.ci.into_iter().flat_map(|(a, b)| [a, b]));
         }
     }
     vals.retain(|v| v.is_finite());
@@ -235,8 +235,8 @@ fn draw_panel(
             // Mean and CI, beside the dots (outside the group).
             let s = &c.final_klc;
             let xm = x + if side == 0 { -0.11 } else { 0.11 };
-            if s.ci_lo.is_finite() && s.ci_hi.is_finite() {
-                let (a, b) = (clamp(s.ci_lo), clamp(s.ci_hi));
+            if let Some((a, b)) = s.ci {
+                let (a, b) = (clamp(a), clamp(b));
                 chart.draw_series([
                     PathElement::new(vec![(xm, a), (xm, b)], col.stroke_width(2)),
                     PathElement::new(vec![(xm - 0.025, a), (xm + 0.025, a)], col.stroke_width(2)),

@@ -22,8 +22,10 @@ included: the VAE's reparameterisation noise is one draw shared by the whole bat
 shares that noise, broadcasts its log-determinant term to a batch × batch matrix, and encodes \
 outcomes as the flow output of a freshly sampled z0 while its KDE is fitted on flow-less z0 samples \
 (goals and outcomes in different spaces). *Corrected* fixes these defects (per-sample noise, \
-per-sample log-determinant, deterministic encoding of the mean through the flows, for both). The AE \
-has no documented defect and runs once (PAPER-NOTES section 5).";
+per-sample log-determinant, deterministic encoding of the mean through the flows, for both); from \
+results version 4 the corrected RFVAE also puts its prior N(0, I) on the flow output z_K, where its \
+outcomes are encoded, so that its Gaussian goals are drawn in that space (up to version 3 the prior \
+was on z0). The AE has no documented defect and runs once (PAPER-NOTES section 5).";
 
 fn campaign(name: &str) -> String {
     format!("`{}`", campaign_display(name))
@@ -253,10 +255,6 @@ fn summary_cell(s: &Summary) -> String {
     }
 }
 
-fn ci(s: &Summary) -> String {
-    format!("[{}, {}]", fmt_klc(s.ci_lo), fmt_klc(s.ci_hi))
-}
-
 fn signed(v: f64) -> String {
     if v.is_finite() {
         format!("{v:+.3}")
@@ -361,14 +359,16 @@ pub fn variants(w: &mut String, inp: &Context<'_>, figure: Option<&FigureFile>) 
         "The two runs of a seed share their initial weights, their training batches and their \
          exploration streams, so the comparison is paired: *corrected − faithful* is the mean over \
          seeds of the per-seed difference of final KL-coverage (negative: the corrected variant \
-         covers better), with its 90% percentile-bootstrap CI over the pairs ({} resamples). A CI \
-         that excludes 0 is a difference at this training budget; with 5 pairs the CI is rough.\n",
-        inp.opts.n_boot
+         covers better), with its {:.0}% paired t interval (Student's t on the per-seed \
+         differences; — with fewer than 2 pairs). An interval that excludes 0 is a difference at \
+         this training budget; the rows are not corrected for multiple comparisons.\n",
+        stats::CONFIDENCE * 100.0
     );
     let _ = writeln!(w, "![{}]({})\n", fig.caption, fig.link);
     let _ = writeln!(
         w,
-        "| panel | algorithm | goals | faithful: mean (n) | corrected: mean (n) | corrected − faithful | 90% CI | pairs (seeds) |"
+        "| panel | algorithm | goals | faithful: mean (n) | corrected: mean (n) | corrected − faithful | {:.0}% CI | pairs (seeds) |",
+        stats::CONFIDENCE * 100.0
     );
     let _ = writeln!(w, "|---|---|---|---:|---:|---:|---:|---:|");
     let mean_n = |c: Option<&ConditionSummary>| match c {
@@ -379,7 +379,8 @@ pub fn variants(w: &mut String, inp: &Context<'_>, figure: Option<&FigureFile>) 
         let (diff, dci) = match &p.diff {
             Some(d) => (
                 signed(d.mean),
-                format!("[{}, {}]", signed(d.ci_lo), signed(d.ci_hi)),
+                d.ci.map(|(lo, hi)| format!("[{}, {}]", signed(lo), signed(hi)))
+                    .unwrap_or_else(|| "—".into()),
             ),
             None => ("—".into(), "—".into()),
         };
@@ -406,21 +407,25 @@ pub fn variants(w: &mut String, inp: &Context<'_>, figure: Option<&FigureFile>) 
     let _ = writeln!(w);
 }
 
-fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>, seed: u64) {
+fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>) {
     let seeds: Vec<i64> = p.values.iter().map(|v| v.0).collect();
     let xs: Vec<f64> = p.values.iter().map(|v| v.1).collect();
-    let delta = efr
-        .and_then(|ys| {
-            stats::difference_of_means_ci(
-                &xs,
-                ys,
-                BUDGET_N_BOOT,
-                0.05,
-                stats::derive_seed(seed, &format!("budget-vs-efr|{origin}|{}", p.iterations)),
-            )
-        })
-        .map(|(d, lo, hi)| format!("{} [{}, {}]", signed(d), signed(lo), signed(hi)))
-        .unwrap_or_else(|| "—".into());
+    let delta = match efr {
+        None => "—".into(),
+        Some(ys) => match stats::welch_interval(&xs, ys, stats::CONFIDENCE) {
+            Ok(i) => format!(
+                "{} [{}, {}]",
+                signed(i.estimate),
+                signed(i.lo),
+                signed(i.hi)
+            ),
+            Err(_) if xs.is_empty() || ys.is_empty() => "—".into(),
+            Err(_) => format!(
+                "{} (no interval)",
+                signed(stats::mean(&xs) - stats::mean(ys))
+            ),
+        },
+    };
     let _ = writeln!(
         w,
         "| {} | {} | {} ({}) | {} | {} | {delta} |",
@@ -432,12 +437,9 @@ fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>
             .split(" (n=")
             .next()
             .unwrap_or_default(),
-        ci(&p.summary)
+        super::fmt_ci(p.summary.ci)
     );
 }
-
-/// Resamples of the budget table's differences with RGE-EFR.
-const BUDGET_N_BOOT: usize = 10_000;
 
 /// Training-budget sensitivity: the `budget-*` campaigns.
 /// At or below this many seeds a statistic gets [`small_n_warning`].
@@ -446,9 +448,10 @@ pub const SMALL_N: usize = 5;
 /// The warning under a table whose smallest sample has `n` seeds.
 pub fn small_n_warning(n: usize) -> String {
     format!(
-        "⚠ **Small samples**: as few as {n} seed{} per value. Percentile-bootstrap intervals over \
-         so few seeds are too narrow (they under-cover), and one outlying run moves a mean a \
-         lot: read the intervals as rough, and a difference as real only when it is large.",
+        "⚠ **Small samples**: as few as {n} seed{} per value. The t intervals cover as they \
+         say on normal samples; at so few seeds they cover less on skewed ones, and not when a \
+         rare outlying run (a seed stuck at RPE level) is missing from the sample, while one \
+         such run moves a mean a lot: a difference is real only when it is large.",
         if n == 1 { "" } else { "s" }
     )
 }
@@ -483,14 +486,15 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
          seed starts from the same weights and draws the same batches at every budget of these \
          campaigns (the main campaign's network may have another recipe: see the list under the \
          figure). Each dot \
-         is a seed's final KL-coverage; diamonds the mean with its 90% bootstrap CI; the star the \
+         is a seed's final KL-coverage; diamonds the mean with its {level:.0}% t interval; the star the \
          main campaign {} at its own budget; horizontal lines the mean final KL-coverage of \
          RGE-EFR and RPE in the main campaign. The paper trained the VAE for 100,000 iterations. \
-         *Δ vs RGE-EFR*: the mean final KL-coverage minus RGE-EFR's (main campaign), with a 95% \
-         percentile-bootstrap interval resampling the seeds of both sides: whether the paper's \
-         main claim for this learner (no worse than RGE-EFR) depends on the budget.\n",
+         *Δ vs RGE-EFR*: the mean final KL-coverage minus RGE-EFR's (main campaign), with its \
+         {level:.0}% Welch t interval: whether the paper's main claim for this learner (no worse \
+         than RGE-EFR) depends on the budget.\n",
         list.join(", "),
-        campaign(&inp.campaigns.main.name)
+        campaign(&inp.campaigns.main.name),
+        level = stats::CONFIDENCE * 100.0
     );
     for f in figures {
         let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
@@ -517,7 +521,8 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
         let _ = writeln!(w, "### {}\n", series_title(s));
         let _ = writeln!(
             w,
-            "| training iterations | campaign | n seeds | final KLC mean ± sd | 90% CI | Δ vs RGE-EFR [95% CI] |"
+            "| training iterations | campaign | n seeds | final KLC mean ± sd | {level:.0}% CI | Δ vs RGE-EFR [{level:.0}% CI] |",
+            level = stats::CONFIDENCE * 100.0
         );
         let _ = writeln!(w, "|---:|---|---:|---:|---:|---:|");
         let efr = s
@@ -525,10 +530,9 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
             .iter()
             .find(|r| r.algo == "rge-efr")
             .map(|r| r.values.as_slice());
-        let seed = inp.opts.bootstrap_seed;
         for p in &s.points {
             let names: Vec<String> = p.campaigns.iter().map(|c| campaign(c)).collect();
-            budget_row(w, p, &names.join(", "), efr, seed);
+            budget_row(w, p, &names.join(", "), efr);
         }
         for p in &s.main {
             budget_row(
@@ -536,7 +540,6 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
                 p,
                 &format!("{} (main)", campaign(&inp.campaigns.main.name)),
                 efr,
-                seed,
             );
         }
         let min_n = s

@@ -209,7 +209,8 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
          RFVAE's warm-up; the training loss includes the KL and the flows' log-det, so this is \
          indicative), *never (k)* counting the runs that did not; **position R²** is the median \
          held-out k-NN R² of the object's position from the latents; **final KLC** is the mean \
-         over the pairs, **Δ** the mean paired difference (recipe − `{m}`) with its range, and \
+         over the pairs, **Δ** the mean paired difference (recipe − `{m}`) with the range of the per-pair \
+         differences (*min to max*: a range, not a confidence interval), and \
          **recipe better** the pairs where the recipe's run ends with the lower (better) \
          KL-coverage. n ≤ 5 pairs: read the \
          differences as indications, not tests.\n",
@@ -277,7 +278,7 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
             let lo = deltas.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = deltas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             let delta = match mean(&deltas) {
-                Some(d) => format!("{d:+.3} [{lo:+.3}, {hi:+.3}]"),
+                Some(d) => format!("{d:+.3} ({lo:+.3} to {hi:+.3})"),
                 None => "—".into(),
             };
             let better = deltas.iter().filter(|d| **d < 0.0).count();

@@ -21,14 +21,8 @@ impl Section for Followup {
         let Some((lead, variants)) = ctx.campaigns.followup_lead() else {
             return Ok(String::new());
         };
-        let Some(section) = armballs::render(
-            lead,
-            &variants,
-            &out.figures_dir(),
-            &ctx.opts.paper_dir,
-            ctx.opts.n_boot,
-            ctx.opts.bootstrap_seed,
-        )?
+        let Some(section) =
+            armballs::render(lead, &variants, &out.figures_dir(), &ctx.opts.paper_dir)?
         else {
             return Ok(String::new());
         };

@@ -6,6 +6,7 @@
 //!
 //! Adding a section: one type implementing [`Section`] and one entry in [`SECTIONS`].
 
+mod discovery;
 mod followup;
 mod pages;
 mod paper;
@@ -52,6 +53,7 @@ pub static SECTIONS: &[&dyn Section] = &[
     &paper::Quality,
     &paper::Recipes,
     &paper::Outcomes,
+    &discovery::Discovery,
     &paper::Illustrations,
     &paper::Deviations,
     &paper::Reproduce,

@@ -1,0 +1,219 @@
+//! A new environment is one file plus one registry entry: this file declares ArmReach (the
+//! outcome is where the hand ends; no object), registers it, and runs it through the command
+//! line (`ugl run`, `ugl campaign`, `ugl report`) in this process, as a program that adds its
+//! own environment would. Nothing outside this file knows it.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use ugl_bench::env::render::render_ball_into;
+use ugl_bench::env::{EnvConfig, EnvEntry, EnvKind, Environment, PARAMS, Rollout, dmp, register};
+use ugl_bench::seed::Stream;
+use ugl_types::{DISK, EnvSpec, Manifest, ObjectSpec};
+
+/// The declaration the report and the command line read.
+static SPEC: EnvSpec = EnvSpec {
+    name: "armreach",
+    display: "ArmReach",
+    description: "where the hand ends (2-D outcome: x, y); a test environment",
+    in_paper: false,
+    objects: &[ObjectSpec {
+        name: "hand",
+        start: 0,
+        end: 2,
+        controllable: true,
+    }],
+    state_dim: 2,
+    true_latents: 2,
+    outcome_columns: &["x", "y"],
+    klc: DISK,
+};
+
+/// Its registry entry.
+static ENTRY: EnvEntry = EnvEntry {
+    spec: &SPEC,
+    build: |cfg| Box::new(ArmReach::new(cfg)),
+};
+
+/// The dynamics: the arm's movement, the hand's last position.
+struct ArmReach {
+    cfg: EnvConfig,
+    rest: [f64; 2],
+}
+
+impl ArmReach {
+    fn new(cfg: &EnvConfig) -> Self {
+        let rest = cfg.arm.forward(&[0.0; ugl_bench::env::JOINTS]).hand;
+        ArmReach {
+            cfg: cfg.clone(),
+            rest,
+        }
+    }
+}
+
+impl Environment for ArmReach {
+    fn kind(&self) -> EnvKind {
+        EnvKind::of(&ENTRY)
+    }
+
+    fn initial_state(&self) -> &[f64] {
+        &self.rest
+    }
+
+    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut Stream) -> Rollout {
+        let theta = theta.map(|v| v.clamp(-1.0, 1.0));
+        let path = dmp::trajectory(&self.cfg.dmp, &theta);
+        let hand = path
+            .last()
+            .map_or(self.rest, |q| self.cfg.arm.forward(q).hand);
+        Rollout {
+            state: [hand[0].clamp(-1.0, 1.0), hand[1].clamp(-1.0, 1.0), 0.0, 0.0],
+            dim: 2,
+            caught: hand != self.rest,
+            hand,
+        }
+    }
+
+    fn render_into(&self, state: &[f64], out: &mut [f32]) {
+        render_ball_into(state[0], state[1], out);
+    }
+}
+
+fn ugl(args: &[&str]) -> ExitCode {
+    ugl::main_with(std::iter::once("ugl").chain(args.iter().copied()))
+}
+
+fn ok(args: &[&str]) {
+    assert_eq!(ugl(args), ExitCode::SUCCESS, "ugl {}", args.join(" "));
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+fn manifest(path: &Path) -> Manifest {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
+    // Before registration the command line does not know it.
+    let dir = tempfile::tempdir().unwrap();
+    let rollout_params = dir.path().join("params.json");
+    std::fs::write(&rollout_params, format!("[{:?}]", [0.5; PARAMS])).unwrap();
+    let rollout = [
+        "rollout",
+        "--env",
+        "armreach",
+        "--params",
+        p(&rollout_params),
+    ];
+    assert_eq!(ugl(&rollout), ExitCode::from(2));
+
+    let kind = register(&ENTRY).unwrap();
+    assert_eq!(
+        register(&ENTRY).unwrap(),
+        kind,
+        "registering twice is a no-op"
+    );
+    assert_eq!("armreach".parse::<EnvKind>().unwrap(), kind);
+    assert!(EnvKind::all().last() == Some(&kind) && kind > EnvKind::ARMBALLS);
+    ok(&rollout);
+
+    // A declaration whose grid is not the measure's is refused, with the reason.
+    static WRONG_GRID: EnvSpec = EnvSpec {
+        name: "armreach-square",
+        klc: ugl_types::KlcGrid {
+            achievable_cells: 900,
+            ..DISK
+        },
+        ..SPEC
+    };
+    static WRONG: EnvEntry = EnvEntry {
+        spec: &WRONG_GRID,
+        build: |cfg| Box::new(ArmReach::new(cfg)),
+    };
+    let e = register(&WRONG).unwrap_err().to_string();
+    assert!(e.contains("armreach-square") && e.contains("756"), "{e}");
+    assert!("armreach-square".parse::<EnvKind>().is_err());
+
+    // `ugl run`, in the engineered space and in a learned one.
+    let profile = dir.path().join("reach.toml");
+    std::fs::write(
+        &profile,
+        "[campaign]\nname = \"reach\"\nrole = \"main\"\nreps = 2\n[matrix]\nenvs = [\"armreach\"]\n\
+         algos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
+         [ugl]\nimages = 200\n[explore]\nepochs = 150\neval_every = 50\n",
+    )
+    .unwrap();
+    let single = dir.path().join("single");
+    for algo in ["rge-efr", "rge-pca"] {
+        ok(&[
+            "run",
+            "--env",
+            "armreach",
+            "--algo",
+            algo,
+            "--latents",
+            "2",
+            "--seed",
+            "1",
+            "--profile",
+            p(&profile),
+            "--out",
+            p(&single),
+        ]);
+    }
+    let m = manifest(&single.join("armreach.rge-pca.kde.l2.s1.json"));
+    assert_eq!((m.env.as_str(), m.latents), ("armreach", 2));
+    assert!(m.summary.final_klc > 0.0 && m.summary.final_klc <= DISK.max_klc());
+
+    // A campaign: the same bytes as `ugl run` for the same identity.
+    let results = dir.path().join("results");
+    ok(&[
+        "campaign",
+        "--config",
+        p(&profile),
+        "--out",
+        p(&results.join("reach")),
+        "--quiet",
+    ]);
+    for f in [
+        "armreach.rge-efr.s1.parquet",
+        "armreach.rge-pca.kde.l2.s1.parquet",
+        "armreach.rge-pca.kde.l2.s1.outcomes.parquet",
+    ] {
+        assert_eq!(
+            std::fs::read(results.join("reach").join(f)).unwrap(),
+            std::fs::read(single.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+
+    // The report names it from its declaration and bounds its KL-coverage by its grid.
+    let report = dir.path().join("report");
+    ok(&[
+        "report",
+        "--results",
+        p(&results),
+        "--out",
+        p(&report),
+        "--main",
+        "reach",
+    ]);
+    let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
+    for needle in [
+        "| ArmReach | RGE-PCA † | kde | 2 |",
+        "![ArmReach: KL-coverage vs exploration epochs (ArmReach, 2 latents)](figures/klc_armreach.svg)",
+        "### ArmReach",
+    ] {
+        assert!(md.contains(needle), "no `{needle}` in:\n{md}");
+    }
+    assert!(report.join("figures/klc_armreach.svg").is_file());
+    let finals = std::fs::read_to_string(report.join("data/final_by_seed.csv")).unwrap();
+    assert_eq!(
+        finals.lines().filter(|l| l.contains("armreach")).count(),
+        6,
+        "{finals}"
+    );
+}
