@@ -339,13 +339,6 @@ fn invalid_configurations_are_rejected() {
     let base = tiny(Model::Vae, Variant::Faithful, 2);
     let cases: Vec<(&str, NeuralConfig)> = vec![
         (
-            "iterations",
-            NeuralConfig {
-                iterations: 0,
-                ..base.clone()
-            },
-        ),
-        (
             "batch",
             NeuralConfig {
                 batch: 0,
@@ -1030,4 +1023,47 @@ fn capacity_annealing_is_the_beta_kl_against_a_rising_target() {
     }
     let (_, z50) = fit_neural(Model::Bvae, cfg(Some(50.0)), &set, 3, 4);
     assert_ne!(zp.data, z50.data);
+}
+
+/// `iterations = 0` is the untrained twin: the initial weights of the same stream (the weights
+/// a trained network starts from), no loss curve, and flagged as untrained by the evidence.
+#[test]
+fn zero_iterations_keep_the_initial_weights_and_are_flagged_untrained() {
+    let set = images(EnvKind::ARMBALL, 200);
+    for model in [Model::Ae, Model::Vae, Model::Rfvae] {
+        let cfg = tiny(model, Variant::Corrected, 0);
+        let mut twin = ugl_bench::repr::neural::train(
+            model,
+            &cfg,
+            &set,
+            2,
+            &mut stream_named(5, "twin"),
+            None,
+        )
+        .unwrap();
+        let init = init_net(model, &cfg, set.dim, 2, &mut stream_named(5, "twin"));
+        assert_eq!(twin.net, init, "{}", model.name());
+        assert!(twin.losses.is_empty());
+        let record = twin.training_record(&set).unwrap();
+        assert!(
+            !record.evidence.trained,
+            "{}: {:?}",
+            model.name(),
+            record.evidence
+        );
+        let trained = ugl_bench::repr::neural::train(
+            model,
+            &tiny(model, Variant::Corrected, 30),
+            &set,
+            2,
+            &mut stream_named(5, "twin"),
+            None,
+        )
+        .unwrap();
+        assert_ne!(trained.net, init);
+        assert_ne!(twin.encode(&set).unwrap(), {
+            let mut t = trained;
+            t.encode(&set).unwrap()
+        });
+    }
 }

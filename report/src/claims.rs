@@ -4,9 +4,11 @@
 //! A claim compares *subject* conditions with *reference* conditions, paired on some fields (the
 //! same environment, say). Each comparison is the difference `subject - reference` of the mean
 //! over seeds of a statistic (final KLC, area under the KLC curve, episodes that moved the
-//! object), with Welch's t interval (Welch 1947; the seeds of the two sides are independent
-//! samples; [`stats::interval`] shows by simulation that it covers at 5 and 20 seeds, where the
-//! percentile bootstrap does not). Fewer than two seeds on a side, or an infinite value, give no
+//! object), taken per repetition (the mean over its exploration replicates: [`seed_values`]).
+//! Two conditions with the same repetitions are compared with the paired t interval of the
+//! per-repetition differences, others with Welch's t interval (Welch 1947); the simulations
+//! of `report/src/stats/coverage.rs` show that both cover at the designs used, where the percentile
+//! bootstrap does not. Fewer than two repetitions on a side, or an infinite value, give no
 //! interval and an inconclusive comparison. The claim's relation is a set of differences
 //! (`d < 0`, `|d| < margin`, ...): a comparison is reproduced when its whole interval lies inside
 //! the set, not reproduced when it lies entirely outside, inconclusive otherwise.
@@ -140,9 +142,10 @@ pub struct PremiseCheck {
 pub trait Observations {
     /// The conditions, in report order.
     fn keys(&self) -> Vec<ConditionKey>;
-    /// The per-seed values of `statistic` for the condition `key` (seed order; empty when the
-    /// statistic is not measured there).
-    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64>;
+    /// The values of `statistic` for the condition `key`, one per repetition: `(seed, value)` in
+    /// seed order, the value the mean over the repetition's exploration replicates (empty when
+    /// the statistic is not measured there).
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)>;
     /// Whether `premise` holds on these results (None: it cannot be checked on them).
     fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
         let _ = premise;
@@ -160,11 +163,56 @@ impl Observations for CampaignObservations<'_> {
     fn keys(&self) -> Vec<ConditionKey> {
         self.conditions.iter().map(|c| c.key.clone()).collect()
     }
-    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<f64> {
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
         self.conditions
             .iter()
             .find(|c| &c.key == key)
-            .map(|c| values(self.store, c, statistic))
+            .map(|c| seed_values(self.store, c, statistic))
+            .unwrap_or_default()
+    }
+}
+
+/// The main campaign's conditions and, tagged `ALGO@TAG`, those of the campaigns that vary it
+/// on its repetitions (the `recipe` campaigns: `paper-untrained`'s twins are `rge-vae@untrained`,
+/// ...). A claim selects a variant's conditions by the tagged name and pairs a condition with
+/// its variant by [`Field::Learner`].
+pub struct TaggedObservations<'a> {
+    /// `(tag, conditions, the store holding their runs)`; the main campaign's tag is None.
+    pub parts: Vec<(Option<String>, &'a [ConditionSummary], &'a Store)>,
+}
+
+impl TaggedObservations<'_> {
+    fn tagged(tag: &Option<String>, key: &ConditionKey) -> ConditionKey {
+        match tag {
+            Some(t) => ConditionKey {
+                algo: format!("{}@{t}", key.algo),
+                ..key.clone()
+            },
+            None => key.clone(),
+        }
+    }
+}
+
+impl Observations for TaggedObservations<'_> {
+    fn keys(&self) -> Vec<ConditionKey> {
+        self.parts
+            .iter()
+            .flat_map(|(tag, conds, _)| conds.iter().map(|c| Self::tagged(tag, &c.key)))
+            .collect()
+    }
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
+        let tag = key.algo.split_once('@').map(|(_, t)| t.to_string());
+        let plain = ConditionKey {
+            algo: untagged(&key.algo).to_string(),
+            ..key.clone()
+        };
+        self.parts
+            .iter()
+            .filter(|(t, _, _)| *t == tag)
+            .find_map(|(_, conds, store)| {
+                let c = conds.iter().find(|c| c.key == plain)?;
+                Some(seed_values(store, c, statistic))
+            })
             .unwrap_or_default()
     }
 }
@@ -238,6 +286,16 @@ pub enum Statistic {
     /// Mean distance from the origin (the centre of the disk of reachable positions) of the
     /// object's final positions in the episodes that moved it: larger is nearer the boundary.
     Boundary,
+    /// KL-coverage of the outcomes of the episodes that moved the object only, at the last
+    /// epoch (lower is better; [`crate::discovery`]): KLC without the repeats of the resting
+    /// position.
+    MovedKlc,
+    /// Goal-reaching error: the mean distance from a fixed grid of test goals (spread over the
+    /// achievable outcomes) to the nearest outcome reached, at the last epoch (lower is better;
+    /// [`crate::discovery`]).
+    GoalError,
+    /// The 90th percentile of those distances (lower is better).
+    GoalErrorP90,
     /// ArmBalls: the follow-up's exploration ratio of the controllable ball at the last epoch
     /// (ball cells visited, of all cells of its grid).
     BallRatio,
@@ -255,6 +313,9 @@ impl Statistic {
             Statistic::Moved => "episodes that moved the object",
             Statistic::Boundary => "mean distance of the moved object from the centre",
             Statistic::Coverage => "fraction of the achievable cells reached",
+            Statistic::MovedKlc => "final KLC of the episodes that moved the object",
+            Statistic::GoalError => "goal-reaching error (mean)",
+            Statistic::GoalErrorP90 => "goal-reaching error (90th percentile)",
             Statistic::BallRatio => "final exploration ratio of the ball",
             Statistic::BallModuleGoals => "share of goals in the ball's module",
         }
@@ -314,6 +375,9 @@ pub enum Field {
     Sampler,
     Latents,
     Variant,
+    /// The learner: the algorithm without a variant campaign's tag (`rge-vae` of
+    /// `rge-vae@untrained`), to pair a condition with its control.
+    Learner,
 }
 
 /// A latent-size selector: a number, or `"true"` for the environment's true dimension.
@@ -364,7 +428,13 @@ fn same_on(fields: &[Field], a: &ConditionKey, b: &ConditionKey) -> bool {
         Field::Sampler => a.sampler == b.sampler,
         Field::Latents => a.latents == b.latents,
         Field::Variant => a.variant == b.variant,
+        Field::Learner => untagged(&a.algo) == untagged(&b.algo),
     })
+}
+
+/// An algorithm without its variant campaign's tag (`rge-vae@untrained` → `rge-vae`).
+pub fn untagged(algo: &str) -> &str {
+    algo.split_once('@').map_or(algo, |(a, _)| a)
 }
 
 /// Reads and validates `claims.toml`: any problem is a [`ReportError::Invalid`] naming the file
@@ -493,12 +563,15 @@ pub struct Comparison {
     pub reference: ConditionKey,
     pub n_subject: usize,
     pub n_reference: usize,
+    /// Whether the interval is the paired t interval over the repetitions both sides ran
+    /// ([`is_paired`]); otherwise it is Welch's.
+    pub paired: bool,
     pub subject_mean: f64,
     pub reference_mean: f64,
     /// `subject_mean - reference_mean`.
     pub diff: f64,
-    /// Its Welch interval at the claims' confidence; `None` (no interval) with fewer than two
-    /// seeds on a side or an infinite value.
+    /// Its t interval at the claims' confidence (paired or Welch's); `None` (no interval) with
+    /// fewer than two seeds on a side or an infinite value.
     pub interval: Option<TInterval>,
     /// The margin of this comparison's relation (the claim's, or its `relative_margin` times
     /// the reference mean).
@@ -690,17 +763,71 @@ pub fn attach_paper_checks(
     }
 }
 
-/// The per-seed values of `statistic` for a condition (seed order). Runs whose curve has no area
-/// (fewer than two points) are left out of `auc`.
+/// Whether two conditions' values pair up: the same repetitions (seeds), at least two. The
+/// learners of a repetition share its data set and, replicate by replicate, its exploration
+/// streams, so their paired differences are less spread than independent samples (the noise
+/// campaign measured about half the spread); the baselines' streams are their own, and pairing
+/// them by repetition is still a valid pairing of independent repetitions. Paired by design,
+/// not chosen by the data: any two conditions of one campaign with the same repetitions pair.
+pub fn is_paired(x: &[(i64, f64)], y: &[(i64, f64)]) -> bool {
+    x.len() >= 2 && x.len() == y.len() && x.iter().zip(y).all(|(a, b)| a.0 == b.0)
+}
+
+/// The values of `statistic` per repetition of a condition: `(seed, mean over the seed's
+/// exploration replicates)`, in seed order. The repetition is the unit of the analysis: each
+/// has its own data set and fit, its replicates share them, so the replicates' mean is one
+/// independent observation (a two-level design analysed on its cluster means, which is exact
+/// for the balanced design the campaigns run).
+pub fn seed_values(
+    store: &Store,
+    cond: &ConditionSummary,
+    statistic: Statistic,
+) -> Vec<(i64, f64)> {
+    let mut per: std::collections::BTreeMap<i64, (f64, usize)> = Default::default();
+    let runs: Vec<i64> = cond.runs.iter().map(|&i| store.runs[i].seed).collect();
+    for (seed, v) in runs.into_iter().zip(run_values(store, cond, statistic)) {
+        if let Some(v) = v {
+            let e = per.entry(seed).or_insert((0.0, 0));
+            e.0 += v;
+            e.1 += 1;
+        }
+    }
+    per.into_iter()
+        .map(|(s, (t, n))| (s, t / n as f64))
+        .collect()
+}
+
+/// The values of `statistic` per repetition, without the seeds ([`seed_values`]).
 pub fn values(store: &Store, cond: &ConditionSummary, statistic: Statistic) -> Vec<f64> {
+    seed_values(store, cond, statistic)
+        .into_iter()
+        .map(|v| v.1)
+        .collect()
+}
+
+/// The value of `statistic` of each run of a condition (the condition's run order; None where
+/// it is not measured). Runs whose curve has no area (fewer than two points) have no `auc`.
+pub fn run_values(
+    store: &Store,
+    cond: &ConditionSummary,
+    statistic: Statistic,
+) -> Vec<Option<f64>> {
     cond.runs
         .iter()
-        .filter_map(|&i| {
+        .map(|&i| {
             let run = &store.runs[i];
             match statistic {
                 Statistic::FinalKlc => Some(run.final_point().klc),
                 Statistic::Moved => Some(run.final_point().n_moved as f64),
                 Statistic::Coverage => Some(run.final_point().coverage),
+                Statistic::MovedKlc | Statistic::GoalError | Statistic::GoalErrorP90 => {
+                    let d = crate::discovery::measure_run(run).ok().flatten()?;
+                    match statistic {
+                        Statistic::MovedKlc => d.moved_klc,
+                        Statistic::GoalError => Some(d.goal_error_mean),
+                        _ => Some(d.goal_error_p90),
+                    }
+                }
                 Statistic::Boundary => {
                     let r: Vec<f64> = run
                         .outcomes
@@ -743,21 +870,30 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
             let margin = claim.margin.unwrap_or(file.settings.margin);
             let mut comparisons = Vec::new();
             for s in keys.iter().filter(|k| claim.subject.matches(k)) {
-                let xs = obs.values(s, claim.statistic);
+                let sx = obs.values(s, claim.statistic);
                 for r in keys.iter().filter(|k| {
                     *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k)
                 }) {
-                    let ys = obs.values(r, claim.statistic);
-                    let unusable = |v: &[f64]| v.is_empty() || v.iter().any(|x| x.is_nan());
-                    if unusable(&xs) || unusable(&ys) {
+                    let sy = obs.values(r, claim.statistic);
+                    let unusable =
+                        |v: &[(i64, f64)]| v.is_empty() || v.iter().any(|x| x.1.is_nan());
+                    if unusable(&sx) || unusable(&sy) {
                         continue;
                     }
+                    let xs: Vec<f64> = sx.iter().map(|v| v.1).collect();
+                    let ys: Vec<f64> = sy.iter().map(|v| v.1).collect();
                     let (subject_mean, reference_mean) = (stats::mean(&xs), stats::mean(&ys));
                     let margin = match claim.relative_margin {
                         Some(f) => f * reference_mean.abs(),
                         None => margin,
                     };
-                    let interval = stats::welch_interval(&xs, &ys, file.settings.confidence).ok();
+                    let paired = is_paired(&sx, &sy);
+                    let interval = if paired {
+                        let d: Vec<f64> = xs.iter().zip(&ys).map(|(x, y)| x - y).collect();
+                        stats::t_interval(&d, file.settings.confidence).ok()
+                    } else {
+                        stats::welch_interval(&xs, &ys, file.settings.confidence).ok()
+                    };
                     let uncorrected = match interval {
                         Some(i) => {
                             Verdict::of_interval(i.lo, i.hi, claim.relation.interval(margin))
@@ -769,6 +905,7 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
                         reference: r.clone(),
                         n_subject: xs.len(),
                         n_reference: ys.len(),
+                        paired,
                         subject_mean,
                         reference_mean,
                         diff: subject_mean - reference_mean,
@@ -863,6 +1000,20 @@ pub(crate) mod tests {
         );
         // Claims on other statistics, only on our corrected variants, or on a condition the
         // paper ran but reported no value for (RFVAE-GP), cannot be checked.
+        // Our controls (untrained twins, the random projection, the position-only EFR) are
+        // not in the paper.
+        let paper_unchecked: Vec<&str> = unchecked
+            .iter()
+            .copied()
+            .filter(|id| {
+                !file
+                    .claims
+                    .iter()
+                    .any(|c| c.id == *id && c.source.contains("a control of ours"))
+            })
+            .collect();
+        assert_eq!(unchecked.len() - paper_unchecked.len(), 13);
+        let unchecked = paper_unchecked;
         assert_eq!(
             unchecked,
             [
@@ -1190,7 +1341,12 @@ pair_on = ["env"]
     #[test]
     fn holm_correction_changes_a_verdict() {
         let efr: &[f64] = &[4.5, 4.6, 4.4, 4.55, 4.45];
-        let shifted: Vec<f64> = efr.iter().map(|v| v + 0.13).collect();
+        // Paired (same seeds): the differences 0.13, 0.03, 0.23, 0.08, 0.18 (t = 3.68, 4 df).
+        let shifted: Vec<f64> = efr
+            .iter()
+            .zip([0.13, 0.03, 0.23, 0.08, 0.18])
+            .map(|(v, d)| v + d)
+            .collect();
         let (store, conds) = synthetic(&[
             ("rge-efr", 0, efr),
             ("rge-pca", 10, &shifted),
@@ -1245,6 +1401,7 @@ pair_on = ["env"]
                 reference: k("rge-efr"),
                 n_subject: 5,
                 n_reference: 5,
+                paired: false,
                 subject_mean: 0.0,
                 reference_mean: 0.0,
                 diff: estimate,

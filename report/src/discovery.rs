@@ -527,6 +527,19 @@ pub fn measure_run(run: &Run) -> Result<Option<Discovery>, DiscoveryError> {
     EnvMeasures::by_name(&run.key.env)?.measure(&run.outcomes, None)
 }
 
+/// The goal-reaching error of an exploration that never moved the object: every outcome at the
+/// object's resting position (read from an outcome of `run` that did not move it). The
+/// leaderboard's unit for the error, as `ln(cells)` is KL-coverage's: 1 is "never moved the
+/// object", 0 "reached every test goal". None when every outcome of the run moved it.
+pub fn error_at_rest(run: &Run) -> Option<f64> {
+    let rest = run.outcomes.iter().find(|o| !o.moved)?;
+    let d = EnvMeasures::by_name(&run.key.env)
+        .ok()?
+        .measure(std::slice::from_ref(rest), None)
+        .ok()??;
+    Some(d.goal_error_mean)
+}
+
 // ---------------------------------------------------------------------------------------------
 // Every run of the report, measured; the validity check.
 

@@ -14,9 +14,16 @@
 //! * the paper's value where it has one for every task of the entry: the mean of its (single-run)
 //!   normalised final KLC values.
 //!
+//! * **IQM** of the normalised goal-reaching error (the mean distance from a fixed grid of test
+//!   goals to the nearest outcome, divided by that of an exploration that never moved the
+//!   object), likewise: the ranking statistic, since KL-coverage mostly counts the episodes
+//!   that moved the object (`crate::discovery` checks which measures tell a goal space that
+//!   encodes the object's position from an untrained one).
+//!
 //! Baselines (RPE, RGE-EFR) do not depend on the latent size: their runs serve both tasks of an
-//! environment. Entries are ranked by the IQM of the normalised final KLC (lower first); entries
-//! that miss some task are ranked after the complete ones.
+//! environment. Entries are ranked by the IQM of the normalised goal-reaching error (lower
+//! first); entries that miss some task are ranked after the complete ones. A value is a
+//! repetition's: the mean over its exploration replicates.
 
 use std::collections::BTreeMap;
 
@@ -45,9 +52,13 @@ pub struct Entry {
     pub variant: String,
     /// The tasks it has runs on, in task order.
     pub tasks: Vec<Task>,
-    pub n_runs: usize,
+    pub n_reps: usize,
     /// (point, lo, hi) of the IQM of the normalised final KLC.
     pub final_iqm: (f64, f64, f64),
+    /// (point, lo, hi) of the IQM of the normalised goal-reaching error (the error divided by
+    /// that of an exploration that never moved the object, [`crate::discovery::error_at_rest`]);
+    /// the ranking statistic.
+    pub goal_iqm: Option<(f64, f64, f64)>,
     /// (point, lo, hi) of the IQM of the normalised area under the curve.
     pub auc_iqm: Option<(f64, f64, f64)>,
     /// (point, lo, hi) of `P(X < RGE-EFR)`; `None` for EFR itself or without EFR runs.
@@ -108,8 +119,19 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     tasks.sort_by_key(|(env, l)| (ugl_types::EnvSpec::order(env), env.clone(), -*l));
     let alpha = 1.0 - confidence;
 
-    // entry -> task -> (final values, auc values, paper value, final coverages)
-    type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>)>;
+    // The goal-reaching error of an exploration that never moved the object, per environment.
+    let mut rest: BTreeMap<String, f64> = BTreeMap::new();
+    for src in sources {
+        for r in &src.store.runs {
+            if !rest.contains_key(&r.key.env)
+                && let Some(e) = crate::discovery::error_at_rest(r)
+            {
+                rest.insert(r.key.env.clone(), e);
+            }
+        }
+    }
+    // entry -> task -> (final values, auc values, paper value, final coverages, goal errors)
+    type PerTask = BTreeMap<usize, (Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>, Vec<f64>)>;
     let mut groups: BTreeMap<EntryKey, PerTask> = BTreeMap::new();
     let mut untrained: BTreeMap<EntryKey, usize> = BTreeMap::new();
     let mut at_rpe: BTreeMap<EntryKey, usize> = BTreeMap::new();
@@ -161,6 +183,13 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 .map(|v| v / max)
                 .collect();
             let coverages = claims::values(src.store, c, Statistic::Coverage);
+            let goals: Vec<f64> = match rest.get(&c.key.env) {
+                Some(&r) if r > 0.0 => claims::values(src.store, c, Statistic::GoalError)
+                    .iter()
+                    .map(|v| v / r)
+                    .collect(),
+                _ => Vec::new(),
+            };
             if c.key.latents == 0 {
                 shared.insert(key.clone());
             }
@@ -176,7 +205,13 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 if *env == c.key.env && (c.key.latents == *l || c.key.latents == 0) {
                     groups.entry(key.clone()).or_default().insert(
                         ti,
-                        (finals.clone(), aucs.clone(), paper_value, coverages.clone()),
+                        (
+                            finals.clone(),
+                            aucs.clone(),
+                            paper_value,
+                            coverages.clone(),
+                            goals.clone(),
+                        ),
                     );
                 }
             }
@@ -199,7 +234,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             // A baseline's runs are the same in both tasks of an environment: in the pooled
             // statistics (IQM, mean, run count) they count once, one stratum per environment.
             let mut seen_envs: Vec<&str> = Vec::new();
-            let strata: Vec<&(Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>)> = per
+            let strata: Vec<&(Vec<f64>, Vec<f64>, Option<f64>, Vec<f64>, Vec<f64>)> = per
                 .iter()
                 .filter(|(t, _)| {
                     let env = tasks[**t].0.as_str();
@@ -224,6 +259,18 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 alpha,
                 stats::derive_seed(seed, &format!("{label}|final")),
             )?;
+            let goal_strata: Vec<Vec<f64>> = strata.iter().map(|v| v.4.clone()).collect();
+            let goal_iqm = if goal_strata.iter().all(|g| !g.is_empty()) {
+                stratified_bootstrap_ci(
+                    &goal_strata,
+                    iqm,
+                    n_boot,
+                    alpha,
+                    stats::derive_seed(seed, &format!("{label}|goal")),
+                )
+            } else {
+                None
+            };
             let auc_iqm = stratified_bootstrap_ci(
                 &aucs,
                 iqm,
@@ -257,8 +304,9 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 sampler,
                 variant,
                 tasks: per.keys().map(|&t| tasks[t].clone()).collect(),
-                n_runs: finals.iter().map(Vec::len).sum(),
+                n_reps: finals.iter().map(Vec::len).sum(),
                 final_iqm,
+                goal_iqm,
                 auc_iqm,
                 poi_vs_efr,
                 paper,
@@ -275,7 +323,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     entries.sort_by(|a, b| {
         b.is_complete(n_tasks)
             .cmp(&a.is_complete(n_tasks))
-            .then(a.final_iqm.0.total_cmp(&b.final_iqm.0))
+            .then(rank_value(a).total_cmp(&rank_value(b)))
             .then_with(|| {
                 (&a.campaign, &a.algo, &a.sampler, &a.variant).cmp(&(
                     &b.campaign,
@@ -290,6 +338,16 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
         entries,
         confidence,
         n_boot,
+    }
+}
+
+/// What the leaderboard ranks by: the IQM of the normalised goal-reaching error, which does
+/// not count repeated outcomes (entries without it, e.g. runs without outcomes, after those
+/// with it, by final KLC).
+fn rank_value(e: &Entry) -> f64 {
+    match e.goal_iqm {
+        Some(g) => g.0,
+        None => 10.0 + e.final_iqm.0,
     }
 }
 
@@ -336,7 +394,7 @@ mod tests {
         assert_eq!(lb.entries[2].poi_vs_efr, Some((0.0, 0.0, 0.0)));
         assert_eq!(lb.entries[1].poi_vs_efr, None);
         // EFR's runs serve both tasks, and count once in its pooled statistics.
-        assert_eq!(lb.entries[1].n_runs, 4);
+        assert_eq!(lb.entries[1].n_reps, 4);
         assert_eq!(lb.entries[1].tasks.len(), 2);
         assert!(!lb.entries[3].is_complete(2));
     }

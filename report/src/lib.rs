@@ -112,9 +112,24 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     } else {
         None
     };
+    // The recipe campaigns (the untrained twins, ...) on the main campaign's repetitions,
+    // tagged for the claims that compare a learner with its variant.
+    let recipe_conditions: Vec<(String, Vec<aggregate::ConditionSummary>)> = camps
+        .recipe
+        .iter()
+        .map(|c| {
+            let tag = c.decl.tag.clone().unwrap_or_else(|| c.name.clone());
+            (tag, aggregate::aggregate(&c.store, &paper))
+        })
+        .collect();
+    let mut parts = vec![(None, conditions.as_slice(), store)];
+    for ((tag, conds), c) in recipe_conditions.iter().zip(&camps.recipe) {
+        parts.push((Some(tag.clone()), conds.as_slice(), &c.store));
+    }
+    let observations = claims::TaggedObservations { parts };
     let mut claim_results = claims_file
         .as_ref()
-        .map(|f| claims::evaluate(f, &conditions, store))
+        .map(|f| claims::evaluate_on(f, &observations))
         .unwrap_or_default();
     let keys: Vec<_> = conditions.iter().map(|c| c.key.clone()).collect();
     claims::attach_paper_checks(&mut claim_results, &keys, &paper);

@@ -301,6 +301,12 @@ impl EnvSpec {
             .collect()
     }
 
+    /// Whether the engineered outcome holds more than the objects' positions (ArmArrow's angle):
+    /// only then is the position-only goal space (`rge-efr-position`) a condition of its own.
+    pub fn has_orientation(&self) -> bool {
+        self.position_dims().len() < self.state_dim
+    }
+
     /// The controllable object's name (`ball`, `arrow`), or `object` when several are.
     pub fn controllable_object(&self) -> &'static str {
         let mut c = self.objects.iter().filter(|o| o.controllable);

@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use super::config::CampaignConfig;
 use crate::env::EnvKind;
-use crate::explore::{Algo, SamplerKind};
+use crate::explore::{Algo, GoalSpaceKind, SamplerKind};
 use crate::repr::neural::Variant;
 
 /// One run of the matrix.
@@ -198,12 +198,20 @@ impl RunSpec {
 /// exploration replicate).
 /// Learned goal spaces are crossed with `matrix.samplers` and `matrix.latents`; the VAE and
 /// RFVAE also with `matrix.variants`. `gaussian` goals need a prior, so they are planned only
-/// for the learners that may have one (VAE, RFVAE, external), as in the paper.
+/// for the learners that may have one (VAE, RFVAE, external), as in the paper. The position-only
+/// engineered goal space is planned only where the outcome has more than the positions.
 pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
     let mut runs = Vec::new();
     for &env in &cfg.matrix.envs {
         for &algo in &cfg.matrix.algos {
             let Some(learner) = algo.learner() else {
+                if algo.space() == GoalSpaceKind::EngineeredPosition
+                    && !env.spec().has_orientation()
+                {
+                    // The position is the whole engineered outcome (ArmBall): the run would be
+                    // RGE-EFR's, byte for byte.
+                    continue;
+                }
                 for seed in 0..cfg.campaign.reps as u64 {
                     for j in 0..cfg.campaign.explorations as u32 {
                         runs.push(RunSpec::baseline(env, algo, seed).with_exploration(j));
@@ -350,6 +358,26 @@ mod tests {
             )
             .run_id(),
             "armball.rge-ae.kde.l2.s0"
+        );
+    }
+
+    /// The position-only engineered goal space is a condition only where the outcome has an
+    /// orientation (ArmArrow); on ArmBall it would repeat RGE-EFR's runs.
+    #[test]
+    fn the_position_only_goal_space_is_planned_where_there_is_an_angle() {
+        let text = "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\n\
+                    envs = [\"armball\", \"armarrow\", \"armballs\"]\n\
+                    algos = [\"rge-efr\", \"rge-efr-position\"]\n";
+        let cfg = CampaignConfig::from_toml(text, std::path::Path::new("t.toml")).unwrap();
+        let ids: Vec<String> = plan(&cfg).iter().map(|r| r.run_id()).collect();
+        assert_eq!(
+            ids,
+            [
+                "armball.rge-efr.s0",
+                "armarrow.rge-efr.s0",
+                "armarrow.rge-efr-position.s0",
+                "armballs.rge-efr.s0",
+            ]
         );
     }
 

@@ -114,7 +114,9 @@ impl Model {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NeuralConfig {
-    /// Optimiser steps.
+    /// Optimiser steps. 0 keeps the initial weights: the *untrained twin* of a trained network
+    /// (same architecture, init, data set and exploration streams), the control of
+    /// `data/campaigns/paper-untrained.toml`.
     pub iterations: usize,
     /// Hidden sizes `[H1, H2]` (paper: 1200, 1200).
     pub hidden: [usize; 2],
@@ -152,7 +154,7 @@ impl NeuralConfig {
     /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
     pub fn capacity_at(&self, step: usize) -> Option<f64> {
         self.capacity
-            .map(|c| c * (step as f64 / self.iterations as f64).min(1.0))
+            .map(|c| c * (step as f64 / self.iterations.max(1) as f64).min(1.0))
     }
 
     /// The paper's configuration of `model`, faithful variant.
@@ -181,9 +183,6 @@ impl NeuralConfig {
                 format!("{who}: {msg}")
             }))
         };
-        if self.iterations == 0 {
-            return bad("iterations must be at least 1".into());
-        }
         if self.batch == 0 {
             return bad("batch must be at least 1".into());
         }

@@ -54,15 +54,18 @@ impl Observations for FollowupObservations<'_> {
         keys
     }
 
-    fn values(&self, k: &ConditionKey, statistic: Statistic) -> Vec<f64> {
+    fn values(&self, k: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
         let runs: Vec<&FollowupRun> = self.runs.iter().filter(|r| key(r) == *k).collect();
-        match statistic {
-            Statistic::BallRatio => runs.iter().map(|r| r.final_ratio()).collect(),
-            Statistic::BallModuleGoals => {
-                runs.iter().filter_map(|r| ball_module_goals(r)).collect()
-            }
+        let mut v: Vec<(i64, f64)> = match statistic {
+            Statistic::BallRatio => runs.iter().map(|r| (r.seed, r.final_ratio())).collect(),
+            Statistic::BallModuleGoals => runs
+                .iter()
+                .filter_map(|r| Some((r.seed, ball_module_goals(r)?)))
+                .collect(),
             _ => Vec::new(),
-        }
+        };
+        v.sort_by_key(|x| x.0);
+        v
     }
 
     fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {

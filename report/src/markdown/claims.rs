@@ -71,12 +71,20 @@ fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
 pub fn method_text(confidence: f64) -> String {
     let level = confidence * 100.0;
     format!(
-        "Each comparison is Δ = subject − reference of the mean over seeds, with its {level:.0}% \
-         Welch t interval (Welch 1947: the two sides' seeds are independent samples, their \
-         variances not assumed equal; no interval with fewer than 2 seeds on a side). In a seeded \
-         simulation at the measured spread (`report/src/stats/coverage.rs`: 4000 replicates per \
-         case) the nominal 95% Welch interval covers 0.95-0.96 at 5 seeds per side and \
-         0.945-0.955 at 20, on normal samples and on skewed (lognormal) ones; the percentile \
+        "Each comparison is Δ = subject − reference of the mean over repetitions. A repetition \
+         (seed) has its own data set and fit, and its exploration replicates share them, so a \
+         condition's value per repetition is the mean over its replicates and the repetitions \
+         are the independent observations. When both sides ran the same repetitions (any two \
+         conditions of one campaign), the interval is the {level:.0}% paired t interval of the \
+         per-repetition differences (Student 1908): the learners of a repetition share its data \
+         set and exploration streams, so the pairing removes what they share. Otherwise it is \
+         Welch's t interval (Welch 1947: independent sides, variances not assumed equal). No \
+         interval with fewer than 2 repetitions on a side. In a seeded simulation at the \
+         measured spread (`report/src/stats/coverage.rs`: 4000 replicates per case) the nominal \
+         95% intervals cover 0.93-0.97: Welch's at 5 and 20 seeds per side, on normal samples \
+         and on skewed (lognormal) ones, and the paired one on the two-level design at 5 x 1 \
+         and 10 x 3 (repetitions x replicates), with correlated or independent fits; the \
+         percentile \
          bootstrap used before covered 0.85-0.88 at 5 seeds, and BCa no better. No interval \
          computed from 5 seeds covers a rare outlier (a seed stuck at RPE level with \
          probability 0.1: 0.89; 0.91 at 20 seeds). A comparison is *reproduced* (✅) when its \
@@ -342,11 +350,18 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
          with the statistics of Agarwal et al. (2021, *rliable*). Scores are normalised so that \
          tasks pool: KLC divided by the KLC of outcomes all in one cell ({}), so 0 is a \
          perfect cover and 1 is \"the object never moved\"; \
-         lower is better. *Final*: interquartile mean (IQM) of the normalised final KLC over all \
-         runs of all tasks; *speed*: IQM of the normalised area under the KLC curve (the mean \
+         lower is better. *Goal error*: interquartile mean (IQM) over all repetitions of all \
+         tasks of the normalised goal-reaching error (the mean distance from a fixed grid of \
+         test goals over the achievable outcomes to the nearest outcome reached, divided by the \
+         error of an exploration that never moved the object: 0 reaches every goal, 1 never \
+         moved it). It does not count repeated outcomes, and the section *What the explorations \
+         discovered* checks it against the controls; the ranking uses it. *Final*: IQM of the \
+         normalised final KLC; *speed*: IQM of the normalised area under the KLC curve (the mean \
          KLC during exploration); *P(better than EFR)*: probability that a run beats a run of \
-         RGE-EFR on the same task, averaged over tasks (0.5: no difference). Brackets: {:.0}% \
-         stratified bootstrap intervals ({} resamples, runs resampled within each task, seeded). \
+         RGE-EFR on the same task, averaged over tasks (0.5: no difference). A value is a \
+         repetition's (the mean over its exploration replicates). Brackets: {:.0}% \
+         stratified bootstrap intervals ({} resamples, repetitions resampled within each task, \
+         seeded). \
          Baselines do not depend on the latent size: their runs serve both tasks of an \
          environment for the probability of improvement, and count once in their own IQM, mean \
          and run count (one stratum per environment). *Paper*: the mean of the paper's normalised single-run final values on the \
@@ -358,7 +373,7 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
          on. *Coverage*: the mean fraction of the achievable histogram cells its outcomes \
          reached (each run once). KL-coverage also rewards moving the object often (every \
          episode that leaves it in place adds to one cell), so an entry can rank high here \
-         with little coverage: read the two together. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *final*; entries missing a task come last.\n",
+         with little coverage: read the two together. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *goal error*; entries missing a task come last.\n",
         lb.tasks.len(),
         tasks.join(", "),
         super::paper_envs(|e| format!("ln {} on {}", e.klc.achievable_cells, e.display)),
@@ -367,11 +382,11 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
     );
     let _ = writeln!(
         w,
-        "| rank | algorithm | goal sampler | campaign | tasks | runs | untrained | at RPE level | final (IQM) | final (mean) | coverage | speed (IQM) | P(better than EFR) | paper |"
+        "| rank | algorithm | goal sampler | campaign | tasks | repetitions | untrained | at RPE level | goal error (IQM) | final (IQM) | final (mean) | coverage | speed (IQM) | P(better than EFR) | paper |"
     );
     let _ = writeln!(
         w,
-        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     let n = lb.tasks.len();
     for (i, e) in lb.entries.iter().enumerate() {
@@ -379,7 +394,7 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
         let name = condition_name(&e.algo, &e.variant);
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.1}% | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.1}% | {} | {} | {} |",
             if e.is_complete(n) {
                 (i + 1).to_string()
             } else {
@@ -400,7 +415,7 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
             sampler_name(&e.sampler),
             super::campaign_name(&e.campaign),
             tasks_cell(e, n),
-            e.n_runs,
+            e.n_reps,
             match e.untrained {
                 Some(0) => "0".to_string(),
                 Some(k) => format!("**{k}**"),
@@ -411,6 +426,7 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
                 Some(k) => format!("**{k}**"),
                 None => "—".into(),
             },
+            e.goal_iqm.map(ci3).unwrap_or_else(|| "—".into()),
             ci3(e.final_iqm),
             e.final_mean,
             100.0 * e.coverage_mean,

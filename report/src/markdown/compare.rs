@@ -135,16 +135,16 @@ pub fn page(
         let _ = writeln!(w, "## {}\n", entry_name(e));
         let _ = writeln!(
             w,
-            "- {rank}; final IQM {:.3} [{:.3}, {:.3}], untrimmed mean {:.3}, over {} runs;",
-            e.final_iqm.0, e.final_iqm.1, e.final_iqm.2, e.final_mean, e.n_runs
+            "- {rank}; final IQM {:.3} [{:.3}, {:.3}], untrimmed mean {:.3}, over {} repetitions;",
+            e.final_iqm.0, e.final_iqm.1, e.final_iqm.2, e.final_mean, e.n_reps
         );
         let _ = writeln!(
             w,
             "- failed explorations (fewer than twice RPE's object moves): {};",
             e.at_rpe_level
                 .map_or("not measured (no RPE runs)".to_string(), |k| format!(
-                    "{k} of {}",
-                    e.n_runs
+                    "{k} run{}",
+                    if k == 1 { "" } else { "s" }
                 ))
         );
         let _ = writeln!(

@@ -87,6 +87,10 @@ impl Section for Claims {
     fn name(&self) -> &'static str {
         "claims"
     }
+    /// Our claims compare learners with their untrained twins (a `recipe` campaign).
+    fn wants(&self) -> &'static [CampaignRole] {
+        &[CampaignRole::Recipe]
+    }
     fn render(&self, ctx: &Context<'_>, _: &mut Output) -> Result<String, ReportError> {
         words(|w| claims::claims(w, ctx))
     }
