@@ -589,6 +589,26 @@ impl Comparison {
     pub fn bounds(&self) -> Option<(f64, f64)> {
         self.interval.map(|i| (i.lo, i.hi))
     }
+
+    /// A power statement for an undecided comparison: the repetitions per side at which its
+    /// interval would exclude the nearest boundary of `set` (the relation's set of differences),
+    /// if the difference and the spread stayed as observed. The interval's half-width shrinks
+    /// as `1/√n` (its t quantile is held at the observed one, so the estimate errs on the
+    /// large side). None without an interval or with a difference on the boundary itself.
+    pub fn repetitions_to_decide(&self, (a, b): (f64, f64)) -> Option<f64> {
+        let i = self.interval?;
+        let half = (i.hi - i.lo) / 2.0;
+        let gap = [a, b]
+            .into_iter()
+            .filter(|x| x.is_finite())
+            .map(|x| (i.estimate - x).abs())
+            .fold(f64::INFINITY, f64::min);
+        if !(gap.is_finite() && gap > 0.0) {
+            return None;
+        }
+        let n = self.n_subject.min(self.n_reference) as f64;
+        Some((n * (half / gap).powi(2)).ceil().max(n))
+    }
 }
 
 /// p-value of the test "the difference lies outside the open set `(a, b)`" (null: it lies

@@ -728,7 +728,7 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     // A compare campaign has no RPE of its own: "at RPE level" uses the main campaign's.
     let cells: Vec<&str> = row.split('|').map(str::trim).collect();
     assert_eq!(cells[8], "**6**", "at RPE level: {row}");
-    assert!(cells[11].ends_with('%'), "coverage: {row}");
+    assert!(cells[12].ends_with('%'), "coverage: {row}");
     assert!(md.contains("1 `compare-*` campaign in the store"));
     // Its one-page summary: rank, failures, coverage, latent R², PoI against each algorithm.
     let page_path = out.join("compare_compare-random-projection.md");
@@ -736,7 +736,7 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     let page = std::fs::read_to_string(&page_path).unwrap();
     assert!(page.contains("**rank 1 of "), "{page}");
     assert!(
-        page.contains("failed explorations (fewer than twice RPE's object moves): 6 of 6"),
+        page.contains("failed explorations (fewer than twice RPE's object moves): 6 runs"),
         "{page}"
     );
     assert!(
@@ -759,11 +759,11 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     );
     // Claims: the committed claims file is evaluated, and the verdicts are counted.
     assert!(md.contains("## The paper's claims"));
-    // 22 of the paper's claims in the headline; our one finding apart.
+    // 22 of the paper's claims in the headline; our 14 findings apart.
     let summary = line(&md, "**The paper's claims**", "of 22 claims of the paper");
     assert!(summary.contains("reproduced"), "{summary}");
     assert!(
-        summary.contains("(1 finding(s) of ours are listed apart)"),
+        summary.contains("(14 finding(s) of ours are listed apart)"),
         "{summary}"
     );
     assert!(md.contains("| `rfvae-worse` |"));

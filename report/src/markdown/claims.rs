@@ -242,6 +242,95 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
     }
 }
 
+/// The report's conclusions, generated from the verdicts (nothing is written per result): what
+/// the evidence supports, what it contradicts, and the claims still undecided with the number
+/// of repetitions that would decide them at the observed difference and spread.
+pub fn conclusions(w: &mut String, inp: &Context<'_>) {
+    let ClaimsInput::Evaluated { results, .. } = inp.claims else {
+        return;
+    };
+    let _ = writeln!(
+        w,
+        "## Conclusions
+"
+    );
+    let _ = writeln!(
+        w,
+        "Generated from the verdicts above: the claims the results support, those they \
+         contradict, and those they leave undecided. For an undecided claim, *repetitions to \
+         decide* is the number of repetitions per condition at which every undecided \
+         comparison's interval would clear the nearest boundary of its claim, if the observed \
+         differences and spread held (the interval's half-width shrinks as 1/√n); \
+         \"—\" where an observed difference sits on the boundary, which no number of \
+         repetitions decides.\n"
+    );
+    for ours in [false, true] {
+        let part: Vec<&ClaimResult> = results.iter().filter(|r| r.claim.ours == ours).collect();
+        if part.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            w,
+            "**{}** ({} claims)\n",
+            if ours {
+                "Our controls and findings"
+            } else {
+                "The paper's claims"
+            },
+            part.len()
+        );
+        for (verdict, title) in [
+            (Verdict::Reproduced, "Supported"),
+            (Verdict::NotReproduced, "Contradicted"),
+            (Verdict::Inconclusive, "Undecided"),
+        ] {
+            let these: Vec<&&ClaimResult> = part.iter().filter(|r| r.verdict == verdict).collect();
+            if these.is_empty() {
+                continue;
+            }
+            let _ = writeln!(w, "- *{title}* ({}):", these.len());
+            for r in these {
+                let extra = if verdict == Verdict::Inconclusive {
+                    let set = r.claim.relation.interval(r.margin);
+                    let undecided: Vec<&Comparison> = r
+                        .comparisons
+                        .iter()
+                        .filter(|c| c.verdict == Verdict::Inconclusive)
+                        .collect();
+                    if r.comparisons.is_empty() {
+                        " (no condition of these results matches)".to_string()
+                    } else {
+                        let ns: Vec<Option<f64>> = undecided
+                            .iter()
+                            .map(|c| c.repetitions_to_decide(set))
+                            .collect();
+                        let have = undecided
+                            .iter()
+                            .map(|c| c.n_subject.min(c.n_reference))
+                            .min()
+                            .unwrap_or(0);
+                        match ns.iter().copied().collect::<Option<Vec<f64>>>() {
+                            Some(v) if !v.is_empty() => {
+                                let n = v.into_iter().fold(0.0, f64::max);
+                                if n > 1000.0 {
+                                    format!(" (repetitions to decide: more than 1000; {have} run)")
+                                } else {
+                                    format!(" (repetitions to decide: about {n:.0}; {have} run)")
+                                }
+                            }
+                            _ => format!(" (repetitions to decide: —; {have} run)"),
+                        }
+                    }
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(w, "  - `{}`: {}{extra}", r.claim.id, r.claim.statement);
+            }
+        }
+        let _ = writeln!(w);
+    }
+}
+
 fn claims_table(w: &mut String, results: &[&ClaimResult]) {
     let _ = writeln!(
         w,

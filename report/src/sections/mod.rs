@@ -46,6 +46,7 @@ pub static SECTIONS: &[&dyn Section] = &[
     &paper::FinalTable,
     &paper::Claims,
     &paper::Leaderboard,
+    &paper::Conclusions,
     &paper::Figure4,
     &paper::Variants,
     &paper::Budget,

@@ -96,6 +96,17 @@ impl Section for Claims {
     }
 }
 
+/// What the evidence supports, contradicts and leaves undecided (generated from the verdicts).
+pub struct Conclusions;
+impl Section for Conclusions {
+    fn name(&self) -> &'static str {
+        "conclusions"
+    }
+    fn render(&self, ctx: &Context<'_>, _: &mut Output) -> Result<String, ReportError> {
+        words(|w| claims::conclusions(w, ctx))
+    }
+}
+
 /// The leaderboard of the main and `compare` campaigns.
 pub struct Leaderboard;
 impl Section for Leaderboard {
