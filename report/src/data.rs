@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
 use crate::load::Run;
-use crate::markdown::quality::group_r2;
 use crate::output::Output;
 
 /// The directory under the report's output.
@@ -96,9 +95,9 @@ pub fn write(out: &mut Output, camps: &Campaigns) -> Result<Vec<PathBuf>, Report
                         .unwrap_or(1)
                         .to_string())
                     .unwrap_or_default(),
-                num(group_r2(&r.manifest, "position").map(|g| g.1)),
-                num(group_r2(&r.manifest, "angle").map(|g| g.1)),
-                num(group_r2(&r.manifest, "angle_mod_120").map(|g| g.1)),
+                num(r.manifest.group_r2("position").map(|g| g.1)),
+                num(r.manifest.group_r2("angle").map(|g| g.1)),
+                num(r.manifest.group_r2("angle_mod_120").map(|g| g.1)),
             );
             for p in &r.curve {
                 let _ = writeln!(

@@ -35,7 +35,6 @@ use ugl_types::EnvSpec;
 use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
 use crate::load::{Outcome, Run};
-use crate::markdown::quality::group_r2;
 use crate::output::Output;
 
 /// Goal grid: position cells per axis over [-1, 1] (cells of 0.2; their centres inside the open
@@ -586,7 +585,7 @@ pub fn group_of(run: &Run) -> Option<Group> {
     if run.key.algo == "rge-efr" {
         return Some(Group::Encodes);
     }
-    group_r2(m, "position")
+    m.group_r2("position")
         .filter(|&(_, knn)| knn >= POSITION_R2)
         .map(|_| Group::Encodes)
 }
@@ -800,7 +799,7 @@ pub fn write_csv(out: &mut Output, rows: &[RunRow<'_>]) -> Result<(), ReportErro
                 .trained()
                 .map(|t| t.to_string())
                 .unwrap_or_default(),
-            num(group_r2(&run.manifest, "position").map(|g| g.1)),
+            num(run.manifest.group_r2("position").map(|g| g.1)),
             r.group.map(Group::name).unwrap_or_default(),
             d.map(|d| d.n_outcomes.to_string()).unwrap_or_default(),
             d.map(|d| d.n_moved.to_string()).unwrap_or_default(),

@@ -164,6 +164,16 @@ impl Manifest {
         self.train_field("evidence")?.get("trained")?.as_bool()
     }
 
+    /// The (linear, k-NN) R² of a group of targets (`position`, `angle`, `angle_mod_120`) in
+    /// the latent quality (measure version 2 and later).
+    pub fn group_r2(&self, group: &str) -> Option<(f64, f64)> {
+        let groups = self.latent_quality.as_ref()?.get("groups")?.as_array()?;
+        let g = groups
+            .iter()
+            .find(|g| g.get("group").and_then(|v| v.as_str()) == Some(group))?;
+        Some((g.get("linear_r2")?.as_f64()?, g.get("knn_r2")?.as_f64()?))
+    }
+
     /// `CPU model (SIMD level)`.
     pub fn cpu_label(&self) -> Option<String> {
         self.cpu

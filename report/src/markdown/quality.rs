@@ -58,14 +58,9 @@ pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
     Some((e.get("loss_fraction")?.as_f64()?, m.trained()?))
 }
 
-/// The (linear, k-NN) R² of a group of targets (`position`, `angle`, `angle_mod_120`) in a
-/// manifest's latent quality (measure version 2 and later).
+/// The (linear, k-NN) R² of a group of targets ([`Manifest::group_r2`]).
 pub fn group_r2(m: &Manifest, group: &str) -> Option<(f64, f64)> {
-    let groups = m.latent_quality.as_ref()?.get("groups")?.as_array()?;
-    let g = groups
-        .iter()
-        .find(|g| g.get("group").and_then(|v| v.as_str()) == Some(group))?;
-    Some((g.get("linear_r2")?.as_f64()?, g.get("knn_r2")?.as_f64()?))
+    m.group_r2(group)
 }
 
 pub(crate) fn median(v: &[f64]) -> Option<f64> {
