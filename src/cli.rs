@@ -145,26 +145,25 @@ pub(crate) enum Command {
     /// paper's), into data/results/compare-NAME; the report ranks it against the paper's
     /// algorithms with the same statistics.
     Compare(CompareArgs),
-    /// Write a Slurm array job (one task per shard) and a merge step for a campaign.
-    Slurm {
+    /// Write a Slurm job for a campaign into a job directory: an array job (one task per
+    /// shard), a report step that runs once every task succeeded, and `submit.sh`, which builds
+    /// ugl once and submits both. Nothing is written into the checkout unless told.
+    Slurm(SlurmArgs),
+    /// How far a campaign's results directory is: runs complete, missing, damaged or of
+    /// another configuration, overall and per shard (what a resumed campaign would compute).
+    Status {
         /// Campaign file (data/campaigns/NAME.toml).
         #[arg(long)]
         config: PathBuf,
-        /// Number of array tasks (shards).
-        #[arg(long)]
-        shards: usize,
-        /// Results directory the tasks write to (on a shared file system).
+        /// Results directory (default: data/results/<campaign name>).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Directory for the generated scripts.
-        #[arg(long, default_value = "slurm")]
-        scripts: PathBuf,
-        /// CPUs per task (each task runs that many runs in parallel).
-        #[arg(long, default_value_t = 2)]
-        cpus: usize,
-        /// Wall-time limit per task (Slurm syntax).
-        #[arg(long, default_value = "04:00:00")]
-        time: String,
+        /// Also count per shard of this many (as `ugl slurm --shards` deals them).
+        #[arg(long, default_value_t = 1)]
+        shards: usize,
+        /// Exit with an error unless every run is complete.
+        #[arg(long)]
+        require_complete: bool,
     },
     /// Merge run files from several results directories (e.g. one per machine) into one store.
     Merge {
@@ -192,6 +191,46 @@ pub(crate) enum Command {
         #[arg(long = "main", default_value = "paper")]
         main_campaign: String,
     },
+}
+
+/// `ugl slurm`'s options.
+#[derive(clap::Args, Debug)]
+pub(crate) struct SlurmArgs {
+    /// Campaign file (data/campaigns/NAME.toml).
+    #[arg(long)]
+    pub(crate) config: PathBuf,
+    /// Number of array tasks (shards): 1 to the campaign's number of fit groups (runs sharing a
+    /// trained representation stay in one shard).
+    #[arg(long)]
+    pub(crate) shards: usize,
+    /// Results directory the tasks write to, on a file system every node sees (default:
+    /// data/results/<campaign name>). Not the checkout or a directory above it.
+    #[arg(long)]
+    pub(crate) out: Option<PathBuf>,
+    /// Job directory: the scripts, bin/ugl and logs/ (default: OUT/slurm).
+    #[arg(long)]
+    pub(crate) scripts: Option<PathBuf>,
+    /// Where the report step writes REPORT.md and its figures (default: OUT/report).
+    #[arg(long)]
+    pub(crate) report_out: Option<PathBuf>,
+    /// CPUs per task (each task runs that many runs in parallel), 1 to 1024.
+    #[arg(long, default_value_t = 2)]
+    pub(crate) cpus: usize,
+    /// Wall-time limit per task, in Slurm's syntax: MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM or
+    /// D-HH:MM:SS.
+    #[arg(long, default_value = "04:00:00")]
+    pub(crate) time: String,
+    /// Wall-time limit of the report step.
+    #[arg(long, default_value = "00:30:00")]
+    pub(crate) report_time: String,
+    /// At most this many tasks at once (Slurm's `--array=...%N`).
+    #[arg(long)]
+    pub(crate) throttle: Option<usize>,
+    /// An extra sbatch option for both jobs, long form with '=' (repeatable):
+    /// --sbatch-arg=--partition=NAME --sbatch-arg=--account=NAME --sbatch-arg=--qos=NAME
+    /// --sbatch-arg=--mem=8G.
+    #[arg(long = "sbatch-arg", allow_hyphen_values = true)]
+    pub(crate) sbatch_args: Vec<String>,
 }
 
 #[derive(clap::Args, Debug)]

@@ -20,7 +20,7 @@ use ugl_bench::campaign::plan;
 use ugl_bench::campaign::single::RunRequest;
 
 use crate::cli::{Cli, Command};
-use crate::commands::campaign::{campaign, merge, slurm};
+use crate::commands::campaign::{campaign, merge, slurm, status};
 use crate::commands::compare::{compare, learners};
 use crate::commands::environment::{klc, render, rollout};
 use crate::commands::single::{embed, run};
@@ -165,14 +165,13 @@ fn dispatch(cmd: Command) -> Result<()> {
             refresh_diagnostics,
             &cache,
         ),
-        Command::Slurm {
+        Command::Slurm(a) => slurm(a),
+        Command::Status {
             config,
-            shards,
             out,
-            scripts,
-            cpus,
-            time,
-        } => slurm(&config, shards, out, &scripts, cpus, &time),
+            shards,
+            require_complete,
+        } => status(&config, out, shards, require_complete),
         Command::Merge { into, sources } => merge(&into, &sources),
         Command::Learners => learners(),
         Command::Compare(a) => compare(a),

@@ -585,6 +585,50 @@ fn shards_merge_into_the_whole_campaign() {
     );
 }
 
+/// `ugl status` says what a resumed campaign would compute: complete, missing and damaged runs,
+/// overall and per shard; `--require-complete` fails until every run is there.
+#[test]
+fn status_counts_complete_missing_and_damaged_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("st.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"st\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\", \"rge-efr\"]\n\
+         [explore]\nepochs = 60\neval_every = 20\n",
+    )
+    .unwrap();
+    let out = dir.path().join("st");
+    let status = |extra: &[&str]| {
+        let mut args = vec!["status", "--config", p(&cfg), "--out", p(&out)];
+        args.extend_from_slice(extra);
+        ugl(&args)
+    };
+    let o = status(&["--shards", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("4 runs: 0 complete, 4 missing"), "{text}");
+    assert_one_line_error(&status(&["--require-complete"]), "is not complete");
+    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = status(&["--shards", "2", "--require-complete"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains(": 4 runs: 4 complete\n"), "{text}");
+    assert!(text.contains("shard 0/2: 2 runs: 2 complete"), "{text}");
+    assert!(text.contains("shard 1/2: 2 runs: 2 complete"), "{text}");
+    std::fs::remove_file(out.join("armball.rpe.s0.json")).unwrap();
+    std::fs::write(out.join("armball.rge-efr.s1.parquet"), b"damaged").unwrap();
+    let o = status(&[]);
+    let text = stdout(&o);
+    assert!(
+        text.contains("4 runs: 2 complete, 1 missing, 1 damaged"),
+        "{text}"
+    );
+    assert!(text.contains("missing: armball.rpe.s0\n"), "{text}");
+    assert!(text.contains("damaged: armball.rge-efr.s1 ("), "{text}");
+    assert_one_line_error(&status(&["--require-complete"]), "1 missing, 1 damaged");
+}
+
 #[test]
 fn slurm_scripts() {
     let dir = tempfile::tempdir().unwrap();
@@ -607,8 +651,14 @@ fn slurm_scripts() {
     );
     let submit = std::fs::read_to_string(scripts.join("submit.sh")).unwrap();
     assert!(
-        submit.contains("--dependency=afterok:${jid} report.sh"),
+        submit.contains("--dependency=afterok:\"$jid\" --kill-on-invalid-dep=yes report.sh"),
         "{submit}"
+    );
+    assert!(
+        array
+            .lines()
+            .all(|l| l.starts_with('#') || !l.contains("cargo")),
+        "no cargo on a compute node: {array}"
     );
     for f in ["array.sh", "report.sh", "submit.sh"] {
         let st = Command::new("bash")
@@ -629,6 +679,85 @@ fn slurm_scripts() {
         ]),
         "--shards",
     );
+}
+
+/// Every option of `ugl slurm` is checked before a script is written: the hostile audit's cases
+/// (a newline in --time that would run a command, nonsense shard and CPU counts, an --out above
+/// the checkout, an sbatch option that breaks its line) are one line and exit 2, and leave no
+/// script behind.
+#[test]
+fn slurm_refuses_bad_options_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scripts = dir.path().join("job");
+    let base = [
+        "slurm",
+        "--config",
+        "data/campaigns/baselines.toml",
+        "--scripts",
+        p(&scripts),
+    ];
+    let cases: [(&[&str], &str); 12] = [
+        (
+            &["--shards", "2", "--time", "04:00:00\ntouch PWNED"],
+            "--time",
+        ),
+        (&["--shards", "2", "--time", "banana"], "--time"),
+        (&["--shards", "2", "--time", ""], "--time"),
+        (
+            &["--shards", "2", "--report-time", "25:99:00"],
+            "--report-time",
+        ),
+        (
+            &["--shards", "5000"],
+            "--shards 5000: must be between 1 and 20",
+        ),
+        (&["--shards", "18446744073709551615"], "--shards"),
+        (&["--shards", "0"], "--shards 0"),
+        (
+            &["--shards", "2", "--cpus", "100000000"],
+            "--cpus 100000000",
+        ),
+        (&["--shards", "2", "--out", ".."], "is the checkout"),
+        (&["--shards", "2", "--report-out", "."], "is the checkout"),
+        (&["--shards", "2", "--throttle", "3"], "--throttle 3"),
+        (
+            &[
+                "--shards",
+                "2",
+                "--sbatch-arg",
+                "--partition=x\ntouch PWNED",
+            ],
+            "--sbatch-arg",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend_from_slice(extra);
+        assert_one_line_error(&ugl(&args), expected);
+        assert!(!scripts.exists(), "{extra:?} wrote no script");
+    }
+    // Extra sbatch options reach both jobs; a throttle the array.
+    let mut args: Vec<&str> = base.to_vec();
+    args.extend_from_slice(&[
+        "--shards",
+        "4",
+        "--throttle",
+        "2",
+        "--sbatch-arg=--partition=short",
+        "--sbatch-arg",
+        "--mem=2G",
+    ]);
+    let o = ugl(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let array = std::fs::read_to_string(scripts.join("array.sh")).unwrap();
+    let report = std::fs::read_to_string(scripts.join("report.sh")).unwrap();
+    assert!(array.contains("#SBATCH --array=0-3%2\n"), "{array}");
+    for text in [&array, &report] {
+        assert!(
+            text.contains("#SBATCH --partition=short\n#SBATCH --mem=2G\n"),
+            "{text}"
+        );
+    }
 }
 
 /// A tiny profile with the neural learners.
@@ -1401,16 +1530,16 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
     };
     exe(
         "cargo",
-        "#!/usr/bin/env bash\n# fake cargo: `build` succeeds, `run ... -- ARGS` runs ugl ARGS\n\
-         [ \"$1\" = build ] && exit 0\nwhile [ \"$1\" != -- ]; do shift; done; shift\n\
-         exec \"$UGL_BIN\" \"$@\"\n",
+        "#!/usr/bin/env bash\n# fake cargo: `build` reports the test's ugl binary as cargo's JSON does\n\
+         [ \"$1\" = build ] || exit 1\n\
+         echo '{\"reason\":\"compiler-artifact\",\"executable\":\"'\"$UGL_BIN\"'\",\"fresh\":true}'\n",
     );
     exe(
         "sbatch",
         "#!/usr/bin/env bash\n# fake sbatch: runs the script now (every array task in turn)\n\
-         parsable=0; script=\"\"\nfor a in \"$@\"; do case \"$a\" in --parsable) parsable=1;; \
-         --*) ;; *) script=\"$a\";; esac; done\n\
-         last=$(sed -n 's/^#SBATCH --array=0-\\([0-9]*\\)$/\\1/p' \"$script\")\n\
+         parsable=0; script=\"\"; last=\"\"\nfor a in \"$@\"; do case \"$a\" in --parsable) parsable=1;; \
+         --array=*) last=${a#--array=0-}; last=${last%%%*};; --*) ;; *) script=\"$a\";; esac; done\n\
+         [ -n \"$last\" ] || last=$(sed -n 's/^#SBATCH --array=0-\\([0-9]*\\).*$/\\1/p' \"$script\")\n\
          if [ -n \"$last\" ]; then for i in $(seq 0 \"$last\"); do \
          SLURM_ARRAY_TASK_ID=$i bash \"$script\" || exit 1; done; else bash \"$script\" || exit 1; fi\n\
          [ $parsable = 1 ] && echo 42\nexit 0\n",
@@ -1452,10 +1581,18 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
         })
         .count();
     assert_eq!(n, 4, "every run of the campaign");
-    let report = std::fs::read_to_string(work.join("report/out/REPORT.md")).unwrap();
+    let report = std::fs::read_to_string(out.join("report/REPORT.md")).unwrap();
     assert!(
         report.contains("tiny-camp"),
         "the report draws on the campaign"
+    );
+    assert!(
+        !work.join("report").exists(),
+        "the report step writes next to the results, not into the checkout"
+    );
+    assert!(
+        scripts.join("bin/ugl").is_file(),
+        "the tasks run the binary submit.sh copied"
     );
 }
 

@@ -10,7 +10,7 @@ use ugl_bench::campaign::config::CampaignConfig;
 use ugl_bench::campaign::plan::parse_shard;
 use ugl_bench::campaign::{CampaignOptions, Harness, Progress, plan, run_campaign};
 
-use crate::cli::CacheArgs;
+use crate::cli::{CacheArgs, SlurmArgs};
 use crate::commands::single::check_out_dir;
 use crate::progress::{learner_lines, stop_on_ctrl_c, training_bars};
 
@@ -177,38 +177,130 @@ pub(crate) fn run_config(
     Ok(())
 }
 
-pub(crate) fn slurm(
-    config: &Path,
-    shards: usize,
-    out: Option<PathBuf>,
-    scripts: &Path,
-    cpus: usize,
-    time: &str,
-) -> Result<()> {
-    use ugl_bench::campaign::slurm::{SlurmJob, scripts as slurm_scripts, write_scripts};
-    let cfg = CampaignConfig::load(config)?;
-    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
+    use ugl_bench::campaign::plan::shard_groups;
+    use ugl_bench::campaign::slurm::{SlurmJob, resolve, scripts as slurm_scripts, write_scripts};
+    let cfg = CampaignConfig::load(&a.config)?;
     let cwd = std::env::current_dir().context("cannot read the current directory")?;
-    let (config_abs, out_abs) = (cwd.join(config), cwd.join(&out));
+    let checkout = resolve(&cwd, &cwd);
+    let out = a
+        .out
+        .unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let out = resolve(&out, &cwd);
+    let dir = resolve(&a.scripts.unwrap_or_else(|| out.join("slurm")), &cwd);
+    let report_out = resolve(&a.report_out.unwrap_or_else(|| out.join("report")), &cwd);
+    let config = resolve(&a.config, &cwd);
+    if !checkout.join("data/paper").is_dir() {
+        bail!(
+            "run ugl slurm from the repository's root: the report step reads the paper's \
+             reference values from {}/data/paper, which is not there",
+            checkout.display()
+        );
+    }
+    let runs = plan(&cfg);
+    let n_groups = shard_groups(&runs, cfg.ugl.images)
+        .into_iter()
+        .max()
+        .map_or(0, |g| g + 1);
     let job = SlurmJob {
         name: &cfg.campaign.name,
-        n_runs: plan(&cfg).len(),
-        checkout: &cwd,
-        config: &config_abs,
-        out: &out_abs,
-        shards,
-        cpus,
-        time,
+        n_runs: runs.len(),
+        n_groups,
+        checkout: &checkout,
+        config: &config,
+        out: &out,
+        report_out: &report_out,
+        dir: &dir,
+        shards: a.shards,
+        cpus: a.cpus,
+        time: &a.time,
+        report_time: &a.report_time,
+        throttle: a.throttle,
+        sbatch_args: &a.sbatch_args,
     };
     let texts = slurm_scripts(&job)?;
-    check_out_dir(scripts)?;
-    write_scripts(scripts, &texts)?;
+    check_out_dir(&dir)?;
+    write_scripts(&dir, &texts)?;
     eprintln!(
-        "wrote {}/{{array,report,submit}}.sh: {} runs in {shards} shards; run {}/submit.sh",
-        scripts.display(),
+        "wrote {}/{{array,report,submit}}.sh: {} runs in {} shards; run: bash {}/submit.sh",
+        dir.display(),
         job.n_runs,
-        scripts.display()
+        a.shards,
+        dir.display()
     );
+    Ok(())
+}
+
+/// `ugl status`: the state of a campaign's results directory, overall and per shard.
+pub(crate) fn status(
+    config: &Path,
+    out: Option<PathBuf>,
+    shards: usize,
+    require_complete: bool,
+) -> Result<()> {
+    use ugl_bench::campaign::status::{RunState, store_status};
+    let cfg = CampaignConfig::load(config)?;
+    if shards == 0 {
+        bail!("--shards must be at least 1");
+    }
+    let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
+    let st = store_status(&cfg, &out, shards)?;
+    let mut text = format!(
+        "campaign {} in {}: {}\n",
+        cfg.campaign.name,
+        out.display(),
+        st.counts().describe()
+    );
+    if shards > 1 {
+        for i in 0..shards {
+            text.push_str(&format!(
+                "  shard {i}/{shards}: {}\n",
+                st.shard_counts(i).describe()
+            ));
+        }
+    }
+    const SHOWN: usize = 10;
+    let mut list = |what: &str, ids: Vec<String>| {
+        if ids.is_empty() {
+            return;
+        }
+        let more = ids.len().saturating_sub(SHOWN);
+        let mut line = format!("  {what}: {}", ids[..ids.len().min(SHOWN)].join(", "));
+        if more > 0 {
+            line.push_str(&format!(" (and {more} more)"));
+        }
+        text.push_str(&line);
+        text.push('\n');
+    };
+    let ids = |f: &dyn Fn(&RunState) -> bool| -> Vec<String> {
+        st.runs
+            .iter()
+            .filter(|r| f(&r.state))
+            .map(|r| match &r.state {
+                RunState::Damaged(why) => format!("{} ({why})", r.run_id),
+                _ => r.run_id.clone(),
+            })
+            .collect()
+    };
+    list("missing", ids(&|s| *s == RunState::Missing));
+    list("damaged", ids(&|s| matches!(s, RunState::Damaged(_))));
+    list(
+        "of another configuration",
+        ids(&|s| *s == RunState::OtherConfiguration),
+    );
+    list("not in this campaign's plan", st.unplanned.clone());
+    if !st.is_complete() {
+        text.push_str("  (a resumed campaign computes the runs that are not complete)\n");
+    }
+    crate::output::outln!("{}", text.trim_end())?;
+    if require_complete && !st.is_complete() {
+        bail!(
+            "campaign {} in {} is not complete ({}): nothing rendered from partial results",
+            cfg.campaign.name,
+            out.display(),
+            st.counts().describe()
+        );
+    }
     Ok(())
 }
 

@@ -16,6 +16,7 @@ pub mod remeasure;
 pub mod runner;
 pub mod single;
 pub mod slurm;
+pub mod status;
 pub mod store;
 
 pub use config::{CampaignConfig, ConfigError};

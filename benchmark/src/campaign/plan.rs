@@ -247,33 +247,37 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
     runs
 }
 
+/// The representation group of every run of `runs`, numbered in plan order of first
+/// appearance: runs that share a trained representation share a group; every other run is a
+/// group of its own. Shards deal these groups round-robin ([`shard`]), so a campaign has at most
+/// `groups` non-empty shards.
+pub fn shard_groups(runs: &[RunSpec], images: usize) -> Vec<usize> {
+    let mut keys: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    runs.iter()
+        .map(|spec| {
+            let key = spec
+                .representation_identity(images)
+                .unwrap_or_else(|| spec.identity());
+            let next = keys.len();
+            *keys.entry(key).or_insert(next)
+        })
+        .collect()
+}
+
 /// A deterministic slice `index` of `count` (0-based) of the plan, for spreading a campaign over
 /// machines (`ugl campaign --shard i/n`). Runs that share a trained representation stay in one
-/// shard, so no representation is fitted twice; groups are dealt round-robin in plan order. The
-/// shards are disjoint and their union is the whole plan.
+/// shard, so no representation is fitted twice; groups are dealt round-robin in plan order
+/// ([`shard_groups`]). The shards are disjoint and their union is the whole plan.
 pub fn shard(runs: &[RunSpec], images: usize, index: usize, count: usize) -> Vec<RunSpec> {
     assert!(
         index < count,
         "shard index {index} must be below the shard count {count}"
     );
-    let mut keys: Vec<String> = Vec::new();
-    let mut out = Vec::new();
-    for spec in runs {
-        let key = spec
-            .representation_identity(images)
-            .unwrap_or_else(|| spec.identity());
-        let g = match keys.iter().position(|k| *k == key) {
-            Some(g) => g,
-            None => {
-                keys.push(key);
-                keys.len() - 1
-            }
-        };
-        if g % count == index {
-            out.push(spec.clone());
-        }
-    }
-    out
+    runs.iter()
+        .zip(shard_groups(runs, images))
+        .filter(|(_, g)| g % count == index)
+        .map(|(spec, _)| spec.clone())
+        .collect()
 }
 
 /// Parse `i/n` (0 <= i < n).
