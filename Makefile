@@ -11,11 +11,13 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test campaign bench verify verify-update check-toolchain check-shared-build
+.PHONY: help report test test-cargo test-slurm campaign bench verify verify-update check-toolchain check-shared-build
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
-	@echo "make test                the test suite (what CI runs)"
+	@echo "make test                the test suite (what CI runs): make test-cargo, then make test-slurm"
+	@echo "make test-cargo          cargo test --workspace (no cluster needed)"
+	@echo "make test-slurm          the cluster path on a private single-node Slurm (root; slurm-wlm, munge)"
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
 	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC, Isomap)"
 	@echo "make verify              rerun the smoke campaign; compare result checksums with data/checksums/smoke.sha256"
@@ -36,8 +38,16 @@ report: check-toolchain
 	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT) --main $(MAIN)
 	@echo "report: $(REPORT_OUT)/REPORT.md"
 
-test: check-toolchain
+test: test-cargo test-slurm
+
+test-cargo: check-toolchain
 	$(CARGO) test --workspace
+
+# The cluster path on a real Slurm: a private single-node cluster started and stopped by the
+# test (tests/slurm/real_cluster.sh). Needs root and Debian's slurm-wlm + munge (.ci/run installs
+# them); without them it fails and says so.
+test-slurm: check-toolchain
+	bash tests/slurm/real_cluster.sh
 
 campaign: check-toolchain
 	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))

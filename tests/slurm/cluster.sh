@@ -77,7 +77,7 @@ cluster_start() {
   cpus=$(nproc)
   cat > "$d/slurm.conf" <<CONF
 ClusterName=ugltest
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmctldPort=$ctl_port
 SlurmdPort=$node_port
 SlurmUser=root
@@ -105,7 +105,7 @@ ReturnToService=2
 MinJobAge=600
 SlurmctldTimeout=30
 SlurmdTimeout=30
-NodeName=$host CPUs=$cpus State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
   export SLURM_CONF="$d/slurm.conf"

@@ -318,7 +318,7 @@ pub fn scripts(job: &SlurmJob<'_>) -> Result<SlurmScripts, SlurmError> {
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
     let q = |p: &Path| sh_quote(p);
-    let (cwd_q, config_q, out_q, dir_q) = (q(job.checkout), q(job.config), q(job.out), q(job.dir));
+    let (cwd_q, config_q, out_q) = (q(job.checkout), q(job.config), q(job.out));
     let bin_q = q(&job.dir.join("bin/ugl"));
     let report_q = q(job.report_out);
     let throttle = job.throttle.map(|t| format!("%{t}")).unwrap_or_default();
@@ -380,10 +380,11 @@ pub fn scripts(job: &SlurmJob<'_>) -> Result<SlurmScripts, SlurmError> {
          \u{20}          or, without Slurm: {bin_q} status --config {config_q} --out {out_q} --shards {shards}\n  \
          logs:      {dir}/logs/\n  \
          a task that fails or is cancelled cancels the report step; fix the cause, then resubmit\n  \
-         \u{20}          the tasks that did not finish (finished runs are kept): bash {dir_q}/submit.sh TASKS\n  \
+         \u{20}          the tasks that did not finish (finished runs are kept): bash {submit_q} TASKS\n  \
          report:    {report}/REPORT.md\n\
          MSG\n",
         last = shards - 1,
+        submit_q = q(&job.dir.join("submit.sh")),
         dir = job.dir.display(),
         report = job.report_out.display(),
     );
