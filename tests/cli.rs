@@ -230,6 +230,81 @@ fn run_contract_and_determinism() {
     assert_eq!(m["explore"]["epochs"], 400);
 }
 
+/// A run measures what it discovered when it ends and records it in its manifest: the same
+/// numbers the report computes from its outcomes file. So the outcomes file may be left out of
+/// a store (the report and a resumed campaign accept the run without it), but not when the
+/// manifest records no measures, and a present outcomes file must still match its digest.
+#[test]
+fn a_run_records_its_discovery_and_its_outcomes_file_may_be_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    for (env, algo, id) in [
+        ("armarrow", "rge-efr", "armarrow.rge-efr.s1"),
+        ("armball", "rpe", "armball.rpe.s1"),
+    ] {
+        let out = dir.path().join(env);
+        let o = ugl(&[
+            "run",
+            "--env",
+            env,
+            "--algo",
+            algo,
+            "--seed",
+            "1",
+            "--epochs",
+            "300",
+            "--out",
+            p(&out),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let stem = out.join(id);
+        let run = ugl_report::load::load_run(&stem, String::new()).unwrap();
+        let recorded = run
+            .manifest
+            .discovery
+            .clone()
+            .expect("the manifest records discovery");
+        let spec = ugl_types::EnvSpec::by_name(env).unwrap();
+        let measured = ugl_types::RunDiscovery::measure(spec, &run.outcomes)
+            .unwrap()
+            .unwrap();
+        assert_eq!(
+            recorded, measured,
+            "{id}: recorded = measured from the outcomes file"
+        );
+        assert_eq!(recorded.at_end.klc, run.manifest.summary.final_klc, "{id}");
+        assert_eq!(recorded.at_end.n_outcomes, run.outcomes.len(), "{id}");
+        assert!(
+            recorded.error_at_rest.is_some(),
+            "{id}: some episode left the object"
+        );
+
+        // Without its outcomes file the run is still complete, with the same measures.
+        let outcomes = out.join(format!("{id}.outcomes.parquet"));
+        let bytes = std::fs::read(&outcomes).unwrap();
+        std::fs::remove_file(&outcomes).unwrap();
+        let kept = ugl_report::load::load_run(&stem, String::new()).unwrap();
+        assert!(kept.outcomes.is_empty());
+        assert_eq!(kept.discovery().unwrap(), Some(recorded.clone()));
+        ugl_types::verify_files(&out, &kept.manifest).unwrap();
+        // A present outcomes file must match its digest.
+        std::fs::write(&outcomes, &bytes[..bytes.len() / 2]).unwrap();
+        assert!(ugl_types::verify_files(&out, &kept.manifest).is_err());
+        assert!(ugl_report::load::load_run(&stem, String::new()).is_err());
+        // A manifest without measures needs its outcomes file: refused, naming it.
+        std::fs::remove_file(&outcomes).unwrap();
+        let json_path = out.join(format!("{id}.json"));
+        let mut m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+        m.as_object_mut().unwrap().remove("discovery");
+        std::fs::write(&json_path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+        let err = ugl_report::load::load_run(&stem, String::new()).unwrap_err();
+        assert!(
+            err.to_string().contains(&format!("{id}.outcomes.parquet")),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn run_errors() {
     let dir = tempfile::tempdir().unwrap();

@@ -848,15 +848,7 @@ pub fn run_values(
                         _ => Some(d.goal_error_p90),
                     }
                 }
-                Statistic::Boundary => {
-                    let r: Vec<f64> = run
-                        .outcomes
-                        .iter()
-                        .filter(|o| o.moved)
-                        .map(|o| o.x.hypot(o.y))
-                        .collect();
-                    (!r.is_empty()).then(|| r.iter().sum::<f64>() / r.len() as f64)
-                }
+                Statistic::Boundary => run.discovery().ok().flatten()?.moved_radius_mean,
                 Statistic::Auc => {
                     let e: Vec<f64> = run.curve.iter().map(|p| p.epoch as f64).collect();
                     let v: Vec<f64> = run.curve.iter().map(|p| p.klc).collect();

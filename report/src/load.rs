@@ -76,16 +76,8 @@ pub struct CurvePoint {
     pub coverage: f64,
 }
 
-/// One row of `<run_id>.outcomes.parquet`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Outcome {
-    pub index: i64,
-    pub epoch: i64,
-    pub x: f64,
-    pub y: f64,
-    pub angle: Option<f64>,
-    pub moved: bool,
-}
+/// One row of `<run_id>.outcomes.parquet` (`ugl-types`' type, which the measures read).
+pub use ugl_types::Outcome;
 
 /// The manifest of a run: the runner's own type (`ugl-types`), read through serde.
 pub use ugl_types::Manifest;
@@ -121,7 +113,8 @@ pub struct Run {
     pub seed: i64,
     /// Sorted by epoch, epochs distinct.
     pub curve: Vec<CurvePoint>,
-    /// In history order.
+    /// In history order; empty when the outcomes file is not kept (then the manifest records
+    /// what the run discovered, [`Manifest::discovery`]).
     pub outcomes: Vec<Outcome>,
     /// The manifest as the run wrote it, except `latent_quality`, which is its diagnostics
     /// sidecar's where there is one ([`ugl_types::Diagnostics`]: a later measure).
@@ -137,6 +130,23 @@ pub struct Run {
 impl Run {
     pub fn final_point(&self) -> &CurvePoint {
         self.curve.last().expect("curves are never empty")
+    }
+
+    /// What the run discovered: as its manifest records it (results version 4 on), else
+    /// measured from its outcomes with the same code ([`ugl_types::RunDiscovery::measure`]).
+    /// None for a run without outcomes.
+    pub fn discovery(&self) -> Result<Option<ugl_types::RunDiscovery>, ugl_types::DiscoveryError> {
+        if let Some(d) = &self.manifest.discovery {
+            return Ok(Some(d.clone()));
+        }
+        let spec = ugl_types::EnvSpec::by_name(&self.key.env)
+            .ok_or_else(|| ugl_types::DiscoveryError::UnknownEnv(self.key.env.clone()))?;
+        ugl_types::RunDiscovery::measure(spec, &self.outcomes)
+    }
+
+    /// Whether its outcomes were read (the outcomes file is kept).
+    pub fn has_outcomes(&self) -> bool {
+        !self.outcomes.is_empty()
     }
 }
 
@@ -169,13 +179,20 @@ pub struct CampaignDir {
     stems: BTreeMap<PathBuf, [bool; 3]>,
 }
 
+/// Whether a run's files make it complete: its curve and its manifest (written last). The
+/// outcomes file may be left out of a store when the manifest records what the run
+/// discovered; whether it may is the manifest's to say ([`ugl_types::verify_files`]).
+fn complete([curve, _, manifest]: [bool; 3]) -> bool {
+    curve && manifest
+}
+
 impl CampaignDir {
-    /// Runs whose three files are all present.
+    /// Runs whose curve and manifest are present.
     pub fn n_complete(&self) -> usize {
-        self.stems.values().filter(|p| p.iter().all(|&b| b)).count()
+        self.stems.values().filter(|&&p| complete(p)).count()
     }
 
-    /// Runs missing one of their three files.
+    /// Runs missing their curve or manifest (a run being written, or a damaged one).
     pub fn n_incomplete(&self) -> usize {
         self.stems.len() - self.n_complete()
     }
@@ -186,17 +203,13 @@ impl CampaignDir {
         let mut runs = Vec::new();
         let mut incomplete = Vec::new();
         for (stem, present) in &self.stems {
-            let [curve, outcomes, manifest] = *present;
-            if !(curve && outcomes && manifest) {
-                let missing: Vec<String> = [
-                    (curve, CURVE_SUFFIX),
-                    (outcomes, OUTCOMES_SUFFIX),
-                    (manifest, MANIFEST_SUFFIX),
-                ]
-                .iter()
-                .filter(|(p, _)| !p)
-                .map(|(_, s)| format!("{}{s}", stem_name(stem)))
-                .collect();
+            let [curve, _, manifest] = *present;
+            if !complete(*present) {
+                let missing: Vec<String> = [(curve, CURVE_SUFFIX), (manifest, MANIFEST_SUFFIX)]
+                    .iter()
+                    .filter(|(p, _)| !p)
+                    .map(|(_, s)| format!("{}{s}", stem_name(stem)))
+                    .collect();
                 tracing::warn!(run = %stem.display(), ?missing, "incomplete run skipped");
                 incomplete.push((stem.clone(), missing));
                 continue;
@@ -431,39 +444,19 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         ));
     }
 
-    let odf = read_parquet(&outcomes_path)?;
-    let o = Cols {
-        df: &odf,
-        path: &outcomes_path,
-    };
-    if odf.height() > 0 {
-        let orun = o.constant_str("run_id")?;
-        if orun != run_id {
-            return Err(column_error(
-                &outcomes_path,
-                "run_id",
-                format!("holds `{orun}`, the curve file holds `{run_id}`"),
-            ));
-        }
+    let outcomes = if outcomes_path.is_file() {
+        read_outcomes(&outcomes_path, &run_id)?
+    } else if manifest.discovery.is_some() {
+        Vec::new()
     } else {
-        o.require("run_id")?;
-    }
-    let index = o.i64s("index")?;
-    let oepoch = o.i64s("epoch")?;
-    let x = o.f64s("x")?;
-    let y = o.f64s("y")?;
-    let angle = o.f64s_nullable("angle")?;
-    let moved = o.bools("moved")?;
-    let outcomes = (0..odf.height())
-        .map(|i| Outcome {
-            index: index[i],
-            epoch: oepoch[i],
-            x: x[i],
-            y: y[i],
-            angle: angle[i],
-            moved: moved[i],
-        })
-        .collect();
+        return Err(ReportError::Invalid {
+            path: outcomes_path,
+            problem: "is missing, and the run's manifest records no discovery measures (written \
+                      before results version 4): restore the file, or resume the campaign to \
+                      recompute the run"
+                .into(),
+        });
+    };
 
     let mut key = key;
     reconcile_identity(&mut key, seed, &manifest, &manifest_path)?;
@@ -491,6 +484,40 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         outcomes_path,
         manifest_path,
     })
+}
+
+/// Reads a run's outcomes file, whose `run_id` column must be the curve file's `run_id`.
+fn read_outcomes(path: &Path, run_id: &str) -> Result<Vec<Outcome>, ReportError> {
+    let odf = read_parquet(path)?;
+    let o = Cols { df: &odf, path };
+    if odf.height() > 0 {
+        let orun = o.constant_str("run_id")?;
+        if orun != *run_id {
+            return Err(column_error(
+                path,
+                "run_id",
+                format!("holds `{orun}`, the curve file holds `{run_id}`"),
+            ));
+        }
+    } else {
+        o.require("run_id")?;
+    }
+    let index = o.i64s("index")?;
+    let oepoch = o.i64s("epoch")?;
+    let x = o.f64s("x")?;
+    let y = o.f64s("y")?;
+    let angle = o.f64s_nullable("angle")?;
+    let moved = o.bools("moved")?;
+    Ok((0..odf.height())
+        .map(|i| Outcome {
+            index: index[i],
+            epoch: oepoch[i],
+            x: x[i],
+            y: y[i],
+            angle: angle[i],
+            moved: moved[i],
+        })
+        .collect())
 }
 
 /// Checks the curve file's identity columns against the manifest's fields of the same name

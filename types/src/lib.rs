@@ -10,6 +10,8 @@
 //!   recorded beside its runs, so that the report never infers it from a directory name;
 //! - [`LearnerInfo`]: the representation learners' names, display names and paper training;
 //! - [`Diagnostics`]: measures taken after a run, beside it (manifests are immutable);
+//! - [`RunDiscovery`]: what a run discovered (KL-coverage, cells, goal-reaching error), measured
+//!   from its [`Outcome`]s by [`EnvMeasures`], recorded in its manifest;
 //! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs.
 //!
 //! ```
@@ -20,6 +22,7 @@
 
 mod campaign;
 mod diagnostics;
+mod discovery;
 mod env;
 mod goal_space;
 mod learner;
@@ -28,6 +31,10 @@ mod paths;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
+pub use discovery::{
+    Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Grid,
+    Outcome, RunDiscovery, median, quantile_sorted,
+};
 pub use env::{
     ARMARROW, ARMBALL, ARMBALLS, BUILT_IN, DISK, EnvSpec, EnvSpecError, KlcGrid, ObjectSpec,
     environments,

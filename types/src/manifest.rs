@@ -116,6 +116,11 @@ pub struct Manifest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub latent_quality: Option<serde_json::Value>,
     pub summary: Summary,
+    /// What the run discovered, measured from its outcomes when it ended (results version 4
+    /// on; [`crate::RunDiscovery`]). A run that records it is complete without its outcomes
+    /// file, which the committed stores keep only for some runs (`data/results/README.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub discovery: Option<crate::RunDiscovery>,
     /// The run's data files as written: name, length and BLAKE3 hash. A run is complete only
     /// if its files still match (checked on resume, merge and report). Absent in manifests
     /// written before it was recorded.
@@ -211,7 +216,23 @@ fn none_string() -> String {
     "none".into()
 }
 
-mod inf_as_string {
+/// An optional f64 that may be +inf, written as `inf_as_string` writes it; None is `null`.
+pub(crate) mod opt_inf_as_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(x) => super::inf_as_string::serialize(x, s),
+            None => s.serialize_none(),
+        }
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        #[derive(Deserialize)]
+        struct W(#[serde(with = "super::inf_as_string")] f64);
+        Ok(Option::<W>::deserialize(d)?.map(|W(x)| x))
+    }
+}
+
+pub(crate) mod inf_as_string {
     use serde::{Deserialize, Deserializer, Serializer};
     pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
         if v.is_infinite() && *v > 0.0 {

@@ -16,6 +16,7 @@ use crate::explore::{
 use crate::goals::{GaussianGoals, GoalSampler, KdeGoals};
 use crate::repr::{GaussianPrior, Latents, ReprError};
 use crate::seed::{Component, run_seed, stream};
+use ugl_types::RunDiscovery;
 
 use super::context::RunContext;
 use super::error::RunError;
@@ -222,6 +223,19 @@ pub fn execute(
     let wall_s = t0.elapsed().as_secs_f64();
     let log = explored.log;
     let summary = summarize(spec, &log);
+    // What the run discovered, recorded in its manifest so that the outcomes file need not be
+    // kept (`ugl_types::discovery`).
+    let discovery = match RunDiscovery::measure(spec.env.spec(), &store::outcomes_of(&log)) {
+        Ok(d) => d,
+        Err(e) => {
+            tracing::warn!(
+                "run {}: its discovery measures cannot be computed ({e}); the report will read \
+                 its outcomes file",
+                spec.run_id()
+            );
+            None
+        }
+    };
     let paper = ExploreConfig::default();
     let mut notes = Vec::new();
     if ctx.explore.epochs < paper.epochs {
@@ -285,6 +299,7 @@ pub fn execute(
         cpu: Some(cpu_info().clone()),
         latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
         summary: summary.clone(),
+        discovery,
         // Filled in by `write_run` from the bytes it writes.
         files: None,
     };

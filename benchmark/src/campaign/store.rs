@@ -14,7 +14,8 @@ use thiserror::Error;
 use super::plan::RunSpec;
 use crate::explore::ExplorationLog;
 pub use ugl_types::{
-    Diagnostics, DigestError, FileDigest, Manifest, RunPaths, Summary, run_paths, verify_files,
+    Diagnostics, DigestError, FileDigest, Manifest, Outcome, RunPaths, Summary, run_paths,
+    verify_files,
 };
 
 /// Errors of the results store.
@@ -63,6 +64,25 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         df.with_column(Column::new("control_coverage".into(), control(|v| v.1)))?;
     }
     Ok(df)
+}
+
+/// A run's outcomes as the discovery measures read them ([`ugl_types::Outcome`]: the same
+/// values as its outcomes table, `outcomes_frame`).
+pub fn outcomes_of(log: &ExplorationLog) -> Vec<Outcome> {
+    log.outcomes
+        .iter()
+        .zip(&log.epochs)
+        .zip(&log.moved)
+        .enumerate()
+        .map(|(i, ((s, &epoch), &moved))| Outcome {
+            index: i as i64,
+            epoch: epoch as i64,
+            x: s[0],
+            y: s[1],
+            angle: (log.dim == 3).then_some(s[2]),
+            moved,
+        })
+        .collect()
 }
 
 /// The outcomes table of a run; ArmBalls' distractor adds `distractor_x`, `distractor_y`.

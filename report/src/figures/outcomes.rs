@@ -24,13 +24,20 @@ const TITLE_H: u32 = 34;
 const DOT_ALPHA: f64 = 0.6;
 /// Length of an ArmArrow outcome's stroke, in world units (the arrow's radius is 10 px of 70).
 const STROKE: f64 = 0.08;
-/// The object's initial position in both environments (PAPER-NOTES section 1).
+/// The object's initial position in both environments (docs/original-code.md section 1).
 pub const INITIAL: (f64, f64) = (0.6, 0.6);
 
 /// The run shown for a condition: its median run by final KLC (for an even number of runs the
 /// lower of the two middle ones; ties by seed), so the panels show a typical run, not seed 0.
-pub fn representative<'a>(store: &'a Store, c: &ConditionSummary) -> &'a Run {
-    let mut runs: Vec<&Run> = c.runs.iter().map(|&i| &store.runs[i]).collect();
+/// Only runs whose outcomes file the store keeps are candidates (`data/results/README.md`);
+/// None when there is none.
+pub fn representative<'a>(store: &'a Store, c: &ConditionSummary) -> Option<&'a Run> {
+    let mut runs: Vec<&Run> = c
+        .runs
+        .iter()
+        .map(|&i| &store.runs[i])
+        .filter(|r| r.has_outcomes())
+        .collect();
     runs.sort_by(|a, b| {
         a.final_point()
             .klc
@@ -38,8 +45,7 @@ pub fn representative<'a>(store: &'a Store, c: &ConditionSummary) -> &'a Run {
             .then(a.seed.cmp(&b.seed))
             .then(a.campaign.cmp(&b.campaign))
     });
-    assert!(!runs.is_empty(), "a condition has runs");
-    runs[(runs.len() - 1) / 2]
+    (!runs.is_empty()).then(|| runs[(runs.len() - 1) / 2])
 }
 
 /// The epochs shown for a run whose last epoch is `last`: last/50, last/5 and last
@@ -76,7 +82,9 @@ pub fn draw_all(
 ) -> Result<Vec<FigureFile>, ReportError> {
     let mut out = Vec::new();
     for c in conditions {
-        let run = representative(store, c);
+        let Some(run) = representative(store, c) else {
+            continue;
+        };
         let last = run
             .outcomes
             .iter()
@@ -236,14 +244,36 @@ fn draw_panel(
 mod tests {
     use super::*;
 
+    /// Gives every run of the store one outcome (as if its outcomes file were kept).
+    fn keep_outcomes(store: &mut Store) {
+        for r in &mut store.runs {
+            r.outcomes = vec![crate::load::Outcome {
+                index: 0,
+                epoch: 0,
+                x: 0.6,
+                y: 0.6,
+                angle: None,
+                moved: false,
+            }];
+        }
+    }
+
     #[test]
     fn the_representative_run_is_the_median_by_final_klc() {
-        let (store, conds) =
+        let (mut store, conds) =
             crate::claims::tests::synthetic(&[("rge-efr", 0, &[5.0, 3.0, 4.0, 4.5])]);
+        // Without any outcomes file there is nothing to draw.
+        assert!(representative(&store, &conds[0]).is_none());
+        keep_outcomes(&mut store);
         // Final KLC 3.0 (seed 1), 4.0 (seed 2), 4.5 (seed 3), 5.0 (seed 0): the lower middle.
-        assert_eq!(representative(&store, &conds[0]).seed, 2);
-        let (store, conds) = crate::claims::tests::synthetic(&[("rge-efr", 0, &[5.0, 3.0, 4.0])]);
-        assert_eq!(representative(&store, &conds[0]).seed, 2);
+        assert_eq!(representative(&store, &conds[0]).unwrap().seed, 2);
+        // Among the runs whose outcomes are kept only: without seed 2's, 3.0 / 4.5 / 5.0.
+        store.runs[2].outcomes.clear();
+        assert_eq!(representative(&store, &conds[0]).unwrap().seed, 3);
+        let (mut store, conds) =
+            crate::claims::tests::synthetic(&[("rge-efr", 0, &[5.0, 3.0, 4.0])]);
+        keep_outcomes(&mut store);
+        assert_eq!(representative(&store, &conds[0]).unwrap().seed, 2);
     }
 
     #[test]

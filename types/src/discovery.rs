@@ -1,0 +1,762 @@
+//! What an exploration discovered, measured from its outcomes without counting repeats (the
+//! report's "exploration measures"; `docs/statistics.md`).
+//!
+//! KL-coverage (paper Section 4.2) compares the histogram of *every* outcome with the uniform
+//! distribution over the achievable cells, so each episode that leaves the object where it lay
+//! adds weight to one cell: a run that moves the object more often scores better whatever it
+//! found. Beside it:
+//!
+//! - **KL-coverage of all outcomes**, re-implemented from `benchmark/src/metrics/klc.rs` (numpy
+//!   `histogramdd` bins over [-1, 1], achievable cells = the (x, y) bins meeting the open unit
+//!   disk times every other bin; KLC = Σ p ln(p / q), +inf when an outcome lies outside the
+//!   achievable set). Its only role is to prove the re-implementation: it equals the runs' own
+//!   `klc` (the report's tests).
+//! - **KL-coverage of the moved outcomes only** (`moved`: the object moved in the episode), the
+//!   same histogram and formula over the episodes that changed something.
+//! - **Cell coverage**: the fraction of achievable cells holding at least one outcome (it
+//!   equals the runs' `coverage`).
+//! - **Goal-reaching error**: for a fixed grid of test goals spread over the achievable outcomes
+//!   ([`GoalGrid`]), the distance from each goal to the nearest discovered outcome, i.e. the error
+//!   of a nearest-neighbour inverse model on a deterministic environment (explauto's
+//!   `Evaluation`, which tests an inverse model on a fixed set of goals; the original code's
+//!   inverse-model error in `measures.py`). Mean and 90th percentile over the goals. Distances
+//!   are Euclidean in the controllable object's outcome coordinates
+//!   ([`crate::EnvSpec::metric_dims`]), the angle in units of π like the KL-coverage bins
+//!   it (not wrapped around).
+//!
+//! A run measures itself when it ends and records the result in its manifest
+//! ([`RunDiscovery`], `Manifest::discovery`, results version 4 on), so that its outcomes file,
+//! the largest of its files, need not be kept; the report measures older runs from their
+//! outcomes files with the same code.
+//!
+//! Everything is defined from the environment registry ([`crate::EnvSpec`]: its objects and
+//! KL-coverage grid), not from environment names, and a nearest-neighbour query goes through a
+//! k-d tree, so a whole store is measured in seconds.
+
+use serde::{Deserialize, Serialize};
+
+use crate::EnvSpec;
+
+/// One outcome of an exploration (a row of `<run_id>.outcomes.parquet`): the controllable
+/// object's state at the end of an episode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    pub index: i64,
+    pub epoch: i64,
+    pub x: f64,
+    pub y: f64,
+    pub angle: Option<f64>,
+    pub moved: bool,
+}
+
+/// Goal grid: position cells per axis over [-1, 1] (cells of 0.2; their centres inside the open
+/// unit disk are the position goals: 80 of the 100).
+pub const GOAL_POSITION_BINS: usize = 10;
+/// Goal grid: cells per measured coordinate beyond the position (ArmArrow's angle: 6 angles,
+/// the centres of cells of π/3).
+pub const GOAL_OTHER_BINS: usize = 6;
+
+/// Why a run cannot be measured.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DiscoveryError {
+    /// The run's environment is not in this build's registry.
+    #[error("environment `{0}` is not in the registry")]
+    UnknownEnv(String),
+    /// A measured outcome coordinate is not one the outcomes file holds (`x`, `y`, `angle`).
+    #[error(
+        "environment `{env}`: outcome column `{column}` is not one of the outcomes file's x, y, angle"
+    )]
+    Column { env: String, column: String },
+    /// The registry's grid is not of the form these measures know (the disk times full ranges).
+    #[error("environment `{env}`: {why}")]
+    Grid { env: String, why: String },
+    /// An outcome lacks a measured coordinate (a null angle) or holds a NaN.
+    #[error("outcome {index}: coordinate `{column}` is missing or NaN")]
+    BadOutcome { index: i64, column: String },
+}
+
+/// Which field of an [`Outcome`] a measured coordinate is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Coord {
+    X,
+    Y,
+    Angle,
+}
+
+impl Coord {
+    fn name(self) -> &'static str {
+        match self {
+            Coord::X => "x",
+            Coord::Y => "y",
+            Coord::Angle => "angle",
+        }
+    }
+
+    fn get(self, o: &Outcome) -> Option<f64> {
+        match self {
+            Coord::X => Some(o.x),
+            Coord::Y => Some(o.y),
+            Coord::Angle => o.angle,
+        }
+        .filter(|v| !v.is_nan())
+    }
+}
+
+/// The KL-coverage histogram grid of an environment, as `benchmark/src/metrics/klc.rs` builds
+/// it: `bins` per measured coordinate over [-1, 1]; the first two coordinates are the position,
+/// whose achievable bins meet the open unit disk (exact integer test), every bin of the others
+/// is achievable.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    dims: usize,
+    bins: usize,
+    edges: Vec<f64>,
+    achievable: Vec<bool>,
+    n_achievable: usize,
+}
+
+impl Grid {
+    /// The grid of `spec`, checked against the number of achievable cells it declares.
+    pub fn for_env(spec: &EnvSpec) -> Result<Self, DiscoveryError> {
+        let bad = |why: String| DiscoveryError::Grid {
+            env: spec.name.to_string(),
+            why,
+        };
+        let (dims, bins) = (spec.klc.dims, spec.klc.bins);
+        if dims < 2 || bins < 2 || bins % 2 != 0 {
+            return Err(bad(format!(
+                "a KL-coverage grid of {dims} coordinates and {bins} bins is not a disk grid"
+            )));
+        }
+        let n_cells = bins
+            .checked_pow(dims as u32)
+            .filter(|&n| n <= 1 << 26)
+            .ok_or_else(|| bad(format!("{bins}^{dims} cells is too many")))?;
+        // np.linspace(-1, 1, bins + 1), as the runs' measure computes it.
+        let step = 2.0 / bins as f64;
+        let mut edges: Vec<f64> = (0..=bins).map(|i| i as f64 * step + -1.0).collect();
+        edges[bins] = 1.0;
+        let half = (bins / 2) as i64;
+        let near = |i: usize| -> i64 {
+            let (lo, hi) = (i as i64 - half, i as i64 - half + 1);
+            if lo <= 0 && 0 <= hi {
+                0
+            } else {
+                lo.abs().min(hi.abs())
+            }
+        };
+        let per_pair = n_cells / (bins * bins);
+        let mut achievable = Vec::with_capacity(n_cells);
+        for ix in 0..bins {
+            for iy in 0..bins {
+                let (dx, dy) = (near(ix), near(iy));
+                let ok = dx * dx + dy * dy < half * half;
+                achievable.extend(std::iter::repeat_n(ok, per_pair));
+            }
+        }
+        let n_achievable = achievable.iter().filter(|&&a| a).count();
+        if n_achievable != spec.klc.achievable_cells {
+            return Err(bad(format!(
+                "the disk grid has {n_achievable} achievable cells, the registry declares {}",
+                spec.klc.achievable_cells
+            )));
+        }
+        Ok(Grid {
+            dims,
+            bins,
+            edges,
+            achievable,
+            n_achievable,
+        })
+    }
+
+    /// Achievable cells.
+    pub fn n_achievable(&self) -> usize {
+        self.n_achievable
+    }
+
+    /// Bin of one coordinate (numpy `histogramdd`: closed on the left, the last bin also on the
+    /// right); None outside [-1, 1].
+    fn bin(&self, v: f64) -> Option<usize> {
+        if !(-1.0..=1.0).contains(&v) {
+            return None;
+        }
+        if v == 1.0 {
+            return Some(self.bins - 1);
+        }
+        Some(self.edges.partition_point(|&e| e <= v) - 1)
+    }
+
+    /// Cell of a point (C order); None outside [-1, 1]^dims.
+    fn cell(&self, p: &[f64]) -> Option<usize> {
+        let mut idx = 0;
+        for &v in p {
+            idx = idx * self.bins + self.bin(v)?;
+        }
+        Some(idx)
+    }
+}
+
+/// A histogram of outcomes over a [`Grid`].
+struct Histogram<'g> {
+    grid: &'g Grid,
+    counts: Vec<u32>,
+    touched: Vec<usize>,
+    total: u64,
+    outside: u64,
+    reached: usize,
+}
+
+impl<'g> Histogram<'g> {
+    fn new(grid: &'g Grid) -> Self {
+        Histogram {
+            grid,
+            counts: vec![0; grid.achievable.len()],
+            touched: Vec::new(),
+            total: 0,
+            outside: 0,
+            reached: 0,
+        }
+    }
+
+    fn add(&mut self, p: &[f64]) {
+        self.total += 1;
+        match self.grid.cell(p) {
+            None => self.outside += 1,
+            Some(c) => {
+                if !self.grid.achievable[c] {
+                    self.outside += 1;
+                }
+                if self.counts[c] == 0 {
+                    self.touched.push(c);
+                    if self.grid.achievable[c] {
+                        self.reached += 1;
+                    }
+                }
+                self.counts[c] += 1;
+            }
+        }
+    }
+
+    /// KL(visited ‖ uniform on achievable), summed in cell order as the runs' measure does;
+    /// +inf with an outcome outside the achievable set; None without outcomes.
+    fn klc(&self) -> Option<f64> {
+        if self.total == 0 {
+            return None;
+        }
+        if self.outside > 0 {
+            return Some(f64::INFINITY);
+        }
+        let n = self.total as f64;
+        let q = 1.0 / self.grid.n_achievable as f64;
+        let mut cells = self.touched.clone();
+        cells.sort_unstable();
+        Some(cells.iter().fold(0.0, |s, &c| {
+            let p = self.counts[c] as f64 / n;
+            s + p * (p / q).ln()
+        }))
+    }
+
+    fn coverage(&self) -> f64 {
+        self.reached as f64 / self.grid.n_achievable as f64
+    }
+}
+
+/// The fixed test goals of an environment: the centres of a coarser grid's cells
+/// ([`GOAL_POSITION_BINS`] per position axis, kept when inside the open unit disk, times
+/// [`GOAL_OTHER_BINS`] centres per further measured coordinate), x-major. Deterministic, from
+/// the registry's grid alone.
+#[derive(Debug, Clone)]
+pub struct GoalGrid {
+    dims: usize,
+    /// Flattened, `dims` per goal.
+    goals: Vec<f64>,
+}
+
+impl GoalGrid {
+    /// The goals of an environment whose KL-coverage grid measures `dims` coordinates (≥ 2).
+    pub fn new(dims: usize) -> Self {
+        let centre = |i: usize, n: usize| -1.0 + (i as f64 + 0.5) * 2.0 / n as f64;
+        let mut goals = Vec::new();
+        let others = GOAL_OTHER_BINS.pow(dims.saturating_sub(2) as u32);
+        for ix in 0..GOAL_POSITION_BINS {
+            for iy in 0..GOAL_POSITION_BINS {
+                let (x, y) = (
+                    centre(ix, GOAL_POSITION_BINS),
+                    centre(iy, GOAL_POSITION_BINS),
+                );
+                if x * x + y * y >= 1.0 {
+                    continue;
+                }
+                for mut k in 0..others {
+                    goals.extend([x, y]);
+                    let mut rest = vec![0.0; dims.saturating_sub(2)];
+                    for r in rest.iter_mut().rev() {
+                        *r = centre(k % GOAL_OTHER_BINS, GOAL_OTHER_BINS);
+                        k /= GOAL_OTHER_BINS;
+                    }
+                    goals.extend(rest);
+                }
+            }
+        }
+        GoalGrid { dims, goals }
+    }
+
+    /// Number of goals.
+    pub fn len(&self) -> usize {
+        self.goals.len() / self.dims.max(1)
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.goals.is_empty()
+    }
+
+    /// The goals, `dims` coordinates each.
+    pub fn goals(&self) -> impl Iterator<Item = &[f64]> {
+        self.goals.chunks_exact(self.dims.max(1))
+    }
+}
+
+/// A static k-d tree over points of `dims` coordinates (median splits, cycling axes), for the
+/// nearest-neighbour distance of each goal.
+struct KdTree<'p> {
+    dims: usize,
+    points: &'p [f64],
+    /// Point indices in tree order: the node of `lo..hi` is its middle.
+    order: Vec<usize>,
+}
+
+impl<'p> KdTree<'p> {
+    fn new(points: &'p [f64], dims: usize) -> Self {
+        let mut order: Vec<usize> = (0..points.len() / dims).collect();
+        Self::build(points, dims, &mut order, 0);
+        KdTree {
+            dims,
+            points,
+            order,
+        }
+    }
+
+    fn build(points: &[f64], dims: usize, idx: &mut [usize], depth: usize) {
+        if idx.len() <= 1 {
+            return;
+        }
+        let axis = depth % dims;
+        let mid = idx.len() / 2;
+        idx.select_nth_unstable_by(mid, |&a, &b| {
+            points[a * dims + axis].total_cmp(&points[b * dims + axis])
+        });
+        let (left, right) = idx.split_at_mut(mid);
+        Self::build(points, dims, left, depth + 1);
+        Self::build(points, dims, &mut right[1..], depth + 1);
+    }
+
+    fn point(&self, i: usize) -> &[f64] {
+        &self.points[i * self.dims..(i + 1) * self.dims]
+    }
+
+    /// Distance from `q` to the nearest point; None for an empty tree.
+    fn nearest(&self, q: &[f64]) -> Option<f64> {
+        if self.order.is_empty() {
+            return None;
+        }
+        let mut best = f64::INFINITY;
+        self.search(q, 0, self.order.len(), 0, &mut best);
+        Some(best.sqrt())
+    }
+
+    fn search(&self, q: &[f64], lo: usize, hi: usize, depth: usize, best: &mut f64) {
+        if lo >= hi {
+            return;
+        }
+        let mid = lo + (hi - lo) / 2;
+        let p = self.point(self.order[mid]);
+        let d2: f64 = p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum();
+        if d2 < *best {
+            *best = d2;
+        }
+        let axis = depth % self.dims;
+        let diff = q[axis] - p[axis];
+        let (near, far) = if diff < 0.0 {
+            ((lo, mid), (mid + 1, hi))
+        } else {
+            ((mid + 1, hi), (lo, mid))
+        };
+        self.search(q, near.0, near.1, depth + 1, best);
+        if diff * diff < *best {
+            self.search(q, far.0, far.1, depth + 1, best);
+        }
+    }
+}
+
+/// The measures of one environment: its grid, its goals and which outcome fields it measures.
+#[derive(Debug, Clone)]
+pub struct EnvMeasures {
+    coords: Vec<Coord>,
+    grid: Grid,
+    goals: GoalGrid,
+}
+
+/// What a run discovered up to an epoch.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Discovery {
+    /// Outcomes up to the epoch.
+    pub n_outcomes: usize,
+    /// Those in which the object moved.
+    pub n_moved: usize,
+    /// KL-coverage of every outcome (the runs' own `klc`, recomputed); +inf is written "inf".
+    #[serde(with = "crate::manifest::inf_as_string")]
+    pub klc: f64,
+    /// KL-coverage of the moved outcomes only; None when the object never moved.
+    #[serde(with = "crate::manifest::opt_inf_as_string")]
+    pub moved_klc: Option<f64>,
+    /// Fraction of the achievable cells reached.
+    pub coverage: f64,
+    /// Mean distance from a test goal to the nearest outcome.
+    pub goal_error_mean: f64,
+    /// 90th percentile of those distances (linear interpolation between order statistics).
+    pub goal_error_p90: f64,
+}
+
+impl EnvMeasures {
+    /// The measures of `spec`: its controllable object's coordinates, its KL-coverage grid and
+    /// the goal grid of that many coordinates.
+    pub fn new(spec: &EnvSpec) -> Result<Self, DiscoveryError> {
+        let coords = spec
+            .metric_dims()
+            .map(|i| match spec.outcome_columns.get(i).copied() {
+                Some("x") => Ok(Coord::X),
+                Some("y") => Ok(Coord::Y),
+                Some("angle") => Ok(Coord::Angle),
+                other => Err(DiscoveryError::Column {
+                    env: spec.name.to_string(),
+                    column: other.unwrap_or("?").to_string(),
+                }),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let grid = Grid::for_env(spec)?;
+        if coords.len() != grid.dims {
+            return Err(DiscoveryError::Grid {
+                env: spec.name.to_string(),
+                why: format!(
+                    "the grid measures {} coordinates, the controllable objects have {}",
+                    grid.dims,
+                    coords.len()
+                ),
+            });
+        }
+        let goals = GoalGrid::new(grid.dims);
+        Ok(EnvMeasures {
+            coords,
+            grid,
+            goals,
+        })
+    }
+
+    /// The measures of the environment called `env`.
+    pub fn by_name(env: &str) -> Result<Self, DiscoveryError> {
+        let spec = EnvSpec::by_name(env).ok_or_else(|| DiscoveryError::UnknownEnv(env.into()))?;
+        Self::new(spec)
+    }
+
+    /// The test goals.
+    pub fn goals(&self) -> &GoalGrid {
+        &self.goals
+    }
+
+    /// The KL-coverage grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The measures of `outcomes` whose epoch is at most `epoch` (every outcome with None).
+    /// None when there is no such outcome.
+    pub fn measure(
+        &self,
+        outcomes: &[Outcome],
+        epoch: Option<i64>,
+    ) -> Result<Option<Discovery>, DiscoveryError> {
+        let d = self.coords.len();
+        let mut points = Vec::with_capacity(outcomes.len() * d);
+        let mut all = Histogram::new(&self.grid);
+        let mut moved = Histogram::new(&self.grid);
+        let mut p = vec![0.0; d];
+        for o in outcomes
+            .iter()
+            .filter(|o| epoch.is_none_or(|e| o.epoch <= e))
+        {
+            for (v, c) in p.iter_mut().zip(&self.coords) {
+                *v = c.get(o).ok_or_else(|| DiscoveryError::BadOutcome {
+                    index: o.index,
+                    column: c.name().to_string(),
+                })?;
+            }
+            all.add(&p);
+            if o.moved {
+                moved.add(&p);
+            }
+            points.extend_from_slice(&p);
+        }
+        let Some(klc) = all.klc() else {
+            return Ok(None);
+        };
+        let tree = KdTree::new(&points, d);
+        let mut errors: Vec<f64> = self.goals.goals().filter_map(|g| tree.nearest(g)).collect();
+        errors.sort_by(f64::total_cmp);
+        Ok(Some(Discovery {
+            n_outcomes: all.total as usize,
+            n_moved: moved.total as usize,
+            klc,
+            moved_klc: moved.klc(),
+            coverage: all.coverage(),
+            goal_error_mean: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+            goal_error_p90: quantile_sorted(&errors, 0.9).unwrap_or(f64::NAN),
+        }))
+    }
+}
+
+/// The `q` quantile of sorted values, linear interpolation between order statistics (numpy's
+/// default); None when empty.
+pub fn quantile_sorted(sorted: &[f64], q: f64) -> Option<f64> {
+    let n = sorted.len();
+    if n == 0 {
+        return None;
+    }
+    let pos = q.clamp(0.0, 1.0) * (n - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    Some(sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64))
+}
+
+/// The median of values (sorted copy); None when empty.
+pub fn median(v: &[f64]) -> Option<f64> {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    quantile_sorted(&s, 0.5)
+}
+
+/// What a run discovered by its end, as its manifest records it (`Manifest::discovery`): the
+/// measures of every outcome ([`Discovery`]) and the two numbers the report derives from the
+/// outcomes beside them. Computed by [`RunDiscovery::measure`] from the outcomes in memory when
+/// the run ends, or by the report from an older run's outcomes file: the same code, the same
+/// numbers (the outcomes file stores the f64 values exactly).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunDiscovery {
+    /// The measures of every outcome, at the run's last epoch.
+    #[serde(rename = "final")]
+    pub at_end: Discovery,
+    /// The goal-reaching error of an exploration that never moved the object: every outcome at
+    /// the object's resting position (that of the first outcome that did not move it). The
+    /// leaderboard's unit for the error, as `ln(cells)` is KL-coverage's. None when every
+    /// outcome moved the object.
+    pub error_at_rest: Option<f64>,
+    /// Mean distance from the origin of the positions (x, y) of the outcomes that moved the
+    /// object (how far out the exploration pushed it); None when none did.
+    pub moved_radius_mean: Option<f64>,
+}
+
+impl RunDiscovery {
+    /// The measures of a run's `outcomes` (in history order) in the environment `spec`; None
+    /// for a run without outcomes.
+    pub fn measure(spec: &EnvSpec, outcomes: &[Outcome]) -> Result<Option<Self>, DiscoveryError> {
+        let env = EnvMeasures::new(spec)?;
+        let Some(at_end) = env.measure(outcomes, None)? else {
+            return Ok(None);
+        };
+        let error_at_rest = match outcomes.iter().find(|o| !o.moved) {
+            Some(rest) => env
+                .measure(std::slice::from_ref(rest), None)?
+                .map(|d| d.goal_error_mean),
+            None => None,
+        };
+        let radii: Vec<f64> = outcomes
+            .iter()
+            .filter(|o| o.moved)
+            .map(|o| o.x.hypot(o.y))
+            .collect();
+        let moved_radius_mean =
+            (!radii.is_empty()).then(|| radii.iter().sum::<f64>() / radii.len() as f64);
+        Ok(Some(RunDiscovery {
+            at_end,
+            error_at_rest,
+            moved_radius_mean,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_grids_follow_the_registry() {
+        let ball = EnvMeasures::by_name("armball").unwrap();
+        let arrow = EnvMeasures::by_name("armarrow").unwrap();
+        let balls = EnvMeasures::by_name("armballs").unwrap();
+        assert_eq!(ball.grid().n_achievable(), 756);
+        assert_eq!(arrow.grid().n_achievable(), 22_680);
+        assert_eq!(balls.coords, [Coord::X, Coord::Y], "the ball only");
+        assert_eq!((ball.goals().len(), arrow.goals().len()), (80, 480));
+        for g in arrow.goals().goals() {
+            assert!(g[0] * g[0] + g[1] * g[1] < 1.0 && g[2].abs() < 1.0, "{g:?}");
+        }
+        assert!(matches!(
+            EnvMeasures::by_name("nope"),
+            Err(DiscoveryError::UnknownEnv(_))
+        ));
+        static ODD: EnvSpec = EnvSpec {
+            name: "odd-grid",
+            klc: crate::KlcGrid {
+                dims: 2,
+                bins: 30,
+                achievable_cells: 900,
+            },
+            ..crate::ARMBALL
+        };
+        assert!(matches!(
+            EnvMeasures::new(&ODD),
+            Err(DiscoveryError::Grid { .. })
+        ));
+    }
+
+    fn outcome(index: i64, x: f64, y: f64, moved: bool) -> Outcome {
+        Outcome {
+            index,
+            epoch: index,
+            x,
+            y,
+            angle: None,
+            moved,
+        }
+    }
+
+    #[test]
+    fn repeats_weigh_on_klc_not_on_the_other_measures() {
+        let env = EnvMeasures::by_name("armball").unwrap();
+        let mut few = vec![outcome(0, 0.0, 0.5, false)];
+        few.extend((1..10).map(|i| outcome(i, 0.5 - 0.1 * i as f64, 0.0, true)));
+        let mut many = few.clone();
+        many.extend((10..200).map(|i| outcome(i, 0.0, 0.5, false)));
+        let (a, b) = (
+            env.measure(&few, None).unwrap().unwrap(),
+            env.measure(&many, None).unwrap().unwrap(),
+        );
+        assert!(b.klc > a.klc + 1.0, "{} {}", a.klc, b.klc);
+        assert_eq!((a.moved_klc, a.coverage), (b.moved_klc, b.coverage));
+        assert_eq!(
+            (a.goal_error_mean, a.goal_error_p90),
+            (b.goal_error_mean, b.goal_error_p90)
+        );
+        // An epoch cut keeps the outcomes up to it; none at all is None, no panic.
+        assert_eq!(env.measure(&many, Some(0)).unwrap().unwrap().n_outcomes, 1);
+        assert_eq!(env.measure(&[], None).unwrap(), None);
+        assert_eq!(
+            env.measure(&[outcome(0, 0.0, 0.0, false)], None)
+                .unwrap()
+                .unwrap()
+                .moved_klc,
+            None
+        );
+        let e = env
+            .measure(&[outcome(3, f64::NAN, 0.0, true)], None)
+            .unwrap_err();
+        assert_eq!(
+            e,
+            DiscoveryError::BadOutcome {
+                index: 3,
+                column: "x".into()
+            }
+        );
+        let arrow = EnvMeasures::by_name("armarrow").unwrap();
+        assert!(arrow.measure(&few, None).is_err(), "a null angle");
+        // Outside the disk: +inf, as the runs' measure.
+        let out = env
+            .measure(&[outcome(0, 0.99, 0.99, true)], None)
+            .unwrap()
+            .unwrap();
+        assert_eq!(out.klc, f64::INFINITY);
+    }
+
+    #[test]
+    fn the_kd_tree_finds_the_brute_force_nearest_point() {
+        // A small xorshift stream: the test needs spread points, not a particular generator.
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for dims in [2, 3] {
+            for n in [1, 2, 5, 300] {
+                let pts: Vec<f64> = (0..n * dims).map(|_| uniform(-1.0, 1.0)).collect();
+                let tree = KdTree::new(&pts, dims);
+                for _ in 0..200 {
+                    let q: Vec<f64> = (0..dims).map(|_| uniform(-1.2, 1.2)).collect();
+                    let brute = pts
+                        .chunks_exact(dims)
+                        .map(|p| {
+                            p.iter()
+                                .zip(&q)
+                                .map(|(a, b)| (a - b) * (a - b))
+                                .sum::<f64>()
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                        .sqrt();
+                    assert_eq!(tree.nearest(&q), Some(brute));
+                }
+            }
+        }
+        assert_eq!(KdTree::new(&[], 2).nearest(&[0.0, 0.0]), None);
+    }
+
+    #[test]
+    fn quantiles_interpolate_like_numpy() {
+        let v = [1.0, 2.0, 3.0, 4.0, 10.0];
+        assert_eq!(quantile_sorted(&v, 0.5), Some(3.0));
+        assert!((quantile_sorted(&v, 0.9).unwrap() - 7.6).abs() < 1e-12);
+        assert_eq!(quantile_sorted(&[], 0.9), None);
+        assert_eq!(median(&[4.0, 1.0]), Some(2.5));
+    }
+
+    #[test]
+    fn a_run_discovery_has_its_rest_error_and_moved_radius_and_round_trips() {
+        let ball = EnvSpec::by_name("armball").unwrap();
+        let env = EnvMeasures::new(ball).unwrap();
+        let rest = outcome(0, 0.6, 0.6, false);
+        let run = vec![
+            rest.clone(),
+            outcome(1, 0.3, 0.4, true),
+            outcome(2, 0.0, -0.5, true),
+        ];
+        let d = RunDiscovery::measure(ball, &run).unwrap().unwrap();
+        assert_eq!(d.at_end, env.measure(&run, None).unwrap().unwrap());
+        assert_eq!(d.moved_radius_mean, Some(0.5));
+        let at_rest = env.measure(&[rest.clone()], None).unwrap().unwrap();
+        assert_eq!(d.error_at_rest, Some(at_rest.goal_error_mean));
+        // Never moved: no radius; always moved: no rest error; nothing: None.
+        let still = RunDiscovery::measure(ball, &[rest]).unwrap().unwrap();
+        assert_eq!(
+            (still.moved_radius_mean, still.at_end.moved_klc),
+            (None, None)
+        );
+        assert_eq!(
+            RunDiscovery::measure(ball, &run[1..])
+                .unwrap()
+                .unwrap()
+                .error_at_rest,
+            None
+        );
+        assert_eq!(RunDiscovery::measure(ball, &[]).unwrap(), None);
+        // JSON round trip, +inf included (an outcome outside the disk).
+        let outside = RunDiscovery::measure(ball, &[outcome(0, 0.99, 0.99, true)])
+            .unwrap()
+            .unwrap();
+        assert_eq!(outside.at_end.klc, f64::INFINITY);
+        assert_eq!(outside.at_end.moved_klc, Some(f64::INFINITY));
+        for x in [d, still, outside] {
+            let j = serde_json::to_string(&x).unwrap();
+            assert_eq!(serde_json::from_str::<RunDiscovery>(&j).unwrap(), x, "{j}");
+        }
+    }
+}
