@@ -3,7 +3,7 @@
 
 Renders ArmBall / ArmArrow states exactly the way the original code does
 (flowersteam/Unsupervised_Goal_Space_Learning, src/rendering.py; see
-/work/shared/PAPER-NOTES.md section 2): SDL dummy video driver, a 70x70 32-bit
+docs/original-code.md section 2): SDL dummy video driver, a 70x70 32-bit
 display surface, black fill, white gfxdraw primitives, surfarray.array2d
 (indexed [x][y]), then (v - min) / max in float32.
 

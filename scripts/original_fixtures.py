@@ -320,7 +320,7 @@ def make_env_classes():
 
 
 # ----------------------------------------------------------------------------------------------
-# Independent re-implementation of PAPER-NOTES section 1 (pure Python floats, math.exp, sequential
+# Independent re-implementation of docs/original-code.md section 1 (pure Python floats, math.exp, sequential
 # sums) -- used only to cross-check the original code path and report the deviation.
 # ----------------------------------------------------------------------------------------------
 
@@ -479,7 +479,7 @@ def build_rollouts(armball, armarrow, n_catch_rate):
 
 
 def cross_check(out):
-    """Compare the original code path with the PAPER-NOTES re-implementation."""
+    """Compare the original code path with the re-implementation of docs/original-code.md section 1."""
     max_obj, max_hand, flips = 0.0, 0.0, 0
     for name in ("armball", "armarrow"):
         for r in out[name]:

@@ -1,4 +1,4 @@
-//! A run's bytes depend on its identity only (seed.rs; issue: order-independent results).
+//! A run's bytes depend on its identity only (seed.rs: order-independent results).
 //!
 //! Every algorithm of the smoke matrix (both samplers, both variants) is run four ways, and the
 //! result files must be byte-identical:

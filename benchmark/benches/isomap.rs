@@ -1,4 +1,4 @@
-//! Isomap (PAPER-NOTES.md section 5, sklearn `Isomap` defaults, n_neighbors = 5): fit on 2,000
+//! Isomap (docs/original-code.md section 5, sklearn `Isomap` defaults, n_neighbors = 5): fit on 2,000
 //! rendered ball images with 2 latents, and `encode_one` of a new image on the fitted model.
 //! Run: `cargo bench -p ugl-bench --profile dev --bench isomap`.
 

@@ -1,4 +1,4 @@
-//! Criterion bench of the 70x70 renderer (PAPER-NOTES.md section 2): one image per call of
+//! Criterion bench of the 70x70 renderer (docs/original-code.md section 2): one image per call of
 //! `render_ball_into` / `render_arrow_into`, into a reused buffer (no allocation).
 //!
 //! `cargo bench -p ugl-bench --bench render`

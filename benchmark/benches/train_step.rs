@@ -1,5 +1,5 @@
 //! One training iteration (batch 100: batch draw, forward, backward, optimiser step) of each of
-//! the paper's networks (PAPER-NOTES.md section 5), at the paper's architecture
+//! the paper's networks (docs/original-code.md section 5), at the paper's architecture
 //! (4900-1200-1200, d = 10) and a reduced one (4900-512-256, d = 10), on burn's flex CPU
 //! backend and on the host engine (`repr/host_train.rs`); plus `encode_one` of a trained-shape
 //! encoder.

@@ -1,4 +1,4 @@
-//! How much of an ArmArrow image the arrow's angle explains, against its position (issue: no
+//! How much of an ArmArrow image the arrow's angle explains, against its position (why no
 //! learner encodes the angle). Over states drawn like the UGL data set (uniform in [-1, 1]^3):
 //! - the squared pixel distance between an image and the same image with another angle, with
 //!   another position, and for a small change (0.1) of each;

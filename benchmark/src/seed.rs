@@ -1,4 +1,4 @@
-//! Seeding (DESIGN.md "Seeding"): one campaign seed, a stable hash per run identity, and one
+//! Seeding (docs/reproducibility.md): one campaign seed, a stable hash per run identity, and one
 //! independent ChaCha stream per component, so that adding a draw in one component never shifts
 //! another.
 //!

@@ -1,4 +1,4 @@
-//! Isomap (PAPER-NOTES.md section 5: sklearn `Isomap(n_components=d)`, n_neighbors = 5):
+//! Isomap (docs/original-code.md section 5: sklearn `Isomap(n_components=d)`, n_neighbors = 5):
 //! recovery of a rolled sheet, out-of-sample consistency, determinism, errors, and a sanity check
 //! on rendered ball images. The `#[ignore]`d test measures a fit on 10,000 ball images:
 //! `/usr/bin/time -v cargo test -p ugl-bench --test isomap -- --ignored --nocapture`.

@@ -1,4 +1,4 @@
-//! Golden test of the renderer against real pygame (PAPER-NOTES.md section 2).
+//! Golden test of the renderer against real pygame (docs/original-code.md section 2).
 //!
 //! The fixture `fixtures/render_golden.json` was written by `scripts/golden_render.py`, which
 //! draws each state exactly like UGSL `src/rendering.py` (pygame `gfxdraw`, SDL dummy driver,
@@ -202,7 +202,7 @@ fn renderer_matches_pygame_large_random_set() {
 
 #[test]
 fn fixture_ball_counts_match_paper_notes() {
-    // PAPER-NOTES section 2, checked on pygame's own output: 97 pixels, 89 at 255, 8 AA at 151
+    // docs/original-code.md section 2, checked on pygame's own output: 97 pixels, 89 at 255, 8 AA at 151
     // or 228 for a ball fully inside the canvas.
     let fx = load();
     let inside: Vec<&Case> = fx

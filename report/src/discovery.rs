@@ -1,4 +1,4 @@
-//! Measures of what an exploration discovered that do not count repeats (issue 28, item 4),
+//! Measures of what an exploration discovered that do not count repeats,
 //! over every run the report reads, and the validity check that shows they measure.
 //!
 //! The measures themselves (KL-coverage of all and of the moved outcomes, cell coverage,
@@ -433,8 +433,8 @@ mod tests {
     /// The validity check on the committed results: every measure that does not count repeats
     /// ranks the position-encoding goal spaces ahead of the controls in both paper
     /// environments, with P(better) ≥ 0.8; the runs' own final KLC fails at ArmArrow and
-    /// passes at ArmBall only by its median, at P(better) ≈ 0.5, a coin flip (issue 28: it
-    /// mostly counts moves).
+    /// passes at ArmBall only by its median, at P(better) ≈ 0.5, a coin flip (it mostly
+    /// counts moves).
     #[test]
     fn the_validity_check_on_the_committed_results() {
         let camps = crate::campaigns::load_campaigns(

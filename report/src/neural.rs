@@ -1,4 +1,4 @@
-//! The neural learners (AE, VAE, RFVAE; PAPER-NOTES section 5): their training budgets as recorded
+//! The neural learners (AE, VAE, RFVAE; docs/original-code.md section 5): their training budgets as recorded
 //! in the manifests (`train.config`), the faithful-vs-corrected comparison of the VAE and RFVAE
 //! (paired by seed), the training-budget sensitivity of RGE-VAE (the `budget-*` campaigns) and
 //! the recorded training losses.
@@ -35,7 +35,7 @@ pub fn variant_algos() -> Vec<&'static str> {
         .collect()
 }
 
-/// The paper's training of one learner (PAPER-NOTES section 5; the original `src/network.py`).
+/// The paper's training of one learner (docs/original-code.md section 5; the original `src/network.py`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PaperTraining {
     pub learner: &'static str,

@@ -108,7 +108,7 @@ pub struct Matrix {
     /// Latent sizes: numbers, or `"true"` for the environment's true dimension (2 / 3).
     #[serde(default = "default_latents")]
     pub latents: Vec<LatentSize>,
-    /// Variants of the VAE and RFVAE (`faithful`, `corrected`; PAPER-NOTES.md section 5).
+    /// Variants of the VAE and RFVAE (`faithful`, `corrected`; docs/original-code.md section 5).
     /// The other learners have one behaviour and ignore this list.
     #[serde(default = "default_variants")]
     pub variants: Vec<Variant>,

@@ -1,4 +1,4 @@
-//! Goal-space figure data (issue: trained goal spaces, item 3). The paper argues that a learned
+//! Goal-space figure data (what the trained goal spaces look like). The paper argues that a learned
 //! goal space is good when it lays the object's positions out smoothly, and shows what its
 //! networks reconstruct. For the first repetition (seed 0) of every learned cell, a campaign
 //! writes beside its runs, in `DIR/goal_spaces/`:

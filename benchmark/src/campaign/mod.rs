@@ -1,5 +1,5 @@
 //! Campaigns: configuration, the run matrix, running and storing results
-//! (DESIGN.md: `config -> plan -> runner -> store`).
+//! (docs/architecture.md, "The science crate's layers": `config -> plan -> runner -> store`).
 
 pub mod config;
 pub mod context;

@@ -90,7 +90,7 @@ impl RunSpec {
             .unwrap_or_default()
     }
 
-    /// Canonical identity (DESIGN.md "Seeding"): `env=armball/algo=rge-efr/seed=3`, for a
+    /// Canonical identity (docs/reproducibility.md): `env=armball/algo=rge-efr/seed=3`, for a
     /// learned goal space `env=armball/algo=rge-pca/sampler=kde/latents=10/seed=3`, and with a
     /// variant `env=armball/algo=rge-vae/variant=corrected/sampler=kde/latents=10/seed=3`. It
     /// enters the run-seed hash, so it is part of the results' specification.

@@ -1,5 +1,5 @@
 //! The 7-joint planar arm of explauto's `SimpleArmEnvironment` as configured by the paper's code
-//! (PAPER-NOTES.md section 1, "Forward kinematics").
+//! (docs/original-code.md section 1, "Forward kinematics").
 
 use serde::{Deserialize, Serialize};
 

@@ -1,5 +1,5 @@
 //! The discrete DMP of explauto 1.3.0 (`models/dmp.py` + `models/pydmps`), exactly as the paper's
-//! code used it (PAPER-NOTES.md section 1, "DMP"): 7 joints, 3 basis functions per joint, 50
+//! code used it (docs/original-code.md section 1, "DMP"): 7 joints, 3 basis functions per joint, 50
 //! steps of dt = 0.04, start and goal fixed at 0, only the weights controlled.
 //!
 //! The canonical state `x_t = 0.96^t` does not depend on the parameters, so the basis

@@ -1,5 +1,5 @@
-//! The environments of the paper (Section 4.1; PAPER-NOTES.md section 1), the follow-up's
-//! ArmBalls (a distractor ball; `armballs.rs`) and the renderer (PAPER-NOTES.md section 2).
+//! The environments of the paper (Section 4.1; docs/original-code.md section 1), the follow-up's
+//! ArmBalls (a distractor ball; `armballs.rs`) and the renderer (docs/original-code.md section 2).
 //!
 //! A rollout runs one 50-step DMP movement of the 7-joint arm from rest; the object (ball or
 //! arrow) is caught, stickily, as soon as the hand comes within `object_size` of it, and then
@@ -273,7 +273,7 @@ impl<'de> Deserialize<'de> for EnvKind {
     }
 }
 
-/// Constants of the environments; the defaults are the paper's code's (PAPER-NOTES.md section 1).
+/// Constants of the environments; the defaults are the paper's code's (docs/original-code.md section 1).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EnvConfig {
@@ -493,7 +493,7 @@ impl Rollout {
     }
 }
 
-/// An environment of the benchmark (DESIGN.md "Core abstractions").
+/// An environment of the benchmark (docs/architecture.md, "Adding things").
 pub trait Environment: Send + Sync {
     /// Which environment this is.
     fn kind(&self) -> EnvKind;

@@ -1,4 +1,4 @@
-//! The 70x70 renderer of ArmBall / ArmArrow (PAPER-NOTES.md section 2, "Rendering").
+//! The 70x70 renderer of ArmBall / ArmArrow (docs/original-code.md section 2, "Rendering").
 //!
 //! The original code (UGSL `src/rendering.py`) draws with pygame's `gfxdraw` module, which wraps
 //! the SDL_gfx primitives bundled with pygame (`src_c/SDL_gfx/SDL_gfxPrimitives.c`). This module
@@ -891,7 +891,7 @@ mod tests {
 
     #[test]
     fn ball_footprint_counts() {
-        // PAPER-NOTES section 2: 11x11 footprint, 97 non-zero pixels, 89 at 1.0, 8 at
+        // docs/original-code.md section 2: 11x11 footprint, 97 non-zero pixels, 89 at 1.0, 8 at
         // 151/255 or 228/255.
         for (x, y) in [(0.0, 0.0), (0.6, 0.6), (-0.5, 0.3)] {
             let img = render_ball(x, y);

@@ -1,5 +1,5 @@
 //! Random goal exploration (RGE; paper Appendix D, Algorithm 3, with the code's details of
-//! PAPER-NOTES.md section 3).
+//! docs/original-code.md section 3).
 //!
 //! One warm-up random episode, then `epochs` iterations. An iteration uses random parameters
 //! while no stored outcome differs from the initial state in every coordinate, while fewer than
@@ -58,7 +58,7 @@ impl OutcomeSpace for EngineeredSpace {
     }
 }
 
-/// A learned goal space (RGE-REP, PAPER-NOTES.md section 3): the outcome is encoded as
+/// A learned goal space (RGE-REP, docs/original-code.md section 3): the outcome is encoded as
 /// `encoder(render(final state))`. Measures the time spent encoding.
 pub struct LearnedSpace<'a> {
     env: &'a dyn Environment,

@@ -1,4 +1,4 @@
-//! The meta-policy of RGE (PAPER-NOTES.md section 3): nearest stored outcome to the goal, its
+//! The meta-policy of RGE (docs/original-code.md section 3): nearest stored outcome to the goal, its
 //! parameters plus independent Gaussian noise, clipped to [-1,1].
 
 use rand::RngExt;

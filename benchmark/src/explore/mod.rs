@@ -1,4 +1,4 @@
-//! The explorers (paper Section 3 and Appendix D, Algorithm 3; PAPER-NOTES.md section 3):
+//! The explorers (paper Section 3 and Appendix D, Algorithm 3; docs/original-code.md section 3):
 //! random parameter exploration (RPE) and random goal exploration (RGE) with a nearest-neighbour
 //! meta-policy, in an engineered (EFR) or learned goal space; and the follow-up paper's modular
 //! goal exploration (MGE, `mge.rs`) with curiosity-driven module choice (`interest.rs`).

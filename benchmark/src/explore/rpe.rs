@@ -1,4 +1,4 @@
-//! Random parameter exploration (RPE; PAPER-NOTES.md section 3): `epochs` uniformly random
+//! Random parameter exploration (RPE; docs/original-code.md section 3): `epochs` uniformly random
 //! parameter vectors, no warm-up.
 
 use super::history::{ExplorationLog, Metrics, Recorder};

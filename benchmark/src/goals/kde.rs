@@ -1,5 +1,5 @@
 //! Gaussian kernel density estimate of the training latents, as `scipy.stats.gaussian_kde`
-//! with its defaults (PAPER-NOTES.md section 3, "Goal sampling for REP"): full data covariance
+//! with its defaults (docs/original-code.md section 3, "Goal sampling for REP"): full data covariance
 //! (unbiased, n - 1), bandwidth factor by Scott's rule `n^(-1/(d+4))`, kernel covariance =
 //! factor^2 x data covariance. Sampling = a training latent chosen uniformly + the kernel's
 //! Gaussian noise (`gaussian_kde.resample`).

@@ -1,4 +1,4 @@
-//! Goal samplers (paper Section 3, "goal policy"; PAPER-NOTES.md section 3): where the explorer
+//! Goal samplers (paper Section 3, "goal policy"; docs/original-code.md section 3): where the explorer
 //! draws its goals in the goal space.
 
 pub mod kde;

@@ -1,5 +1,5 @@
 //! Goals from an isotropic standard Gaussian, N(0, I): the paper's Gaussian-prior ("GP") goal
-//! sampling for VAE-type latent spaces (PAPER-NOTES.md section 3, `--sampling=normal`).
+//! sampling for VAE-type latent spaces (docs/original-code.md section 3, `--sampling=normal`).
 
 use rand_distr::{Distribution, StandardNormal};
 

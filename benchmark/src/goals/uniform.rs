@@ -1,4 +1,4 @@
-//! Uniform goals in the unit box [0,1)^d: RGE-EFR's goal policy (PAPER-NOTES.md section 3).
+//! Uniform goals in the unit box [0,1)^d: RGE-EFR's goal policy (docs/original-code.md section 3).
 
 use rand::RngExt;
 

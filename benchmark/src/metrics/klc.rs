@@ -1,4 +1,4 @@
-//! KL-coverage (paper Section 4.2; PAPER-NOTES.md section 4).
+//! KL-coverage (paper Section 4.2; docs/original-code.md section 4).
 //!
 //! The engineered outcomes are binned with 30 bins per dimension over [-1,1] (numpy
 //! `histogramdd` semantics: edges `linspace(-1, 1, 31)`, bins closed on the left, the last bin

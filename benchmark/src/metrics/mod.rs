@@ -1,4 +1,4 @@
-//! Exploration measures (paper Section 4.2; PAPER-NOTES.md section 4).
+//! Exploration measures (paper Section 4.2; docs/original-code.md section 4).
 
 pub mod csv;
 pub mod klc;

@@ -1,4 +1,4 @@
-//! The paper's dense auto-encoder (`DenseAE`; PAPER-NOTES.md section 5, "AE"):
+//! The paper's dense auto-encoder (`DenseAE`; docs/original-code.md section 5, "AE"):
 //! `dim -> H1 ReLU -> H2 ReLU -> d sigmoid` (latents in (0, 1)), decoder
 //! `d -> H2 ReLU -> H1 ReLU -> dim` logits, loss = batch mean of the pixel-summed Bernoulli
 //! cross-entropy, TF Adagrad (lr 1e-3, initial accumulator 0.1), 200,000 iterations.

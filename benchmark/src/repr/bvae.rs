@@ -14,7 +14,7 @@
 //! `C_t` rising linearly from 0 to C nats over the training (the follow-up code's
 //! `loss_function`, "Version 1", with its `c` ramp left out and γ = β). Without `capacity`, the
 //! plain β-VAE objective. The budget, init and size follow the ICLR recipe of
-//! `data/campaigns/paper.toml` (the trained-goal-space issue).
+//! `data/campaigns/paper.toml` (`docs/neural.md`).
 
 use burn::tensor::Tensor;
 

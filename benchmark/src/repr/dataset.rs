@@ -1,5 +1,5 @@
 //! The passive observation data set of the UGL stage (paper Section 3, Algorithm 1;
-//! PAPER-NOTES.md section 2, "UGL training set"): N images of the object at states drawn
+//! docs/original-code.md section 2, "UGL training set"): N images of the object at states drawn
 //! uniformly over the whole square [-1,1]^2 (and the arrow's angle uniformly over [-1,1]),
 //! rendered by the project's renderer. Generated on the fly from the data-set stream.
 

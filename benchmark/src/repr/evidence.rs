@@ -1,4 +1,4 @@
-//! Evidence that a neural representation learned something (issue: trained goal spaces).
+//! Evidence that a neural representation learned something (the report's "Did the goal spaces learn?").
 //!
 //! A network that has learned nothing about the object outputs the data set's **mean image**,
 //! the best constant predictor. Its Bernoulli loss (summed over the 4900 pixels, averaged over
@@ -17,7 +17,7 @@ use super::ImageSet;
 
 /// A run is *untrained* when its reconstruction loss is above this fraction of the plateau.
 /// Trained networks end far below it (a VAE's training loss, KL included, of 60-150 against a
-/// plateau of 443 on ArmBall, README), networks on the plateau at about 1.
+/// plateau of 443 on ArmBall, `docs/neural.md`), networks on the plateau at about 1.
 pub const UNTRAINED_FRACTION: f64 = 0.8;
 
 /// The number of training images (the first ones) on which the plateau and the reconstruction

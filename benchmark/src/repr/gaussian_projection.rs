@@ -7,7 +7,7 @@
 //! `GaussianRandomProjection`, and `scripts/external_learners/random_projection.py`, which runs
 //! the same model through the external-learner protocol). Nothing is learned from the images,
 //! so a learned goal space that does not beat it has learned nothing the exploration can use
-//! (issue 12: untrained networks rank with it).
+//! (untrained networks rank with it: the report's controls).
 
 use rand_distr::{Distribution, Normal};
 

@@ -1,6 +1,7 @@
 //! The host training engine (`engine = "host"`, the default): one training iteration of the
 //! paper's dense networks written on the `gemm` crate (the kernel burn's `flex` backend and
-//! `faer` call), with the structure of the data exploited. Issue "speed" / README "Speed".
+//! `faer` call), with the structure of the data exploited. Measured against PyTorch: `docs/neural.md`,
+//! "Speed, side by side with PyTorch".
 //!
 //! What differs from the burn engine ([`super::neural::Engine::Burn`]), and why it is faster:
 //! - **The input is sparse.** A rendered 70x70 image lights ~1-2% of its pixels, so the first

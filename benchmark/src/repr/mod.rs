@@ -1,5 +1,5 @@
 //! Representation learners: the UGL stage of IMGEP-UGL (paper Section 3, Algorithm 1;
-//! PAPER-NOTES.md section 5). A learner is fitted on passively observed images and returns an
+//! docs/original-code.md section 5). A learner is fitted on passively observed images and returns an
 //! encoder that maps images to latent vectors, the goal space of RGE-REP.
 //!
 //! Adding a learner = one file implementing [`RepresentationLearner`] + one entry in

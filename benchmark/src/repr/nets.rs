@@ -1,4 +1,4 @@
-//! Building blocks of the paper's three networks (PAPER-NOTES.md section 5): dense MLPs on the
+//! Building blocks of the paper's three networks (docs/original-code.md section 5): dense MLPs on the
 //! flattened pixels, on burn's `flex` CPU backend.
 //!
 //! - [`HostNet`]: the weights on the host (`Vec<f32>`, row-major `[in, out]` like TF's
@@ -41,7 +41,7 @@ pub const INIT_STD: f64 = 0.001;
 pub enum Init {
     /// The original code's: TF `truncated_normal(stddev = 0.001)` for every layer
     /// ([`INIT_STD`]). With 4900-512-256 layers its ReLUs die and training stays on the
-    /// mean-image plateau for thousands of iterations (README "Neural goal spaces").
+    /// mean-image plateau for thousands of iterations (`docs/neural.md`, "Leaving the plateau, measured").
     #[default]
     Paper,
     /// He (Kaiming) normal for ReLU layers, as Keras' `he_normal`: a normal truncated at 2 std

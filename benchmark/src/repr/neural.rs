@@ -1,4 +1,4 @@
-//! The neural representation learners of the paper (AE, VAE, RFVAE; PAPER-NOTES.md section 5):
+//! The neural representation learners of the paper (AE, VAE, RFVAE; docs/original-code.md section 5):
 //! configuration, the training loop and the fitted encoder. The model-specific parts (loss,
 //! encoding) live in `ae.rs`, `vae.rs` and `rfvae.rs`; the layers and optimisers in `nets.rs`.
 //!

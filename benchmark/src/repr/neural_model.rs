@@ -1,4 +1,4 @@
-//! The model-specific part of the dense neural learners (PAPER-NOTES.md section 5): one
+//! The model-specific part of the dense neural learners (docs/original-code.md section 5): one
 //! [`NeuralModel`] trait that the AE (`ae.rs`), the VAE (`vae.rs`), the RFVAE (`rfvae.rs`) and
 //! the β-VAE (`bvae.rs`) implement, with the types their code shares. `neural.rs` is the generic part (training loop,
 //! encoder, cache keys) and reaches a model only through [`super::neural::Model::spec`]; the

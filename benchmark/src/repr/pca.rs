@@ -1,4 +1,4 @@
-//! PCA learners (PAPER-NOTES.md section 5, "PCA").
+//! PCA learners (docs/original-code.md section 5, "PCA").
 //!
 //! - [`TruncatedSvd`] (`pca`): what the paper's code used, `sklearn.decomposition.TruncatedSVD`
 //!   — **not mean-centred** — with its randomized solver (10 oversamples, 5 power iterations).

@@ -1,5 +1,5 @@
-//! Latent quality: how well the true object state can be read off a goal space (issue: trained
-//! goal spaces; the original code's `src/measures.py` measured embeddings too).
+//! Latent quality: how well the true object state can be read off a goal space (of trained
+//! goal spaces and controls; the original code's `src/measures.py` measured embeddings too).
 //!
 //! For a fitted representation, the targets are the engineered states of its training images
 //! (ball x, y; arrow x, y and the angle as cos / sin, since the angle wraps around) and of a

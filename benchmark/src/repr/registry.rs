@@ -56,7 +56,7 @@ impl std::ops::Deref for LearnerEntry {
 }
 
 impl LearnerEntry {
-    /// The paper's training of a neural learner (PAPER-NOTES.md section 5).
+    /// The paper's training of a neural learner (docs/original-code.md section 5).
     pub fn paper_training(&self) -> Option<NeuralConfig> {
         match self.kind {
             Kind::Neural(model) => Some(NeuralConfig::paper(model)),

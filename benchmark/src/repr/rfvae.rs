@@ -1,4 +1,4 @@
-//! The paper's dense VAE with radial flows (`DenseRadialVAE`; PAPER-NOTES.md section 5,
+//! The paper's dense VAE with radial flows (`DenseRadialVAE`; docs/original-code.md section 5,
 //! "RFVAE"): the VAE's trunk with linear heads mu, logvar and the amortised parameters of
 //! `K` = 10 radial flows (Rezende & Mohamed 2015): centres `c` (K x d), `a` (K), `b` (K).
 //!

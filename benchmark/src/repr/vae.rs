@@ -1,4 +1,4 @@
-//! The paper's dense VAE (`DenseVAE`; PAPER-NOTES.md section 5, "VAE"): the AE's trunk with
+//! The paper's dense VAE (`DenseVAE`; docs/original-code.md section 5, "VAE"): the AE's trunk with
 //! linear heads mu and logvar, `z = mu + eps * exp(logvar / 2)`, loss = batch mean of
 //! (pixel-summed Bernoulli cross-entropy + analytic KL(N(mu, sigma^2) || N(0, I))), beta = 1,
 //! no warm-up, TF Adam (lr 1e-3), 100,000 iterations. Encoding = mu; prior = N(0, I).

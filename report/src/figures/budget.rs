@@ -4,7 +4,7 @@
 //! ([`crate::stats::CONFIDENCE`]; none with one seed), is a diamond on a line. The main campaign's runs of the same condition are a star
 //! at their own budget; RGE-EFR and RPE of the main campaign on the same environment are horizontal
 //! reference lines (their mean final KL-coverage). The paper trained the VAE for 100,000
-//! iterations (PAPER-NOTES section 5), far right of what a CPU campaign affords.
+//! iterations (docs/original-code.md section 5), far right of what a CPU campaign affords.
 
 use std::path::Path;
 

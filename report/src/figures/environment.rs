@@ -1,6 +1,6 @@
 //! The paper's Figures 1 and 6, drawn from the benchmark's own environment code (the report reads
 //! no results for them): the ArmBall environment with the images the learners see, and one DMP
-//! episode (PAPER-NOTES.md sections 1-2: a 7-joint planar arm whose links sum to 1, so the
+//! episode (docs/original-code.md sections 1-2: a 7-joint planar arm whose links sum to 1, so the
 //! reachable set is the unit disk; 21 DMP parameters; 50 steps).
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! What the goal spaces look like (issue: trained goal spaces, item 3; the paper's argument that
+//! What the goal spaces look like (the paper's argument that
 //! a good learned space lays the object's positions out smoothly): for seed 0 of each learned
 //! cell, the campaign stores (`DIR/goal_spaces/`, written by the benchmark's
 //! `campaign::goal_space`) the latents of a 21 x 21 lattice of object positions over

@@ -97,7 +97,7 @@ pub fn algo_name(algo: &str) -> String {
 }
 
 /// An algorithm with its variant: `RGE-VAE (corrected)`; `RGE-AE` for variant `none`.
-/// *faithful* is the original code's behaviour, defects included (PAPER-NOTES section 5);
+/// *faithful* is the original code's behaviour, defects included (docs/original-code.md section 5);
 /// *corrected* has those defects fixed.
 pub fn condition_name(algo: &str, variant: &str) -> String {
     let a = algo_name(algo);
@@ -253,7 +253,7 @@ pub fn draw_curve<'a, 'b: 'a>(
 }
 
 /// The fixed KLC axis range of an environment: 0 .. ln(number of achievable cells), which is the
-/// KLC of outcomes all in one cell (PAPER-NOTES section 4). `None` for unknown environments.
+/// KLC of outcomes all in one cell (docs/original-code.md section 4). `None` for unknown environments.
 pub fn klc_max(env: &str) -> Option<f64> {
     ugl_types::EnvSpec::by_name(env).map(|e| e.klc.max_klc())
 }

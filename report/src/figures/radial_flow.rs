@@ -1,5 +1,5 @@
 //! The paper's Figure 5 (appendix): the effect of a radial flow (Rezende & Mohamed 2015) on an
-//! isotropic Gaussian, the transformation the RFVAE stacks ten of (PAPER-NOTES.md section 5;
+//! isotropic Gaussian, the transformation the RFVAE stacks ten of (docs/original-code.md section 5;
 //! the benchmark's `repr::rfvae`): `z' = z + beta h(a, r) (z - c)`, `h = 1 / (a + r)`,
 //! `r = |z - c|`, invertible for `beta >= -a`. Drawn from seeded samples, so the figure is the
 //! same on every render.

@@ -1,7 +1,7 @@
 //! Recorded training losses (`training_loss.svg`): for each environment (rows) and neural learner
 //! (columns), the mean loss over the trainings of the main campaign against the iteration, one
 //! curve per latent size and variant (faithful solid, corrected dashed). The loss is the one each
-//! learner minimises (PAPER-NOTES section 5: pixel-summed Bernoulli cross-entropy, plus the KL
+//! learner minimises (docs/original-code.md section 5: pixel-summed Bernoulli cross-entropy, plus the KL
 //! for the VAE, minus the flows' log-determinant for the RFVAE), so levels differ between
 //! learners; the y axis starts after the first recorded point, which can be far above the rest.
 //! A dotted grey line marks the mean-image loss of the training images (the *plateau*, the loss of

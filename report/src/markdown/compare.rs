@@ -1,5 +1,5 @@
-//! One page per new learner (`compare_<campaign>.md`, issue: the report a reviewer trusts, item
-//! 11): where a `compare-*` campaign's learner ranks, its probability of improvement over each
+//! One page per new learner (`compare_<campaign>.md`):
+//! where a `compare-*` campaign's learner ranks, its probability of improvement over each
 //! algorithm of the main campaign, how often it failed, what its goal spaces encode and how much
 //! of the outcome space it covered. `ugl compare` prints it when its runs are done.
 

@@ -19,10 +19,10 @@ pub mod neural;
 pub mod quality;
 pub mod recipe;
 
-/// The text of the epoch-label note (PAPER-NOTES section 4).
+/// The text of the epoch-label note (docs/original-code.md section 4).
 pub const EPOCH_NOTE: &str = "The paper's notebooks labelled the snapshot holding 100i+12 outcomes as \
 epoch 100(i+1), i.e. shifted by ~90 epochs, and never plotted the last ~190 outcomes; our epochs are \
-exact counts of exploration iterations (PAPER-NOTES section 4).";
+exact counts of exploration iterations (`docs/original-code.md` section 4).";
 
 /// KLC with 3 decimals; `inf` spelled out.
 pub fn fmt_klc(v: f64) -> String {
@@ -471,7 +471,7 @@ pub fn klc_curves(
         let _ = writeln!(
             w,
             "The same runs and styles, with the fraction of the achievable histogram cells \
-             (PAPER-NOTES section 4; the arrow's angle is a dimension of ArmArrow's cells) that \
+             (`docs/original-code.md` section 4; the arrow's angle is a dimension of ArmArrow's cells) that \
              the outcomes have reached, higher is better. KL-coverage also rewards moving the \
              object often (every episode that leaves it in place adds to one cell), so a \
              condition can lower its KL-coverage without reaching new cells; this figure shows \
@@ -571,8 +571,8 @@ pub fn outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile
     let _ = writeln!(w, "## Object positions reached\n");
     let _ = writeln!(
         w,
-        "For each condition, the outcomes of its median run (by final KL-coverage; the title \
-         names its seed) at three epochs: every episode that moved the object is a dot at the \
+        "For each condition, the outcomes of its median run (by final KL-coverage, among the \
+         runs whose outcomes file the store keeps; the title names its seed) at three epochs: every episode that moved the object is a dot at the \
          object's final (x, y), for ArmArrow a short stroke from the arrow's position toward its \
          tip (angles grouped in 30° sectors); the circle is the reachable unit disk and the red \
          mark the initial position (0.6, 0.6), where every other episode ends. Panel titles \

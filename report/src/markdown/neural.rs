@@ -25,7 +25,7 @@ outcomes as the flow output of a freshly sampled z0 while its KDE is fitted on f
 per-sample log-determinant, deterministic encoding of the mean through the flows, for both); from \
 results version 4 the corrected RFVAE also puts its prior N(0, I) on the flow output z_K, where its \
 outcomes are encoded, so that its Gaussian goals are drawn in that space (up to version 3 the prior \
-was on z0). The AE has no documented defect and runs once (PAPER-NOTES section 5).";
+was on z0). The AE has no documented defect and runs once (`docs/original-code.md` section 5).";
 
 fn campaign(name: &str) -> String {
     format!("`{}`", campaign_display(name))
@@ -109,7 +109,7 @@ pub fn training_budgets(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(
         w,
         "What the main campaign's neural learners were trained with, read from each run's manifest \
-         (`train.config`), under the paper's settings (PAPER-NOTES section 5; dense networks on the \
+         (`train.config`), under the paper's settings (`docs/original-code.md` section 5; dense networks on the \
          4900 pixels, batch 100). A training is shared by the runs that differ only in their goal \
          sampler; *trainings* counts distinct ones, and the fit time (data set and training) is \
          their mean.\n"

@@ -191,8 +191,8 @@ pub fn section(
          10-NN regression on 9,000 ArmArrow images predicts cos 3a and sin 3a with R² 0.85 but \
          cos a and sin a with only 0.15 (0.45 at 38,000 images): the full angle is barely in \
          the pixels' neighbourhoods at the paper's 10,000 images, and a learner that misses it \
-         is not broken. (Measured with `ugl embed` and numpy; the issue's closing note has the \
-         commands.)\n"
+         is not broken. (Measured once outside the report: 10-NN regression with numpy on images \
+         written by `ugl embed`; not rerun by `make report`.)\n"
     );
     let recorded = rows
         .iter()

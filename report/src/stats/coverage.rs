@@ -184,7 +184,7 @@ const SHORT: [(&str, usize, bool, f64); 9] = [
 ];
 
 /// The claims' interval covers as it says at 5 seeds per side (the committed campaigns) and 20
-/// (the target design), on normal samples with equal and unequal spread and on skewed
+/// (the rerun's design), on normal samples with equal and unequal spread and on skewed
 /// (lognormal) samples, skewed on one side or both: the coverage of the nominal 95% Welch
 /// interval lies in [0.93, 0.97]. So does the tables' one-sample t interval on normal samples
 /// and on moderately skewed ones at n = 20. The cases of [`SHORT`] are printed with their

@@ -1,4 +1,4 @@
-//! Isomap, as the paper's UGL stage uses it (PAPER-NOTES.md section 5, "Isomap"):
+//! Isomap, as the paper's UGL stage uses it (docs/original-code.md section 5, "Isomap"):
 //! `sklearn.manifold.Isomap(n_components=d, n_jobs=8)` with all defaults, i.e. **n_neighbors = 5**,
 //! Euclidean metric, `path_method='auto'` (Dijkstra) and KernelPCA on the geodesic kernel
 //! (`eigen_solver='auto'`). The reproduced sklearn behaviour, step by step:
@@ -141,7 +141,7 @@ impl LearnerParams for Isomap {
     }
 }
 
-/// Isomap learner (PAPER-NOTES.md section 5): sklearn `Isomap(n_components=latents)` defaults.
+/// Isomap learner (docs/original-code.md section 5): sklearn `Isomap(n_components=latents)` defaults.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Isomap {
     /// Number of neighbours of the kNN graph (sklearn default 5).
@@ -175,7 +175,7 @@ impl RepresentationLearner for Isomap {
     }
 }
 
-/// What a fit does when the kNN graph is disconnected (PAPER-NOTES.md section 5).
+/// What a fit does when the kNN graph is disconnected (docs/original-code.md section 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Disconnected {
@@ -394,7 +394,7 @@ pub struct FitTimings {
 }
 
 /// The fitted Isomap: training geodesics, centring statistics and projection (sklearn
-/// `Isomap.transform`, PAPER-NOTES.md section 5).
+/// `Isomap.transform`, docs/original-code.md section 5).
 pub struct IsomapEncoder {
     n_neighbors: usize,
     latents: usize,
