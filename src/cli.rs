@@ -135,6 +135,10 @@ pub(crate) enum Command {
         /// OUT/diagnostics/<run_id>.json.
         #[arg(long)]
         refresh_diagnostics: bool,
+        /// Write into the checkout's data/ although tracked files have uncommitted changes
+        /// (the runs then record a `-dirty` git revision, which no commit reproduces exactly).
+        #[arg(long)]
+        allow_dirty: bool,
         #[command(flatten)]
         cache: CacheArgs,
     },
@@ -231,6 +235,10 @@ pub(crate) struct SlurmArgs {
     /// --sbatch-arg=--mem=8G.
     #[arg(long = "sbatch-arg", allow_hyphen_values = true)]
     pub(crate) sbatch_args: Vec<String>,
+    /// Let the tasks write into the checkout's data/ although tracked files have uncommitted
+    /// changes (passed on to each task's `ugl campaign`).
+    #[arg(long)]
+    pub(crate) allow_dirty: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -295,6 +303,9 @@ pub(crate) struct CompareArgs {
     /// `ugl campaign --refresh-diagnostics`).
     #[arg(long)]
     pub(crate) refresh_diagnostics: bool,
+    /// Write into the checkout's data/ although tracked files have uncommitted changes.
+    #[arg(long)]
+    pub(crate) allow_dirty: bool,
     #[command(flatten)]
     pub(crate) cache: CacheArgs,
 }

@@ -155,6 +155,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             quiet,
             shard,
             refresh_diagnostics,
+            allow_dirty,
             cache,
         } => campaign(
             &config,
@@ -163,6 +164,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             quiet,
             shard.as_deref(),
             refresh_diagnostics,
+            allow_dirty,
             &cache,
         ),
         Command::Slurm(a) => slurm(a),

@@ -305,6 +305,74 @@ fn a_run_records_its_discovery_and_its_outcomes_file_may_be_left_out() {
     }
 }
 
+/// Results written into a checkout's data/ are the committed ones: a campaign refuses to write
+/// there while tracked files have uncommitted changes (one line, exit 2, nothing written),
+/// unless `--allow-dirty`, which the runs then record as a `-dirty` revision. Elsewhere it
+/// writes whatever the tree's state.
+#[test]
+fn a_campaign_refuses_a_dirty_checkout_for_its_data() {
+    let repo = tempfile::tempdir().unwrap();
+    let git = |args: &[&str]| {
+        let o = Command::new("git")
+            .args([
+                "-c",
+                "user.name=t",
+                "-c",
+                "user.email=t@t",
+                "-c",
+                "commit.gpgsign=false",
+            ])
+            .args(args)
+            .current_dir(repo.path())
+            .output()
+            .expect("git runs");
+        assert!(o.status.success(), "git {args:?}: {}", stderr(&o));
+    };
+    git(&["init", "-q"]);
+    std::fs::write(
+        repo.path().join("tiny.toml"),
+        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n[explore]\nepochs = 50\neval_every = 50\n",
+    )
+    .unwrap();
+    git(&["add", "tiny.toml"]);
+    git(&["commit", "-q", "-m", "tiny"]);
+    let campaign = |out: &str, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_ugl"))
+            .args(["campaign", "--config", "tiny.toml", "--out", out, "--quiet"])
+            .args(extra)
+            .current_dir(repo.path())
+            .output()
+            .expect("ugl runs")
+    };
+    let revision = |out: &str| {
+        manifest(&repo.path().join(out).join("armball.rpe.s0.json"))["git_revision"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    // Clean: allowed, and the revision is the commit's.
+    let o = campaign("data/results/clean", &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!revision("data/results/clean").ends_with("-dirty"));
+    // A tracked file changed: refused before anything is written, naming the way out.
+    std::fs::write(
+        repo.path().join("tiny.toml"),
+        "# changed\n".to_string()
+            + &std::fs::read_to_string(repo.path().join("tiny.toml")).unwrap(),
+    )
+    .unwrap();
+    let o = campaign("data/results/dirty", &[]);
+    assert_one_line_error(&o, "--allow-dirty");
+    assert!(!repo.path().join("data/results/dirty").exists());
+    // Told to: allowed, recorded as dirty.
+    let o = campaign("data/results/dirty", &["--allow-dirty"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(revision("data/results/dirty").ends_with("-dirty"));
+    // Outside the checkout's data/: allowed.
+    let o = campaign("elsewhere", &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 #[test]
 fn run_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -708,6 +776,8 @@ fn status_counts_complete_missing_and_damaged_runs() {
 fn slurm_scripts() {
     let dir = tempfile::tempdir().unwrap();
     let scripts = dir.path().join("slurm");
+    // `--allow-dirty` (passed on to the tasks): the default results directory is in this
+    // checkout's data/, which a developer's tree may have changed.
     let o = ugl(&[
         "slurm",
         "--config",
@@ -716,10 +786,12 @@ fn slurm_scripts() {
         "4",
         "--scripts",
         p(&scripts),
+        "--allow-dirty",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let array = std::fs::read_to_string(scripts.join("array.sh")).unwrap();
     assert!(array.contains("#SBATCH --array=0-3"), "{array}");
+    assert!(array.contains(" --quiet --allow-dirty "), "{array}");
     assert!(
         array.contains("--shard \"${SLURM_ARRAY_TASK_ID}/4\""),
         "{array}"
@@ -764,12 +836,15 @@ fn slurm_scripts() {
 fn slurm_refuses_bad_options_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let scripts = dir.path().join("job");
+    // `--allow-dirty`: the default results directory is in this checkout's data/, which a
+    // developer's tree may have changed (`a_campaign_refuses_a_dirty_checkout_for_its_data`).
     let base = [
         "slurm",
         "--config",
         "data/campaigns/baselines.toml",
         "--scripts",
         p(&scripts),
+        "--allow-dirty",
     ];
     let cases: [(&[&str], &str); 12] = [
         (

@@ -268,7 +268,26 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("| 50.0 % |"));
     // What was run, links, notes, the reduced budget.
     assert!(md.contains("Reduced budget"));
-    assert!(md.contains("500 epochs instead of 5000 (paper)"));
+    // The box names the algorithm and counts every reduced run of every campaign rendered.
+    assert!(md.contains("6 of the 12 runs in this report"), "{md}");
+    assert!(
+        md.contains("- **RPE**: 500 epochs instead of 5000: 3 runs (paper)"),
+        "{md}"
+    );
+    assert!(
+        md.contains("- **RGE-EFR**: 500 epochs instead of 5000: 3 runs (paper)"),
+        "{md}"
+    );
+    // One row per campaign: role, runs, conditions, design, reduced runs, a committed tree.
+    let row = md
+        .lines()
+        .find(|l| l.starts_with("| `paper` | main |"))
+        .unwrap_or_else(|| panic!("no campaign row in\n{md}"));
+    assert!(
+        row.starts_with("| `paper` | main | 12 | 4 | 3 x 1 |"),
+        "{row}"
+    );
+    assert!(row.ends_with("| — | 6 | committed |"), "{row}");
     assert!(
         md.contains("- **Campaigns:** main `paper` (12 runs"),
         "{md}"
@@ -505,6 +524,25 @@ fn empty_or_missing_results_dir_is_a_clear_error() {
         matches!(err, ReportError::NoCompleteRuns { incomplete: 1, .. }),
         "{err:?}"
     );
+}
+
+/// Runs written from a tree with uncommitted changes are counted in their campaign's row.
+#[test]
+fn runs_from_a_dirty_tree_are_flagged() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    synthetic_store(&results);
+    let path = results.join("paper/armball.rpe.s2.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.replace("\"abc1234\"", "\"abc1234-dirty\"")).unwrap();
+    let out = tmp.path().join("out");
+    render_report(&opts(&results, &out)).unwrap();
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    let row = md
+        .lines()
+        .find(|l| l.starts_with("| `paper` | main |"))
+        .unwrap_or_else(|| panic!("no campaign row in\n{md}"));
+    assert!(row.ends_with("| **1 `-dirty`** |"), "{row}");
 }
 
 #[test]

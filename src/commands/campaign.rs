@@ -22,6 +22,7 @@ pub(crate) fn campaign(
     quiet: bool,
     shard: Option<&str>,
     refresh_diagnostics: bool,
+    allow_dirty: bool,
     cache: &CacheArgs,
 ) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
@@ -33,7 +34,7 @@ pub(crate) fn campaign(
     if refresh_diagnostics {
         refresh_config(&cfg, &profile, out, jobs, shard, cache)
     } else {
-        run_config(&cfg, &profile, out, jobs, quiet, shard, cache)
+        run_config(&cfg, &profile, out, jobs, quiet, shard, allow_dirty, cache)
     }
 }
 
@@ -84,6 +85,39 @@ pub(crate) fn refresh_config(
     Ok(())
 }
 
+/// Results written into the checkout's `data/` are the ones that get committed: refused while
+/// tracked files of the checkout (the working directory's repository, whose revision every
+/// manifest records) have uncommitted changes, since the manifests would record a `-dirty`
+/// revision that no commit reproduces. `--allow-dirty` overrides; results written elsewhere are
+/// never refused.
+fn check_clean_tree(out: &Path) -> Result<()> {
+    let revision = ugl_bench::campaign::provenance::git_revision();
+    if !revision.ends_with("-dirty") {
+        return Ok(());
+    }
+    let Some(top) = std::process::Command::new("git")
+        .args(["rev-parse", "--show-toplevel"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))
+    else {
+        return Ok(());
+    };
+    let data = top.canonicalize().unwrap_or(top).join("data");
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    if ugl_bench::campaign::slurm::resolve(out, &cwd).starts_with(&data) {
+        bail!(
+            "--out {}: the checkout {} has uncommitted changes to tracked files, and runs written \
+             into its data/ would record the revision {revision}, which no commit reproduces: \
+             commit or stash the changes, write elsewhere with --out, or pass --allow-dirty",
+            out.display(),
+            data.parent().unwrap_or(&data).display(),
+        );
+    }
+    Ok(())
+}
+
 /// The checked `--shard`, `--out` (default `data/results/<campaign>`) and `--jobs` (default: the
 /// number of cores) of a campaign command.
 pub(crate) fn campaign_args(
@@ -115,10 +149,14 @@ pub(crate) fn run_config(
     jobs: Option<usize>,
     quiet: bool,
     shard: Option<&str>,
+    allow_dirty: bool,
     cache: &CacheArgs,
 ) -> Result<()> {
     // Every argument is checked before anything touches the disk.
     let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
+    if !allow_dirty {
+        check_clean_tree(&out)?;
+    }
     check_out_dir(&out)?;
     let stop = stop_on_ctrl_c("the runs in flight")?;
     let mp = MultiProgress::new();
@@ -217,8 +255,12 @@ pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
         report_time: &a.report_time,
         throttle: a.throttle,
         sbatch_args: &a.sbatch_args,
+        allow_dirty: a.allow_dirty,
     };
     let texts = slurm_scripts(&job)?;
+    if !a.allow_dirty {
+        check_clean_tree(&out)?;
+    }
     check_out_dir(&dir)?;
     write_scripts(&dir, &texts)?;
     eprintln!(

@@ -67,6 +67,7 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
         a.jobs,
         a.quiet,
         None,
+        a.allow_dirty,
         &a.cache,
     )?;
     print_compare_page(&out, &cfg.campaign.name, &base)

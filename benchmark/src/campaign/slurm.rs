@@ -102,6 +102,9 @@ pub struct SlurmJob<'a> {
     pub throttle: Option<usize>,
     /// Extra `#SBATCH` options of both jobs (`--partition=NAME`, `--account=NAME`, ...).
     pub sbatch_args: &'a [String],
+    /// The tasks' `ugl campaign` may write into a checkout with uncommitted changes
+    /// (`--allow-dirty`).
+    pub allow_dirty: bool,
 }
 
 /// The three scripts' texts.
@@ -332,9 +335,14 @@ pub fn scripts(job: &SlurmJob<'_>) -> Result<SlurmScripts, SlurmError> {
          #SBATCH --job-name=ugl-{name}\n#SBATCH --array=0-{last}{throttle}\n#SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --time={time}\n#SBATCH --output=logs/ugl-{name}-%A_%a.log\n{extra}\
          set -euo pipefail\ncd {cwd_q}\n\
-         exec {bin_q} campaign --config {config_q} --out {out_q} --jobs {cpus} --quiet \\\n  \
+         exec {bin_q} campaign --config {config_q} --out {out_q} --jobs {cpus} --quiet{dirty} \\\n  \
          --shard \"${{SLURM_ARRAY_TASK_ID}}/{shards}\"\n",
         last = shards - 1,
+        dirty = if job.allow_dirty {
+            " --allow-dirty"
+        } else {
+            ""
+        },
     );
     let report = format!(
         "#!/usr/bin/env bash\n\
@@ -440,6 +448,7 @@ mod tests {
             report_time: "00:30:00",
             throttle: None,
             sbatch_args: extra,
+            allow_dirty: false,
         }
     }
 

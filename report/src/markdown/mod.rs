@@ -10,7 +10,7 @@ use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
 use crate::context::Context;
 use crate::figures::outcomes::describe;
-use crate::figures::{FigureFile, env_name};
+use crate::figures::{FigureFile, algo_name, env_name};
 use crate::load::{Run, campaign_display};
 
 pub mod claims;
@@ -74,6 +74,24 @@ fn distinct(values: impl Iterator<Item = Option<String>>) -> String {
         parts.push(format!("not recorded ({missing} run{})", plural(missing)));
     }
     parts.join(", ")
+}
+
+/// Distinct values, compactly: `4` when all agree, `3 (240), 4 (12)` when they do not, `—` for
+/// none; missing ones count as `?`.
+fn compact(values: impl Iterator<Item = Option<String>>) -> String {
+    let mut m: BTreeMap<String, usize> = BTreeMap::new();
+    for v in values {
+        *m.entry(v.unwrap_or_else(|| "?".into())).or_default() += 1;
+    }
+    match m.len() {
+        0 => "—".into(),
+        1 => m.into_keys().next().unwrap_or_default(),
+        _ => m
+            .into_iter()
+            .map(|(v, n)| format!("{v} ({n})"))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
 }
 
 pub(crate) fn plural(n: usize) -> &'static str {
@@ -152,27 +170,35 @@ pub fn header(w: &mut String, inp: &Context<'_>) {
         inp.paper.looked_at.display()
     );
 
-    // --- Reduced budget: prominently, before anything else (main and budget campaigns).
+    // --- Reduced budget: prominently, before anything else (every campaign rendered).
     let (used, reduced) = budget_runs(inp);
     if !reduced.is_empty() {
-        let mut notes: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+        // (algorithm, note) -> (runs, campaigns)
+        let mut notes: BTreeMap<(String, String), (usize, BTreeSet<String>)> = BTreeMap::new();
         for r in &reduced {
-            notes
-                .entry(r.manifest.budget_note.clone())
-                .or_default()
-                .insert(campaign_name(&r.campaign));
+            let e = notes
+                .entry((algo_name(&r.key.algo), r.manifest.budget_note.clone()))
+                .or_default();
+            e.0 += 1;
+            e.1.insert(campaign_name(&r.campaign));
         }
         let _ = writeln!(
             w,
-            "> **⚠ Reduced budget.** {} of the {} runs in this report were run with a budget reduced \
-             relative to the paper's; their numbers are not directly comparable with the paper's. \
-             Conditions with such runs are marked † in the tables.",
+            "> **⚠ Reduced budget.** {} of the {} runs in this report (every campaign it renders) \
+             were run with a budget reduced relative to the paper's; their numbers are not \
+             directly comparable with the paper's. Conditions with such runs are marked † in the \
+             tables. By algorithm:",
             reduced.len(),
             used.len()
         );
-        for (note, camps) in &notes {
+        for ((algo, note), (n, camps)) in &notes {
             let camps: Vec<&str> = camps.iter().map(String::as_str).collect();
-            let _ = writeln!(w, ">\n> - {} ({})", note, camps.join(", "));
+            let _ = writeln!(
+                w,
+                ">\n> - **{algo}**: {note}: {n} run{} ({})",
+                plural(*n),
+                camps.join(", ")
+            );
         }
         let _ = writeln!(w);
     }
@@ -208,18 +234,13 @@ pub fn header(w: &mut String, inp: &Context<'_>) {
     }
 }
 
-/// The main and budget campaigns' runs, and those of them with a budget reduced from the paper's.
+/// The runs of every campaign the report renders, and those of them with a budget reduced from
+/// the paper's.
 fn budget_runs<'a>(inp: &'a Context<'_>) -> (Vec<&'a Run>, Vec<&'a Run>) {
     let used: Vec<&Run> = inp
-        .store
-        .runs
-        .iter()
-        .chain(
-            inp.campaigns
-                .budget
-                .iter()
-                .flat_map(|c| c.store.runs.iter()),
-        )
+        .campaigns
+        .used()
+        .flat_map(|c| c.store.runs.iter())
         .collect();
     let reduced = used
         .iter()
@@ -267,6 +288,104 @@ fn last_epochs(inp: &Context<'_>) -> Vec<i64> {
     last_epochs.into_iter().collect()
 }
 
+/// Every campaign the report renders, one row each, from its record and its manifests: role,
+/// runs, design (repetitions x exploration replicates), results version, exploration budget,
+/// neural training, reduced-budget runs and whether its runs came from a committed tree.
+fn campaigns_table(w: &mut String, inp: &Context<'_>) {
+    let _ = writeln!(
+        w,
+        "Every campaign this report renders (its role says what the report does with it; \
+         *repetitions x replicates*: distinct repetition seeds x exploration replicates per \
+         repetition; *training*: the neural learners' iterations and hidden layers, from the manifests; *tree*: \
+         runs whose manifest records a git revision with uncommitted changes (`-dirty`), which no \
+         commit reproduces exactly; the command of each campaign is under *How to reproduce*):\n"
+    );
+    let _ = writeln!(
+        w,
+        "| campaign | role | runs | conditions | repetitions x replicates | results version | \
+         epochs | training | reduced budget | tree |"
+    );
+    let _ = writeln!(w, "|---|---|---:|---:|---|---|---|---|---:|---|");
+    for c in inp.campaigns.used() {
+        let runs = &c.store.runs;
+        let conditions: BTreeSet<String> = runs.iter().map(|r| r.key.slug()).collect();
+        let seeds: BTreeSet<i64> = runs.iter().map(|r| r.seed).collect();
+        let replicates: BTreeSet<u32> = runs.iter().map(|r| r.manifest.exploration).collect();
+        let versions = compact(
+            runs.iter()
+                .map(|r| r.manifest.results_version().map(|v| v.to_string())),
+        );
+        let epochs = compact(runs.iter().map(|r| {
+            r.manifest
+                .explore
+                .get("epochs")
+                .and_then(|e| e.as_u64())
+                .map(|e| e.to_string())
+        }));
+        // learner -> distinct (iterations, hidden layers)
+        let mut training: BTreeMap<String, BTreeSet<(u64, String)>> = BTreeMap::new();
+        for r in runs {
+            let Some(config) = r.manifest.train_field("config") else {
+                continue;
+            };
+            if let Some(it) = config.get("iterations").and_then(|i| i.as_u64()) {
+                let hidden = config
+                    .get("hidden")
+                    .and_then(|h| h.as_array())
+                    .map(|h| {
+                        let h: Vec<String> = h.iter().map(|v| v.to_string()).collect();
+                        h.join("-")
+                    })
+                    .unwrap_or_else(|| "?".into());
+                training
+                    .entry(algo_name(&r.key.algo))
+                    .or_default()
+                    .insert((it, hidden));
+            }
+        }
+        let training: Vec<String> = training
+            .iter()
+            .map(|(a, its)| {
+                let its: Vec<String> = its
+                    .iter()
+                    .map(|(it, hidden)| format!("{it} it., {hidden}"))
+                    .collect();
+                format!("{a} {}", its.join(" / "))
+            })
+            .collect();
+        let reduced = runs.iter().filter(|r| r.manifest.reduced_budget).count();
+        let dirty = runs
+            .iter()
+            .filter(|r| r.manifest.git_revision.ends_with("-dirty"))
+            .count();
+        let tree = if dirty == 0 {
+            "committed".to_string()
+        } else {
+            format!("**{dirty} `-dirty`**")
+        };
+        let _ = writeln!(
+            w,
+            "| `{}` | {} | {} | {} | {} x {} | {} | {} | {} | {} | {} |",
+            campaign_name(&c.name),
+            c.decl.role.name(),
+            runs.len(),
+            conditions.len(),
+            seeds.len(),
+            replicates.len(),
+            versions,
+            epochs,
+            if training.is_empty() {
+                "—".to_string()
+            } else {
+                training.join("; ")
+            },
+            reduced,
+            tree
+        );
+    }
+    let _ = writeln!(w);
+}
+
 /// What was run: campaigns, runs, seeds, epochs, compute and provenance, the table of conditions.
 pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     let store = inp.store;
@@ -274,6 +393,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     let main = campaign_name(&inp.campaigns.main.name);
     let reduced_keys = reduced_keys(inp);
     let _ = writeln!(w, "## What was run (main campaign `{main}`)\n");
+    campaigns_table(w, inp);
     neural::campaigns_line(w, inp);
     let _ = writeln!(
         w,
@@ -613,6 +733,16 @@ pub fn deviations(w: &mut String, inp: &Context<'_>) {
     let store = inp.store;
     let _ = writeln!(w, "## Deviations and notes\n");
     let _ = writeln!(w, "- {EPOCH_NOTE}");
+    let _ = writeln!(
+        w,
+        "- **Where the paper's text and its authors' code differ, we follow the code** \
+         (`docs/original-code.md`, `docs/fidelity.md`): images of 70 x 70 pixels (the text says \
+         50 x 50); dense networks on the 4900 pixels, 4900-1200-1200-latents with a mirrored \
+         decoder (the appendix's figure of layers, after Higgins et al. 2016, is convolutional); \
+         no KL warm-up for the VAE (the text describes a deterministic warm-up of 10^4 \
+         iterations; the code's RFVAE has one, which we keep, scaled to our budget); 10 *radial* \
+         flows in the RFVAE (the text says planar flows)."
+    );
     neural::deviations(w, inp);
     let _ = writeln!(
         w,
@@ -747,7 +877,13 @@ pub fn reproduce(w: &mut String, inp: &Context<'_>) {
         }
     };
     let _ = writeln!(w, "{}", profile(&inp.campaigns.main.name));
-    for c in &inp.campaigns.budget {
+    for c in inp
+        .campaigns
+        .budget
+        .iter()
+        .chain(&inp.campaigns.recipe)
+        .chain(&inp.campaigns.followup)
+    {
         let _ = writeln!(w, "{}", profile(&c.name));
     }
     for c in &inp.campaigns.compare {
@@ -786,7 +922,10 @@ pub fn reproduce(w: &mut String, inp: &Context<'_>) {
          campaign on the same thread count gives byte-identical result files (`make verify` checks \
          this for the `smoke` profile against committed checksums); the leaderboard's bootstrap is \
          seeded too and the other intervals draw nothing, so rendering the same results gives the \
-         same bytes."
+         same bytes. A campaign reruns the runs written at another results version than the \
+         code's (version {} here; *What was run* gives each campaign's): to reproduce older runs \
+         byte for byte, check out the git revision their manifests record.",
+        ugl_types::RESULTS_VERSION
     );
 }
 
