@@ -7,6 +7,7 @@
 //! ([`ugl_types::RunDiscovery`]); a run written before that is measured here from its outcomes
 //! file with the same code ([`crate::load::Run::discovery`]).
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -97,6 +98,12 @@ pub struct RunRow<'a> {
     pub in_check: bool,
     /// ln(achievable cells): the moved-only KLC of a run that never moved the object.
     pub max_klc: f64,
+    /// Where the environment measures more than the position (ArmArrow): the measures of the
+    /// position alone ([`ugl_types::RunDiscovery::position`]).
+    pub position: Option<Discovery>,
+    /// With it: the cells of the other coordinates (ArmArrow: angle bins) reached per reached
+    /// position cell, on average (of [`ugl_types::KlcGrid::bins`] per coordinate).
+    pub rest_per_position_cell: Option<f64>,
 }
 
 /// Every run the report reads, measured at its final epoch: the main campaign, then by role
@@ -119,13 +126,30 @@ pub fn measure_all(camps: &Campaigns) -> Result<Vec<RunRow<'_>>, ReportError> {
                 problem: e.to_string(),
             };
             let env = EnvMeasures::by_name(&run.key.env).map_err(invalid)?;
+            let found = run.discovery().map_err(invalid)?;
+            let position = found.as_ref().and_then(|d| d.position.clone());
+            // reached cells / reached position cells
+            let rest_per_position_cell = match (&found, &position) {
+                (Some(d), Some(p)) if p.coverage > 0.0 => {
+                    let spec = EnvSpec::by_name(&run.key.env)
+                        .ok_or_else(|| invalid(DiscoveryError::UnknownEnv(run.key.env.clone())))?;
+                    let cells = env.position(spec).map_err(invalid)?.map(|pe| {
+                        d.at_end.coverage * env.grid().n_achievable() as f64
+                            / (p.coverage * pe.grid().n_achievable() as f64)
+                    });
+                    cells
+                }
+                _ => None,
+            };
             rows.push(RunRow {
                 campaign: camp,
                 run,
-                discovery: measure_run(run).map_err(invalid)?,
+                discovery: found.map(|d| d.at_end),
                 group: group_of(run),
                 in_check: checked.contains(&camp.name.as_str()),
                 max_klc: (env.grid().n_achievable() as f64).ln(),
+                position,
+                rest_per_position_cell,
             });
         }
     }
@@ -269,14 +293,15 @@ fn num(v: Option<f64>) -> String {
 pub fn write_csv(out: &mut Output, rows: &[RunRow<'_>]) -> Result<(), ReportError> {
     let mut s = String::from(
         "campaign,run_id,env,algo,sampler,latents,variant,seed,trained,position_knn_r2,group,\
-         n_outcomes,n_moved,final_klc,moved_klc,coverage,goal_error_mean,goal_error_p90\n",
+         n_outcomes,n_moved,final_klc,moved_klc,coverage,goal_error_mean,goal_error_p90,\
+         position_coverage,position_goal_error_mean,rest_cells_per_position_cell\n",
     );
     for r in rows {
         let run = r.run;
         let d = r.discovery.as_ref();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             if r.campaign.name.is_empty() {
                 "."
             } else {
@@ -302,6 +327,9 @@ pub fn write_csv(out: &mut Output, rows: &[RunRow<'_>]) -> Result<(), ReportErro
             num(d.map(|d| d.coverage)),
             num(d.map(|d| d.goal_error_mean)),
             num(d.map(|d| d.goal_error_p90)),
+            num(r.position.as_ref().map(|p| p.coverage)),
+            num(r.position.as_ref().map(|p| p.goal_error_mean)),
+            num(r.rest_per_position_cell),
         );
     }
     out.write(Path::new(crate::data::DIR).join(FILE), s.as_bytes())?;
@@ -316,7 +344,9 @@ pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
          KL-coverage scores the histogram of *every* outcome, so each episode that leaves the \
          object in place adds weight to one cell, and a goal space that moves the object more \
          often scores better whatever it found. Three measures that do not count repeats, \
-         computed from each run's outcomes file (`data/{FILE}`, one row per run):\n\n\
+         which each run records in its manifest when it ends (runs written before that are \
+         measured from their outcomes files with the same code; `data/{FILE}`, one row per \
+         run):\n\n\
          - **KLC of moved outcomes**: the same 30-bin histogram and formula (paper Section 4.2) \
          over the episodes in which the object moved (ln N, every outcome in one cell, for a run \
          that never moved it). The re-implementation reproduces the runs' own KLC exactly on \
@@ -377,6 +407,88 @@ pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
         );
     }
     w.push('\n');
+    position_and_rest(w, rows);
+}
+
+/// Where an environment measures more than the position (ArmArrow's angle): per condition of
+/// the main campaign, what its runs found of the position and of the rest, apart.
+fn position_and_rest(w: &mut String, rows: &[RunRow<'_>]) {
+    // Conditions in the rows' order (the report's), each with its values.
+    type Cols = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+    let mut by_cond: Vec<(String, String, Cols)> = Vec::new();
+    let mut index: BTreeMap<String, usize> = BTreeMap::new();
+    for r in rows {
+        let (Some(p), Some(rest), Some(d)) = (&r.position, r.rest_per_position_cell, &r.discovery)
+        else {
+            continue;
+        };
+        if r.campaign.name != rows[0].campaign.name {
+            continue; // the main campaign's conditions only
+        }
+        let i = *index.entry(r.run.key.slug()).or_insert_with(|| {
+            by_cond.push((
+                r.run.key.env.clone(),
+                crate::figures::outcomes::describe_key(&r.run.key),
+                Cols::default(),
+            ));
+            by_cond.len() - 1
+        });
+        let e = &mut by_cond[i].2;
+        e.0.push(p.coverage * 100.0);
+        e.1.push(rest);
+        e.2.push(p.goal_error_mean);
+        e.3.push(d.coverage * 100.0);
+        e.4.push(d.goal_error_mean);
+    }
+    if by_cond.is_empty() {
+        return;
+    }
+    let envs: BTreeSet<&str> = by_cond.iter().map(|k| k.0.as_str()).collect();
+    let bins = envs
+        .iter()
+        .filter_map(|e| EnvSpec::by_name(e))
+        .map(|s| {
+            format!(
+                "{} bins of each further coordinate in {}",
+                s.klc.bins, s.display
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let _ = writeln!(
+        w,
+        "**The position and the rest, apart** ({}). The measures above bin the whole outcome; \
+         here the position's part of it: *position cells* is the fraction of the disk's \
+         position cells reached (the 30 x 30 grid, as ArmBall's), *angle bins per position \
+         cell* the mean number of angle bins reached in a reached position cell ({bins}: \
+         what the exploration found of the angle where it found the position), and the goal \
+         errors on the position goals alone and on the position-angle goals. Medians over each \
+         condition's runs of the main campaign.\n",
+        envs.iter()
+            .map(|e| EnvSpec::display_of(e))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let _ = writeln!(
+        w,
+        "| env | condition | runs | position cells | angle bins per position cell | goal error \
+         (position) | all cells | goal error (position and angle) |\n|---|---|---:|---:|---:|---:|---:|---:|"
+    );
+    for (env, label, (pc, rest, pe, ac, ae)) in &by_cond {
+        let m = |v: &[f64]| median(v).unwrap_or(f64::NAN);
+        let _ = writeln!(
+            w,
+            "| {} | {label} | {} | {:.1}% | {:.2} | {:.3} | {:.2}% | {:.3} |",
+            EnvSpec::display_of(env),
+            pc.len(),
+            m(pc),
+            m(rest),
+            m(pe),
+            m(ac),
+            m(ae),
+        );
+    }
+    w.push('\n');
 }
 
 #[cfg(test)]
@@ -386,6 +498,16 @@ mod tests {
 
     fn results() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/results")
+    }
+
+    /// The committed campaigns, as the report reads them.
+    fn committed() -> Campaigns {
+        crate::campaigns::load_campaigns(
+            &results(),
+            "paper",
+            &crate::sections::wanted_roles(crate::sections::SECTIONS),
+        )
+        .unwrap()
     }
 
     /// The re-implemented KL-coverage and cell coverage equal what the runs recorded, at every
@@ -437,12 +559,7 @@ mod tests {
     /// counts moves).
     #[test]
     fn the_validity_check_on_the_committed_results() {
-        let camps = crate::campaigns::load_campaigns(
-            &results(),
-            "paper",
-            &crate::sections::wanted_roles(crate::sections::SECTIONS),
-        )
-        .unwrap();
+        let camps = committed();
         let t = std::time::Instant::now();
         let rows = measure_all(&camps).unwrap();
         println!("measured {} runs in {:.2?}", rows.len(), t.elapsed());
@@ -495,6 +612,34 @@ mod tests {
             ],
             [76, 103, 93, 100]
         );
+    }
+
+    /// ArmArrow's runs are measured on the position apart: a position cell holds 1 to 30
+    /// angle bins, the position's coverage is at least the whole outcome's, and a position goal
+    /// is nearer than the position-angle goals; ArmBall's are not split.
+    #[test]
+    fn armarrow_position_and_rest_on_the_committed_results() {
+        let camps = committed();
+        let rows = measure_all(&camps).unwrap();
+        let mut arrows = 0;
+        for r in rows.iter().filter(|r| r.discovery.is_some()) {
+            let d = r.discovery.as_ref().unwrap();
+            match (
+                r.run.key.env.as_str(),
+                &r.position,
+                r.rest_per_position_cell,
+            ) {
+                ("armarrow", Some(p), Some(rest)) => {
+                    arrows += 1;
+                    assert!((1.0..=30.0).contains(&rest), "{}: {rest}", r.run.run_id);
+                    assert!(p.coverage >= d.coverage, "{}", r.run.run_id);
+                    assert!(p.goal_error_mean <= d.goal_error_mean, "{}", r.run.run_id);
+                }
+                ("armarrow", ..) => panic!("{}: no position measures", r.run.run_id),
+                (_, p, rest) => assert!(p.is_none() && rest.is_none(), "{}", r.run.run_id),
+            }
+        }
+        assert!(arrows > 200, "{arrows} ArmArrow runs");
     }
 
     /// What the committed data show (measure, environment, passes).

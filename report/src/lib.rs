@@ -21,6 +21,7 @@ pub mod markdown;
 pub mod neural;
 pub mod output;
 pub mod paper;
+pub mod predicts;
 pub mod sections;
 pub mod stats;
 

@@ -118,11 +118,26 @@ pub struct Grid {
 impl Grid {
     /// The grid of `spec`, checked against the number of achievable cells it declares.
     pub fn for_env(spec: &EnvSpec) -> Result<Self, DiscoveryError> {
+        let grid = Self::disk(spec.name, spec.klc.dims, spec.klc.bins)?;
+        if grid.n_achievable != spec.klc.achievable_cells {
+            return Err(DiscoveryError::Grid {
+                env: spec.name.to_string(),
+                why: format!(
+                    "the disk grid has {} achievable cells, the registry declares {}",
+                    grid.n_achievable, spec.klc.achievable_cells
+                ),
+            });
+        }
+        Ok(grid)
+    }
+
+    /// The grid of `bins` per coordinate over [-1, 1]^dims whose first two coordinates are a
+    /// position in the unit disk (`env` names the environment in errors).
+    fn disk(env: &str, dims: usize, bins: usize) -> Result<Self, DiscoveryError> {
         let bad = |why: String| DiscoveryError::Grid {
-            env: spec.name.to_string(),
+            env: env.to_string(),
             why,
         };
-        let (dims, bins) = (spec.klc.dims, spec.klc.bins);
         if dims < 2 || bins < 2 || bins % 2 != 0 {
             return Err(bad(format!(
                 "a KL-coverage grid of {dims} coordinates and {bins} bins is not a disk grid"
@@ -155,12 +170,6 @@ impl Grid {
             }
         }
         let n_achievable = achievable.iter().filter(|&&a| a).count();
-        if n_achievable != spec.klc.achievable_cells {
-            return Err(bad(format!(
-                "the disk grid has {n_achievable} achievable cells, the registry declares {}",
-                spec.klc.achievable_cells
-            )));
-        }
         Ok(Grid {
             dims,
             bins,
@@ -454,6 +463,20 @@ impl EnvMeasures {
         })
     }
 
+    /// The same measures on the position (the first two measured coordinates) alone: the
+    /// disk grid of the environment's bins per axis and the position goals. None where the
+    /// environment measures nothing beyond the position.
+    pub fn position(&self, spec: &EnvSpec) -> Result<Option<Self>, DiscoveryError> {
+        if self.coords.len() <= 2 {
+            return Ok(None);
+        }
+        Ok(Some(EnvMeasures {
+            coords: self.coords[..2].to_vec(),
+            grid: Grid::disk(spec.name, 2, spec.klc.bins)?,
+            goals: GoalGrid::new(2),
+        }))
+    }
+
     /// The measures of the environment called `env`.
     pub fn by_name(env: &str) -> Result<Self, DiscoveryError> {
         let spec = EnvSpec::by_name(env).ok_or_else(|| DiscoveryError::UnknownEnv(env.into()))?;
@@ -553,6 +576,12 @@ pub struct RunDiscovery {
     /// Mean distance from the origin of the positions (x, y) of the outcomes that moved the
     /// object (how far out the exploration pushed it); None when none did.
     pub moved_radius_mean: Option<f64>,
+    /// Where the environment measures more than the object's position (ArmArrow's angle): the
+    /// same measures on the position alone (2-D cells of the disk, the position goals), so that
+    /// what an exploration found of the position and of the rest can be told apart. Absent
+    /// (None) for the other environments, and in records written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<Discovery>,
 }
 
 impl RunDiscovery {
@@ -576,10 +605,15 @@ impl RunDiscovery {
             .collect();
         let moved_radius_mean =
             (!radii.is_empty()).then(|| radii.iter().sum::<f64>() / radii.len() as f64);
+        let position = match env.position(spec)? {
+            Some(p) => p.measure(outcomes, None)?,
+            None => None,
+        };
         Ok(Some(RunDiscovery {
             at_end,
             error_at_rest,
             moved_radius_mean,
+            position,
         }))
     }
 }
@@ -717,6 +751,39 @@ mod tests {
         assert!((quantile_sorted(&v, 0.9).unwrap() - 7.6).abs() < 1e-12);
         assert_eq!(quantile_sorted(&[], 0.9), None);
         assert_eq!(median(&[4.0, 1.0]), Some(2.5));
+    }
+
+    /// ArmArrow's position measures are ArmBall's measures of the same positions (same disk
+    /// grid and position goals): the angle left out. ArmBall has none.
+    #[test]
+    fn armarrow_measures_its_position_apart() {
+        let arrow = EnvSpec::by_name("armarrow").unwrap();
+        let ball = EnvSpec::by_name("armball").unwrap();
+        let with_angle = |index: i64, x: f64, y: f64, a: f64, moved: bool| Outcome {
+            angle: Some(a),
+            ..outcome(index, x, y, moved)
+        };
+        let run = vec![
+            with_angle(0, 0.6, 0.6, 0.0, false),
+            with_angle(1, 0.3, 0.4, 0.5, true),
+            with_angle(2, 0.3, 0.4, -0.5, true),
+            with_angle(3, -0.2, 0.1, 0.9, true),
+        ];
+        let d = RunDiscovery::measure(arrow, &run).unwrap().unwrap();
+        let flat: Vec<Outcome> = run
+            .iter()
+            .map(|o| Outcome {
+                angle: None,
+                ..o.clone()
+            })
+            .collect();
+        let as_ball = RunDiscovery::measure(ball, &flat).unwrap().unwrap();
+        assert_eq!(d.position.as_ref(), Some(&as_ball.at_end));
+        assert_eq!(as_ball.position, None);
+        // Two angles in one position cell: one position cell, two full cells.
+        let p = d.position.unwrap();
+        assert!(d.at_end.coverage * 22_680.0 > p.coverage * 756.0 + 0.5);
+        assert!(p.goal_error_mean <= d.at_end.goal_error_mean);
     }
 
     #[test]

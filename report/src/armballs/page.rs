@@ -131,7 +131,8 @@ pub(super) fn write(
     }
     let _ = writeln!(
         p,
-        "\n![Ball and distractor exploration](figures/{COVERAGE_FIGURE})\n"
+        "\n![Ball and distractor exploration ratio, mean over the seeds of each condition (no \
+         interval drawn)](figures/{COVERAGE_FIGURE})\n"
     );
 
     // 2. Interest per module.
@@ -212,7 +213,10 @@ pub(super) fn write(
             }
         }
         if figures.iter().any(|f| f.link.ends_with(INTEREST_FIGURE)) {
-            let _ = writeln!(p, "\n![Interest per module](figures/{INTEREST_FIGURE})\n");
+            let _ = writeln!(
+                p,
+                "\n![Interest per module, mean over the seeds, log scale](figures/{INTEREST_FIGURE})\n"
+            );
         }
     }
 

@@ -217,6 +217,7 @@ fn draw_panel(
     let pad = ((hi - lo) * 0.08).max(0.05);
     let (y_min, y_max) = (lo - pad, hi + pad);
     let clamp = |v: f64| v.clamp(y_min, y_max);
+    let y_decimals = super::tick_decimals(y_min, y_max, 8);
 
     let key_points: Vec<f64> = its.iter().map(|&i| i as f64).collect();
     let mut chart = ChartBuilder::on(area)
@@ -233,7 +234,7 @@ fn draw_panel(
         .x_desc("training iterations (log scale)")
         .y_desc("final KL-coverage (nats, lower is better)")
         .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.2}"))
+        .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
         .y_labels(8)
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))

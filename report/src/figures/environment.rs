@@ -11,11 +11,18 @@ use rand_chacha::ChaCha8Rng;
 use ugl_bench::env::render::{PIXELS, SIDE, render_arrow_into, render_ball_into};
 use ugl_bench::env::{EnvConfig, EnvKind, JOINTS, PARAMS, dmp, make_env};
 
-use super::{FIG1, FIG6, FONT, FigureFile, PanelChart, plain_panel, write_svg};
+use super::{
+    FIG1, FIG6, FONT, FigureFile, Icon, LineStyle, PanelChart, draw_curve, legend_height,
+    legend_strip, marker_points, plain_panel, write_svg,
+};
 use crate::ReportError;
 
 const PANEL: u32 = 340;
 const TITLE_H: u32 = 36;
+/// Figure 6's joint panel is wider than the square world panel.
+const JOINTS_EXTRA_W: u32 = 120;
+/// The clip lines of Figure 6.
+const CLIP_GREY: RGBColor = RGBColor(0x66, 0x66, 0x66);
 
 /// The joint positions (base, then the end of each link) for a joint command `q` (units of pi,
 /// clipped to [-1, 1]), as the benchmark's forward kinematics accumulates them.
@@ -40,7 +47,7 @@ fn world<'a, DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = plain_panel(area, title, (-1.1, 1.1), 5)?;
+    let mut chart = plain_panel(area, title, (-1.1, 1.1), 5, ("x", "y"))?;
     chart.draw_series(std::iter::once(PathElement::new(
         super::unit_circle(),
         RGBColor(0x99, 0x99, 0x99),
@@ -57,7 +64,13 @@ fn draw_image<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = plain_panel(area, title, (0.0, SIDE as f64), 3)?;
+    let mut chart = plain_panel(
+        area,
+        title,
+        (0.0, SIDE as f64),
+        8,
+        ("pixel column", "pixel row"),
+    )?;
     chart.draw_series(std::iter::once(Rectangle::new(
         [(0.0, 0.0), (SIDE as f64, SIDE as f64)],
         BLACK.filled(),
@@ -148,10 +161,53 @@ pub fn draw_dmp_episode(fig_dir: &Path) -> Result<Option<FigureFile>, ReportErro
     let title = format!(
         "One DMP episode on ArmBall (paper Figure 6): uniform parameters, seed {seed}, {steps} steps"
     );
-    write_svg(&path, (PANEL * 2, PANEL + TITLE_H), |root| {
+    // The joints' commands as the DMP produces them (units of pi), not clipped: the arm clips
+    // them to [-1, 1] (dashed lines), so a stretch beyond is a saturated joint.
+    let styles: Vec<LineStyle> = (0..JOINTS)
+        .map(|j| {
+            let (pts, filled) = marker_points(j, 3.5);
+            LineStyle {
+                colour: super::colour(j + 1),
+                dash: None,
+                marker: (pts, filled),
+                width: 2,
+            }
+        })
+        .collect();
+    let mut legend: Vec<(Icon, String)> = styles
+        .iter()
+        .enumerate()
+        .map(|(j, s)| s.legend_item(format!("joint {}", j + 1)))
+        .collect();
+    legend.push((
+        Icon::Line {
+            colour: CLIP_GREY,
+            dash: Some((6, 4)),
+            width: 1,
+            marker: None,
+        },
+        "±1: the arm clips each command to [-1, 1]".into(),
+    ));
+    let width = PANEL * 2 + JOINTS_EXTRA_W;
+    let legend_h = legend_height(width, &legend, 13);
+    let peak = traj
+        .iter()
+        .flat_map(|q| q.iter())
+        .map(|v| v.abs())
+        .fold(1.0f64, f64::max);
+    // Symmetric, to the next 0.5 above the largest command (at least 1.5, so that ±1 shows).
+    let y_lim = ((peak * 1.04) * 2.0).ceil().max(3.0) / 2.0;
+    let clipped = traj
+        .iter()
+        .flat_map(|q| q.iter())
+        .filter(|v| v.abs() > 1.0)
+        .count();
+    write_svg(&path, (width, PANEL + TITLE_H + legend_h), |root| {
         let area = root.titled(&title, (FONT, 15))?;
-        let areas = area.split_evenly((1, 2));
-        let mut chart = world(&areas[0], "the arm every 7 steps, and the hand's path")?;
+        let (plots, strip) = area.split_vertically(PANEL);
+        legend_strip(&strip, &legend, 13)?;
+        let (left, right) = plots.split_horizontally(PANEL);
+        let mut chart = world(&left, "the arm every 7 steps, and the hand's path")?;
         for (t, q) in traj
             .iter()
             .enumerate()
@@ -183,37 +239,67 @@ pub fn draw_dmp_episode(fig_dir: &Path) -> Result<Option<FigureFile>, ReportErro
             RGBColor(0xD5, 0x5E, 0x00).filled(),
         )))?;
         // The joint commands over time.
-        let mut joints_chart = ChartBuilder::on(&areas[1])
-            .caption("the 7 joint commands (units of pi)", (FONT, 14))
+        let last = (steps - 1) as f64;
+        let y_decimals = super::tick_decimals(-y_lim, y_lim, 9);
+        let mut joints_chart = ChartBuilder::on(&right)
+            .caption(
+                format!(
+                    "the 7 joint commands, as the DMP outputs them ({clipped} of {} beyond ±1)",
+                    steps * JOINTS
+                ),
+                (FONT, 14),
+            )
             .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(36)
-            .build_cartesian_2d(0.0..(steps - 1) as f64, -1.1..1.1)?;
+            .margin_right(super::right_margin(&format!("{last:.0}"), 11))
+            .x_label_area_size(38)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0.0..last, -y_lim..y_lim)?;
         joints_chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("step")
+            .x_desc("DMP step")
+            .y_desc("joint command (units of pi rad)")
             .x_labels(6)
-            .y_labels(5)
+            .y_labels(9)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
             .label_style((FONT, 11))
+            .axis_desc_style((FONT, 12))
             .draw()?;
-        for j in 0..JOINTS {
+        for lim in [-1.0, 1.0] {
+            joints_chart.draw_series(std::iter::once(
+                plotters::element::DashedPathElement::new(
+                    vec![(0.0, lim), (last, lim)],
+                    6,
+                    4,
+                    CLIP_GREY.stroke_width(1),
+                ),
+            ))?;
+        }
+        let mut off = super::OffScaleMarks::default();
+        for (j, style) in styles.iter().enumerate() {
             let line: Vec<(f64, f64)> = traj
                 .iter()
                 .enumerate()
-                .map(|(t, q)| (t as f64, q[j].clamp(-1.1, 1.1)))
+                .map(|(t, q)| (t as f64, q[j]))
                 .collect();
-            joints_chart.draw_series(std::iter::once(PathElement::new(
-                line,
-                super::colour(j + 1).stroke_width(2),
-            )))?;
+            off.extend(draw_curve(
+                &mut joints_chart,
+                &line,
+                style,
+                j as f64 / JOINTS as f64,
+                None,
+            )?);
         }
+        super::draw_off_scale(&mut joints_chart, &off)?;
         Ok(())
     })?;
     Ok(Some(FigureFile {
         path,
         link: format!("figures/{FIG6}"),
-        caption: "One DMP episode on ArmBall that catches the ball".into(),
+        caption: "One DMP episode on ArmBall that catches the ball: the arm and the hand's path, \
+                  and the 7 joint commands as the DMP outputs them (the arm clips them to ±1)"
+            .into(),
         env: String::new(),
     }))
 }

@@ -10,6 +10,7 @@ pub mod budget;
 pub mod environment;
 pub mod goal_space;
 pub mod klc_curves;
+pub mod lines;
 pub mod outcomes;
 pub mod radial_flow;
 pub mod sampler_compare;
@@ -186,7 +187,7 @@ pub type Chart2d<'a, 'b> = ChartContext<
 >;
 
 /// How one mean curve is drawn.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct LineStyle {
     pub colour: RGBColor,
     /// (dash, gap) in pixels; `None` solid.
@@ -196,32 +197,273 @@ pub struct LineStyle {
     pub width: u32,
 }
 
+impl LineStyle {
+    /// The legend icon of a curve drawn in this style: the same colour, dash, width and marker,
+    /// so that a legend entry always looks like its series.
+    pub fn icon(&self) -> Icon {
+        Icon::Line {
+            colour: self.colour,
+            dash: self.dash,
+            width: self.width,
+            marker: Some(self.marker.clone()),
+        }
+    }
+
+    /// The legend entry of a curve drawn in this style.
+    pub fn legend_item(&self, label: impl Into<String>) -> (Icon, String) {
+        (self.icon(), label.into())
+    }
+}
+
+/// What a series asks of its line style; [`assign_styles`] turns the requests of one figure into
+/// styles that are all different in (colour, dash).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StyleRequest {
+    /// Series of one family share their colour (an algorithm, a goal space, a variant campaign).
+    pub family: String,
+    /// The family's own colour, if it has one; a family without one, or whose colour an earlier
+    /// family took, gets the first free colour of [`EXTRA_COLOURS`].
+    pub colour: Option<RGBColor>,
+    /// The wanted dash: an index into [`DASHES`] (the series' kind within its family).
+    pub dash: usize,
+    /// Marker shape slot ([`marker_points`]) and whether the marker is filled.
+    pub marker: usize,
+    pub filled: bool,
+}
+
+/// The dash patterns, (dash, gap) in pixels: solid, dashed, dotted, long-dashed.
+pub const DASHES: [Option<(i32, i32)>; 4] = [None, Some((8, 5)), Some((2, 4)), Some((14, 4))];
+
+/// Colours for families without their own (variant campaigns, unknown algorithms), in the order
+/// they are handed out: the rest of Okabe–Ito, then Tol's muted scheme, dark to light.
+pub const EXTRA_COLOURS: [RGBColor; 12] = [
+    RGBColor(0xCC, 0x79, 0xA7), // reddish purple
+    RGBColor(0x88, 0x22, 0x55), // wine
+    RGBColor(0x44, 0xAA, 0x99), // teal
+    RGBColor(0xE6, 0x9F, 0x00), // orange
+    RGBColor(0x56, 0xB4, 0xE9), // sky blue
+    RGBColor(0x33, 0x22, 0x88), // indigo
+    RGBColor(0x99, 0x99, 0x33), // olive
+    RGBColor(0xAA, 0x44, 0x99), // purple
+    RGBColor(0x11, 0x77, 0x33), // green
+    RGBColor(0x77, 0x77, 0x77), // grey
+    RGBColor(0x00, 0x9E, 0x73), // bluish green
+    RGBColor(0xD5, 0x5E, 0x00), // vermillion
+];
+
+/// The k-th fallback colour: [`EXTRA_COLOURS`], then distinct greys (never reached in practice,
+/// but the styles stay unique however many series a figure has).
+fn extra_colour(k: usize) -> RGBColor {
+    match EXTRA_COLOURS.get(k) {
+        Some(&c) => c,
+        None => {
+            let g = ((k - EXTRA_COLOURS.len()) % 200) as u8;
+            RGBColor(g, g, g)
+        }
+    }
+}
+
+/// The styles of a figure's series, in the order of `requests`: each family keeps one colour (its
+/// own, else the first free extra colour) and each series its wanted dash when no earlier series
+/// of that colour has it, else the next free one; a colour whose four dashes are all taken hands
+/// the series on to the next free colour. No two series get the same (colour, dash); markers are
+/// `marker_size` pixels, lines `width`. Deterministic: the same requests give the same styles.
+pub fn assign_styles(requests: &[StyleRequest], marker_size: f64, width: u32) -> Vec<LineStyle> {
+    let mut family_colour: Vec<(&str, RGBColor)> = Vec::new();
+    let mut taken: Vec<(RGBColor, usize)> = Vec::new();
+    let mut next_extra = 0;
+    let mut fresh_colour = |family_colour: &Vec<(&str, RGBColor)>| loop {
+        let c = extra_colour(next_extra);
+        next_extra += 1;
+        if family_colour.iter().all(|f| f.1 != c) {
+            break c;
+        }
+    };
+    requests
+        .iter()
+        .map(|r| {
+            let mut colour = match family_colour.iter().find(|f| f.0 == r.family) {
+                Some(f) => f.1,
+                None => {
+                    let c = match r.colour {
+                        Some(c) if family_colour.iter().all(|f| f.1 != c) => c,
+                        _ => fresh_colour(&family_colour),
+                    };
+                    family_colour.push((&r.family, c));
+                    c
+                }
+            };
+            let dash = loop {
+                let free = (0..DASHES.len())
+                    .map(|i| (r.dash + i) % DASHES.len())
+                    .find(|d| !taken.contains(&(colour, *d)));
+                match free {
+                    Some(d) => break d,
+                    None => {
+                        colour = fresh_colour(&family_colour);
+                        family_colour.push(("", colour));
+                    }
+                }
+            };
+            taken.push((colour, dash));
+            let (pts, _) = marker_points(r.marker, marker_size);
+            LineStyle {
+                colour,
+                dash: DASHES[dash],
+                marker: (pts, r.filled),
+                width,
+            }
+        })
+        .collect()
+}
+
+/// A curve cut to the y range of its chart: what is drawn of it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ClippedCurve {
+    /// The pieces of line inside the range: a non-finite y breaks the line, and a step that
+    /// leaves the range ends at the frame (at `crossing(a, b, edge)`), so that nothing is drawn
+    /// beyond it.
+    pub segments: Vec<Vec<(f64, f64)>>,
+    /// The data points inside the range (where markers go).
+    pub inside: Vec<(f64, f64)>,
+    /// The points outside it: drawn as an arrow at the frame with their value, never clamped as
+    /// if they were data.
+    pub off_scale: Vec<OffScale>,
+}
+
+/// A data point outside the y range of its chart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OffScale {
+    pub x: f64,
+    pub y: f64,
+    /// Above the range (else below).
+    pub above: bool,
+}
+
+/// Cuts `pts` to `lo..=hi` in y. `crossing(a, b, edge)` is where the step from the inside point
+/// `a` to the outside point `b` meets the edge value (linear interpolation in data space for a
+/// linear axis; [`draw_curve`] interpolates in pixels, which is right for any axis).
+pub fn clip_curve(
+    pts: &[(f64, f64)],
+    (lo, hi): (f64, f64),
+    crossing: impl Fn((f64, f64), (f64, f64), f64) -> (f64, f64),
+) -> ClippedCurve {
+    let mut out = ClippedCurve::default();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    let inside = |y: f64| y >= lo && y <= hi;
+    let mut prev: Option<(f64, f64)> = None;
+    for &(x, y) in pts {
+        if !y.is_finite() {
+            if !current.is_empty() {
+                out.segments.push(std::mem::take(&mut current));
+            }
+            prev = None;
+            continue;
+        }
+        let edge = |y: f64| if y > hi { hi } else { lo };
+        match prev {
+            Some(p) if inside(p.1) && inside(y) => current.push((x, y)),
+            Some(p) if inside(p.1) => {
+                // Leaving the range: the line goes on to the frame and stops there.
+                current.push(crossing(p, (x, y), edge(y)));
+                out.segments.push(std::mem::take(&mut current));
+            }
+            Some(p) if inside(y) => {
+                // Coming back: the line starts at the frame.
+                current.push(crossing((x, y), p, edge(p.1)));
+                current.push((x, y));
+            }
+            Some(p) if (p.1 > hi) != (y > hi) => {
+                // Across the whole range in one step.
+                let a = crossing(p, (x, y), edge(p.1));
+                let b = crossing((x, y), p, edge(y));
+                out.segments.push(vec![a, b]);
+            }
+            Some(_) => {}
+            None if inside(y) => current.push((x, y)),
+            None => {}
+        }
+        if inside(y) {
+            out.inside.push((x, y));
+        } else {
+            out.off_scale.push(OffScale {
+                x,
+                y,
+                above: y > hi,
+            });
+        }
+        prev = Some((x, y));
+    }
+    if !current.is_empty() {
+        out.segments.push(current);
+    }
+    out
+}
+
+/// The value of an off-scale point as printed beside its arrow: 3 significant digits.
+pub fn fmt_off_scale(v: f64) -> String {
+    let a = v.abs();
+    if a >= 1e5 || (a > 0.0 && a < 1e-3) {
+        format!("{v:.2e}")
+    } else {
+        let decimals = (2 - a.log10().floor().max(-3.0) as i32).clamp(0, 6) as usize;
+        format!("{v:.decimals$}")
+    }
+}
+
+/// The arrow of an off-scale point, in pixels around the point where it meets the frame: a
+/// triangle pointing out of the plot.
+pub fn off_scale_arrow(above: bool) -> Vec<(i32, i32)> {
+    if above {
+        vec![(0, -1), (5, 8), (-5, 8)]
+    } else {
+        vec![(0, 1), (5, -8), (-5, -8)]
+    }
+}
+
 /// Draws a curve (its finite points; a non-finite y breaks the line) with about 8 markers,
 /// staggered by `stagger` in `0..1` so that markers of overlapping curves do not coincide, and
-/// a legend entry `label` (line and marker) when given.
-pub fn draw_curve<'a, 'b: 'a>(
-    chart: &mut Chart2d<'a, 'b>,
+/// a legend entry `label` (line and marker, [`LineStyle::icon`]'s look) when given. Points
+/// outside the chart's y range are not clamped: the line runs to the frame and stops (see
+/// [`clip_curve`]); the points are returned, for [`draw_off_scale`] to mark at the frame with
+/// their values once every curve of the panel is drawn.
+pub fn draw_curve<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     pts: &[(f64, f64)],
     style: &LineStyle,
     stagger: f64,
     label: Option<String>,
-) -> Result<(), Box<dyn std::error::Error>> {
+) -> Result<OffScaleMarks, Box<dyn std::error::Error>>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
     use plotters::element::DashedPathElement;
-    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for &(x, y) in pts {
-        if y.is_finite() {
-            segments.last_mut().expect("one segment").push((x, y));
-        } else if !segments.last().expect("one segment").is_empty() {
-            segments.push(Vec::new());
-        }
-    }
-    segments.retain(|s| !s.is_empty());
+    let y_range = chart.y_range();
+    let (lo, hi) = (
+        y_range.start.min(y_range.end),
+        y_range.start.max(y_range.end),
+    );
+    // Where a step leaves the range, in pixels (exact on a linear or a logarithmic axis).
+    let crossing = |a: (f64, f64), b: (f64, f64), edge: f64| {
+        let (pa, pb) = (chart.backend_coord(&a), chart.backend_coord(&b));
+        let pe = chart.backend_coord(&(a.0, edge));
+        let t = if pb.1 != pa.1 {
+            ((pe.1 - pa.1) as f64 / (pb.1 - pa.1) as f64).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a.0 + t * (b.0 - a.0), edge)
+    };
+    let clipped = clip_curve(pts, (lo, hi), crossing);
     let (dash_len, gap) = style.dash.unwrap_or((SOLID, 0));
     let line_style = style.colour.stroke_width(style.width);
     let (mpts, filled) = style.marker.clone();
     let col = style.colour;
     let mut label = label;
-    for seg in &segments {
+    for seg in &clipped.segments {
         let series = chart.draw_series(std::iter::once(DashedPathElement::new(
             seg.clone(),
             dash_len,
@@ -239,7 +481,7 @@ pub fn draw_curve<'a, 'b: 'a>(
             });
         }
     }
-    let finite: Vec<(f64, f64)> = segments.iter().flatten().copied().collect();
+    let finite = &clipped.inside;
     let step = (finite.len() / 8).max(1);
     let offset = ((stagger.clamp(0.0, 0.999) * step as f64) as usize).min(step - 1);
     chart.draw_series(
@@ -249,6 +491,81 @@ pub fn draw_curve<'a, 'b: 'a>(
             .step_by(step)
             .map(|&pt| marker(pt, &mpts, filled, col, 1)),
     )?;
+    Ok(OffScaleMarks(
+        clipped.off_scale.into_iter().map(|o| (o, col)).collect(),
+    ))
+}
+
+/// The points of curves that fell outside their chart's y range, with their curves' colours:
+/// [`draw_off_scale`] draws them once every curve of a panel is drawn.
+#[must_use = "off-scale points are drawn by draw_off_scale"]
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OffScaleMarks(pub Vec<(OffScale, RGBColor)>);
+
+impl OffScaleMarks {
+    pub fn extend(&mut self, other: OffScaleMarks) {
+        self.0.extend(other.0);
+    }
+}
+
+/// Draws the off-scale points of a panel: at the frame, above or below the point's x, an arrow
+/// pointing out of the plot in the curve's colour, and the value printed beside it on a white
+/// ground; points sharing an x are put side by side and their values one under the other.
+pub fn draw_off_scale<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    marks: &OffScaleMarks,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let y_range = chart.y_range();
+    let (lo, hi) = (
+        y_range.start.min(y_range.end),
+        y_range.start.max(y_range.end),
+    );
+    // (x, above, [(value, colour)]) of the points sharing an x and a side.
+    type Group = (f64, bool, Vec<(f64, RGBColor)>);
+    let mut groups: Vec<Group> = Vec::new();
+    for (o, c) in &marks.0 {
+        match groups.iter_mut().find(|g| g.0 == o.x && g.1 == o.above) {
+            Some(g) => g.2.push((o.y, *c)),
+            None => groups.push((o.x, o.above, vec![(o.y, *c)])),
+        }
+    }
+    for (x, above, items) in &groups {
+        let edge = if *above { hi } else { lo };
+        let k = items.len() as i32;
+        for (j, (y, c)) in items.iter().enumerate() {
+            let j = j as i32;
+            let arrow_dx = 12 * j;
+            let text = fmt_off_scale(*y);
+            let text_dx = 12 * k;
+            let text_dy = if *above {
+                3 + 13 * j
+            } else {
+                -15 - 13 * (k - 1 - j)
+            };
+            let w = (text.chars().count() as f64 * 6.2).ceil() as i32 + 4;
+            chart.draw_series(std::iter::once(
+                EmptyElement::at((*x, edge))
+                    + Polygon::new(
+                        off_scale_arrow(*above)
+                            .into_iter()
+                            .map(|(a, b)| (a + arrow_dx, b))
+                            .collect::<Vec<_>>(),
+                        c.filled(),
+                    )
+                    + Rectangle::new(
+                        [(text_dx - 2, text_dy - 1), (text_dx + w, text_dy + 12)],
+                        WHITE.mix(0.85).filled(),
+                    )
+                    + Text::new(text, (text_dx, text_dy), (FONT, 13).into_font().color(c)),
+            ))?;
+        }
+    }
     Ok(())
 }
 
@@ -397,29 +714,39 @@ pub type PanelChart<'a, DB> = ChartContext<
     Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
 >;
 
-/// A square panel without grid lines over `[lo, hi]^2`, with `labels` ticks per axis: the
-/// illustrations' (Figures 1, 5, 6) common frame.
+/// A square panel without grid lines over `[lo, hi]^2`, with `labels` ticks per axis (as
+/// precise as their step needs) and the axes' names `(x, y)`: the illustrations' (Figures 1, 5,
+/// 6) common frame.
 pub fn plain_panel<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
     (lo, hi): (f64, f64),
     labels: usize,
+    (x_desc, y_desc): (&str, &str),
 ) -> Result<PanelChart<'a, DB>, Box<dyn std::error::Error>>
 where
     DB::ErrorType: 'static,
 {
+    let decimals = tick_decimals(lo, hi, labels);
+    let fmt = move |v: &f64| format!("{v:.decimals$}");
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FONT, 14))
         .margin(8)
-        .x_label_area_size(26)
-        .y_label_area_size(30)
+        .margin_right(right_margin(&fmt(&hi), 11))
+        .x_label_area_size(38)
+        .y_label_area_size(46)
         .build_cartesian_2d(lo..hi, lo..hi)?;
     chart
         .configure_mesh()
         .disable_mesh()
         .x_labels(labels)
         .y_labels(labels)
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
+        .x_desc(x_desc)
+        .y_desc(y_desc)
         .label_style((FONT, 11))
+        .axis_desc_style((FONT, 12))
         .draw()?;
     Ok(chart)
 }
@@ -481,6 +808,50 @@ pub fn fmt_epoch(v: &f64) -> String {
     format!("{:.0}", v)
 }
 
+/// The fewest decimals (at most 6) that print exactly every tick plotters puts on a linear axis
+/// over `lo..hi` asked for `labels` labels: none for ticks at whole numbers (so `5000`, never
+/// `5000.0` or, cut at the frame, `5000.`), one for ticks at 0.5 steps, two for 0.25 or 0.05...
+pub fn tick_decimals(lo: f64, hi: f64, labels: usize) -> usize {
+    use plotters::coord::ranged1d::Ranged;
+    if !(lo.is_finite() && hi.is_finite()) || lo == hi {
+        return 0;
+    }
+    let ticks = plotters::coord::types::RangedCoordf64::from(lo.min(hi)..lo.max(hi))
+        .key_points(labels.max(1));
+    (0..=6)
+        .find(|&d| {
+            let scale = 10f64.powi(d as i32);
+            ticks
+                .iter()
+                .all(|t| ((t * scale) - (t * scale).round()).abs() < 1e-6 * scale.max(1.0))
+        })
+        .unwrap_or(6)
+}
+
+/// A tick label of a logarithmic axis, in one format for every tick: `1e-3`, `2e-3`, `1e0`.
+pub fn fmt_log_tick(v: f64) -> String {
+    if v > 0.0 && v.is_finite() {
+        let e = v.log10().floor() as i32;
+        let m = v / 10f64.powi(e);
+        // Mantissas like 0.9999 from the division are rounded back to 1.
+        let m = (m * 10.0).round() / 10.0;
+        if (m - m.round()).abs() < 1e-9 {
+            format!("{}e{e}", m.round() as i64)
+        } else {
+            format!("{m:.1}e{e}")
+        }
+    } else {
+        String::new()
+    }
+}
+
+/// The room (pixels) right of a plot that the last x tick label, centred on the frame's edge,
+/// needs: half its estimated width and a few pixels.
+pub fn right_margin(last_label: &str, font_size: u32) -> u32 {
+    let half = (last_label.chars().count() as f64 * font_size as f64 * 0.3).ceil() as u32;
+    (half + 6).max(12)
+}
+
 /// A linear f64 axis whose ticks are exactly `keys` (e.g. the centres of categories), labelled by
 /// the chart's `x_label_formatter`. (plotters' `with_key_points` on an f64 range has no value
 /// formatter, so its mesh cannot be configured.)
@@ -518,7 +889,7 @@ impl plotters::coord::ranged1d::ValueFormatter<f64> for KeyedAxis {
 }
 
 /// The icon of a legend entry drawn outside the plots (see [`legend_strip`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Icon {
     /// A line segment, optionally dashed, optionally with a marker in its middle.
     Line {
@@ -553,8 +924,9 @@ pub fn paper_star_item(label: &str) -> (Icon, String) {
     )
 }
 
-/// Width of the icon column of a legend entry, in pixels.
-const ICON_W: i32 = 30;
+/// Width of the icon column of a legend entry, in pixels: room for two periods of the longest
+/// dash on either side of the marker in its middle, so that no dashed line looks solid.
+const ICON_W: i32 = 40;
 
 /// Lays out `items` left to right, wrapping to a new row when the area is full, in a strip drawn
 /// under the panels (so that no legend hides data). Text widths are estimated from the character
@@ -662,4 +1034,120 @@ pub fn dedup_legend(items: Vec<(Icon, String)>) -> Vec<(Icon, String)> {
         .into_iter()
         .filter(|(_, l)| seen.insert(l.clone()))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Linear interpolation in data space, as on a linear axis.
+    fn linear(a: (f64, f64), b: (f64, f64), edge: f64) -> (f64, f64) {
+        let t = (edge - a.1) / (b.1 - a.1);
+        (a.0 + t * (b.0 - a.0), edge)
+    }
+
+    #[test]
+    fn an_off_scale_point_is_never_clamped_as_if_it_were_data() {
+        // Iteration 0 far above the rest, as in the training losses.
+        let pts = [
+            (0.0, 4000.0),
+            (100.0, 400.0),
+            (200.0, 200.0),
+            (300.0, 100.0),
+        ];
+        let c = clip_curve(&pts, (0.0, 500.0), linear);
+        assert_eq!(
+            c.off_scale,
+            vec![OffScale {
+                x: 0.0,
+                y: 4000.0,
+                above: true
+            }]
+        );
+        // No marker at the frame: markers go on the data inside only.
+        assert_eq!(c.inside, pts[1..].to_vec());
+        assert!(c.inside.iter().all(|p| p.1 != 500.0));
+        // The line starts where the step from iteration 0 crosses the top edge.
+        assert_eq!(c.segments.len(), 1);
+        let start = c.segments[0][0];
+        assert_eq!(start.1, 500.0);
+        assert!(
+            (start.0 - 100.0 * 3500.0 / 3600.0).abs() < 1e-9,
+            "{start:?}"
+        );
+        // Leaving and coming back, crossing the whole range, and a NaN break.
+        let pts = [
+            (0.0, 1.0),
+            (1.0, 3.0),
+            (2.0, 1.0),
+            (3.0, f64::NAN),
+            (4.0, 1.0),
+            (5.0, -1.0),
+            (6.0, 3.0),
+        ];
+        let c = clip_curve(&pts, (0.0, 2.0), linear);
+        assert_eq!(
+            c.segments,
+            vec![
+                vec![(0.0, 1.0), (0.5, 2.0)],
+                vec![(1.5, 2.0), (2.0, 1.0)],
+                vec![(4.0, 1.0), (4.5, 0.0)],
+                vec![(5.25, 0.0), (5.75, 2.0)],
+            ]
+        );
+        assert_eq!(c.off_scale.len(), 3);
+        assert!(c.off_scale[1].y == -1.0 && !c.off_scale[1].above);
+    }
+
+    #[test]
+    fn off_scale_values_print_three_significant_digits() {
+        assert_eq!(fmt_off_scale(4258.3), "4258");
+        assert_eq!(fmt_off_scale(466.04), "466");
+        assert_eq!(fmt_off_scale(1.2345), "1.23");
+        assert_eq!(fmt_off_scale(-0.01234), "-0.0123");
+        assert_eq!(fmt_off_scale(2.5e6), "2.50e6");
+    }
+
+    #[test]
+    fn ticks_print_as_many_decimals_as_their_step_needs() {
+        // Whole-number ticks: "5000", never "5000.0" (cut at the frame into "5000.").
+        assert_eq!(tick_decimals(0.0, 5000.0, 6), 0);
+        // plotters puts 0, 0.1, ..., 0.4 here (1 decimal), and 0, 0.05, ..., 0.4 with 10 labels.
+        assert_eq!(tick_decimals(0.0, 0.43, 7), 1);
+        assert_eq!(tick_decimals(0.0, 0.43, 10), 2);
+        assert_eq!(tick_decimals(-4.0, 4.0, 9), 0);
+        assert_eq!(tick_decimals(3.5, 3.5, 5), 0);
+        assert_eq!(fmt_log_tick(1e-3), "1e-3");
+        assert_eq!(fmt_log_tick(0.002), "2e-3");
+        assert_eq!(fmt_log_tick(1.0), "1e0");
+        assert_eq!(fmt_log_tick(0.0), "");
+        assert!(right_margin("5000", 12) >= 4 * 12 * 3 / 10);
+    }
+
+    #[test]
+    fn a_legend_icon_is_its_line_style() {
+        let (pts, _) = marker_points(3, 4.0);
+        let style = LineStyle {
+            colour: RGBColor(1, 2, 3),
+            dash: DASHES[2],
+            marker: (pts, false),
+            width: 2,
+        };
+        assert_eq!(
+            style.legend_item("x"),
+            (
+                Icon::Line {
+                    colour: style.colour,
+                    dash: style.dash,
+                    width: 2,
+                    marker: Some(style.marker.clone()),
+                },
+                "x".to_string()
+            )
+        );
+        // The legend's icon is wide enough to show a gap of every dash beside its marker.
+        for (d, g) in DASHES.iter().flatten() {
+            assert!(ICON_W >= 2 * (d + g), "{d} {g}");
+        }
+    }
 }

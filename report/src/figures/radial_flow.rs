@@ -63,10 +63,17 @@ pub fn draw(fig_dir: &Path) -> Result<FigureFile, ReportError> {
         )?;
         let areas = area.split_evenly((1, 3));
         for ((title, pts), a) in panels.iter().zip(areas.iter()) {
-            let mut chart = plain_panel(a, title, (-4.0, 4.0), 5)?;
+            let inside = |p: &&(f64, f64)| p.0.abs() < 4.0 && p.1.abs() < 4.0;
+            let outside = pts.len() - pts.iter().filter(inside).count();
+            let title = if outside > 0 {
+                format!("{title} ({outside} of {} outside)", pts.len())
+            } else {
+                title.clone()
+            };
+            let mut chart = plain_panel(a, &title, (-4.0, 4.0), 5, ("z1", "z2"))?;
             chart.draw_series(
                 pts.iter()
-                    .filter(|p| p.0.abs() < 4.0 && p.1.abs() < 4.0)
+                    .filter(inside)
                     .map(|&p| Circle::new(p, 1, RGBColor(0x00, 0x72, 0xB2).mix(0.5).filled())),
             )?;
             chart.draw_series(std::iter::once(Cross::new(c, 5, RED.stroke_width(2))))?;

@@ -255,6 +255,7 @@ fn draw_panel(
         )))?;
     }
     let n = panel.members.len().max(1);
+    let mut off = super::OffScaleMarks::default();
     for (i, &(sampler, variant, c)) in panel.members.iter().enumerate() {
         let (mpts, _) = marker_points(sampler_marker_slot(sampler), 4.5);
         let style = LineStyle {
@@ -263,20 +264,17 @@ fn draw_panel(
             marker: (mpts, variant_filled(variant)),
             width: 2,
         };
-        let pts: Vec<(f64, f64)> = c
-            .curve
-            .iter()
-            .map(|p| {
-                let y = if p.mean.is_finite() {
-                    clamp(p.mean)
-                } else {
-                    p.mean
-                };
-                (p.epoch as f64, y)
-            })
-            .collect();
-        draw_curve(&mut chart, &pts, &style, i as f64 / n as f64, None)?;
+        // Means are not clamped: one outside the axis is marked at the frame with its value.
+        let pts: Vec<(f64, f64)> = c.curve.iter().map(|p| (p.epoch as f64, p.mean)).collect();
+        off.extend(draw_curve(
+            &mut chart,
+            &pts,
+            &style,
+            i as f64 / n as f64,
+            None,
+        )?);
     }
+    super::draw_off_scale(&mut chart, &off)?;
 
     // The paper's single-run values (its Figure 4 has ArmBall 10 latents only in our table).
     let star = star_points(8.0, 3.5);

@@ -1,13 +1,17 @@
 //! Recorded training losses (`training_loss.svg`): for each environment (rows) and neural learner
 //! (columns), the mean loss over the trainings of the main campaign against the iteration, one
 //! curve per latent size and variant (faithful solid, corrected dashed). The loss is the one each
-//! learner minimises (docs/original-code.md section 5: pixel-summed Bernoulli cross-entropy, plus the KL
-//! for the VAE, minus the flows' log-determinant for the RFVAE), so levels differ between
-//! learners; the y axis starts after the first recorded point, which can be far above the rest.
+//! learner minimises (docs/original-code.md section 5: pixel-summed Bernoulli cross-entropy, in
+//! nats per image, plus the KL for the VAE; the RFVAE's is annealed and minus the flows'
+//! log-determinant), so levels differ between learners. The y axis spans every point unless the
+//! first recorded one is far above the rest: then that point is an arrow at the top edge with its
+//! value printed, never a marker clamped to the edge as if it were data.
 //! A dotted grey line marks the mean-image loss of the training images (the *plateau*, the loss of
-//! the best constant prediction): a network whose loss stays on it learned nothing. (The RFVAE's
-//! loss subtracts the flows' log-determinant, so it can sit below the plateau without having
-//! learned; its evidence of training is the reconstruction loss, "Did the goal spaces learn?".)
+//! the best constant prediction): a network whose loss stays on it learned nothing. The RFVAE's
+//! panels have no plateau line: its loss weights the cross-entropy and the KL by an annealing
+//! factor (0.01 at the start) and subtracts the flows' log-determinant, so it is not on the
+//! plateau's scale; its evidence of training is the reconstruction loss ("Did the goal spaces
+//! learn?").
 
 use std::path::Path;
 
@@ -15,8 +19,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, learner_name,
-    legend_height, legend_strip, marker_points, variant_dash, variant_filled, write_svg,
+    FONT, FigureFile, Icon, LineStyle, draw_curve, env_name, learner_name, legend_height,
+    legend_strip, marker_points, variant_dash, variant_filled, write_svg,
 };
 use crate::ReportError;
 use crate::load::rank;
@@ -39,38 +43,75 @@ fn latents_colour(env: &str, latents: i64) -> RGBColor {
 /// The plateau's reference line.
 const PLATEAU_GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
 
-/// (colour, marker points, dash, filled marker) of a curve: colour and marker by latent size,
-/// dash and fill by variant.
-fn curve_style(
-    env: &str,
-    latents: i64,
-    variant: &str,
-) -> (RGBColor, Vec<(i32, i32)>, Option<(i32, i32)>, bool) {
+/// The style of a curve: colour and marker by latent size, dash and fill by variant.
+fn curve_style(env: &str, latents: i64, variant: &str) -> LineStyle {
     let slot = if Some(latents) == super::true_latents(env) {
         2
     } else {
         0
     };
     let (mpts, _) = marker_points(slot, 4.0);
-    (
-        latents_colour(env, latents),
-        mpts,
-        variant_dash(variant),
-        variant_filled(variant),
-    )
+    LineStyle {
+        colour: latents_colour(env, latents),
+        dash: variant_dash(variant),
+        marker: (mpts, variant_filled(variant)),
+        width: 2,
+    }
 }
 
-/// The legend label of a curve's style: `10 latents, corrected`, `true dimension, faithful`.
-fn curve_label(env: &str, latents: i64, variant: &str) -> String {
-    let mut label = if Some(latents) == super::true_latents(env) {
+/// The legend label of a latent size: `10 latents`, `true dimension`.
+fn size_label(env: &str, latents: i64) -> String {
+    if Some(latents) == super::true_latents(env) {
         "true dimension".to_string()
     } else {
         format!("{latents} latents")
-    };
-    if variant != "none" {
-        label.push_str(&format!(", {variant}"));
     }
-    label
+}
+
+/// Whether a learner's loss is on the plateau's scale: not the RFVAE's, which is annealed (its
+/// cross-entropy and KL weighted by min(1, 0.01 + step/1e4)) and minus the flows' log-determinant.
+fn has_plateau(learner: &str) -> bool {
+    learner != "rfvae"
+}
+
+/// The legend: one entry per drawn style. The AE has no variant (`none`) and is drawn as the
+/// faithful variant of the others (solid, filled): one entry says both. Ordered by latent size
+/// (as the curves' colours), then faithful before corrected.
+fn legend_items(curves: &[LossCurve]) -> Vec<(Icon, String)> {
+    let mut groups: Vec<(LineStyle, String, i64, bool, Vec<&str>)> = Vec::new();
+    for c in curves {
+        let style = curve_style(&c.env, c.latents, &c.variant);
+        match groups.iter_mut().find(|g| g.0 == style) {
+            Some(g) => {
+                if !g.4.contains(&c.variant.as_str()) {
+                    g.4.push(&c.variant);
+                }
+            }
+            None => groups.push((
+                style,
+                size_label(&c.env, c.latents),
+                c.latents,
+                c.variant == "corrected",
+                vec![&c.variant],
+            )),
+        }
+    }
+    groups.sort_by(|a, b| {
+        (a.1 == "true dimension", a.2, a.3).cmp(&(b.1 == "true dimension", b.2, b.3))
+    });
+    groups
+        .into_iter()
+        .map(|(style, size, _, _, variants)| {
+            let none = variants.contains(&"none");
+            let named: Vec<&str> = variants.iter().copied().filter(|v| *v != "none").collect();
+            let label = match (named.is_empty(), none) {
+                (true, _) => size,
+                (false, false) => format!("{size}, {}", named.join(", ")),
+                (false, true) => format!("{size}, {} (and the AE, no variant)", named.join(", ")),
+            };
+            style.legend_item(label)
+        })
+        .collect()
 }
 
 /// Draws the figure; `None` when no run recorded a loss.
@@ -94,39 +135,65 @@ pub fn draw(curves: &[LossCurve], fig_dir: &Path) -> Result<Option<FigureFile>, 
     let (rows, cols) = (envs.len(), learners.len());
     let width = PANEL_W * cols as u32;
     // One legend for all panels, under them (no legend hides a curve).
-    let mut legend: Vec<(Icon, String)> = curves
+    let mut legend = legend_items(curves);
+    let with_plateau = curves
         .iter()
-        .map(|c| {
-            let (colour, mpts, dash, filled) = curve_style(&c.env, c.latents, &c.variant);
-            (
-                Icon::Line {
-                    colour,
-                    dash,
-                    width: 2,
-                    marker: Some((mpts, filled)),
-                },
-                curve_label(&c.env, c.latents, &c.variant),
-            )
+        .any(|c| c.plateau.is_some() && has_plateau(&c.learner));
+    if with_plateau {
+        legend.push((
+            Icon::Line {
+                colour: PLATEAU_GREY,
+                dash: Some((3, 4)),
+                width: 1,
+                marker: None,
+            },
+            "mean-image loss (the plateau; its value in each panel's title; none for the RFVAE, \
+             whose loss is annealed and minus the flows' log-determinant)"
+                .into(),
+        ));
+    }
+    let off_scale = envs.iter().any(|env| {
+        learners.iter().any(|l| {
+            let of: Vec<&LossCurve> = curves
+                .iter()
+                .filter(|c| c.env == *env && c.learner == *l)
+                .collect();
+            let (lo, hi) = y_bounds(&of, plateau_of(&of, l)).0;
+            of.iter()
+                .flat_map(|c| c.points.iter())
+                .any(|p| p.1.is_finite() && (p.1 < lo || p.1 > hi))
         })
-        .collect();
-    legend.sort_by(|a, b| a.1.cmp(&b.1));
-    let mut legend = dedup_legend(legend);
-    legend.push((
-        Icon::Line {
-            colour: PLATEAU_GREY,
-            dash: Some((3, 4)),
-            width: 1,
-            marker: None,
-        },
-        "mean-image loss (the plateau; its value in each panel's title)".into(),
-    ));
+    });
+    if off_scale {
+        legend.push((
+            Icon::Marker {
+                colour: RGBColor(0x44, 0x44, 0x44),
+                points: super::off_scale_arrow(true),
+                filled: true,
+                stroke: 1,
+            },
+            "a mean above the axis (iteration 0): an arrow at the top edge, its value beside it"
+                .into(),
+        ));
+    }
+    let mut trainings: Vec<usize> = curves.iter().map(|c| c.trainings).collect();
+    trainings.sort_unstable();
+    trainings.dedup();
+    let per_curve = match (trainings.first(), trainings.last()) {
+        (Some(a), Some(b)) if a == b => format!("{a}"),
+        (Some(a), Some(b)) => format!("{a}-{b}"),
+        _ => "0".into(),
+    };
     let legend_h = legend_height(width, &legend, 13);
     write_svg(
         &path,
         (width, PANEL_H * rows as u32 + TITLE_H + legend_h),
         |root| {
             let area = root.titled(
-                "Training loss of the neural learners, mean over trainings",
+                &format!(
+                    "Training loss of the neural learners, mean over {} trainings per curve",
+                    per_curve
+                ),
                 (FONT, 18),
             )?;
             let (plots, strip) = area.split_vertically(PANEL_H * rows as u32);
@@ -144,23 +211,72 @@ pub fn draw(curves: &[LossCurve], fig_dir: &Path) -> Result<Option<FigureFile>, 
             Ok(())
         },
     )?;
-    let mut trainings: Vec<usize> = curves.iter().map(|c| c.trainings).collect();
-    trainings.sort_unstable();
-    trainings.dedup();
-    let per_curve = match (trainings.first(), trainings.last()) {
-        (Some(a), Some(b)) if a == b => format!("{a}"),
-        (Some(a), Some(b)) => format!("{a}-{b}"),
-        _ => "0".into(),
-    };
     Ok(Some(FigureFile {
         path,
         link: format!("figures/{FILE}"),
         caption: format!(
-            "Training loss of the AE, VAE and RFVAE against the iteration (mean over the main \
-             campaign's trainings, {per_curve} per curve)"
+            "Training loss of the AE, VAE and RFVAE (nats per image) against the training \
+             iteration (mean over the main campaign's trainings, {per_curve} per curve; no \
+             interval drawn)"
         ),
         env: String::new(),
     }))
+}
+
+/// The plateau a panel draws: the mean of its curves' plateaus, for a learner whose loss is on
+/// its scale.
+fn plateau_of(curves: &[&LossCurve], learner: &str) -> Option<f64> {
+    let plateaus: Vec<f64> = curves.iter().filter_map(|c| c.plateau).collect();
+    (has_plateau(learner) && !plateaus.is_empty())
+        .then(|| plateaus.iter().sum::<f64>() / plateaus.len() as f64)
+        .filter(|v| v.is_finite())
+}
+
+/// The y axis of a panel, `((lo, hi), (y_min, y_max))`: the data's span and the padded axis. It
+/// spans every point and the plateau, except a curve's first point when it lies far above the
+/// rest (more than half their span above their top): that one is drawn off scale.
+fn y_bounds(curves: &[&LossCurve], plateau: Option<f64>) -> ((f64, f64), (f64, f64)) {
+    let finite = |v: &f64| v.is_finite();
+    let rest: Vec<f64> = curves
+        .iter()
+        .flat_map(|c| c.points.iter().skip(1).map(|p| p.1))
+        .chain(plateau)
+        .filter(finite)
+        .collect();
+    let firsts: Vec<f64> = curves
+        .iter()
+        .filter_map(|c| c.points.first().map(|p| p.1))
+        .filter(finite)
+        .collect();
+    let span = |v: &[f64]| {
+        v.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            })
+    };
+    let (mut lo, mut hi) = span(&rest);
+    if rest.len() >= 2 && hi > lo {
+        let reach = hi + 0.5 * (hi - lo);
+        for &f in &firsts {
+            if f <= reach {
+                hi = hi.max(f);
+            }
+            lo = lo.min(f);
+        }
+    } else {
+        let (a, b) = span(&firsts);
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    let (lo, hi) = if lo.is_finite() && hi.is_finite() && hi > lo {
+        (lo, hi)
+    } else if lo.is_finite() {
+        (lo - 1.0, lo + 1.0)
+    } else {
+        (0.0, 1.0)
+    };
+    let pad = (hi - lo) * 0.06;
+    ((lo, hi), (lo - pad, hi + pad))
 }
 
 fn draw_panel(
@@ -184,54 +300,27 @@ fn draw_panel(
         .max()
         .unwrap_or(1)
         .max(1) as f64;
-    // Cut the first recorded point only where each curve has a body after it.
-    let skip = usize::from(curves.iter().all(|c| c.points.len() >= 3));
-    let body: Vec<f64> = curves
-        .iter()
-        .flat_map(|c| c.points.iter().skip(skip).map(|p| p.1))
-        .filter(|v| v.is_finite())
-        .collect();
-    let plateaus: Vec<f64> = curves.iter().filter_map(|c| c.plateau).collect();
-    let plateau = (!plateaus.is_empty())
-        .then(|| plateaus.iter().sum::<f64>() / plateaus.len() as f64)
-        .filter(|v| v.is_finite());
-    let all: Vec<f64> = curves
-        .iter()
-        .flat_map(|c| c.points.iter().map(|p| p.1))
-        .chain(plateau)
-        .filter(|v| v.is_finite())
-        .collect();
-    let lo = all.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = if body.is_empty() { &all } else { &body }
-        .iter()
-        .copied()
-        .chain(plateau)
-        .fold(f64::NEG_INFINITY, f64::max);
-    if let Some(p) = plateau {
-        title.push_str(&format!(" (plateau {p:.0})"));
+    let plateau = plateau_of(curves, learner);
+    match plateau {
+        Some(p) => title.push_str(&format!(" (plateau {p:.0})")),
+        None if !has_plateau(learner) => title.push_str(" (annealed, minus log-det; no plateau)"),
+        None => {}
     }
-    let (lo, hi) = if lo.is_finite() && hi.is_finite() && hi > lo {
-        (lo, hi)
-    } else if lo.is_finite() {
-        (lo - 1.0, lo + 1.0)
-    } else {
-        (0.0, 1.0)
-    };
-    let pad = (hi - lo) * 0.06;
-    let (y_min, y_max) = (lo - pad, hi + pad);
-    // Enough decimals to tell the ticks apart.
-    let decimals = (-((y_max - y_min) / 7.0).log10()).ceil().clamp(0.0, 6.0) as usize;
+    let (_, (y_min, y_max)) = y_bounds(curves, plateau);
+    let decimals = super::tick_decimals(y_min, y_max, 7);
+    let x_decimals = super::tick_decimals(0.0, x_hi, 6);
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FONT, 16))
         .margin(10)
+        .margin_right(super::right_margin(&format!("{x_hi:.x_decimals$}"), 12))
         .x_label_area_size(40)
         .y_label_area_size(64)
         .build_cartesian_2d(-0.01 * x_hi..x_hi * 1.03, y_min..y_max)?;
     chart
         .configure_mesh()
-        .x_desc("training iteration")
-        .y_desc("loss")
-        .x_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("training iteration (batches of 100 images)")
+        .y_desc("loss (nats per image)")
+        .x_label_formatter(&|v| format!("{v:.x_decimals$}"))
         .y_label_formatter(&|v| format!("{v:.decimals$}"))
         .x_labels(6)
         .y_labels(7)
@@ -250,29 +339,107 @@ fn draw_panel(
         )))?;
     }
     let n = curves.len().max(1);
+    let mut off = super::OffScaleMarks::default();
     for (i, c) in curves.iter().enumerate() {
-        let (colour, mpts, dash, filled) = curve_style(env, c.latents, &c.variant);
-        let style = LineStyle {
-            colour,
-            dash,
-            marker: (mpts, filled),
-            width: 2,
-        };
-        let pts: Vec<(f64, f64)> = c
-            .points
-            .iter()
-            .map(|&(it, v)| {
-                (
-                    it as f64,
-                    if v.is_finite() {
-                        v.clamp(y_min, y_max)
-                    } else {
-                        v
-                    },
-                )
-            })
-            .collect();
-        draw_curve(&mut chart, &pts, &style, i as f64 / n as f64, None)?;
+        let style = curve_style(env, c.latents, &c.variant);
+        let pts: Vec<(f64, f64)> = c.points.iter().map(|&(it, v)| (it as f64, v)).collect();
+        off.extend(draw_curve(
+            &mut chart,
+            &pts,
+            &style,
+            i as f64 / n as f64,
+            None,
+        )?);
     }
+    super::draw_off_scale(&mut chart, &off)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(learner: &str, variant: &str, latents: i64, points: Vec<(i64, f64)>) -> LossCurve {
+        LossCurve {
+            env: "armball".into(),
+            learner: learner.into(),
+            variant: variant.into(),
+            latents,
+            trainings: 5,
+            points,
+            plateau: Some(440.0),
+        }
+    }
+
+    fn all_curves() -> Vec<LossCurve> {
+        let pts = vec![(0, 4000.0), (100, 400.0), (200, 100.0), (300, 90.0)];
+        let mut v = Vec::new();
+        for latents in [10, 2] {
+            v.push(curve("ae", "none", latents, pts.clone()));
+            for learner in ["vae", "rfvae"] {
+                for variant in ["faithful", "corrected"] {
+                    v.push(curve(learner, variant, latents, pts.clone()));
+                }
+            }
+        }
+        v
+    }
+
+    /// One entry per drawn style: the AE (no variant) and the faithful variants share a style, so
+    /// they share one entry, never two entries that look the same.
+    #[test]
+    fn every_style_has_one_legend_entry_drawn_as_its_curves() {
+        let curves = all_curves();
+        let legend = legend_items(&curves);
+        assert_eq!(legend.len(), 4, "{legend:?}");
+        for (i, (icon, _)) in legend.iter().enumerate() {
+            assert!(!legend[..i].iter().any(|(j, _)| j == icon), "{legend:?}");
+        }
+        for c in &curves {
+            let icon = curve_style(&c.env, c.latents, &c.variant).icon();
+            assert!(
+                legend.iter().any(|(i, _)| *i == icon),
+                "{} {}",
+                c.learner,
+                c.variant
+            );
+        }
+        let labels: Vec<&str> = legend.iter().map(|l| l.1.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "10 latents, faithful (and the AE, no variant)",
+                "10 latents, corrected",
+                "true dimension, faithful (and the AE, no variant)",
+                "true dimension, corrected",
+            ]
+        );
+    }
+
+    /// The first iteration far above the rest is off scale (drawn as an arrow at the edge), not
+    /// inside the axis; near the rest, it is inside.
+    #[test]
+    fn a_far_first_point_is_off_the_axis_and_a_near_one_on_it() {
+        let far = curve(
+            "ae",
+            "none",
+            10,
+            vec![(0, 4000.0), (100, 400.0), (200, 100.0)],
+        );
+        let ((_, hi), (_, y_max)) = y_bounds(&[&far], Some(440.0));
+        assert_eq!(hi, 440.0);
+        assert!(y_max < 4000.0);
+        let near = curve(
+            "ae",
+            "none",
+            10,
+            vec![(0, 466.0), (100, 400.0), (200, 100.0)],
+        );
+        let ((_, hi), _) = y_bounds(&[&near], Some(440.0));
+        assert_eq!(hi, 466.0);
+        // The RFVAE's panel has no plateau.
+        let rf = curve("rfvae", "faithful", 10, vec![(0, 100.0), (100, 200.0)]);
+        assert_eq!(plateau_of(&[&rf], "rfvae"), None);
+        assert_eq!(plateau_of(&[&far], "ae"), Some(440.0));
+    }
 }

@@ -1,32 +1,37 @@
-//! Faithful vs corrected (`variants.svg`): the final KL-coverage of RGE-VAE and RGE-RFVAE in their
-//! two variants, one panel per environment and latent size. Within a panel, one group per
-//! (algorithm, goal sampler; colour by algorithm as in the curve figures); in a group the faithful
-//! runs on the left (filled circles) and the corrected ones on the right (hollow circles), every seed a dot, a thin grey line joining the two runs
-//! of a seed (they share initial weights and batches), and the mean with its 95% t interval
-//! ([`crate::stats::CONFIDENCE`]) as a bar with whiskers.
+//! Faithful vs corrected (`variants.svg`): the paired comparison of RGE-VAE and RGE-RFVAE in
+//! their two variants, one panel per environment and latent size, one group per (algorithm, goal
+//! sampler; colour by algorithm as in the curve figures). The two runs of a seed share their
+//! initial weights, batches and exploration streams, so the figure draws what the paired test
+//! looks at: every seed's difference of final KL-coverage, *corrected − faithful* (a dot; below 0
+//! the corrected variant covers better), their mean (a black bar) and its 95% paired t interval
+//! ([`crate::stats::CONFIDENCE`], Student's t on the differences; whiskers), against a dashed
+//! line at 0. (Whiskers of the two variants' own means, side by side, overlap even where the
+//! paired interval excludes 0: the seeds' shared part of the variance cancels in the
+//! differences.) The number of pairs and the interval are printed over each group.
 
 use std::path::Path;
 
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, KeyedAxis, algo_name, colour, env_name, marker, marker_points, panel_order,
-    sampler_name, write_svg,
+    FONT, FigureFile, Icon, KeyedAxis, algo_name, colour, env_name, legend_height, legend_strip,
+    marker, marker_points, panel_order, sampler_name, write_svg,
 };
 use crate::ReportError;
-use crate::aggregate::ConditionSummary;
 use crate::neural::VariantPair;
+use crate::stats::CONFIDENCE;
 
 pub const FILE: &str = "variants.svg";
 const PANEL_W: u32 = 620;
 const PANEL_H: u32 = 430;
 const TITLE_H: u32 = 36;
-const LEGEND_H: u32 = 34;
-/// Offset of the faithful (−) and corrected (+) columns from the group centre, in groups.
-const COLUMN: f64 = 0.2;
-/// Spread of the seeds within a column, in groups.
-const SEED_SPREAD: f64 = 0.025;
-const GREY: RGBColor = RGBColor(0xAA, 0xAA, 0xAA);
+/// Spread of the seeds' dots, in groups.
+const SEED_SPREAD: f64 = 0.035;
+/// Offset of the mean and interval from the group centre (right of the dots), in groups.
+const SUMMARY_DX: f64 = 0.2;
+const ZERO_GREY: RGBColor = RGBColor(0x55, 0x55, 0x55);
+const DARK: RGBColor = RGBColor(0x44, 0x44, 0x44);
 
 /// Colour and marker slot of an algorithm, as in the curve figures.
 fn slot(algo: &str) -> usize {
@@ -57,20 +62,24 @@ pub fn draw(pairs: &[VariantPair<'_>], fig_dir: &Path) -> Result<Option<FigureFi
     let panels = panels(pairs);
     let cols = panels.len().min(2);
     let rows = panels.len().div_ceil(2);
+    let width = PANEL_W * cols as u32;
+    let legend = legend();
+    let legend_h = legend_height(width, &legend, 13);
+    let level = CONFIDENCE * 100.0;
     let path = fig_dir.join(FILE);
     write_svg(
         &path,
-        (
-            PANEL_W * cols as u32,
-            PANEL_H * rows as u32 + TITLE_H + LEGEND_H,
-        ),
+        (width, PANEL_H * rows as u32 + TITLE_H + legend_h),
         |root| {
             let area = root.titled(
-                "Final KL-coverage, faithful vs corrected: every seed, mean and 95% t interval",
+                &format!(
+                    "Corrected − faithful, final KL-coverage per seed: mean and {level:.0}% \
+                     paired t interval"
+                ),
                 (FONT, 17),
             )?;
             let (area, strip) = area.split_vertically(PANEL_H * rows as u32);
-            draw_legend(&strip)?;
+            legend_strip(&strip, &legend, 13)?;
             let areas = area.split_evenly((rows, cols));
             for (p, a) in panels.iter().zip(areas.iter()) {
                 draw_panel(a, p)?;
@@ -81,46 +90,51 @@ pub fn draw(pairs: &[VariantPair<'_>], fig_dir: &Path) -> Result<Option<FigureFi
     Ok(Some(FigureFile {
         path,
         link: format!("figures/{FILE}"),
-        caption: "Final KL-coverage of the faithful and corrected variants of RGE-VAE and \
-                  RGE-RFVAE, per seed, with the mean and its 95% t interval"
-            .into(),
+        caption: format!(
+            "Faithful vs corrected RGE-VAE and RGE-RFVAE: the per-seed difference of final \
+             KL-coverage (corrected − faithful; below 0 the corrected variant covers better), \
+             with the mean and its {level:.0}% paired t interval; n pairs over each group"
+        ),
         env: String::new(),
     }))
 }
 
 /// The legend, once for all panels, in a strip under them.
-fn draw_legend(
-    strip: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let dark = RGBColor(0x44, 0x44, 0x44);
+fn legend() -> Vec<(Icon, String)> {
     let (circle, _) = marker_points(0, 4.5);
-    let y = (LEGEND_H / 2) as i32;
-    let text = |s: &str, x: i32| Text::new(s.to_string(), (x, y - 7), (FONT, 13));
-    let mut x = 20;
-    for (label, filled) in [
-        ("faithful: left, filled markers", true),
-        ("corrected: right, hollow markers", false),
-    ] {
-        strip.draw(&marker((x, y), &circle, filled, dark, 1))?;
-        strip.draw(&text(label, x + 12))?;
-        x += 250;
-    }
-    strip.draw(&PathElement::new(
-        vec![(x - 6, y), (x + 6, y)],
-        BLACK.stroke_width(3),
-    ))?;
-    strip.draw(&PathElement::new(
-        vec![(x + 14, y - 8), (x + 14, y + 8)],
-        dark.stroke_width(2),
-    ))?;
-    strip.draw(&text("mean (black bar), 95% t CI (whiskers)", x + 24))?;
-    x += 280;
-    strip.draw(&PathElement::new(
-        vec![(x - 8, y + 5), (x + 8, y - 5)],
-        GREY.stroke_width(1),
-    ))?;
-    strip.draw(&text("the two runs of one seed", x + 16))?;
-    Ok(())
+    vec![
+        (
+            Icon::Marker {
+                colour: DARK,
+                points: circle,
+                filled: true,
+                stroke: 1,
+            },
+            "one seed: corrected − faithful (colour: algorithm)".into(),
+        ),
+        (
+            Icon::Line {
+                colour: BLACK,
+                dash: None,
+                width: 3,
+                marker: None,
+            },
+            "mean difference".into(),
+        ),
+        (
+            Icon::Whisker { colour: DARK },
+            format!("{:.0}% paired t interval of the mean", CONFIDENCE * 100.0),
+        ),
+        (
+            Icon::Line {
+                colour: ZERO_GREY,
+                dash: Some((6, 4)),
+                width: 1,
+                marker: None,
+            },
+            "0: no difference".into(),
+        ),
+    ]
 }
 
 /// `RGE-VAE, KDE`.
@@ -128,14 +142,28 @@ fn group_label(p: &VariantPair<'_>) -> String {
     format!("{}, {}", algo_name(&p.algo), sampler_name(&p.sampler))
 }
 
-/// x of a seed's dot: the column, spread by the seed's rank among `n`.
+/// x of a seed's dot: left of the group centre, spread by the seed's rank among `n`.
 fn seed_x(centre: f64, rank: usize, n: usize) -> f64 {
-    centre + (rank as f64 - (n as f64 - 1.0) / 2.0) * SEED_SPREAD
+    centre - 0.05 + (rank as f64 - (n as f64 - 1.0) / 2.0) * SEED_SPREAD
 }
 
-/// The faithful and corrected conditions of a pair.
-fn sides<'a>(p: &VariantPair<'a>) -> [Option<&'a ConditionSummary>; 2] {
-    [p.faithful, p.corrected]
+/// `+0.251`: a signed difference.
+fn signed(v: f64) -> String {
+    format!("{v:+.3}")
+}
+
+/// The values a panel's y axis spans: every difference, mean and interval end, and 0.
+fn panel_values(pairs: &[&VariantPair<'_>]) -> Vec<f64> {
+    let mut vals = vec![0.0];
+    for p in pairs {
+        vals.extend(p.differences.iter().map(|d| d.1));
+        if let Some(d) = &p.diff {
+            vals.push(d.mean);
+            vals.extend(d.ci.into_iter().flat_map(|(a, b)| [a, b]));
+        }
+    }
+    vals.retain(|v| v.is_finite());
+    vals
 }
 
 fn draw_panel(
@@ -146,40 +174,33 @@ fn draw_panel(
         return Ok(());
     };
     let title = format!("{}, {} latents", env_name(&first.env), first.latents);
-    let mut vals: Vec<f64> = Vec::new();
-    for p in pairs {
-        for c in sides(p).into_iter().flatten() {
-            vals.extend(c.final_by_seed.iter().map(|v| v.1));
-            vals.extend(c.final_klc.ci.into_iter().flat_map(|(a, b)| [a, b]));
-        }
-    }
-    vals.retain(|v| v.is_finite());
+    let vals = panel_values(pairs);
     let (lo, hi) = vals
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
-    let pad = ((hi - lo) * 0.1).max(0.05);
-    // Room at the top for the run counts.
-    let (y_min, y_max) = (lo - pad, hi + 1.8 * pad);
+    let pad = ((hi - lo) * 0.08).max(0.05);
+    // Room at the top for the counts and intervals.
+    let (y_min, y_max) = (lo - pad, hi + 3.2 * pad);
     let g = pairs.len();
     let labels: Vec<String> = pairs.iter().map(|p| group_label(p)).collect();
     let x_range = KeyedAxis {
         range: -0.5..g as f64 - 0.5,
         keys: (0..g).map(|i| i as f64).collect(),
     };
+    let decimals = super::tick_decimals(y_min, y_max, 8);
 
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FONT, 17))
         .margin(12)
         .x_label_area_size(38)
-        .y_label_area_size(56)
+        .y_label_area_size(62)
         .build_cartesian_2d(x_range, y_min..y_max)?;
     chart
         .configure_mesh()
         .disable_x_mesh()
-        .y_desc("final KL-coverage (nats, lower is better)")
+        .y_desc("Δ final KL-coverage, corrected − faithful (nats)")
         .x_label_formatter(&|v| {
             let i = v.round();
             if (v - i).abs() < 1e-9 && i >= 0.0 && (i as usize) < labels.len() {
@@ -188,7 +209,18 @@ fn draw_panel(
                 String::new()
             }
         })
-        .y_label_formatter(&|v| format!("{v:.2}"))
+        .y_label_formatter(&|v| {
+            let s = format!("{v:+.decimals$}");
+            // No sign on zero.
+            if s.trim_start_matches(['+', '-'])
+                .chars()
+                .all(|c| c == '0' || c == '.')
+            {
+                s[1..].to_string()
+            } else {
+                s
+            }
+        })
         .y_labels(8)
         .max_light_lines(1)
         .label_style((FONT, 13))
@@ -196,66 +228,90 @@ fn draw_panel(
         .light_line_style(RGBColor(0xF0, 0xF0, 0xF0))
         .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
         .draw()?;
-
-    let clamp = |v: f64| v.clamp(y_min, y_max);
+    chart.draw_series(std::iter::once(DashedPathElement::new(
+        vec![(-0.5, 0.0), (g as f64 - 0.5, 0.0)],
+        6,
+        4,
+        ZERO_GREY.stroke_width(1),
+    )))?;
+    let grey_text = (FONT, 12).into_font().color(&RGBColor(0x33, 0x33, 0x33));
+    let row = |k: f64| y_max - (0.02 + 0.055 * k) * (y_max - y_min);
     for (gi, p) in pairs.iter().enumerate() {
         let centre = gi as f64;
         let col = colour(slot(&p.algo));
         let (mpts, _) = marker_points(0, 4.5);
-        // Paired lines first, under the dots.
-        if let (Some(f), Some(c)) = (p.faithful, p.corrected) {
-            let (nf, nc) = (f.final_by_seed.len(), c.final_by_seed.len());
-            for (rf, &(seed, vf)) in f.final_by_seed.iter().enumerate() {
-                if let Some(rc) = c.final_by_seed.iter().position(|x| x.0 == seed) {
-                    let vc = c.final_by_seed[rc].1;
-                    if vf.is_finite() && vc.is_finite() {
-                        chart.draw_series(std::iter::once(PathElement::new(
-                            vec![
-                                (seed_x(centre - COLUMN, rf, nf), vf),
-                                (seed_x(centre + COLUMN, rc, nc), vc),
-                            ],
-                            GREY.stroke_width(1),
-                        )))?;
-                    }
+        let n = p.differences.len();
+        chart.draw_series(
+            p.differences
+                .iter()
+                .enumerate()
+                .filter(|(_, d)| d.1.is_finite())
+                .map(|(r, d)| marker((seed_x(centre, r, n), d.1), &mpts, true, col, 1)),
+        )?;
+        let xm = centre + SUMMARY_DX;
+        let (count, interval) = match &p.diff {
+            Some(d) => {
+                if let Some((a, b)) = d.ci {
+                    chart.draw_series([
+                        PathElement::new(vec![(xm, a), (xm, b)], col.stroke_width(2)),
+                        PathElement::new(vec![(xm - 0.03, a), (xm + 0.03, a)], col.stroke_width(2)),
+                        PathElement::new(vec![(xm - 0.03, b), (xm + 0.03, b)], col.stroke_width(2)),
+                    ])?;
                 }
+                if d.mean.is_finite() {
+                    chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(xm - 0.06, d.mean), (xm + 0.06, d.mean)],
+                        BLACK.stroke_width(3),
+                    )))?;
+                }
+                let interval = match d.ci {
+                    Some((a, b)) => format!("[{}, {}]", signed(a), signed(b)),
+                    None => "no interval".into(),
+                };
+                (format!("n={n} pairs, {}", signed(d.mean)), interval)
             }
-        }
-        for (side, c) in sides(p).into_iter().enumerate() {
-            let Some(c) = c else { continue };
-            let filled = side == 0;
-            let x = centre + if side == 0 { -COLUMN } else { COLUMN };
-            let n = c.final_by_seed.len();
-            chart.draw_series(
-                c.final_by_seed
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, v)| v.1.is_finite())
-                    .map(|(r, v)| marker((seed_x(x, r, n), clamp(v.1)), &mpts, filled, col, 1)),
-            )?;
-            // Mean and CI, beside the dots (outside the group).
-            let s = &c.final_klc;
-            let xm = x + if side == 0 { -0.11 } else { 0.11 };
-            if let Some((a, b)) = s.ci {
-                let (a, b) = (clamp(a), clamp(b));
-                chart.draw_series([
-                    PathElement::new(vec![(xm, a), (xm, b)], col.stroke_width(2)),
-                    PathElement::new(vec![(xm - 0.025, a), (xm + 0.025, a)], col.stroke_width(2)),
-                    PathElement::new(vec![(xm - 0.025, b), (xm + 0.025, b)], col.stroke_width(2)),
-                ])?;
-            }
-            if s.mean.is_finite() {
-                chart.draw_series(std::iter::once(PathElement::new(
-                    vec![(xm - 0.05, s.mean), (xm + 0.05, s.mean)],
-                    BLACK.stroke_width(3),
-                )))?;
-            }
-            chart.draw_series(std::iter::once(Text::new(
-                format!("n={n}"),
-                (x - 0.06, y_max - 0.02 * (y_max - y_min)),
-                (FONT, 11).into_font().color(&RGBColor(0x55, 0x55, 0x55)),
-            )))?;
-        }
+            None => ("no pair".into(), String::new()),
+        };
+        chart.draw_series([
+            Text::new(count, (centre - 0.42, row(0.0)), grey_text.clone()),
+            Text::new(interval, (centre - 0.42, row(1.0)), grey_text.clone()),
+        ])?;
     }
-
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::paired_summary;
+
+    /// The figure draws the paired differences and the paired interval, as the table reports
+    /// them: an interval that excludes 0 is drawn excluding 0 (the axis spans it and 0).
+    #[test]
+    fn the_panel_spans_the_differences_their_interval_and_zero() {
+        let faithful = [(0, 4.3), (1, 4.1), (2, 4.5), (3, 4.0), (4, 4.4)];
+        let corrected = [(0, 4.7), (1, 4.4), (2, 4.95), (3, 4.35), (4, 4.8)];
+        let diff = paired_summary(&faithful, &corrected).unwrap();
+        let (lo, hi) = diff.ci.unwrap();
+        assert!(lo > 0.0, "the paired interval excludes 0: {lo} {hi}");
+        let pair = VariantPair {
+            env: "armball".into(),
+            algo: "rge-rfvae".into(),
+            sampler: "gaussian".into(),
+            latents: 2,
+            faithful: None,
+            corrected: None,
+            differences: crate::stats::paired_differences(&faithful, &corrected),
+            diff: Some(diff),
+        };
+        let vals = panel_values(&[&pair]);
+        assert!(vals.contains(&0.0) && vals.contains(&lo) && vals.contains(&hi));
+        assert_eq!(pair.differences.len(), 5);
+        assert!(
+            pair.differences
+                .iter()
+                .all(|d| vals.contains(&d.1) && d.1 > 0.0)
+        );
+        assert_eq!(signed(0.389), "+0.389");
+    }
 }

@@ -720,7 +720,8 @@ pub fn illustrations(w: &mut String, figures: &[FigureFile]) {
              (invertible for `beta >= -a`), on 1000 seeded samples of an isotropic Gaussian. \
              Figure 6: one DMP episode on ArmBall, the first seeded uniform parameter vector (as \
              RPE samples them) that catches the ball: the arm every 7 steps (light to dark), the \
-             hand's path (blue), the ball's start (pale) and end, and the joint commands.\n"
+             hand's path (blue), the ball's start (pale) and end, and the seven joint commands as the \
+             DMP outputs them (units of π; the arm clips them to [-1, 1], dashed lines).\n"
         );
         for f in figures {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);

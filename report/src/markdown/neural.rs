@@ -600,8 +600,10 @@ pub fn training_loss(w: &mut String, figure: Option<&FigureFile>) {
         "The loss each neural learner minimised, as recorded during training (`train.losses` in \
          the manifests), averaged over the main campaign's distinct trainings: blue the 10-latent \
          spaces, orange the true dimension; faithful (and the AE) solid, corrected dashed. The \
-         y axis is cut above the second recorded point: the untrained network's first loss can be \
-         far higher. Levels differ between learners (the VAE adds its KL term, the RFVAE \
+         y axis spans every point unless the untrained network's first loss is far above the \
+         rest; such a point is an arrow at the top edge with its value. Loss in nats per image. \
+         The dotted line is the plateau (mean-image loss); the RFVAE panels have none (annealed \
+         loss minus the flows' log-determinant). Levels differ between learners (the VAE adds its KL term, the RFVAE \
          subtracts its flows' log-determinant and anneals the rest), not their quality.\n"
     );
     let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);

@@ -1,0 +1,890 @@
+//! Does latent quality predict exploration once the number of moves is accounted for?
+//!
+//! KL-coverage mostly counts how often the object moved, and a goal space whose latents encode
+//! the object's position well may simply move it more often. Over the learned-goal-space runs
+//! of the main campaign and its `recipe` campaigns (the untrained twins of `paper-init`, ...),
+//! per environment and per measure of discovery ([`crate::discovery::Measure`]), this section
+//! correlates the held-out k-NN R² of the position from the latents with the measure, raw and
+//! partial given ln(1 + moves), and asks how much R² position quality adds to a regression of
+//! the measure on ln(1 + moves): a part of `REPORT.md` and `data/latent_quality_vs_moves.csv`.
+//!
+//! Everything is closed-form (least squares, Pearson, Fisher's z): no resampling, so the
+//! numbers are deterministic.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ugl_types::{CampaignRole, EnvSpec};
+
+use crate::ReportError;
+use crate::campaigns::Campaigns;
+use crate::discovery::{self, Measure, RunRow};
+use crate::load::Run;
+use crate::output::Output;
+use crate::sections::{Context, Section};
+use crate::stats::{self, CONFIDENCE};
+
+/// The measures of discovery the table reads, in its order, with their names in the data file.
+pub const MEASURES: [(Measure, &str); 4] = [
+    (Measure::FinalKlc, "final_klc"),
+    (Measure::MovedKlc, "moved_klc"),
+    (Measure::Coverage, "coverage"),
+    (Measure::GoalErrorMean, "goal_error_mean"),
+];
+
+/// Goal spaces without latents (no latent quality): random parameter exploration and the
+/// engineered features.
+pub const WITHOUT_LATENTS: &[&str] = &["rpe", "rge-efr"];
+
+/// The data file, under the report's `data/`.
+pub const FILE: &str = "latent_quality_vs_moves.csv";
+
+// ---------------------------------------------------------------------------------------------
+// Least squares, correlation, Fisher's z.
+
+/// A sum of squares about the mean this small, relative to the sum of squares of the values, is
+/// zero variance (rounding leaves ~1e-32 on a constant sample).
+const ZERO_VARIANCE: f64 = 1e-20;
+
+/// Mean and sum of squared deviations; None for an empty, non-finite or constant sample.
+fn centred(xs: &[f64]) -> Option<(f64, f64)> {
+    if xs.is_empty() || xs.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let m = stats::mean(xs);
+    let ss: f64 = xs.iter().map(|x| (x - m) * (x - m)).sum();
+    let scale: f64 = xs.iter().map(|x| x * x).sum();
+    (ss > ZERO_VARIANCE * scale).then_some((m, ss))
+}
+
+/// The residuals of the least-squares regression of `y` on `x` with an intercept,
+/// `y − (a + b·x)`. None when the lengths differ, with fewer than 2 points, a non-finite
+/// value, or `x` constant.
+pub fn residuals(y: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    if y.len() != x.len() || y.len() < 2 || y.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let (mx, sxx) = centred(x)?;
+    let my = stats::mean(y);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let slope = sxy / sxx;
+    Some(
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| (b - my) - slope * (a - mx))
+            .collect(),
+    )
+}
+
+/// Pearson's correlation; None with fewer than 3 points, differing lengths, a non-finite value
+/// or a constant sample. Clamped to [-1, 1].
+pub fn pearson(x: &[f64], y: &[f64]) -> Option<f64> {
+    if x.len() != y.len() || x.len() < 3 {
+        return None;
+    }
+    let (mx, sxx) = centred(x)?;
+    let (my, syy) = centred(y)?;
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    Some((sxy / (sxx * syy).sqrt()).clamp(-1.0, 1.0))
+}
+
+/// The partial correlation of `x` and `y` given `z`: both residualised on `z` by least squares
+/// ([`residuals`]), the residuals correlated. None with fewer than 4 points, `z` constant, or a
+/// residual without variance (`x` or `y` a linear function of `z`).
+pub fn partial_r(x: &[f64], y: &[f64], z: &[f64]) -> Option<f64> {
+    if x.len() < 4 {
+        return None;
+    }
+    let (rx, ry) = (residuals(x, z)?, residuals(y, z)?);
+    // A residual that is rounding noise: zero variance relative to what it was residualised from.
+    let (_, sx) = centred(x)?;
+    let (_, sy) = centred(y)?;
+    let ss = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    if ss(&rx) <= ZERO_VARIANCE * sx || ss(&ry) <= ZERO_VARIANCE * sy {
+        return None;
+    }
+    pearson(&rx, &ry)
+}
+
+/// The standard normal quantile, Wichura's algorithm AS241 (PPND16, relative error ~1e-16;
+/// the coefficients as in CPython's `statistics.NormalDist.inv_cdf`). NaN outside (0, 1).
+#[allow(clippy::excessive_precision)]
+pub fn normal_quantile(p: f64) -> f64 {
+    if !(p > 0.0 && p < 1.0) {
+        return f64::NAN;
+    }
+    let q = p - 0.5;
+    if q.abs() <= 0.425 {
+        let r = 0.180625 - q * q;
+        let num = (((((((2.5090809287301226727e+3 * r + 3.3430575583588128105e+4) * r
+            + 6.7265770927008700853e+4)
+            * r
+            + 4.5921953931549871457e+4)
+            * r
+            + 1.3731693765509461125e+4)
+            * r
+            + 1.9715909503065514427e+3)
+            * r
+            + 1.3314166789178437745e+2)
+            * r
+            + 3.3871328727963666080e+0)
+            * q;
+        let den = ((((((5.2264952788528545610e+3 * r + 2.8729085735721942674e+4) * r
+            + 3.9307895800092710610e+4)
+            * r
+            + 2.1213794301586595867e+4)
+            * r
+            + 5.3941960214247511077e+3)
+            * r
+            + 6.8718700749205790830e+2)
+            * r
+            + 4.2313330701600911252e+1)
+            * r
+            + 1.0;
+        return num / den;
+    }
+    let r = if q <= 0.0 { p } else { 1.0 - p };
+    let r = (-r.ln()).sqrt();
+    let x = if r <= 5.0 {
+        let r = r - 1.6;
+        let num = ((((((7.74545014278341407640e-4 * r + 2.27238449892691845833e-2) * r
+            + 2.41780725177450611770e-1)
+            * r
+            + 1.27045825245236838258e+0)
+            * r
+            + 3.64784832476320460504e+0)
+            * r
+            + 5.76949722146069140550e+0)
+            * r
+            + 4.63033784615654529590e+0)
+            * r
+            + 1.42343711074968357734e+0;
+        let den = ((((((1.05075007164441684324e-9 * r + 5.47593808499534494600e-4) * r
+            + 1.51986665636164571966e-2)
+            * r
+            + 1.48103976427480074590e-1)
+            * r
+            + 6.89767334985100004550e-1)
+            * r
+            + 1.67638483018380384940e+0)
+            * r
+            + 2.05319162663775882187e+0)
+            * r
+            + 1.0;
+        num / den
+    } else {
+        let r = r - 5.0;
+        let num = ((((((2.01033439929228813265e-7 * r + 2.71155556874348757815e-5) * r
+            + 1.24266094738807843860e-3)
+            * r
+            + 2.65321895265761230930e-2)
+            * r
+            + 2.96560571828504891230e-1)
+            * r
+            + 1.78482653991729133580e+0)
+            * r
+            + 5.46378491116411436990e+0)
+            * r
+            + 6.65790464350110377720e+0;
+        let den = ((((((2.04426310338993978564e-15 * r + 1.42151175831644588870e-7) * r
+            + 1.84631831751005468180e-5)
+            * r
+            + 7.86869131145613259100e-4)
+            * r
+            + 1.48753612908506148525e-2)
+            * r
+            + 1.36929880922735805310e-1)
+            * r
+            + 5.99832206555887937690e-1)
+            * r
+            + 1.0;
+        num / den
+    };
+    if q < 0.0 { -x } else { x }
+}
+
+/// The confidence interval of a correlation `r` over `n` points, `controls` variables partialled
+/// out (0: Pearson's r), by Fisher's z: `tanh(atanh r ± z_{(1+level)/2} / √(n − 3 − controls))`.
+/// None when `n − 3 − controls < 1`, `r` is not in [-1, 1] or the level not in (0, 1); `r = ±1`
+/// gives the point `(r, r)`.
+pub fn fisher_ci(r: f64, n: usize, controls: usize, level: f64) -> Option<(f64, f64)> {
+    let df = n.checked_sub(3 + controls).filter(|&d| d >= 1)? as f64;
+    if !((-1.0..=1.0).contains(&r) && level > 0.0 && level < 1.0) {
+        return None;
+    }
+    if r.abs() == 1.0 {
+        return Some((r, r));
+    }
+    let half = normal_quantile(0.5 + level / 2.0) / df.sqrt();
+    let z = r.atanh();
+    Some(((z - half).tanh(), (z + half).tanh()))
+}
+
+/// One line of the table: a measure `y` against latent quality `x`, controlling for
+/// `z` = ln(1 + moves). Every statistic is None where it is undefined (too few points, a
+/// constant sample).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Association {
+    pub n: usize,
+    /// Pearson's r of `x` with `y`, and its Fisher-z interval (n − 3).
+    pub r: Option<f64>,
+    pub r_ci: Option<(f64, f64)>,
+    /// The partial r given `z`, and its Fisher-z interval (n − 4).
+    pub partial: Option<f64>,
+    pub partial_ci: Option<(f64, f64)>,
+    /// R² of the regression of `y` on `z` alone.
+    pub r2_moves: Option<f64>,
+    /// R² of `y` on `z` and `x`: `r2_moves + gain`.
+    pub r2_both: Option<f64>,
+    /// What adding `x` adds: `(1 − r2_moves) · partial²` (the identity of least squares).
+    pub gain: Option<f64>,
+}
+
+impl Association {
+    /// The statistics of `y` against `x` given `z` at [`CONFIDENCE`]; None with fewer than 4
+    /// points or differing lengths.
+    pub fn compute(x: &[f64], y: &[f64], z: &[f64]) -> Option<Association> {
+        let n = y.len();
+        if n < 4 || x.len() != n || z.len() != n {
+            return None;
+        }
+        let r = pearson(x, y);
+        let partial = partial_r(x, y, z);
+        let r2_moves = pearson(z, y).map(|r| r * r);
+        let gain = r2_moves.zip(partial).map(|(r2, p)| (1.0 - r2) * p * p);
+        Some(Association {
+            n,
+            r,
+            r_ci: r.and_then(|r| fisher_ci(r, n, 0, CONFIDENCE)),
+            partial,
+            partial_ci: partial.and_then(|p| fisher_ci(p, n, 1, CONFIDENCE)),
+            r2_moves,
+            r2_both: r2_moves.zip(gain).map(|(a, g)| a + g),
+            gain,
+        })
+    }
+
+    /// Whether `x` still predicts `y` beyond `z`: the partial r's interval excludes 0 (None:
+    /// untestable).
+    pub fn predicts_beyond_moves(&self) -> Option<bool> {
+        self.partial_ci.map(|(lo, hi)| lo > 0.0 || hi < 0.0)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The observations.
+
+/// One observation: a learned-goal-space run (or the mean of the exploration replicates of one
+/// fit with one goal sampler, where a campaign holds several).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    pub campaign: String,
+    pub env: String,
+    pub algo: String,
+    pub variant: String,
+    pub sampler: String,
+    pub latents: i64,
+    pub seed: i64,
+    /// How many runs it averages.
+    pub n_runs: usize,
+    /// Held-out k-NN R² of the object's position from the latents.
+    pub position_knn_r2: f64,
+    /// ln(1 + episodes that moved the object).
+    pub ln_moves: f64,
+    /// The value of each of [`MEASURES`] (None: not measured, or not finite).
+    pub values: [Option<f64>; MEASURES.len()],
+}
+
+/// Whether a run is in a learned goal space with a recorded position R².
+fn has_latents(run: &Run) -> bool {
+    !WITHOUT_LATENTS.contains(&run.key.algo.as_str()) && run.manifest.group_r2("position").is_some()
+}
+
+/// The observations of the main campaign and its `recipe` campaigns: every learned-goal-space
+/// run with a position R² and outcomes measured, replicates of one fit and sampler averaged; in
+/// campaign order, then the report's condition order and seed.
+pub fn observations(camps: &Campaigns) -> Result<Vec<Observation>, ReportError> {
+    let read: Vec<&str> = std::iter::once(&camps.main)
+        .chain(&camps.recipe)
+        .map(|c| c.name.as_str())
+        .collect();
+    let rows: Vec<RunRow<'_>> = discovery::measure_all(camps)?
+        .into_iter()
+        .filter(|r| read.contains(&r.campaign.name.as_str()) && has_latents(r.run))
+        .filter(|r| r.discovery.is_some())
+        .collect();
+    // `measure_all` lists a campaign's runs in condition order, then seed: the runs of one fit
+    // and sampler are adjacent.
+    let same = |a: &RunRow<'_>, b: &RunRow<'_>| {
+        a.campaign.name == b.campaign.name && a.run.key == b.run.key && a.run.seed == b.run.seed
+    };
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < rows.len() {
+        let j = i + rows[i..].iter().take_while(|r| same(r, &rows[i])).count();
+        out.push(observe(&rows[i..j]));
+        i = j;
+    }
+    Ok(out)
+}
+
+/// The mean over the replicates `reps` (one fit, one sampler; at least one, every one measured
+/// and with a position R²); a mean is None where a replicate lacks the value or it is not finite.
+fn observe(reps: &[RunRow<'_>]) -> Observation {
+    let mean_of = |f: &dyn Fn(&RunRow<'_>) -> Option<f64>| -> Option<f64> {
+        let v: Option<Vec<f64>> = reps
+            .iter()
+            .map(|r| f(r).filter(|v| v.is_finite()))
+            .collect();
+        v.map(|v| stats::mean(&v))
+    };
+    let first = &reps[0];
+    let key = &first.run.key;
+    Observation {
+        campaign: first.campaign.name.clone(),
+        env: key.env.clone(),
+        algo: key.algo.clone(),
+        variant: key.variant.clone(),
+        sampler: key.sampler.clone(),
+        latents: key.latents,
+        seed: first.run.seed,
+        n_runs: reps.len(),
+        position_knn_r2: mean_of(&|r| r.run.manifest.group_r2("position").map(|g| g.1))
+            .unwrap_or(f64::NAN),
+        ln_moves: mean_of(&|r| r.discovery.as_ref().map(|d| (1.0 + d.n_moved as f64).ln()))
+            .unwrap_or(f64::NAN),
+        values: MEASURES.map(|(m, _)| mean_of(&|r| m.value(r))),
+    }
+}
+
+/// One line of the table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Line {
+    pub env: String,
+    pub measure: Measure,
+    /// None: fewer than 4 observations with the measure.
+    pub stats: Option<Association>,
+}
+
+/// The environments of the observations, in the report's order.
+fn envs(obs: &[Observation]) -> Vec<String> {
+    let mut envs: Vec<String> = obs.iter().map(|o| o.env.clone()).collect();
+    envs.sort_by_key(|e| (EnvSpec::order(e), e.clone()));
+    envs.dedup();
+    envs
+}
+
+/// The table: per environment and measure, position R² against the measure given ln(1 + moves).
+pub fn table(obs: &[Observation]) -> Vec<Line> {
+    let mut out = Vec::new();
+    for env in envs(obs) {
+        for (k, (m, _)) in MEASURES.into_iter().enumerate() {
+            let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+            for o in obs.iter().filter(|o| o.env == env) {
+                if let Some(v) = o.values[k]
+                    && o.position_knn_r2.is_finite()
+                    && o.ln_moves.is_finite()
+                {
+                    x.push(o.position_knn_r2);
+                    y.push(v);
+                    z.push(o.ln_moves);
+                }
+            }
+            out.push(Line {
+                env: env.clone(),
+                measure: m,
+                stats: Association::compute(&x, &y, &z),
+            });
+        }
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// The data file and the words.
+
+/// A float as CSV: shortest round-trip form; empty when absent.
+fn num(v: Option<f64>) -> String {
+    v.map(|v| format!("{v}")).unwrap_or_default()
+}
+
+/// `data/latent_quality_vs_moves.csv`: one row per line of the table.
+pub fn write_csv(out: &mut Output, lines: &[Line]) -> Result<(), ReportError> {
+    let mut s = String::from(
+        "env,measure,n,r,r_lo,r_hi,partial_r,partial_lo,partial_hi,r2_moves,\
+         r2_moves_and_quality,r2_gain\n",
+    );
+    for l in lines {
+        let a = l.stats.as_ref();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            l.env,
+            MEASURES
+                .iter()
+                .find(|(m, _)| *m == l.measure)
+                .map_or("", |(_, s)| s),
+            a.map(|a| a.n).unwrap_or(0),
+            num(a.and_then(|a| a.r)),
+            num(a.and_then(|a| a.r_ci).map(|c| c.0)),
+            num(a.and_then(|a| a.r_ci).map(|c| c.1)),
+            num(a.and_then(|a| a.partial)),
+            num(a.and_then(|a| a.partial_ci).map(|c| c.0)),
+            num(a.and_then(|a| a.partial_ci).map(|c| c.1)),
+            num(a.and_then(|a| a.r2_moves)),
+            num(a.and_then(|a| a.r2_both)),
+            num(a.and_then(|a| a.gain)),
+        );
+    }
+    out.write(Path::new(crate::data::DIR).join(FILE), s.as_bytes())?;
+    Ok(())
+}
+
+/// `r [lo, hi]`, or a dash.
+fn with_ci(r: Option<f64>, ci: Option<(f64, f64)>) -> String {
+    match (r, ci) {
+        (Some(r), Some((lo, hi))) => format!("{} [{}, {}]", two(r), two(lo), two(hi)),
+        (Some(r), None) => two(r),
+        _ => "—".into(),
+    }
+}
+
+fn fixed(v: Option<f64>, digits: usize) -> String {
+    v.map(|v| format!("{:.digits$}", v.max(0.0)))
+        .unwrap_or_else(|| "—".into())
+}
+
+/// `a`, `a and b`, `a, b and c` (or `or`).
+fn join(items: &[String], word: &str) -> String {
+    match items {
+        [] => String::new(),
+        [a] => a.clone(),
+        [rest @ .., last] => format!("{} {word} {last}", rest.join(", ")),
+    }
+}
+
+/// Two decimals; a value that is zero up to rounding error is `0.00`, never `-0.00` (a small
+/// negative value keeps its sign: an interval bound of `-0.00` excludes 0).
+fn two(v: f64) -> String {
+    if v.abs() < 1e-12 {
+        "0.00".into()
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+fn campaign_name(name: &str) -> String {
+    if name.is_empty() {
+        "(top level)".into()
+    } else {
+        format!("`{name}`")
+    }
+}
+
+/// The report's section: the method, the table, one sentence per environment.
+pub fn section(w: &mut String, obs: &[Observation], lines: &[Line], main: &str) {
+    let level = CONFIDENCE * 100.0;
+    let z = normal_quantile(0.5 + CONFIDENCE / 2.0);
+    let mut camps: Vec<&str> = Vec::new();
+    for o in obs {
+        if !camps.contains(&o.campaign.as_str()) {
+            camps.push(&o.campaign);
+        }
+    }
+    let counts: Vec<String> = envs(obs)
+        .iter()
+        .map(|env| {
+            let per: Vec<String> = camps
+                .iter()
+                .filter_map(|c| {
+                    let k = obs
+                        .iter()
+                        .filter(|o| o.env == *env && o.campaign == *c)
+                        .count();
+                    (k > 0).then(|| format!("{k} from {}", campaign_name(c)))
+                })
+                .collect();
+            format!("{} {}", EnvSpec::display_of(env), join(&per, "and"))
+        })
+        .collect();
+    let averaged = obs.iter().filter(|o| o.n_runs > 1).count();
+    let recipes: Vec<String> = camps
+        .iter()
+        .filter(|c| **c != main)
+        .map(|c| campaign_name(c))
+        .collect();
+    let _ = writeln!(
+        w,
+        "### Does latent quality predict discovery beyond the number of moves?\n\n\
+         KL-coverage mostly counts how often the object moved, and a goal space that encodes the \
+         object's position may only move it more often. Does the quality of a learned goal \
+         space, the held-out k-NN R² of the object's position from its latents \
+         (`latent_quality`, group `position`), still predict what the exploration discovered \
+         once the number of episodes that moved the object is accounted for?\n\n\
+         **Method.** Observations: the learned-goal-space runs with a recorded position R² \
+         (RPE and RGE-EFR have no latents) of the main campaign {}{}: {}. Each run is one \
+         observation: the runs of one fit with KDE and with Gaussian goals share their latents \
+         (and so their R²) but explore differently, and count twice, so the observations are \
+         not independent and the intervals below are somewhat too narrow. Exploration \
+         replicates of one fit with one sampler would be averaged into one observation ({} \
+         observation{} average{} several runs). For each measure Y: Pearson's r of position R² \
+         with Y; the partial r given ln(1 + moves), both residualised on ln(1 + moves) by least \
+         squares and the residuals correlated; their {level:.0}% intervals by Fisher's z, \
+         tanh(atanh r ± {z:.3}/√(n − 3)), with n − 4 for the partial r; the R² of the \
+         least-squares regression of Y on ln(1 + moves) alone, and the R² that adding position \
+         R² to it gains, (1 − R²) · partial r². Latent quality predicts Y *beyond the moves* \
+         where the partial r's interval excludes 0. The untrained twins sit at low R² and few \
+         moves: the correlations mix the difference between trained and untrained goal spaces \
+         with the differences among trained ones. Per-run inputs are in \
+         `data/{}` (`position_knn_r2`, `n_moved`), this table in `data/{FILE}`.\n",
+        campaign_name(main),
+        if recipes.is_empty() {
+            " (no recipe campaign has such runs)".to_string()
+        } else {
+            format!(" and its recipe campaigns {}", join(&recipes, "and"))
+        },
+        counts.join("; "),
+        if averaged == 0 {
+            "no".to_string()
+        } else {
+            averaged.to_string()
+        },
+        if averaged == 1 { "" } else { "s" },
+        if averaged == 1 { "s" } else { "" },
+        discovery::FILE,
+    );
+    let _ = writeln!(
+        w,
+        "| env | measure | n | r with position R² [{level:.0}% CI] | partial r given \
+         ln(1 + moves) [{level:.0}% CI] | R² on ln(1 + moves) | R² gain from position R² |\n\
+         |---|---|---|---|---|---|---|"
+    );
+    for l in lines {
+        let a = l.stats.as_ref();
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            EnvSpec::display_of(&l.env),
+            l.measure.label(),
+            a.map(|a| a.n).unwrap_or(0),
+            with_ci(a.and_then(|a| a.r), a.and_then(|a| a.r_ci)),
+            with_ci(a.and_then(|a| a.partial), a.and_then(|a| a.partial_ci)),
+            fixed(a.and_then(|a| a.r2_moves), 2),
+            fixed(a.and_then(|a| a.gain), 3),
+        );
+    }
+    w.push('\n');
+    for env in envs(obs) {
+        w.push_str(&sentence(&env, lines));
+        w.push_str("\n\n");
+    }
+}
+
+/// The sentence of one environment: which measures position R² still predicts beyond the
+/// moves (the partial r's interval excludes 0), which it does not, which cannot be tested.
+pub fn sentence(env: &str, lines: &[Line]) -> String {
+    let mine: Vec<&Line> = lines.iter().filter(|l| l.env == env).collect();
+    let named = |want: Option<bool>| -> Vec<String> {
+        mine.iter()
+            .filter(|l| l.stats.as_ref().and_then(|a| a.predicts_beyond_moves()) == want)
+            .map(|l| {
+                let a = l.stats.as_ref();
+                match a.and_then(|a| a.partial) {
+                    Some(p) => format!(
+                        "{} (partial r {})",
+                        l.measure.label(),
+                        with_ci(Some(p), a.and_then(|a| a.partial_ci))
+                    ),
+                    None => l.measure.label().to_string(),
+                }
+            })
+            .collect()
+    };
+    let (yes, no, untestable) = (named(Some(true)), named(Some(false)), named(None));
+    let mut parts = Vec::new();
+    if !yes.is_empty() {
+        parts.push(format!("still predicts {}", join(&yes, "and")));
+    }
+    if !no.is_empty() {
+        parts.push(format!("does not predict {}", join(&no, "or")));
+    }
+    if !untestable.is_empty() {
+        parts.push(format!(
+            "cannot be tested on {} (too few observations or no variance)",
+            join(&untestable, "or")
+        ));
+    }
+    format!(
+        "**{}.** Beyond the number of moves (the {:.0}% interval of the partial r excluding 0), \
+         position R² {}.",
+        EnvSpec::display_of(env),
+        CONFIDENCE * 100.0,
+        parts.join("; it ")
+    )
+}
+
+/// The section: after the discovery measures, whether latent quality predicts them beyond the
+/// number of moves. Nothing (no words, no data file) where no environment has a line with
+/// numbers (no learned goal space with a varying position R²).
+pub struct Predicts;
+impl Section for Predicts {
+    fn name(&self) -> &'static str {
+        "latent quality beyond moves"
+    }
+    fn wants(&self) -> &'static [CampaignRole] {
+        &[CampaignRole::Recipe]
+    }
+    fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
+        let obs = observations(ctx.campaigns)?;
+        let lines = table(&obs);
+        if !lines
+            .iter()
+            .any(|l| l.stats.as_ref().is_some_and(|a| a.r.is_some()))
+        {
+            return Ok(String::new());
+        }
+        write_csv(out, &lines)?;
+        let mut w = String::new();
+        section(&mut w, &obs, &lines, &ctx.campaigns.main.name);
+        Ok(w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol
+    }
+
+    /// Three mutually orthogonal, centred contrasts of 8 points.
+    const Z: [f64; 8] = [1.0, 1.0, 1.0, 1.0, -1.0, -1.0, -1.0, -1.0];
+    const E: [f64; 8] = [1.0, 1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0];
+    const U: [f64; 8] = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
+
+    fn combine(a: f64, p: &[f64; 8], b: f64, q: &[f64; 8], c: f64) -> Vec<f64> {
+        p.iter().zip(q).map(|(p, q)| a * p + b * q + c).collect()
+    }
+
+    /// y = [1, 2, 2, 5] on x = [0, 1, 2, 3]: slope 6/5, intercept 0.7, fitted
+    /// [0.7, 1.9, 3.1, 4.3], residuals [0.3, 0.1, -1.1, 0.7] (by hand).
+    #[test]
+    fn residuals_of_a_hand_computed_regression() {
+        let r = residuals(&[1.0, 2.0, 2.0, 5.0], &[0.0, 1.0, 2.0, 3.0]).unwrap();
+        for (a, b) in r.iter().zip([0.3, 0.1, -1.1, 0.7]) {
+            assert!(close(*a, b, 1e-12), "{r:?}");
+        }
+        assert!(close(r.iter().sum::<f64>(), 0.0, 1e-12));
+        // Pearson of the same: 6 / √(5 · 9).
+        let p = pearson(&[0.0, 1.0, 2.0, 3.0], &[1.0, 2.0, 2.0, 5.0]).unwrap();
+        assert!(close(p, 6.0 / 45f64.sqrt(), 1e-12), "{p}");
+    }
+
+    /// moves z, quality x = z + e/2, y = 3z + u/2 (e, u orthogonal to z and each other): y
+    /// depends on the moves only. Raw r = 24 / √(10 · 74) ≈ 0.88, partial r = 0.
+    #[test]
+    fn a_measure_that_depends_on_moves_only_has_no_partial_correlation() {
+        let z: Vec<f64> = Z.iter().map(|v| v + 3.0).collect();
+        let x = combine(1.0, &Z, 0.5, &E, 0.9);
+        let y = combine(3.0, &Z, 0.5, &U, 10.0);
+        let a = Association::compute(&x, &y, &z).unwrap();
+        let r = a.r.unwrap();
+        assert!(close(r, 24.0 / (10.0f64 * 74.0).sqrt(), 1e-12), "{r}");
+        assert!(r > 0.85);
+        assert!(close(a.partial.unwrap(), 0.0, 1e-12), "{a:?}");
+        assert_eq!(a.predicts_beyond_moves(), Some(false));
+        assert!(close(a.r2_moves.unwrap(), 72.0 / 74.0, 1e-12));
+        assert!(close(a.gain.unwrap(), 0.0, 1e-12));
+    }
+
+    /// y = −2x + 5z exactly: given z, y is a function of x, partial r = −1 (and the gain is
+    /// everything the moves leave).
+    #[test]
+    fn a_measure_that_depends_on_quality_has_partial_correlation_minus_one() {
+        let z: Vec<f64> = Z.iter().map(|v| v + 3.0).collect();
+        let x = combine(1.0, &Z, 0.5, &E, 0.9);
+        let y: Vec<f64> = x.iter().zip(&z).map(|(x, z)| -2.0 * x + 5.0 * z).collect();
+        let a = Association::compute(&x, &y, &z).unwrap();
+        assert!(close(a.partial.unwrap(), -1.0, 1e-12), "{a:?}");
+        let (lo, hi) = a.partial_ci.unwrap();
+        assert!(close(lo, -1.0, 1e-6) && close(hi, -1.0, 1e-6), "{a:?}");
+        assert_eq!(a.predicts_beyond_moves(), Some(true));
+        assert!(close(a.r2_both.unwrap(), 1.0, 1e-12), "{a:?}");
+        // y = 3Z − E + 13.2: R² on z alone 72 / (72 + 8).
+        assert!(close(a.r2_moves.unwrap(), 0.9, 1e-12), "{a:?}");
+        assert!(close(a.gain.unwrap(), 0.1, 1e-12), "{a:?}");
+    }
+
+    /// The gain equals the R² of a direct two-predictor least-squares fit, solved here by the
+    /// normal equations on centred data (Cramer's rule).
+    #[test]
+    fn the_gain_matches_a_two_predictor_fit() {
+        let z = [0.0, 1.0, 1.0, 2.0, 3.0, 5.0, 8.0, 13.0, 21.0];
+        let x = [0.9, 0.1, 0.5, 0.3, 0.8, 0.2, 0.95, 0.6, 0.7];
+        let y = [3.0, 1.0, 4.0, 1.0, 5.0, 9.0, 2.0, 6.0, 5.0];
+        let a = Association::compute(&x, &y, &z).unwrap();
+        let c = |v: &[f64]| {
+            let m = stats::mean(v);
+            v.iter().map(|x| x - m).collect::<Vec<_>>()
+        };
+        let (cz, cx, cy) = (c(&z), c(&x), c(&y));
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
+        let (szz, sxx, szx) = (dot(&cz, &cz), dot(&cx, &cx), dot(&cz, &cx));
+        let (szy, sxy, syy) = (dot(&cz, &cy), dot(&cx, &cy), dot(&cy, &cy));
+        let det = szz * sxx - szx * szx;
+        let bz = (szy * sxx - sxy * szx) / det;
+        let bx = (sxy * szz - szy * szx) / det;
+        let r2 = (bz * szy + bx * sxy) / syy;
+        assert!(close(a.r2_both.unwrap(), r2, 1e-12), "{a:?} vs {r2}");
+        assert!(close(a.r2_moves.unwrap(), szy * szy / (szz * syy), 1e-12));
+    }
+
+    /// r = 0.5 over n = 28: z = atanh 0.5 ± 1.959964 / 5, [0.156028, 0.735818] (Python's
+    /// `statistics.NormalDist` and `math`).
+    #[test]
+    fn fisher_interval_of_a_known_value() {
+        assert!(close(normal_quantile(0.975), 1.959_963_984_540_054, 1e-15));
+        assert!(close(normal_quantile(0.025), -1.959_963_984_540_054, 1e-15));
+        assert!(close(normal_quantile(0.5), 0.0, 0.0));
+        assert!(close(normal_quantile(1e-10), -6.361_340_902_404_056, 1e-12));
+        let (lo, hi) = fisher_ci(0.5, 28, 0, 0.95).unwrap();
+        assert!(close(lo, 0.156_028_362_529_086_03, 1e-12), "{lo}");
+        assert!(close(hi, 0.735_818_479_443_937_6, 1e-12), "{hi}");
+        // The partial r of 29 points has the same 25 degrees of freedom.
+        assert_eq!(fisher_ci(0.5, 29, 1, 0.95), Some((lo, hi)));
+        assert_eq!(fisher_ci(0.0, 28, 0, 0.95).map(|c| c.0 == -c.1), Some(true));
+    }
+
+    /// Too few points, constant samples, a predictor that is a linear function of the moves:
+    /// None, never NaN or a panic.
+    #[test]
+    fn degenerate_inputs_give_none() {
+        assert_eq!(
+            Association::compute(&[1.0, 2.0, 3.0], &[1.0, 0.0, 2.0], &[0.0, 1.0, 1.0]),
+            None
+        );
+        assert_eq!(Association::compute(&[], &[], &[]), None);
+        assert_eq!(Association::compute(&[1.0; 4], &[1.0; 5], &[1.0; 5]), None);
+        assert_eq!(pearson(&[1.0, 2.0], &[2.0, 1.0]), None);
+        assert_eq!(residuals(&[1.0], &[1.0]), None);
+        assert_eq!(
+            partial_r(&[1.0, 2.0, 3.0], &[1.0, 0.0, 2.0], &[0.0, 1.0, 1.0]),
+            None
+        );
+        assert_eq!(fisher_ci(0.3, 3, 0, 0.95), None);
+        assert_eq!(fisher_ci(0.3, 4, 1, 0.95), None);
+        assert_eq!(fisher_ci(f64::NAN, 30, 0, 0.95), None);
+        assert!(normal_quantile(0.0).is_nan() && normal_quantile(1.0).is_nan());
+
+        let z = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let y = [1.0, 3.0, 2.0, 5.0, 4.0];
+        // A constant quality (0.9 five times: rounding leaves a tiny spread): no r, no partial.
+        let a = Association::compute(&[0.9; 5], &y, &z).unwrap();
+        assert_eq!(
+            (a.r, a.partial, a.gain, a.r2_both),
+            (None, None, None, None)
+        );
+        assert!(a.r2_moves.is_some());
+        // A constant measure: nothing.
+        let a = Association::compute(&[0.1, 0.5, 0.2, 0.9, 0.4], &[2.0; 5], &z).unwrap();
+        assert_eq!((a.r, a.partial, a.r2_moves), (None, None, None));
+        // Constant moves: no partial.
+        let a = Association::compute(&[0.1, 0.5, 0.2, 0.9, 0.4], &y, &[3.0; 5]).unwrap();
+        assert!(a.r.is_some());
+        assert_eq!((a.partial, a.r2_moves, a.gain), (None, None, None));
+        // Quality a linear function of the moves: its residual is rounding noise.
+        let x: Vec<f64> = z.iter().map(|z| 0.1 * z + 0.3).collect();
+        let a = Association::compute(&x, &y, &z).unwrap();
+        assert!(close(a.r.unwrap(), a.r2_moves.unwrap().sqrt(), 1e-12));
+        assert_eq!(a.partial, None);
+        // Nothing non-finite anywhere.
+        let a = Association::compute(&[0.1, 0.5, f64::INFINITY, 0.9], &y[..4], &z[..4]).unwrap();
+        assert_eq!((a.r, a.partial), (None, None));
+    }
+
+    /// The words: a sentence per environment naming what latent quality predicts beyond the
+    /// moves, from the numbers only.
+    #[test]
+    fn the_sentence_names_what_is_and_is_not_predicted() {
+        let z: Vec<f64> = Z.iter().map(|v| v + 3.0).collect();
+        let x = combine(1.0, &Z, 0.5, &E, 0.9);
+        let only_moves = combine(3.0, &Z, 0.5, &U, 10.0);
+        let quality: Vec<f64> = x.iter().zip(&z).map(|(x, z)| -2.0 * x + 5.0 * z).collect();
+        let obs: Vec<Observation> = (0..8)
+            .map(|i| Observation {
+                campaign: if i < 6 { "paper" } else { "paper-init" }.into(),
+                env: "armball".into(),
+                algo: "rge-vae".into(),
+                variant: "faithful".into(),
+                sampler: "kde".into(),
+                latents: 10,
+                seed: i,
+                n_runs: 1,
+                position_knn_r2: x[i as usize],
+                ln_moves: z[i as usize],
+                values: [
+                    Some(only_moves[i as usize]),
+                    Some(quality[i as usize]),
+                    None,
+                    Some(only_moves[i as usize]),
+                ],
+            })
+            .collect();
+        let lines = table(&obs);
+        assert_eq!(lines.len(), 4);
+        assert_eq!(lines[2].stats, None);
+        let mut w = String::new();
+        section(&mut w, &obs, &lines, "paper");
+        assert!(
+            w.contains("ArmBall 6 from `paper` and 2 from `paper-init`"),
+            "{w}"
+        );
+        assert!(
+            w.contains(
+                "**ArmBall.** Beyond the number of moves (the 95% interval of the partial r \
+                 excluding 0), position R² still predicts KLC of moved outcomes (partial r \
+                 -1.00 [-1.00, -1.00]); it does not predict final KLC (all outcomes) (partial r \
+                 0.00 [-0.75, 0.75]) or goal error, mean (partial r 0.00 [-0.75, 0.75]); it \
+                 cannot be tested on cells reached (too few observations or no variance)."
+            ),
+            "{w}"
+        );
+        assert!(!w.contains("NaN") && !w.contains("inf"), "{w}");
+    }
+
+    /// The table on the committed results: every learned-goal-space run of `paper` and its
+    /// recipe campaigns is one observation (ArmBall 110 + 90 + 9, ArmArrow 110 + 90), none
+    /// averages replicates, and the moves alone explain most of the final KL-coverage.
+    #[test]
+    fn the_table_on_the_committed_results() {
+        let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/results");
+        let camps = crate::campaigns::load_campaigns(
+            &results,
+            "paper",
+            &crate::sections::wanted_roles(crate::sections::SECTIONS),
+        )
+        .unwrap();
+        let obs = observations(&camps).unwrap();
+        let count = |env: &str| obs.iter().filter(|o| o.env == env).count();
+        assert_eq!([count("armball"), count("armarrow")], [209, 200]);
+        assert!(obs.iter().all(|o| o.n_runs == 1));
+        assert!(
+            obs.iter()
+                .all(|o| !WITHOUT_LATENTS.contains(&o.algo.as_str()))
+        );
+        let lines = table(&obs);
+        let mut w = String::new();
+        section(&mut w, &obs, &lines, "paper");
+        println!("{w}");
+        assert_eq!(lines.len(), 8);
+        for l in &lines {
+            let a = l.stats.as_ref().unwrap();
+            assert!(a.r.is_some() && a.partial_ci.is_some(), "{l:?}");
+            if l.measure == Measure::FinalKlc {
+                assert!(a.r2_moves.unwrap() > 0.5, "{l:?}");
+            }
+        }
+        assert!(!w.contains("NaN"), "{w}");
+    }
+}
