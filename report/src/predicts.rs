@@ -14,14 +14,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use ugl_types::{CampaignRole, EnvSpec};
+use ugl_types::EnvSpec;
 
 use crate::ReportError;
 use crate::campaigns::Campaigns;
 use crate::discovery::{self, Measure, RunRow};
 use crate::load::Run;
 use crate::output::Output;
-use crate::sections::{Context, Section};
 use crate::stats::{self, CONFIDENCE};
 
 /// The measures of discovery the table reads, in its order, with their names in the data file.
@@ -621,33 +620,6 @@ pub fn sentence(env: &str, lines: &[Line]) -> String {
         CONFIDENCE * 100.0,
         parts.join("; it ")
     )
-}
-
-/// The section: after the discovery measures, whether latent quality predicts them beyond the
-/// number of moves. Nothing (no words, no data file) where no environment has a line with
-/// numbers (no learned goal space with a varying position R²).
-pub struct Predicts;
-impl Section for Predicts {
-    fn name(&self) -> &'static str {
-        "latent quality beyond moves"
-    }
-    fn wants(&self) -> &'static [CampaignRole] {
-        &[CampaignRole::Recipe]
-    }
-    fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
-        let obs = observations(ctx.campaigns)?;
-        let lines = table(&obs);
-        if !lines
-            .iter()
-            .any(|l| l.stats.as_ref().is_some_and(|a| a.r.is_some()))
-        {
-            return Ok(String::new());
-        }
-        write_csv(out, &lines)?;
-        let mut w = String::new();
-        section(&mut w, &obs, &lines, &ctx.campaigns.main.name);
-        Ok(w)
-    }
 }
 
 #[cfg(test)]

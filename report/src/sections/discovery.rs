@@ -7,6 +7,7 @@ use super::{Context, Section};
 use crate::ReportError;
 use crate::discovery;
 use crate::output::Output;
+use crate::predicts;
 
 /// The discovery measures of every run, and whether each ranks position-encoding goal spaces
 /// ahead of the controls.
@@ -23,6 +24,33 @@ impl Section for Discovery {
         discovery::write_csv(out, &rows)?;
         let mut w = String::new();
         discovery::section(&mut w, &rows, &discovery::validity(&rows));
+        Ok(w)
+    }
+}
+
+/// The section: after the discovery measures, whether latent quality predicts them beyond the
+/// number of moves. Nothing (no words, no data file) where no environment has a line with
+/// numbers (no learned goal space with a varying position R²).
+pub struct Predicts;
+impl Section for Predicts {
+    fn name(&self) -> &'static str {
+        "latent quality beyond moves"
+    }
+    fn wants(&self) -> &'static [CampaignRole] {
+        &[CampaignRole::Recipe]
+    }
+    fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
+        let obs = predicts::observations(ctx.campaigns)?;
+        let lines = predicts::table(&obs);
+        if !lines
+            .iter()
+            .any(|l| l.stats.as_ref().is_some_and(|a| a.r.is_some()))
+        {
+            return Ok(String::new());
+        }
+        predicts::write_csv(out, &lines)?;
+        let mut w = String::new();
+        predicts::section(&mut w, &obs, &lines, &ctx.campaigns.main.name);
         Ok(w)
     }
 }

@@ -55,7 +55,7 @@ pub static SECTIONS: &[&dyn Section] = &[
     &paper::Recipes,
     &paper::Outcomes,
     &discovery::Discovery,
-    &crate::predicts::Predicts,
+    &discovery::Predicts,
     &paper::Illustrations,
     &paper::Deviations,
     &paper::Reproduce,
