@@ -803,18 +803,13 @@ pub fn seed_values(
     cond: &ConditionSummary,
     statistic: Statistic,
 ) -> Vec<(i64, f64)> {
-    let mut per: std::collections::BTreeMap<i64, (f64, usize)> = Default::default();
     let runs: Vec<i64> = cond.runs.iter().map(|&i| store.runs[i].seed).collect();
-    for (seed, v) in runs.into_iter().zip(run_values(store, cond, statistic)) {
-        if let Some(v) = v {
-            let e = per.entry(seed).or_insert((0.0, 0));
-            e.0 += v;
-            e.1 += 1;
-        }
-    }
-    per.into_iter()
-        .map(|(s, (t, n))| (s, t / n as f64))
-        .collect()
+    let measured: Vec<(i64, f64)> = runs
+        .into_iter()
+        .zip(run_values(store, cond, statistic))
+        .filter_map(|(seed, v)| v.map(|v| (seed, v)))
+        .collect();
+    crate::aggregate::seed_means(&measured)
 }
 
 /// The values of `statistic` per repetition, without the seeds ([`seed_values`]).

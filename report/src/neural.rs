@@ -286,9 +286,21 @@ pub struct BudgetPoint {
     pub iterations: i64,
     /// Campaigns the runs came from, sorted.
     pub campaigns: Vec<String>,
-    /// (seed, final KLC), in seed order.
+    /// (seed, final KLC) of each run, in seed order.
     pub values: Vec<(i64, f64)>,
+    /// Whether each run's network left the mean-image plateau (`train.evidence.trained`), in
+    /// the order of `values`; None where the manifest does not record it.
+    pub trained: Vec<Option<bool>>,
+    /// Over the repetitions' means (a repetition's exploration replicates share its network).
     pub summary: Summary,
+    /// The median of the repetitions' means: the data are often bimodal (networks that trained
+    /// and networks that stayed on the plateau), where a mean describes no run.
+    pub median: f64,
+    /// Runs whose network stayed on the plateau.
+    pub untrained: usize,
+    /// Runs at RPE level (fewer object moves than [`crate::aggregate::RPE_LEVEL_FACTOR`] x the
+    /// main campaign's RPE mean); None without RPE runs there.
+    pub at_rpe_level: Option<usize>,
 }
 
 /// A reference level from the main campaign (RGE-EFR, RPE on the same environment).
@@ -320,16 +332,31 @@ pub struct BudgetAnalysis {
     pub unrecorded: Vec<String>,
 }
 
-fn point(iterations: i64, runs: &[&Run]) -> BudgetPoint {
-    let mut values: Vec<(i64, f64)> = runs.iter().map(|r| (r.seed, r.final_point().klc)).collect();
-    values.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    let xs: Vec<f64> = values.iter().map(|v| v.1).collect();
+/// `rpe_moves`: the object moves below which a run is at RPE level (None: no RPE runs).
+fn point(iterations: i64, runs: &[&Run], rpe_moves: Option<f64>) -> BudgetPoint {
+    let mut rows: Vec<(i64, f64, Option<bool>, i64)> = runs
+        .iter()
+        .map(|r| {
+            let f = r.final_point();
+            (r.seed, f.klc, r.manifest.trained(), f.n_moved)
+        })
+        .collect();
+    rows.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let values: Vec<(i64, f64)> = rows.iter().map(|r| (r.0, r.1)).collect();
+    let means: Vec<f64> = crate::aggregate::seed_means(&values)
+        .into_iter()
+        .map(|v| v.1)
+        .collect();
     let campaigns: BTreeSet<String> = runs.iter().map(|r| r.campaign.clone()).collect();
     BudgetPoint {
         iterations,
         campaigns: campaigns.into_iter().collect(),
+        trained: rows.iter().map(|r| r.2).collect(),
+        untrained: rows.iter().filter(|r| r.2 == Some(false)).count(),
+        at_rpe_level: rpe_moves.map(|t| rows.iter().filter(|r| (r.3 as f64) < t).count()),
+        median: ugl_types::median(&means).unwrap_or(f64::NAN),
+        summary: stats::summarize(&means),
         values,
-        summary: stats::summarize(&xs),
     }
 }
 
@@ -358,7 +385,14 @@ pub fn budget_analysis(
     let mut series: Vec<BudgetSeries> = groups
         .into_iter()
         .map(|(key, by_it)| {
-            let points = by_it.iter().map(|(&it, runs)| point(it, runs)).collect();
+            let rpe_moves = main_conditions
+                .iter()
+                .find(|c| c.key.env == key.env && c.key.algo == "rpe")
+                .map(|c| crate::aggregate::RPE_LEVEL_FACTOR * c.final_moved_mean);
+            let points = by_it
+                .iter()
+                .map(|(&it, runs)| point(it, runs, rpe_moves))
+                .collect();
             let mut main_by_it: BTreeMap<i64, Vec<&Run>> = BTreeMap::new();
             for r in main.runs.iter().filter(|r| r.key == key) {
                 if let Some(it) = iterations(r) {
@@ -367,7 +401,7 @@ pub fn budget_analysis(
             }
             let main_points = main_by_it
                 .iter()
-                .map(|(&it, runs)| point(it, runs))
+                .map(|(&it, runs)| point(it, runs, rpe_moves))
                 .collect();
             let references = ["rge-efr", "rpe"]
                 .iter()

@@ -1,8 +1,10 @@
 //! Training-budget sensitivity (`budget_<learner>.svg`, e.g. `budget_vae.svg`): the final
 //! KL-coverage of a neural condition against its training iterations (log axis), from the
-//! `budget-*` campaigns. Every seed is a dot; the mean over seeds, with its 95% t interval
-//! ([`crate::stats::CONFIDENCE`]; none with one seed), is a diamond on a line. The main campaign's runs of the same condition are a star
-//! at their own budget; RGE-EFR and RPE of the main campaign on the same environment are horizontal
+//! `budget-*` campaigns. Every run is a dot, filled when its network left the mean-image plateau
+//! and hollow when it stayed there; the median over the seeds is a diamond on a line (the values
+//! are often bimodal, trained and untrained networks, where a mean and its interval describe no
+//! run; the report's table gives them). The main campaign's runs of the same condition are grey
+//! dots and a star (their median) at their own budget; RGE-EFR and RPE of the main campaign on the same environment are horizontal
 //! reference lines (their mean final KL-coverage). The paper trained the VAE for 100,000
 //! iterations (docs/original-code.md section 5), far right of what a CPU campaign affords.
 
@@ -24,8 +26,7 @@ const PANEL_H: u32 = 440;
 const TITLE_H: u32 = 36;
 
 fn slot(algo: &str) -> usize {
-    let known = super::algos();
-    known.iter().position(|a| *a == algo).unwrap_or(known.len())
+    super::algo_slot(algo, 0)
 }
 
 /// The file of a learner's budget figure: `budget_vae.svg` for `rge-vae`.
@@ -110,30 +111,35 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
     let col = colour(slot(&s.key.algo));
     let (diamond, _) = marker_points(3, 5.0);
     let (circle, _) = marker_points(0, 3.0);
-    let mut items = vec![
-        (
-            Icon::Marker {
-                colour: col,
-                points: circle.clone(),
-                filled: false,
-                stroke: 1,
-            },
-            "budget campaigns: one seed".to_string(),
-        ),
-        (
-            Icon::Line {
-                colour: col,
-                dash: None,
-                width: 2,
-                marker: Some((diamond, true)),
-            },
-            "budget campaigns: mean over seeds".to_string(),
-        ),
-        (
-            Icon::Whisker { colour: col },
-            "budget campaigns: 95% t interval".to_string(),
-        ),
-    ];
+    let statuses: Vec<Option<bool>> = s.points.iter().flat_map(|p| p.trained.clone()).collect();
+    let mut items = Vec::new();
+    for (status, what) in [
+        (Some(true), "network left the plateau"),
+        (Some(false), "network stayed on the plateau"),
+        (None, "not recorded whether its network trained"),
+    ] {
+        if statuses.contains(&status) {
+            let (points, filled) = run_marker(status);
+            items.push((
+                Icon::Marker {
+                    colour: col,
+                    points,
+                    filled,
+                    stroke: 1,
+                },
+                format!("budget campaigns: one run, {what}"),
+            ));
+        }
+    }
+    items.push((
+        Icon::Line {
+            colour: col,
+            dash: None,
+            width: 2,
+            marker: Some((diamond, true)),
+        },
+        "budget campaigns: median over seeds".to_string(),
+    ));
     if let Some(m) = s.main.first() {
         let main = campaign_display(main_campaign);
         items.extend([
@@ -141,10 +147,10 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
                 Icon::Marker {
                     colour: MAIN_GREY,
                     points: circle,
-                    filled: false,
+                    filled: true,
                     stroke: 1,
                 },
-                format!("main campaign {main}: one seed"),
+                format!("main campaign {main}: one run (hollow: stayed on the plateau)"),
             ),
             (
                 Icon::Marker {
@@ -153,11 +159,7 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
                     filled: false,
                     stroke: 2,
                 },
-                format!("main campaign {main}: mean over seeds (n={})", m.summary.n),
-            ),
-            (
-                Icon::Whisker { colour: BLACK },
-                format!("main campaign {main}: 95% t interval"),
+                format!("main campaign {main}: median over seeds (n={})", m.summary.n),
             ),
         ]);
     }
@@ -177,6 +179,15 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
         ));
     }
     items
+}
+
+/// The dot of a run: a filled circle when its network left the plateau, hollow when it stayed
+/// there, a hollow square when its manifest does not say (results version 1).
+fn run_marker(trained: Option<bool>) -> (Vec<(i32, i32)>, bool) {
+    match trained {
+        Some(t) => (marker_points(0, 3.0).0, t),
+        None => (marker_points(1, 3.5).0, false),
+    }
 }
 
 /// The main campaign's seeds.
@@ -204,7 +215,7 @@ fn draw_panel(
     let mut vals: Vec<f64> = Vec::new();
     for p in &all {
         vals.extend(p.values.iter().map(|v| v.1));
-        vals.extend(p.summary.ci.into_iter().flat_map(|(a, b)| [a, b]));
+        vals.push(p.median);
     }
     vals.extend(s.references.iter().map(|r| r.summary.mean));
     vals.retain(|v| v.is_finite());
@@ -255,7 +266,6 @@ fn draw_panel(
     }
 
     let col = colour(slot(&s.key.algo));
-    let (circle, _) = marker_points(0, 3.0);
     let (diamond, _) = marker_points(3, 5.0);
     let star = star_points(8.0, 3.5);
     // Seeds: the budget campaigns' in the condition's colour, the main campaign's in grey.
@@ -270,56 +280,37 @@ fn draw_panel(
         chart.draw_series(
             p.values
                 .iter()
+                .zip(&p.trained)
                 .enumerate()
-                .filter(|(_, v)| v.1.is_finite())
-                .map(|(r, v)| {
+                .filter(|(_, (v, _))| v.1.is_finite())
+                .map(|(r, (v, trained))| {
+                    let (points, filled) = run_marker(*trained);
                     marker(
                         (seed_x(p.iterations as f64, r, n), clamp(v.1)),
-                        &circle,
-                        false,
+                        &points,
+                        filled,
                         col,
                         1,
                     )
                 }),
         )?;
     }
-    // Whiskers, at a small offset to the right of the dots.
-    let whisker = |p: &BudgetPoint, (a, b): (f64, f64), c: RGBColor, offset: f64| {
-        let x = p.iterations as f64 * 10f64.powf(offset);
-        let (a, b) = (clamp(a), clamp(b));
-        let cap = 10f64.powf(0.01);
-        vec![
-            PathElement::new(vec![(x, a), (x, b)], c.stroke_width(2)),
-            PathElement::new(vec![(x / cap, a), (x * cap, a)], c.stroke_width(2)),
-            PathElement::new(vec![(x / cap, b), (x * cap, b)], c.stroke_width(2)),
-        ]
-    };
-    for p in &s.points {
-        if let Some(ci) = p.summary.ci {
-            chart.draw_series(whisker(p, ci, col, 0.04))?;
-        }
-    }
-    for p in &s.main {
-        if let Some(ci) = p.summary.ci {
-            chart.draw_series(whisker(p, ci, BLACK, 0.075))?;
-        }
-    }
-    // Means.
-    let means: Vec<(f64, f64)> = s
+    // Medians.
+    let medians: Vec<(f64, f64)> = s
         .points
         .iter()
-        .filter(|p| p.summary.mean.is_finite())
-        .map(|p| (p.iterations as f64, clamp(p.summary.mean)))
+        .filter(|p| p.median.is_finite())
+        .map(|p| (p.iterations as f64, clamp(p.median)))
         .collect();
     chart.draw_series(std::iter::once(PathElement::new(
-        means.clone(),
+        medians.clone(),
         col.stroke_width(2),
     )))?;
-    chart.draw_series(means.iter().map(|&pt| marker(pt, &diamond, true, col, 1)))?;
+    chart.draw_series(medians.iter().map(|&pt| marker(pt, &diamond, true, col, 1)))?;
     for p in &s.main {
-        if p.summary.mean.is_finite() {
+        if p.median.is_finite() {
             chart.draw_series(std::iter::once(marker(
-                (p.iterations as f64, clamp(p.summary.mean)),
+                (p.iterations as f64, clamp(p.median)),
                 &star,
                 false,
                 BLACK,

@@ -6,9 +6,12 @@
 //!
 //! - `goal_space_<env>_l<d>.svg`: one panel per learner: the lattice's latents (projected on
 //!   their top two principal axes when d > 2), drawn as a mesh: lines of constant x coloured by
-//!   x (light to dark red), lines of constant y coloured by y (light to dark blue). An unfolded,
-//!   even mesh is a goal space that keeps the object's position; a crumpled or collapsed one
-//!   loses it.
+//!   x (light to dark red), lines of constant y coloured by y (light to dark blue). Only the
+//!   lattice points the object can reach (inside the arm's unit disk) are drawn and projected:
+//!   the data sets hold no image outside it, and what an encoder makes of an image it can never
+//!   see says nothing about its goal space. The first panel is the key: the same mesh in the
+//!   object's own coordinates. An unfolded, even mesh is a goal space that keeps the object's
+//!   position; a crumpled or collapsed one loses it.
 //! - `recon_<label>.png`: the stored reconstruction grids, copied (held-out images above, the
 //!   network's reconstructions below).
 
@@ -139,9 +142,10 @@ pub fn project(z: &[Vec<f32>]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Light to dark shades of one hue, for a value in [-1, 1].
+/// Light to dark shades of one hue, for a value in [-1, 1]; the lightest is still 30% of the
+/// hue (no line fades into the white page).
 fn shade(base: (u8, u8, u8), v: f64) -> RGBColor {
-    let t = ((v + 1.0) / 2.0).clamp(0.0, 1.0);
+    let t = 0.3 + 0.7 * ((v + 1.0) / 2.0).clamp(0.0, 1.0);
     let mix = |c: u8| (230.0 * (1.0 - t) + f64::from(c) * t).round() as u8;
     RGBColor(mix(base.0), mix(base.1), mix(base.2))
 }
@@ -172,8 +176,9 @@ pub fn draw_all(
         panel.sort_by_key(|s| order(s));
         let name = format!("goal_space_{}_l{d}.svg", file_safe(env));
         let path = fig_dir.join(&name);
-        let cols = COLS.min(panel.len()).max(1);
-        let rows = panel.len().div_ceil(cols);
+        // The key, then one panel per learner.
+        let cols = COLS.min(panel.len() + 1).max(1);
+        let rows = (panel.len() + 1).div_ceil(cols);
         let title = format!(
             "{}, {d} latents: a 21 x 21 lattice of object positions in each goal space (seed 0){}",
             env_name(env),
@@ -189,7 +194,10 @@ pub fn draw_all(
             |root| {
                 let area = root.titled(&title, (FONT, 16))?;
                 let areas = area.split_evenly((rows, cols));
-                for (s, a) in panel.iter().zip(areas.iter()) {
+                if let (Some(a), Some(first)) = (areas.first(), panel.first()) {
+                    draw_key(a, first)?;
+                }
+                for (s, a) in panel.iter().zip(areas.iter().skip(1)) {
                     draw_mesh(a, s)?;
                 }
                 Ok(())
@@ -199,8 +207,17 @@ pub fn draw_all(
             path,
             link: format!("figures/{name}"),
             caption: format!(
-                "{}, {d} latents: the lattice of object positions in each goal space",
-                env_name(env)
+                "{}, {d} latents: the lattice of reachable object positions (first panel, the key: \
+                 lines of constant x red, of constant y blue, darker towards +1) in each goal \
+                 space of seed 0{}",
+                env_name(env),
+                if *d > 2 {
+                    ", projected on the top two principal axes of its latents (a flat projection \
+                     can fold a mesh that the latents keep apart: the latent-quality table's \
+                     trustworthiness and continuity measure the whole space)"
+                } else {
+                    ""
+                }
             ),
             env: env.clone(),
         });
@@ -238,6 +255,23 @@ pub fn draw_all(
     Ok((meshes, recon))
 }
 
+/// Whether a lattice position is one the object can reach: inside the arm's unit disk.
+pub fn reachable(p: [f64; 2]) -> bool {
+    p[0] * p[0] + p[1] * p[1] < 1.0
+}
+
+/// The key: the lattice in the object's own coordinates, with the disk it can reach.
+fn draw_key<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    s: &Sample,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let p: Vec<(f64, f64)> = s.positions.iter().map(|q| (q[0], q[1])).collect();
+    draw_lattice(area, "key: object position", ("object x", "object y"), s, &p, true)
+}
+
 fn draw_mesh<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     s: &Sample,
@@ -245,39 +279,121 @@ fn draw_mesh<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let p = project(&s.grid_latents);
+    // Project the reachable points only; the others get a placeholder they are never drawn at.
+    let inside: Vec<Vec<f32>> = s
+        .positions
+        .iter()
+        .zip(&s.grid_latents)
+        .filter(|(q, _)| reachable(**q))
+        .map(|(_, z)| z.clone())
+        .collect();
+    let mut projected = project(&inside).into_iter();
+    let p: Vec<(f64, f64)> = s
+        .positions
+        .iter()
+        .map(|q| {
+            if reachable(*q) {
+                projected.next().expect("one projection per reachable point")
+            } else {
+                (f64::NAN, f64::NAN)
+            }
+        })
+        .collect();
+    let axes = if s.latents > 2 {
+        ("principal axis 1", "principal axis 2")
+    } else {
+        ("latent 1", "latent 2")
+    };
+    draw_lattice(area, &panel_title(s), axes, s, &p, false)
+}
+
+/// The mesh of the lattice points `p` (the positions' order) that the object can reach.
+fn draw_lattice<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    s: &Sample,
+    p: &[(f64, f64)],
+    disk: bool,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in &p {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
+    for (&(x, y), q) in p.iter().zip(&s.positions) {
+        if reachable(*q) && x.is_finite() && y.is_finite() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if disk {
+        (x0, x1, y0, y1) = (-1.0, 1.0, -1.0, 1.0);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
     // A collapsed space (all latents equal) still gets a visible frame.
     let pad = |a: f64, b: f64| ((b - a) * 0.05).max(1e-6);
     let (px, py) = (pad(x0, x1), pad(y0, y1));
     let mut chart = ChartBuilder::on(area)
-        .caption(panel_title(s), (FONT, 14))
+        .caption(title, (FONT, 14))
         .margin(6)
+        .x_label_area_size(28)
+        .y_label_area_size(34)
         .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))?;
+    let fmt = |lo: f64, hi: f64| {
+        let dec = super::tick_decimals(lo, hi, 3);
+        move |v: &f64| format!("{v:.dec$}")
+    };
+    let (fx, fy) = (fmt(x0, x1), fmt(y0, y1));
     chart
         .configure_mesh()
         .disable_mesh()
         .x_labels(3)
         .y_labels(3)
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
         .label_style((FONT, 10))
+        .axis_desc_style((FONT, 11))
         .draw()?;
+    if disk {
+        let circle: Vec<(f64, f64)> = super::unit_circle();
+        chart.draw_series(std::iter::once(PathElement::new(
+            circle,
+            RGBColor(0x88, 0x88, 0x88).stroke_width(1),
+        )))?;
+    }
     let g = s.grid;
+    let ok = |k: usize| reachable(s.positions[k]) && p[k].0.is_finite() && p[k].1.is_finite();
+    // Runs of consecutive reachable points along a lattice line.
+    let pieces = |idx: Vec<usize>| -> Vec<Vec<(f64, f64)>> {
+        let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for k in idx {
+            if ok(k) {
+                out.last_mut().expect("non-empty").push(p[k]);
+            } else if !out.last().expect("non-empty").is_empty() {
+                out.push(Vec::new());
+            }
+        }
+        out.retain(|l| l.len() > 1);
+        out
+    };
     // Positions are x-major: index i * g + j holds (x_i, y_j).
     for i in 0..g {
         let x = s.positions[i * g][0];
-        let line: Vec<(f64, f64)> = (0..g).map(|j| p[i * g + j]).collect();
-        chart.draw_series(std::iter::once(PathElement::new(line, shade(X_HUE, x))))?;
+        for line in pieces((0..g).map(|j| i * g + j).collect()) {
+            chart.draw_series(std::iter::once(PathElement::new(line, shade(X_HUE, x))))?;
+        }
     }
     for j in 0..g {
         let y = s.positions[j][1];
-        let line: Vec<(f64, f64)> = (0..g).map(|i| p[i * g + j]).collect();
-        chart.draw_series(std::iter::once(PathElement::new(line, shade(Y_HUE, y))))?;
+        for line in pieces((0..g).map(|i| i * g + j).collect()) {
+            chart.draw_series(std::iter::once(PathElement::new(line, shade(Y_HUE, y))))?;
+        }
     }
     Ok(())
 }

@@ -1,8 +1,11 @@
 //! KL-coverage against exploration epochs, like the paper's Figure 2: one figure per environment,
 //! one panel per latent size of the learned goal spaces (the baselines RPE and RGE-EFR, which have
 //! no latent size, appear in every panel, as in the paper), one curve per condition: the mean over
-//! seeds with its shaded 95% t-interval band ([`crate::stats::CONFIDENCE`]). The paper's final value is a hollow star at the
-//! condition's last epoch.
+//! the repetitions (each the mean of its exploration replicates). Beside each panel, a strip with
+//! one column per condition gives the final value: the mean with its 95% t interval over the
+//! repetitions ([`crate::stats::CONFIDENCE`]) and, where the paper gives one, the paper's value as a
+//! hollow star. (Bands around every curve ran into one mass; the strip keeps the intervals
+//! readable.) The panels of a figure share their y axis.
 //!
 //! As the paper's figure (its notebook filtered `sampling != 'normal'`), the Gaussian-goal runs are
 //! left out: they have their own figure ([`super::sampler_compare`], the paper's Figure 4).
@@ -18,12 +21,15 @@ use plotters::prelude::*;
 use super::{
     FONT, FigureFile, Icon, SOLID, algo_slot, colour, condition_name, dash_pattern, dedup_legend,
     env_name, file_safe, fmt_epoch, klc_max, legend_height, legend_strip, marker, marker_points,
-    paper_star_item, sampler_name, star_points, write_svg,
+    paper_star_item, sampler_name, write_svg,
 };
+use super::final_strip::{FinalColumn, draw_final_strip};
 use crate::ReportError;
 use crate::aggregate::{ConditionSummary, CurveStat};
 
-const PANEL_W: u32 = 620;
+const PANEL_W: u32 = 820;
+/// Width of a panel's final-value strip, out of [`PANEL_W`].
+const STRIP_W: u32 = 250;
 const PANEL_H: u32 = 520;
 const TITLE_H: u32 = 36;
 
@@ -128,15 +134,16 @@ pub fn draw_metric(
         let legend_h = legend_height(width, &legend, 13);
         write_svg(&path, (width, PANEL_H + TITLE_H + legend_h), |root| {
             let title = format!(
-                "{}: {}, mean over seeds with 95% t interval",
+                "{}: {}, mean over repetitions; right of each panel: final value with 95% t interval",
                 env_name(env),
                 metric.name()
             );
             let area = root.titled(&title, (FONT, 18))?;
             let (plots, strip) = area.split_vertically(PANEL_H);
             let areas = plots.split_evenly((1, panels.len()));
+            let y = y_range(env, &panels, metric);
             for (panel, a) in panels.iter().zip(areas.iter()) {
-                draw_panel(a, env, panel, metric)?;
+                draw_panel(a, panel, metric, y)?;
             }
             legend_strip(&strip, &legend, 13)?;
             Ok(())
@@ -146,10 +153,18 @@ pub fn draw_metric(
             path,
             link: format!("figures/{name}"),
             caption: format!(
-                "{}: {} vs exploration epochs ({})",
+                "{}: {} vs exploration epochs ({}); curves: the mean over repetitions (n in the \
+                 legend: repetitions × exploration replicates); right of each panel: the final \
+                 value, mean and 95% t interval over the repetitions{}",
                 env_name(env),
                 metric.name(),
-                panel_list.join("; ")
+                panel_list.join("; "),
+                match metric {
+                    Metric::Klc => ", and the paper's single-run value (star)",
+                    Metric::Coverage =>
+                        "; the axis ends above the data: 100% would be every achievable cell \
+                         (on ArmArrow, every position cell with every angle bin)",
+                }
             ),
             env: env.to_string(),
         });
@@ -198,7 +213,7 @@ fn styles(members: &[&ConditionSummary]) -> Vec<Style> {
     let mut unknown: Vec<&str> = members
         .iter()
         .map(|c| c.key.algo.as_str())
-        .filter(|a| !super::algos().contains(a))
+        .filter(|a| !super::style_algos().contains(a))
         .collect();
     unknown.sort_unstable();
     unknown.dedup();
@@ -229,7 +244,7 @@ fn label(c: &ConditionSummary) -> String {
     if !matches!(c.key.sampler.as_str(), "none" | "uniform" | "kde") {
         s.push_str(&format!(", {} goals", sampler_name(&c.key.sampler)));
     }
-    s.push_str(&format!(", n={}", c.seeds.len()));
+    s.push_str(&format!(", n={}", c.n_label()));
     if !super::algos().contains(&c.key.algo.as_str()) {
         s.push_str(" (not in the paper)");
     }
@@ -264,11 +279,45 @@ fn panel_legend(panel: &Panel<'_>, metric: Metric) -> Vec<(Icon, String)> {
     items
 }
 
+/// The y range shared by the panels of a figure: the data (means, intervals and the paper's
+/// values), from the next 0.5 below their smallest value (KL-coverage; the differences are a few
+/// tenths) or from 0 (coverage, a fraction), to the largest KL-coverage possible or 5% above the
+/// data.
+fn y_range(env: &str, panels: &[Panel<'_>], metric: Metric) -> (f64, f64) {
+    let values = || {
+        panels.iter().flat_map(|p| &p.members).flat_map(|c| {
+            metric
+                .curve(c)
+                .iter()
+                .flat_map(|p| {
+                    let (lo, hi) = p.ci.unwrap_or((p.mean, p.mean));
+                    [p.mean, lo, hi]
+                })
+                .chain(metric.paper(c))
+        })
+    };
+    let hi = values().filter(|v| v.is_finite()).fold(f64::NEG_INFINITY, f64::max);
+    let lo = values().filter(|v| v.is_finite()).fold(f64::INFINITY, f64::min);
+    let data_max = if hi.is_finite() && hi > 0.0 { hi * 1.05 } else { 1.0 };
+    match metric {
+        Metric::Klc => {
+            let y_max = klc_max(env).unwrap_or(data_max);
+            let y_min = if lo.is_finite() {
+                ((lo - 0.1) * 2.0).floor().max(0.0) / 2.0
+            } else {
+                0.0
+            };
+            (y_min.min(y_max - 0.5).max(0.0), y_max)
+        }
+        Metric::Coverage => (0.0, data_max),
+    }
+}
+
 fn draw_panel(
     area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-    env: &str,
     panel: &Panel<'_>,
     metric: Metric,
+    (y_min, y_max): (f64, f64),
 ) -> Result<(), Box<dyn std::error::Error>> {
     let x_last = panel
         .members
@@ -277,54 +326,17 @@ fn draw_panel(
         .max()
         .unwrap_or(1)
         .max(1) as f64;
-    let data_max = || {
-        let m = panel
-            .members
-            .iter()
-            .flat_map(|c| {
-                metric
-                    .curve(c)
-                    .iter()
-                    .map(|p| p.ci.map_or(p.mean, |ci| ci.1))
-                    .chain(metric.paper(c))
-            })
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, f64::max);
-        if m > 0.0 { m * 1.05 } else { 1.0 }
-    };
-    let y_max = match metric {
-        Metric::Klc => klc_max(env).unwrap_or_else(data_max),
-        Metric::Coverage => data_max(),
-    };
-    let x_range = -0.01 * x_last..x_last * 1.04;
-    // The y axis spans the data (bands and the paper's values), down to the next 0.5 below
-    // their smallest value, not from 0: the differences between conditions are a few tenths.
-    let y_min = panel
-        .members
-        .iter()
-        .flat_map(|c| {
-            metric
-                .curve(c)
-                .iter()
-                .map(|p| p.ci.map_or(p.mean, |ci| ci.0.min(p.mean)))
-                .chain(metric.paper(c))
-        })
-        .filter(|v| v.is_finite())
-        .fold(f64::INFINITY, f64::min);
-    let y_min = if y_min.is_finite() {
-        ((y_min - 0.1) * 2.0).floor().max(0.0) / 2.0
-    } else {
-        0.0
-    };
-    let y_min = match metric {
-        Metric::Klc => y_min.min(y_max - 0.5).max(0.0),
-        // Coverage is a fraction: from 0.
-        Metric::Coverage => 0.0,
+    let x_range = -0.01 * x_last..x_last * 1.02;
+    let (curves_area, strip_area) = area.split_horizontally(PANEL_W - STRIP_W);
+    let y_fmt = |v: &f64| match metric {
+        Metric::Klc => format!("{v:.1}"),
+        Metric::Coverage => format!("{:.0}%", v * 100.0),
     };
 
-    let mut chart = ChartBuilder::on(area)
+    let mut chart = ChartBuilder::on(&curves_area)
         .caption(&panel.title, (FONT, 17))
         .margin(12)
+        .margin_right(4)
         .x_label_area_size(42)
         .y_label_area_size(56)
         .build_cartesian_2d(x_range, y_min..y_max)?;
@@ -333,10 +345,7 @@ fn draw_panel(
         .x_desc("exploration epochs")
         .y_desc(metric.y_desc())
         .x_label_formatter(&fmt_epoch)
-        .y_label_formatter(&|v| match metric {
-            Metric::Klc => format!("{v:.1}"),
-            Metric::Coverage => format!("{:.0}%", v * 100.0),
-        })
+        .y_label_formatter(&y_fmt)
         .x_labels(8)
         .y_labels(8)
         .label_style((FONT, 13))
@@ -350,25 +359,6 @@ fn draw_panel(
         if v.is_nan() { v } else { v.clamp(y_min, y_max) }
     };
     let styles = styles(&panel.members);
-
-    // Bands first, so that every line is drawn over every band.
-    for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
-        // Epochs without an interval (one run, an infinite value) have no band.
-        let pts: Vec<(f64, f64, f64)> = metric
-            .curve(c)
-            .iter()
-            .filter_map(|p| p.ci.map(|(lo, hi)| (p.epoch as f64, lo, hi)))
-            .collect();
-        if pts.len() < 2 || pts.iter().all(|p| p.1 == p.2) {
-            continue;
-        }
-        let mut poly: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, clamp(p.2))).collect();
-        poly.extend(pts.iter().rev().map(|p| (p.0, clamp(p.1))));
-        chart.draw_series(std::iter::once(Polygon::new(
-            poly,
-            colour(slot).mix(0.14).filled(),
-        )))?;
-    }
 
     for (i, (c, &(slot, dash, filled))) in panel.members.iter().zip(&styles).enumerate() {
         let col = colour(slot);
@@ -415,13 +405,28 @@ fn draw_panel(
         )?;
     }
 
-    // The paper's single-run values, at the last epoch of each condition.
-    let star = star_points(8.0, 3.5);
-    for (c, &(slot, _, _)) in panel.members.iter().zip(&styles) {
-        if let Some(p) = metric.paper(c) {
-            let at = (c.last_epoch() as f64, clamp(p));
-            chart.draw_series(std::iter::once(marker(at, &star, false, colour(slot), 2)))?;
-        }
-    }
+    // The final values: one column per condition, in the legend's order.
+    let columns: Vec<FinalColumn> = panel
+        .members
+        .iter()
+        .zip(&styles)
+        .map(|(c, &(slot, _, filled))| {
+            let last = metric.curve(c).last();
+            FinalColumn {
+                colour: colour(slot),
+                marker: (marker_points(slot, 4.5).0, filled),
+                mean: last.map_or(f64::NAN, |p| p.mean),
+                interval: last.and_then(|p| p.ci),
+                paper: metric.paper(c),
+            }
+        })
+        .collect();
+    draw_final_strip(
+        &strip_area,
+        &columns,
+        (y_min, y_max),
+        "final",
+        &format!("epoch {}", fmt_epoch(&x_last)),
+    )?;
     Ok(())
 }

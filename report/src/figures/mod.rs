@@ -8,6 +8,7 @@ pub mod budget;
 /// science crate, behind the `environment-figures` feature (on in the `ugl` binary).
 #[cfg(feature = "environment-figures")]
 pub mod environment;
+pub mod final_strip;
 pub mod goal_space;
 pub mod klc_curves;
 pub mod lines;
@@ -56,16 +57,31 @@ pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<
 pub const FONT: &str = "sans-serif";
 
 /// The paper's algorithms, in the report's order: RPE, RGE-EFR, then the registry's learners
-/// that the paper evaluated (PCA, Isomap, AE, VAE, RFVAE). They index [`ALGO_COLOURS`] and the
-/// marker shapes; every other algorithm takes the following slots.
+/// that the paper evaluated (PCA, Isomap, AE, VAE, RFVAE).
 pub fn algos() -> Vec<&'static str> {
     let mut v = vec!["rpe", "rge-efr"];
     v.extend(LearnerInfo::paper_algos());
     v
 }
 
-/// Okabe–Ito without its yellow (too pale on white), one per known algorithm, then extra colours.
-pub const ALGO_COLOURS: [RGBColor; 10] = [
+/// The algorithms with a fixed colour and marker, in slot order: the paper's ([`algos`]), the
+/// position-only EFR, then the registry's other learners in its order (the β-VAE, the random
+/// projection, ...). They index [`ALGO_COLOURS`] and the marker shapes, so that an algorithm
+/// looks the same in every figure and environment; an algorithm outside the registry takes the
+/// following slots.
+pub fn style_algos() -> Vec<&'static str> {
+    let mut v = algos();
+    v.push("rge-efr-position");
+    v.extend(
+        LearnerInfo::all()
+            .filter(|l| !l.in_paper)
+            .map(|l| l.algo),
+    );
+    v
+}
+
+/// Okabe–Ito without its yellow (too pale on white), one per algorithm of [`style_algos`].
+pub const ALGO_COLOURS: [RGBColor; 13] = [
     RGBColor(0x00, 0x00, 0x00), // rpe: black
     RGBColor(0xE6, 0x9F, 0x00), // efr: orange
     RGBColor(0x56, 0xB4, 0xE9), // pca: sky blue
@@ -73,9 +89,12 @@ pub const ALGO_COLOURS: [RGBColor; 10] = [
     RGBColor(0x00, 0x72, 0xB2), // ae: blue
     RGBColor(0xD5, 0x5E, 0x00), // vae: vermillion
     RGBColor(0xCC, 0x79, 0xA7), // rfvae: reddish purple
-    RGBColor(0x88, 0x22, 0x55), // others: wine
-    RGBColor(0x44, 0xAA, 0x99), // teal
-    RGBColor(0x77, 0x77, 0x77), // grey
+    RGBColor(0x8C, 0x51, 0x0A), // efr, position only: brown
+    RGBColor(0x33, 0x22, 0x88), // pca-centred: indigo
+    RGBColor(0x88, 0x22, 0x55), // bvae: wine
+    RGBColor(0x77, 0x77, 0x77), // gaussian-projection (a control): grey
+    RGBColor(0x44, 0xAA, 0x99), // external: teal
+    RGBColor(0x99, 0x99, 0x33), // others: olive
 ];
 
 /// Display name of an environment.
@@ -578,7 +597,7 @@ pub fn klc_max(env: &str) -> Option<f64> {
 /// Colour and marker slot of an algorithm: its position among the known ones; unknown algorithms
 /// take the following slots in the order given by `unknown_index`.
 pub fn algo_slot(algo: &str, unknown_index: usize) -> usize {
-    let known = algos();
+    let known = style_algos();
     let r = rank(algo, &known);
     if r < known.len() {
         r
@@ -592,9 +611,10 @@ pub fn colour(slot: usize) -> RGBColor {
 }
 
 /// Marker outlines, in pixels around (0, 0): circle, square, triangle up, diamond, triangle down,
-/// plus, x; then the same shapes hollow. (Stars are kept for the paper's values.)
+/// plus, x, triangle left, triangle right, pentagon, hexagon, bar; then the same shapes hollow.
+/// (Stars are kept for the paper's values; hollow markers otherwise mark the corrected variants.)
 pub fn marker_points(slot: usize, size: f64) -> (Vec<(i32, i32)>, bool) {
-    const N_SHAPES: usize = 7;
+    const N_SHAPES: usize = 12;
     let shape = slot % N_SHAPES;
     let filled = (slot / N_SHAPES).is_multiple_of(2);
     let s = size;
@@ -614,6 +634,20 @@ pub fn marker_points(slot: usize, size: f64) -> (Vec<(i32, i32)>, bool) {
         2 => poly(&[(0.0, -1.15), (1.0, 0.75), (-1.0, 0.75)]),
         3 => poly(&[(0.0, -1.25), (1.0, 0.0), (0.0, 1.25), (-1.0, 0.0)]),
         4 => poly(&[(0.0, 1.15), (1.0, -0.75), (-1.0, -0.75)]),
+        7 => poly(&[(-1.15, 0.0), (0.75, -1.0), (0.75, 1.0)]),
+        8 => poly(&[(1.15, 0.0), (-0.75, -1.0), (-0.75, 1.0)]),
+        9 | 10 => {
+            let n = if shape == 9 { 5 } else { 6 };
+            let ring: Vec<(f64, f64)> = (0..n)
+                .map(|i| {
+                    let a = -std::f64::consts::FRAC_PI_2
+                        + i as f64 * 2.0 * std::f64::consts::PI / n as f64;
+                    (1.1 * a.cos(), 1.1 * a.sin())
+                })
+                .collect();
+            poly(&ring)
+        }
+        11 => poly(&[(-0.45, -1.15), (0.45, -1.15), (0.45, 1.15), (-0.45, 1.15)]),
         5 | 6 => {
             // A plus; rotated by 45 degrees it is the "x" of slot 6.
             let plus = [
@@ -1039,6 +1073,30 @@ pub fn dedup_legend(items: Vec<(Icon, String)>) -> Vec<(Icon, String)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every algorithm with a fixed style (the paper's, the position-only EFR and every learner
+    /// of the registry) has its own colour and its own marker shape, drawn filled: an algorithm
+    /// looks the same in every figure, and hollow markers are left to the corrected variants.
+    #[test]
+    fn every_known_algorithm_has_its_own_colour_and_a_filled_marker() {
+        let known = style_algos();
+        assert!(known.contains(&"rge-gaussian-projection") && known.contains(&"rge-bvae"));
+        assert!(known.len() <= ALGO_COLOURS.len(), "a colour per algorithm");
+        let mut seen = Vec::new();
+        for (slot, a) in known.iter().enumerate() {
+            assert_eq!(algo_slot(a, 7), slot, "{a}");
+            let (pts, filled) = marker_points(slot, 4.0);
+            assert!(filled, "{a}: hollow marker on a solid line");
+            assert!(!seen.contains(&(colour(slot), pts.clone())), "{a}");
+            assert!(
+                known[..slot].iter().all(|b| colour(algo_slot(b, 0)) != colour(slot)),
+                "{a} shares a colour"
+            );
+            seen.push((colour(slot), pts));
+        }
+        // An algorithm outside the registry takes the slots after them.
+        assert_eq!(algo_slot("rge-new", 0), known.len());
+    }
 
     /// Linear interpolation in data space, as on a linear axis.
     fn linear(a: (f64, f64), b: (f64, f64), edge: f64) -> (f64, f64) {

@@ -1,7 +1,7 @@
 //! Where the object went, like the paper's Figure 3: for each condition, the outcomes (object x, y)
 //! of one representative run (the median run by final KLC, not seed 0) at three epochs, side by
 //! side, with the unit disk (the reachable set) and the object's initial position (0.6, 0.6).
-//! ArmArrow outcomes are short strokes from the arrow's position toward its tip, so the panels
+//! ArmArrow outcomes are short strokes from the arrow's position to its tip, with a barb at the tip, so the panels
 //! show the angle too.
 
 use std::collections::BTreeMap;
@@ -216,9 +216,15 @@ fn draw_panel(
                 chart.draw_series(std::iter::once(Circle::new(at, 2, col.mix(alpha).filled())))?;
             }
             Some(t) => {
+                // A stroke from the position to the tip, with a barb at the tip (one path): the
+                // direction reads.
                 let end = (at.0 + STROKE * t.cos(), at.1 + STROKE * t.sin());
+                let barb = (
+                    end.0 - 0.4 * STROKE * (t - 0.6).cos(),
+                    end.1 - 0.4 * STROKE * (t - 0.6).sin(),
+                );
                 chart.draw_series(std::iter::once(PathElement::new(
-                    vec![at, end],
+                    vec![at, end, barb],
                     col.mix(alpha).stroke_width(1),
                 )))?;
             }
@@ -232,9 +238,15 @@ fn draw_panel(
             + Circle::new((0, 0), 6, RED.stroke_width(2))
             + Cross::new((0, 0), 3, RED.stroke_width(2)),
     ))?;
+    // Its label outside the disk, with a leader line: the densest data is around the start.
+    let label_at = (INITIAL.0 + 0.3, 1.04);
+    chart.draw_series(std::iter::once(PathElement::new(
+        vec![(INITIAL.0 + 0.05, INITIAL.1 + 0.05), (label_at.0, label_at.1 - 0.02)],
+        RED.stroke_width(1),
+    )))?;
     chart.draw_series(std::iter::once(Text::new(
         "start",
-        (INITIAL.0 - 0.12, INITIAL.1 + 0.16),
+        (label_at.0 + 0.02, label_at.1 + 0.06),
         (FONT, 12).into_font().color(&RED),
     )))?;
     Ok(())

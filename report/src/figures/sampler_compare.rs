@@ -1,8 +1,9 @@
 //! The paper's Figure 4: RGE-VAE exploring with goals from a KDE of the training latents against
 //! goals from the VAE's isotropic Gaussian prior N(0, I), in four panels (ArmBall 10 / 2 latents,
 //! ArmArrow 10 / 3 latents). As in the paper ("mean and standard deviation over 5 independent
-//! runs"), each curve is the mean over seeds with a ±1 sd band (not the t interval of the other
-//! curve figures). Our two variants are both drawn: faithful solid with filled markers, corrected
+//! runs"), the spread shown is ±1 sd over the repetitions (not the t interval of the other curve
+//! figures), at the final epoch in a strip beside each panel
+//! ([`super::final_strip`]; bands around the four curves covered each other). Our two variants are both drawn: faithful solid with filled markers, corrected
 //! dashed with hollow markers; KDE blue circles, Gaussian vermillion triangles.
 //!
 //! The same figure for another algorithm (RGE-RFVAE, which the paper did not plot) is drawn when
@@ -14,15 +15,18 @@ use plotters::prelude::*;
 
 use super::{
     FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, fmt_epoch, klc_max,
-    legend_height, legend_strip, marker, marker_points, panel_order, paper_star_item,
-    sampler_colour, sampler_marker_slot, sampler_name, star_points, variant_dash, variant_filled,
+    legend_height, legend_strip, marker_points, panel_order, paper_star_item,
+    sampler_colour, sampler_marker_slot, sampler_name, variant_dash, variant_filled,
     write_svg,
 };
+use super::final_strip::{FinalColumn, draw_final_strip};
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
 use crate::figures::algo_name;
 
-const PANEL_W: u32 = 620;
+const PANEL_W: u32 = 720;
+/// Width of a panel's final-value strip, out of [`PANEL_W`].
+const STRIP_W: u32 = 130;
 const PANEL_H: u32 = 440;
 const TITLE_H: u32 = 36;
 /// The samplers compared, in legend order.
@@ -110,7 +114,7 @@ pub fn draw(
     let rows = panels.len().div_ceil(2);
     let path = fig_dir.join(name);
     let title = format!(
-        "{}: KDE vs Gaussian goals, mean over seeds ± 1 sd",
+        "{}: KDE vs Gaussian goals, mean over repetitions; right: final value ± 1 sd",
         algo_name(algo)
     );
     let width = PANEL_W * cols as u32;
@@ -136,7 +140,11 @@ pub fn draw(
         path,
         link: format!("figures/{name}"),
         caption: format!(
-            "{}: KL-coverage with KDE vs Gaussian goals, faithful solid, corrected dashed ({})",
+            "{}: KL-coverage with KDE vs Gaussian goals, faithful solid, corrected dashed ({}); \
+             curves: the mean over repetitions (n in the legend: repetitions × exploration \
+             replicates); right of each panel: the final mean ± 1 sd over the repetitions, as the \
+             paper's Figure 4, and the paper's single-run value of the faithful variant (star; the \
+             KDE values of the panels its Figure 4 does not show are its Figure 2's)",
             algo_name(algo),
             titles.join("; ")
         ),
@@ -163,7 +171,7 @@ fn panel_legend(panel: &SamplerPanel<'_>) -> Vec<(Icon, String)> {
         })
         .collect();
     if panel.members.iter().any(|(_, _, c)| c.paper.is_some()) {
-        items.push(paper_star_item("paper: final value (1 run)"));
+        items.push(paper_star_item("paper: final value (1 run, read off its Figures 2 and 4)"));
     }
     items
 }
@@ -174,7 +182,7 @@ fn label(sampler: &str, variant: &str, c: &ConditionSummary) -> String {
     if variant != "none" {
         s.push_str(&format!(", {variant}"));
     }
-    s.push_str(&format!(", n={}", c.seeds.len()));
+    s.push_str(&format!(", n={}", c.n_label()));
     s
 }
 
@@ -189,39 +197,42 @@ fn draw_panel(
         .max()
         .unwrap_or(1)
         .max(1) as f64;
-    let band = |p: &crate::aggregate::CurveStat| match p.std {
-        Some(sd) if p.mean.is_finite() => Some((p.mean - sd, p.mean + sd)),
-        _ => None,
+    let final_sd = |c: &ConditionSummary| {
+        c.curve.last().and_then(|p| match p.std {
+            Some(sd) if p.mean.is_finite() => Some((p.mean - sd, p.mean + sd)),
+            _ => None,
+        })
     };
     let finite = panel
         .members
         .iter()
         .flat_map(|m| {
+            let (lo, hi) = final_sd(m.2).unwrap_or((f64::NAN, f64::NAN));
             m.2.curve
                 .iter()
-                .flat_map(|p| {
-                    let (lo, hi) = band(p).unwrap_or((p.mean, p.mean));
-                    [lo, hi]
-                })
-                .chain(m.2.paper.iter().map(|p| p.klc))
+                .map(|p| p.mean)
+                .chain([lo, hi])
+                .chain(paper_value(m).into_iter())
         })
         .filter(|v| v.is_finite());
     let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
     let y_max = klc_max(&panel.env).unwrap_or(if hi.is_finite() { hi * 1.05 } else { 1.0 });
-    // Zoom on the curves: the bottom of the axis just under the lowest band.
+    // Zoom on the curves: the bottom of the axis just under the lowest value.
     let y_min = if lo.is_finite() {
         (lo - 0.08 * (y_max - lo)).max(0.0).min(y_max - 0.5)
     } else {
         0.0
     };
-    let mut chart = ChartBuilder::on(area)
+    let (curves_area, strip_area) = area.split_horizontally(PANEL_W - STRIP_W);
+    let mut chart = ChartBuilder::on(&curves_area)
         .caption(panel.title(), (FONT, 17))
         .margin(12)
+        .margin_right(4)
         .x_label_area_size(42)
         .y_label_area_size(56)
-        .build_cartesian_2d(-0.01 * x_last..x_last * 1.04, y_min..y_max)?;
+        .build_cartesian_2d(-0.01 * x_last..x_last * 1.02, y_min..y_max)?;
     chart
         .configure_mesh()
         .x_desc("exploration epochs")
@@ -236,27 +247,12 @@ fn draw_panel(
         .light_line_style(RGBColor(0xEE, 0xEE, 0xEE))
         .bold_line_style(RGBColor(0xDD, 0xDD, 0xDD))
         .draw()?;
-    let clamp = |v: f64| v.clamp(y_min, y_max);
 
-    for &(sampler, _, c) in &panel.members {
-        let pts: Vec<(f64, (f64, f64))> = c
-            .curve
-            .iter()
-            .filter_map(|p| band(p).map(|b| (p.epoch as f64, b)))
-            .collect();
-        if pts.len() < 2 {
-            continue;
-        }
-        let mut poly: Vec<(f64, f64)> = pts.iter().map(|(x, b)| (*x, clamp(b.1))).collect();
-        poly.extend(pts.iter().rev().map(|(x, b)| (*x, clamp(b.0))));
-        chart.draw_series(std::iter::once(Polygon::new(
-            poly,
-            sampler_colour(sampler).mix(0.12).filled(),
-        )))?;
-    }
     let n = panel.members.len().max(1);
     let mut off = super::OffScaleMarks::default();
-    for (i, &(sampler, variant, c)) in panel.members.iter().enumerate() {
+    let mut columns = Vec::new();
+    for (i, m) in panel.members.iter().enumerate() {
+        let &(sampler, variant, c) = m;
         let (mpts, _) = marker_points(sampler_marker_slot(sampler), 4.5);
         let style = LineStyle {
             colour: sampler_colour(sampler),
@@ -273,26 +269,28 @@ fn draw_panel(
             i as f64 / n as f64,
             None,
         )?);
+        columns.push(FinalColumn {
+            colour: style.colour,
+            marker: style.marker.clone(),
+            mean: c.curve.last().map_or(f64::NAN, |p| p.mean),
+            interval: final_sd(c),
+            paper: paper_value(m),
+        });
     }
     super::draw_off_scale(&mut chart, &off)?;
-
-    // The paper's single-run values (its Figure 4 has ArmBall 10 latents only in our table).
-    let star = star_points(8.0, 3.5);
-    let mut drawn: Vec<&str> = Vec::new();
-    for &(sampler, _, c) in &panel.members {
-        if let Some(p) = &c.paper
-            && !drawn.contains(&sampler)
-        {
-            drawn.push(sampler);
-            let at = (c.last_epoch() as f64, clamp(p.klc));
-            chart.draw_series(std::iter::once(marker(
-                at,
-                &star,
-                false,
-                sampler_colour(sampler),
-                2,
-            )))?;
-        }
-    }
+    draw_final_strip(
+        &strip_area,
+        &columns,
+        (y_min, y_max),
+        "final",
+        &format!("epoch {}, ± 1 sd", fmt_epoch(&x_last)),
+    )?;
     Ok(())
+}
+
+/// The paper's single-run value drawn beside a member: the paper ran its original code, our
+/// faithful variant (or a learner without variants), so the corrected variant gets none.
+fn paper_value(m: &(&str, &str, &ConditionSummary)) -> Option<f64> {
+    let (_, variant, c) = m;
+    (*variant != "corrected").then(|| c.paper.as_ref().map(|p| p.klc)).flatten()
 }

@@ -35,8 +35,7 @@ const DARK: RGBColor = RGBColor(0x44, 0x44, 0x44);
 
 /// Colour and marker slot of an algorithm, as in the curve figures.
 fn slot(algo: &str) -> usize {
-    let known = super::algos();
-    known.iter().position(|a| *a == algo).unwrap_or(known.len())
+    super::algo_slot(algo, 0)
 }
 
 /// The pairs of each (env, latents) panel, in the paper's panel order.

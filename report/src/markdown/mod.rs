@@ -498,7 +498,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
 
     let _ = writeln!(
         w,
-        "| env | algorithm | goal sampler | latents | variant | seeds | epochs | wall time per run (mean) |"
+        "| env | algorithm | goal sampler | latents | variant | seeds (× replicates) | epochs | wall time per run (mean) |"
     );
     let _ = writeln!(w, "|---|---|---|---:|---|---|---:|---:|");
     for c in inp.conditions {
@@ -525,7 +525,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
                 c.key.latents.to_string()
             },
             c.key.variant,
-            c.seeds.len(),
+            c.n_label(),
             fmt_seeds(&c.seeds),
             fmt_epochs(&c.final_epochs),
             wall
@@ -693,8 +693,8 @@ pub fn outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile
         w,
         "For each condition, the outcomes of its median run (by final KL-coverage, among the \
          runs whose outcomes file the store keeps; the title names its seed) at three epochs: every episode that moved the object is a dot at the \
-         object's final (x, y), for ArmArrow a short stroke from the arrow's position toward its \
-         tip (angles grouped in 30° sectors); the circle is the reachable unit disk and the red \
+         object's final (x, y), for ArmArrow a short stroke from the arrow's position to its \
+         tip, with a barb at the tip (angles grouped in 30° sectors); the circle is the reachable unit disk and the red \
          mark the initial position (0.6, 0.6), where every other episode ends. Panel titles \
          count the episodes that moved the object.\n"
     );

@@ -409,7 +409,10 @@ pub fn variants(w: &mut String, inp: &Context<'_>, figure: Option<&FigureFile>) 
 
 fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>) {
     let seeds: Vec<i64> = p.values.iter().map(|v| v.0).collect();
-    let xs: Vec<f64> = p.values.iter().map(|v| v.1).collect();
+    let xs: Vec<f64> = crate::aggregate::seed_means(&p.values)
+        .into_iter()
+        .map(|v| v.1)
+        .collect();
     let delta = match efr {
         None => "—".into(),
         Some(ys) => match stats::welch_interval(&xs, ys, stats::CONFIDENCE) {
@@ -426,9 +429,18 @@ fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>
             ),
         },
     };
+    let runs = p.values.len();
+    let untrained = if p.trained.iter().all(Option::is_none) {
+        "—".to_string()
+    } else {
+        format!("{} of {runs}", p.untrained)
+    };
+    let at_rpe = p
+        .at_rpe_level
+        .map_or("—".to_string(), |k| format!("{k} of {runs}"));
     let _ = writeln!(
         w,
-        "| {} | {} | {} ({}) | {} | {} | {delta} |",
+        "| {} | {} | {} ({}) | {} | {} | {} | {untrained} | {at_rpe} | {delta} |",
         p.iterations,
         origin,
         p.summary.n,
@@ -437,6 +449,7 @@ fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>
             .split(" (n=")
             .next()
             .unwrap_or_default(),
+        super::fmt_klc(p.median),
         super::fmt_ci(p.summary.ci)
     );
 }
@@ -486,9 +499,13 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
          seed starts from the same weights and draws the same batches at every budget of these \
          campaigns (the main campaign's network may have another recipe: see the list under the \
          figure). Each dot \
-         is a seed's final KL-coverage; diamonds the mean with its {level:.0}% t interval; the star the \
-         main campaign {} at its own budget; horizontal lines the mean final KL-coverage of \
-         RGE-EFR and RPE in the main campaign. The paper trained the VAE for 100,000 iterations. \
+         is a run's final KL-coverage, filled when its network left the mean-image plateau and \
+         hollow when it stayed there; diamonds on a line the median over the seeds (the values \
+         are often bimodal: a mean would describe no run); the star the median of the main \
+         campaign {} at its own budget; horizontal lines the mean final KL-coverage of \
+         RGE-EFR and RPE in the main campaign. The table gives the mean with its {level:.0}% t \
+         interval as well, the networks that stayed on the plateau and the runs at RPE level \
+         (fewer object moves than twice RPE's mean). The paper trained the VAE for 100,000 iterations. \
          *Δ vs RGE-EFR*: the mean final KL-coverage minus RGE-EFR's (main campaign), with its \
          {level:.0}% Welch t interval: whether the paper's main claim for this learner (no worse \
          than RGE-EFR) depends on the budget.\n",
@@ -521,10 +538,10 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
         let _ = writeln!(w, "### {}\n", series_title(s));
         let _ = writeln!(
             w,
-            "| training iterations | campaign | n seeds | final KLC mean ± sd | {level:.0}% CI | Δ vs RGE-EFR [{level:.0}% CI] |",
+            "| training iterations | campaign | n seeds | final KLC mean ± sd | median | {level:.0}% CI | networks on the plateau | at RPE level | Δ vs RGE-EFR [{level:.0}% CI] |",
             level = stats::CONFIDENCE * 100.0
         );
-        let _ = writeln!(w, "|---:|---|---:|---:|---:|---:|");
+        let _ = writeln!(w, "|---:|---|---:|---:|---:|---:|---:|---:|---:|");
         let efr = s
             .references
             .iter()
