@@ -166,7 +166,10 @@ fn summarize_condition(
         let mut by_epoch: BTreeMap<i64, Vec<(i64, f64)>> = BTreeMap::new();
         for r in &rs {
             for p in &r.curve {
-                by_epoch.entry(p.epoch).or_default().push((r.seed, value(p)));
+                by_epoch
+                    .entry(p.epoch)
+                    .or_default()
+                    .push((r.seed, value(p)));
             }
         }
         by_epoch

@@ -51,6 +51,8 @@ pub enum ClaimsInput<'a> {
         path: &'a std::path::Path,
         confidence: f64,
         margin: f64,
+        /// [`Settings::target_half_width`].
+        target_half_width: Option<f64>,
         results: &'a [ClaimResult],
     },
     /// No claims file where the report looked.
@@ -78,6 +80,10 @@ pub struct Settings {
     pub confidence: f64,
     /// Default margin of `much_less`, `at_most`, `at_least` and `similar`.
     pub margin: f64,
+    /// The precision the main campaign was designed for: the median half-width of the paper's
+    /// claims' KL-coverage comparisons, in nats. The report says whether the results meet it.
+    #[serde(default)]
+    pub target_half_width: Option<f64>,
 }
 
 /// One claim.
@@ -783,6 +789,25 @@ pub fn attach_paper_checks(
     }
 }
 
+/// The precision of the paper's claims: the median half-width of the intervals of their
+/// comparisons on KL-coverage (`final_klc`, `auc`; nats), and how many comparisons have one.
+/// None when no such comparison has an interval. Our own claims are left out: the target is
+/// the paper's.
+pub fn precision(results: &[ClaimResult]) -> Option<(f64, usize)> {
+    let mut halves: Vec<f64> = results
+        .iter()
+        .filter(|r| {
+            !r.claim.ours && matches!(r.claim.statistic, Statistic::FinalKlc | Statistic::Auc)
+        })
+        .flat_map(|r| &r.comparisons)
+        .filter_map(|c| c.bounds())
+        .map(|(lo, hi)| (hi - lo) / 2.0)
+        .filter(|h| h.is_finite())
+        .collect();
+    halves.sort_by(f64::total_cmp);
+    ugl_types::median(&halves).map(|m| (m, halves.len()))
+}
+
 /// Whether two conditions' values pair up: the same repetitions (seeds), at least two. The
 /// learners of a repetition share its data set and, replicate by replicate, its exploration
 /// streams, so their paired differences are less spread than independent samples (the noise
@@ -1246,6 +1271,39 @@ pair_on = ["env"]
     fn verdict_of(text: &str, store: &Store, conds: &[ConditionSummary]) -> ClaimResult {
         let f = parse_claims(text, Path::new("c.toml")).unwrap();
         evaluate(&f, conds, store).remove(0)
+    }
+
+    /// The precision line: the median half-width over the paper's KL-coverage comparisons; our
+    /// own claims and other statistics are left out.
+    #[test]
+    fn precision_is_the_median_half_width_of_the_papers_klc_comparisons() {
+        let (store, conds) = synthetic(&[
+            ("rge-efr", 0, &[4.5, 4.6, 4.4, 4.55, 4.45]),
+            ("rge-pca", 10, &[4.0, 4.1, 3.9, 4.05, 3.95]),
+            ("rge-ae", 10, &[3.0, 6.0, 3.2, 5.8, 4.5]),
+            ("rge-vae", 10, &[4.0, 4.4, 3.6, 4.2, 3.8]),
+        ]);
+        let text = claim(
+            "less",
+            "{ algo = [\"rge-pca\", \"rge-ae\", \"rge-vae\"] }",
+            "{ algo = [\"rge-efr\"] }",
+            "[\"env\"]",
+        );
+        let f = parse_claims(&text, Path::new("c.toml")).unwrap();
+        let mut results = evaluate(&f, &conds, &store);
+        let mut halves: Vec<f64> = results[0]
+            .comparisons
+            .iter()
+            .map(|c| c.bounds().map(|(lo, hi)| (hi - lo) / 2.0).unwrap())
+            .collect();
+        halves.sort_by(f64::total_cmp);
+        assert_eq!(halves.len(), 3);
+        assert_eq!(precision(&results), Some((halves[1], 3)));
+        results[0].claim.ours = true;
+        assert_eq!(precision(&results), None);
+        results[0].claim.ours = false;
+        results[0].claim.statistic = Statistic::Moved;
+        assert_eq!(precision(&results), None);
     }
 
     #[test]

@@ -139,6 +139,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
             path: &claims_path,
             confidence: f.settings.confidence,
             margin: f.settings.margin,
+            target_half_width: f.settings.target_half_width,
             results: &claim_results,
         },
         None => claims::ClaimsInput::Missing(&claims_path),

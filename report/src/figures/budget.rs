@@ -159,7 +159,10 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
                     filled: false,
                     stroke: 2,
                 },
-                format!("main campaign {main}: median over seeds (n={})", m.summary.n),
+                format!(
+                    "main campaign {main}: median over seeds (n={})",
+                    m.summary.n
+                ),
             ),
         ]);
     }

@@ -78,7 +78,14 @@ where
     chart.draw_series((0..PIXELS).filter(|&k| img[k] > 0.0).map(|k| {
         let (x, y) = ((k / SIDE) as f64, (k % SIDE) as f64);
         let v = (img[k].clamp(0.0, 1.0) * 255.0).round() as u8;
-        Rectangle::new([(x, y), (x + 1.0, y + 1.0)], RGBColor(v, v, v).filled())
+        // Each pixel overlaps its next neighbours by a quarter pixel: the backend rounds each
+        // rectangle to whole screen pixels (4 or 5 of them per image pixel here), and abutting
+        // rectangles left 1-px gaps that read as grid lines inside the lit pixels.
+        const OVERLAP: f64 = 0.25;
+        Rectangle::new(
+            [(x, y), (x + 1.0 + OVERLAP, y + 1.0 + OVERLAP)],
+            RGBColor(v, v, v).filled(),
+        )
     }))?;
     Ok(())
 }

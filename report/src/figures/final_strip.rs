@@ -4,8 +4,8 @@
 //! Bands around every curve of a crowded panel run into one mass; the strip keeps the
 //! intervals, and the comparison with the paper, readable.
 
-use plotters::prelude::*;
 use plotters::coord::Shift;
+use plotters::prelude::*;
 
 use super::{FONT, marker, star_points};
 
@@ -58,7 +58,9 @@ pub fn draw_final_strip(
     for (i, c) in columns.iter().enumerate() {
         let x = i as f64 + 0.35;
         if c.mean.is_finite() {
-            if let Some((lo, hi)) = c.interval.filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+            if let Some((lo, hi)) = c
+                .interval
+                .filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
             {
                 strip.draw_series(std::iter::once(PathElement::new(
                     vec![(x, inside(lo)), (x, inside(hi))],

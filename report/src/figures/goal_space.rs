@@ -269,7 +269,14 @@ where
     DB::ErrorType: 'static,
 {
     let p: Vec<(f64, f64)> = s.positions.iter().map(|q| (q[0], q[1])).collect();
-    draw_lattice(area, "key: object position", ("object x", "object y"), s, &p, true)
+    draw_lattice(
+        area,
+        "key: object position",
+        ("object x", "object y"),
+        s,
+        &p,
+        true,
+    )
 }
 
 fn draw_mesh<DB: DrawingBackend>(
@@ -293,7 +300,9 @@ where
         .iter()
         .map(|q| {
             if reachable(*q) {
-                projected.next().expect("one projection per reachable point")
+                projected
+                    .next()
+                    .expect("one projection per reachable point")
             } else {
                 (f64::NAN, f64::NAN)
             }

@@ -18,12 +18,12 @@ use std::path::Path;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
+use super::final_strip::{FinalColumn, draw_final_strip};
 use super::{
     FONT, FigureFile, Icon, SOLID, algo_slot, colour, condition_name, dash_pattern, dedup_legend,
     env_name, file_safe, fmt_epoch, klc_max, legend_height, legend_strip, marker, marker_points,
     paper_star_item, sampler_name, write_svg,
 };
-use super::final_strip::{FinalColumn, draw_final_strip};
 use crate::ReportError;
 use crate::aggregate::{ConditionSummary, CurveStat};
 
@@ -296,9 +296,17 @@ fn y_range(env: &str, panels: &[Panel<'_>], metric: Metric) -> (f64, f64) {
                 .chain(metric.paper(c))
         })
     };
-    let hi = values().filter(|v| v.is_finite()).fold(f64::NEG_INFINITY, f64::max);
-    let lo = values().filter(|v| v.is_finite()).fold(f64::INFINITY, f64::min);
-    let data_max = if hi.is_finite() && hi > 0.0 { hi * 1.05 } else { 1.0 };
+    let hi = values()
+        .filter(|v| v.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    let lo = values()
+        .filter(|v| v.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let data_max = if hi.is_finite() && hi > 0.0 {
+        hi * 1.05
+    } else {
+        1.0
+    };
     match metric {
         Metric::Klc => {
             let y_max = klc_max(env).unwrap_or(data_max);

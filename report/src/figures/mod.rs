@@ -72,11 +72,7 @@ pub fn algos() -> Vec<&'static str> {
 pub fn style_algos() -> Vec<&'static str> {
     let mut v = algos();
     v.push("rge-efr-position");
-    v.extend(
-        LearnerInfo::all()
-            .filter(|l| !l.in_paper)
-            .map(|l| l.algo),
-    );
+    v.extend(LearnerInfo::all().filter(|l| !l.in_paper).map(|l| l.algo));
     v
 }
 
@@ -1089,7 +1085,9 @@ mod tests {
             assert!(filled, "{a}: hollow marker on a solid line");
             assert!(!seen.contains(&(colour(slot), pts.clone())), "{a}");
             assert!(
-                known[..slot].iter().all(|b| colour(algo_slot(b, 0)) != colour(slot)),
+                known[..slot]
+                    .iter()
+                    .all(|b| colour(algo_slot(b, 0)) != colour(slot)),
                 "{a} shares a colour"
             );
             seen.push((colour(slot), pts));

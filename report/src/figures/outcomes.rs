@@ -241,7 +241,10 @@ fn draw_panel(
     // Its label outside the disk, with a leader line: the densest data is around the start.
     let label_at = (INITIAL.0 + 0.3, 1.04);
     chart.draw_series(std::iter::once(PathElement::new(
-        vec![(INITIAL.0 + 0.05, INITIAL.1 + 0.05), (label_at.0, label_at.1 - 0.02)],
+        vec![
+            (INITIAL.0 + 0.05, INITIAL.1 + 0.05),
+            (label_at.0, label_at.1 - 0.02),
+        ],
         RED.stroke_width(1),
     )))?;
     chart.draw_series(std::iter::once(Text::new(

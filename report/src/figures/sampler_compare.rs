@@ -13,13 +13,12 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use super::final_strip::{FinalColumn, draw_final_strip};
 use super::{
     FONT, FigureFile, Icon, LineStyle, dedup_legend, draw_curve, env_name, fmt_epoch, klc_max,
-    legend_height, legend_strip, marker_points, panel_order, paper_star_item,
-    sampler_colour, sampler_marker_slot, sampler_name, variant_dash, variant_filled,
-    write_svg,
+    legend_height, legend_strip, marker_points, panel_order, paper_star_item, sampler_colour,
+    sampler_marker_slot, sampler_name, variant_dash, variant_filled, write_svg,
 };
-use super::final_strip::{FinalColumn, draw_final_strip};
 use crate::ReportError;
 use crate::aggregate::ConditionSummary;
 use crate::figures::algo_name;
@@ -171,7 +170,9 @@ fn panel_legend(panel: &SamplerPanel<'_>) -> Vec<(Icon, String)> {
         })
         .collect();
     if panel.members.iter().any(|(_, _, c)| c.paper.is_some()) {
-        items.push(paper_star_item("paper: final value (1 run, read off its Figures 2 and 4)"));
+        items.push(paper_star_item(
+            "paper: final value (1 run, read off its Figures 2 and 4)",
+        ));
     }
     items
 }
@@ -292,5 +293,7 @@ fn draw_panel(
 /// faithful variant (or a learner without variants), so the corrected variant gets none.
 fn paper_value(m: &(&str, &str, &ConditionSummary)) -> Option<f64> {
     let (_, variant, c) = m;
-    (*variant != "corrected").then(|| c.paper.as_ref().map(|p| p.klc)).flatten()
+    (*variant != "corrected")
+        .then(|| c.paper.as_ref().map(|p| p.klc))
+        .flatten()
 }

@@ -130,7 +130,7 @@ pub fn summary_line(w: &mut String, inp: &Context<'_>) {
 /// The claims section.
 pub fn claims(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "## The paper's claims\n");
-    let (path, confidence, margin, results) = match inp.claims {
+    let (path, confidence, margin, target, results) = match inp.claims {
         ClaimsInput::Missing(p) => {
             let _ = writeln!(
                 w,
@@ -143,8 +143,9 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
             path,
             confidence,
             margin,
+            target_half_width,
             results,
-        } => (path, *confidence, *margin, *results),
+        } => (path, *confidence, *margin, *target_half_width, *results),
     };
     let _ = writeln!(
         w,
@@ -157,6 +158,25 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
         path.display(),
         method_text(confidence)
     );
+    if let Some((half, n)) = crate::claims::precision(results) {
+        let _ = writeln!(
+            w,
+            "\n**Precision:** the median half-width of the {level:.0}% intervals of the {n} \
+             comparisons of the paper's claims on KL-coverage is {half:.3} nats{}.",
+            match target {
+                Some(t) if half <= t => format!(
+                    ", within the {t} nats the main campaign was designed for \
+                     (`target_half_width` in the claims file)"
+                ),
+                Some(t) => format!(
+                    ", **wider than the {t} nats the main campaign was designed for** \
+                     (`target_half_width` in the claims file)"
+                ),
+                None => String::new(),
+            },
+            level = confidence * 100.0
+        );
+    }
     // Untrained networks: counted, never silently part of a verdict.
     let flags: Vec<bool> = inp
         .store
