@@ -609,7 +609,9 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "## Final KL-coverage\n");
     let _ = writeln!(
         w,
-        "At each run's last epoch. *mean ± sd* over seeds (sample sd); *{level:.0}% CI*: \
+        "At each run's last epoch. *n*: repetitions (seeds), × exploration replicates where a \
+         repetition has several; *mean ± sd* over the repetitions, each the mean of its \
+         replicates (sample sd); *{level:.0}% CI*: \
          Student's t interval of the mean (— with fewer than 2 seeds or an infinite value; in a \
          seeded simulation it covers 0.94-0.96 on normal samples, but only 0.91 on skewed ones at \
          5 seeds, 0.83 when a seed may be stuck at RPE level); \
@@ -656,7 +658,7 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
                 "| {}{} | {} | {} | {} | {} | {:.0} / {:.0} | {:.1} % | {} | {} | {} |",
                 describe(c),
                 dagger(&reduced_keys, c),
-                s.n,
+                c.n_label(),
                 fmt_epochs(&c.final_epochs),
                 mean_sd,
                 fmt_ci(s.ci),
@@ -664,7 +666,7 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
                 c.final_outcomes_mean,
                 100.0 * c.final_coverage_mean,
                 match c.at_rpe_level {
-                    Some(k) => format!("{k} / {}", s.n),
+                    Some(k) => format!("{k} / {}", c.runs.len()),
                     None => "—".into(),
                 },
                 paper,
