@@ -1,0 +1,224 @@
+//! The numbers the README states about the committed results are those of the committed data
+//! and of the committed report: each sentence is found by its wording, its numbers are read and
+//! compared with what the manifests and `report/out/REPORT.md` say. A README edited without the
+//! data, or data committed without the README, fails here.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn read(rel: &str) -> String {
+    std::fs::read_to_string(root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// The README with its line breaks folded into spaces (a sentence may wrap anywhere).
+fn readme() -> String {
+    read("README.md")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The words standing for the `{}` of `template` where `text` holds it: the template's first
+/// literal part must occur exactly once in `text`, and each `{}` takes everything up to the next
+/// literal part (a template ending in `{}` takes the rest of the line).
+fn captures(text: &str, template: &str) -> Vec<String> {
+    let parts: Vec<&str> = template.split("{}").collect();
+    let head = parts[0];
+    assert_eq!(
+        text.matches(head).count(),
+        1,
+        "{head:?} should occur once in the text"
+    );
+    let mut rest = &text[text.find(head).unwrap() + head.len()..];
+    let mut out = Vec::new();
+    for part in &parts[1..] {
+        let end = if part.is_empty() {
+            rest.find('\n').unwrap_or(rest.len())
+        } else {
+            rest.find(part)
+                .unwrap_or_else(|| panic!("{part:?} not found after {head:?}"))
+        };
+        out.push(rest[..end].to_string());
+        rest = &rest[end + part.len()..];
+    }
+    out
+}
+
+fn number(word: &str) -> usize {
+    match word {
+        "none" | "no" => 0,
+        w => w.parse().unwrap_or_else(|_| panic!("not a number: {w}")),
+    }
+}
+
+/// The manifests of a campaign directory (every `*.json` but the campaign's own files).
+fn manifests(dir: &str) -> Vec<serde_json::Value> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(root().join(dir)).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        if p.extension().is_some_and(|x| x == "json") && name != "campaign.json" {
+            let v: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+            if v.get("run_id").is_some() {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_main_campaigns_size_version_and_training_are_those_of_its_manifests() {
+    let text = readme();
+    let c = captures(
+        &text,
+        "`data/results/paper`**, what `make report` renders: the paper's matrix ({} conditions), \
+         {} repetitions x {} exploration, {} runs at **results version {}**, with trained \
+         4900-1200-1200 networks (all {} trainings left the mean-image plateau)",
+    );
+    let runs = manifests("data/results/paper");
+    assert_eq!(runs.len(), number(&c[3]), "runs");
+    let conditions: BTreeSet<String> = runs
+        .iter()
+        .map(|m| {
+            format!(
+                "{}/{}/{}/{}/{}",
+                m["env"], m["algo"], m["sampler"], m["latents"], m["variant"]
+            )
+        })
+        .collect();
+    assert_eq!(conditions.len(), number(&c[0]), "conditions");
+    let seeds: BTreeSet<String> = runs.iter().map(|m| m["seed"].to_string()).collect();
+    assert_eq!(seeds.len(), number(&c[1]), "repetitions");
+    assert_eq!(runs.len(), conditions.len() * seeds.len() * number(&c[2]));
+    for m in &runs {
+        assert_eq!(
+            m["crate_versions"]["results_version"].as_u64(),
+            Some(number(&c[4]) as u64),
+            "{}",
+            m["run_id"]
+        );
+    }
+    // A training is shared by the runs that differ only in their goal sampler.
+    let mut trainings: BTreeSet<String> = BTreeSet::new();
+    for m in &runs {
+        if let Some(trained) = m["train"]["evidence"]["trained"].as_bool() {
+            assert!(trained, "{} did not leave the plateau", m["run_id"]);
+            trainings.insert(format!(
+                "{}/{}/{}/{}/{}",
+                m["env"], m["algo"], m["latents"], m["variant"], m["seed"]
+            ));
+        }
+    }
+    assert_eq!(trainings.len(), number(&c[5]), "trainings");
+}
+
+#[test]
+fn the_claims_counts_are_those_of_the_committed_report() {
+    let text = readme();
+    let c = captures(
+        &text,
+        "On the committed results: {} of the {} claims reproduced, {} not reproduced, {} \
+         inconclusive at {} seeds",
+    );
+    let report = read("report/out/REPORT.md");
+    let r = captures(
+        &report,
+        "**The paper's claims** ([details](#the-papers-claims)): {} reproduced, {} not \
+         reproduced, {} inconclusive, of {} claims",
+    );
+    assert_eq!(number(&c[0]), number(&r[0]), "reproduced");
+    assert_eq!(number(&c[1]), number(&r[3]), "claims");
+    assert_eq!(number(&c[2]), number(&r[1]), "not reproduced");
+    assert_eq!(number(&c[3]), number(&r[2]), "inconclusive");
+    let seeds: BTreeSet<String> = manifests("data/results/paper")
+        .iter()
+        .map(|m| m["seed"].to_string())
+        .collect();
+    assert_eq!(number(&c[4]), seeds.len(), "seeds");
+
+    let contradicted = captures(&text, "which contradict {} of them");
+    let line = captures(
+        &report,
+        "gives no value for these comparisons. Contradicted: {}.\n",
+    );
+    let ids = if line[0] == "none" {
+        0
+    } else {
+        line[0].matches('`').count() / 2
+    };
+    assert_eq!(number(&contradicted[0]), ids, "contradicted by the paper");
+}
+
+#[test]
+fn the_rerun_runs_without_a_discovery_record_are_counted_right() {
+    let text = readme();
+    let c = captures(
+        &text,
+        "the first {} runs of the rerun, written before the record was kept, keep theirs",
+    );
+    let without: Vec<String> = manifests("data/results-pending/paper")
+        .into_iter()
+        .filter(|m| m.get("discovery").is_none())
+        .map(|m| m["run_id"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(without.len(), number(&c[0]));
+    for id in &without {
+        let outcomes = root()
+            .join("data/results-pending/paper")
+            .join(format!("{id}.outcomes.parquet"));
+        assert!(
+            outcomes.exists(),
+            "{id}: no discovery record and no outcomes file"
+        );
+    }
+}
+
+#[test]
+fn the_validity_check_says_what_the_readme_says() {
+    let text = readme();
+    captures(
+        &text,
+        "On the committed runs the final KL-coverage does not tell the goal spaces that encode \
+         the object's position from the controls (it fails the check on ArmArrow and barely \
+         passes on ArmBall), while cell coverage, the goal-reaching error and the KLC of moved \
+         outcomes do.{}",
+    );
+    let report = read("report/out/REPORT.md");
+    // `| measure | env | better | first group | controls | P(better) | check |`
+    let row = |measure: &str, env: &str| -> (f64, String) {
+        let prefix = format!("| {measure} | {env} |");
+        let line = report
+            .lines()
+            .find(|l| l.starts_with(&prefix))
+            .unwrap_or_else(|| panic!("no validity row {prefix}"));
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        (cells[6].parse().unwrap(), cells[7].to_string())
+    };
+    let (p, check) = row("final KLC (all outcomes)", "ArmArrow");
+    assert_eq!(check, "**fails**", "final KLC on ArmArrow (P(better) {p})");
+    let (p, check) = row("final KLC (all outcomes)", "ArmBall");
+    assert!(
+        check == "passes" && p < 0.6,
+        "final KLC on ArmBall: {check}, {p}"
+    );
+    for measure in [
+        "KLC of moved outcomes",
+        "cells reached",
+        "goal error, mean",
+        "goal error, 90th pct",
+    ] {
+        for env in ["ArmBall", "ArmArrow"] {
+            let (p, check) = row(measure, env);
+            assert!(
+                check == "passes" && p >= 0.75,
+                "{measure} on {env}: {check}, {p}"
+            );
+        }
+    }
+}
