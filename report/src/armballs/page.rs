@@ -131,8 +131,9 @@ pub(super) fn write(
     }
     let _ = writeln!(
         p,
-        "\n![Ball and distractor exploration ratio, mean over the seeds of each condition (no \
-         interval drawn)](figures/{COVERAGE_FIGURE})\n"
+        "\n![Ball and distractor exploration ratio, mean over the seeds of each condition (n in \
+         the legend; no interval drawn: the table above gives the final ball ratios with their \
+         95% t intervals)](figures/{COVERAGE_FIGURE})\n"
     );
 
     // 2. Interest per module.
@@ -215,7 +216,8 @@ pub(super) fn write(
         if figures.iter().any(|f| f.link.ends_with(INTEREST_FIGURE)) {
             let _ = writeln!(
                 p,
-                "\n![Interest per module, mean over the seeds, log scale](figures/{INTEREST_FIGURE})\n"
+                "\n![Interest per module, mean over the seeds (n in the legend; no interval \
+                 drawn), log scale](figures/{INTEREST_FIGURE})\n"
             );
         }
     }

@@ -80,8 +80,10 @@ pub fn draw_all(
             path,
             link: format!("figures/{name}"),
             caption: format!(
-                "{}: final KL-coverage vs training iterations (budget campaigns), with the main \
-                 campaign and the RGE-EFR / RPE levels",
+                "{}: final KL-coverage vs training iterations (budget campaigns): one dot per run \
+                 (hollow: the network stayed on the plateau), the median over the seeds (n in \
+                 the legend and the table; no interval drawn: the table gives the 95% t \
+                 intervals), the main campaign and the RGE-EFR / RPE levels",
                 condition_name(algo, "none")
             ),
             env: String::new(),
