@@ -1044,7 +1044,7 @@ pub(crate) mod tests {
                     .any(|c| c.id == *id && c.source.contains("a control of ours"))
             })
             .collect();
-        assert_eq!(unchecked.len() - paper_unchecked.len(), 13);
+        assert_eq!(unchecked.len() - paper_unchecked.len(), 14);
         let unchecked = paper_unchecked;
         assert_eq!(
             unchecked,

@@ -602,17 +602,32 @@ pub fn algo_slot(algo: &str, unknown_index: usize) -> usize {
     }
 }
 
+/// The colour of a slot ([`algo_slot`]): [`ALGO_COLOURS`], then, for algorithms outside the
+/// registry (external learners), colours none of the registry's algorithms has.
 pub fn colour(slot: usize) -> RGBColor {
-    ALGO_COLOURS[slot % ALGO_COLOURS.len()]
+    const MORE: [RGBColor; 6] = [
+        RGBColor(0xAA, 0x44, 0x99), // purple
+        RGBColor(0x11, 0x77, 0x33), // green
+        RGBColor(0x66, 0x11, 0x00), // dark red
+        RGBColor(0x66, 0x99, 0xCC), // pale blue
+        RGBColor(0xDD, 0xAA, 0x33), // ochre
+        RGBColor(0x55, 0x55, 0x55), // dark grey
+    ];
+    match ALGO_COLOURS.get(slot) {
+        Some(&c) => c,
+        None => MORE[(slot - ALGO_COLOURS.len()) % MORE.len()],
+    }
 }
 
 /// Marker outlines, in pixels around (0, 0): circle, square, triangle up, diamond, triangle down,
-/// plus, x, triangle left, triangle right, pentagon, hexagon, bar; then the same shapes hollow.
-/// (Stars are kept for the paper's values; hollow markers otherwise mark the corrected variants.)
+/// plus, x, triangle left, triangle right, pentagon, hexagon, bar, then again; always filled
+/// (stars are kept for the paper's values; hollow markers mark the corrected variants, which
+/// the caller decides).
 pub fn marker_points(slot: usize, size: f64) -> (Vec<(i32, i32)>, bool) {
     const N_SHAPES: usize = 12;
     let shape = slot % N_SHAPES;
-    let filled = (slot / N_SHAPES).is_multiple_of(2);
+    // Filled: a hollow marker is the corrected variants' (the caller decides).
+    let filled = true;
     let s = size;
     let poly = |pts: &[(f64, f64)]| -> Vec<(i32, i32)> {
         pts.iter()
@@ -1092,8 +1107,17 @@ mod tests {
             );
             seen.push((colour(slot), pts));
         }
-        // An algorithm outside the registry takes the slots after them.
+        // An algorithm outside the registry takes the slots after them, filled, in colours of
+        // its own.
         assert_eq!(algo_slot("rge-new", 0), known.len());
+        for k in 0..4 {
+            let slot = algo_slot("rge-new", k);
+            assert!(marker_points(slot, 4.0).1);
+            assert!(
+                (0..known.len()).all(|s| colour(s) != colour(slot)),
+                "external learner {k} shares a colour with a registry algorithm"
+            );
+        }
     }
 
     /// Linear interpolation in data space, as on a linear axis.
