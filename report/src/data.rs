@@ -18,11 +18,13 @@ pub const FINAL_FILE: &str = "final_by_seed.csv";
 /// One row per run and evaluated epoch.
 pub const CURVES_FILE: &str = "curves.csv";
 
-const KEY_HEADER: &str = "campaign,env,algo,sampler,latents,variant,seed";
+/// A run's key: its condition, its repetition (`seed`) and its exploration replicate
+/// (`exploration`, 0 where a repetition has one).
+const KEY_HEADER: &str = "campaign,env,algo,sampler,latents,variant,seed,exploration";
 
 fn key_fields(camp: &Campaign, r: &Run) -> String {
     format!(
-        "{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{}",
         if camp.name.is_empty() {
             "."
         } else {
@@ -33,7 +35,8 @@ fn key_fields(camp: &Campaign, r: &Run) -> String {
         r.key.sampler,
         r.key.latents,
         r.key.variant,
-        r.seed
+        r.seed,
+        r.manifest.exploration
     )
 }
 

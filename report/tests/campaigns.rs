@@ -385,7 +385,7 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
         lines
             .next()
             .unwrap()
-            .starts_with("campaign,env,algo,sampler,latents,variant,seed,epoch,final_klc")
+            .starts_with("campaign,env,algo,sampler,latents,variant,seed,exploration,epoch,final_klc")
     );
     assert_eq!(lines.count(), n_main);
     let curves = std::fs::read_to_string(out.join("data/curves.csv")).unwrap();
