@@ -794,7 +794,7 @@ pub fn attach_paper_checks(
 /// None when no such comparison has an interval. Our own claims are left out: the target is
 /// the paper's.
 pub fn precision(results: &[ClaimResult]) -> Option<(f64, usize)> {
-    let mut halves: Vec<f64> = results
+    let halves: Vec<f64> = results
         .iter()
         .filter(|r| {
             !r.claim.ours && matches!(r.claim.statistic, Statistic::FinalKlc | Statistic::Auc)
@@ -804,7 +804,6 @@ pub fn precision(results: &[ClaimResult]) -> Option<(f64, usize)> {
         .map(|(lo, hi)| (hi - lo) / 2.0)
         .filter(|h| h.is_finite())
         .collect();
-    halves.sort_by(f64::total_cmp);
     ugl_types::median(&halves).map(|m| (m, halves.len()))
 }
 

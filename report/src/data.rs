@@ -41,7 +41,7 @@ fn key_fields(camp: &Campaign, r: &Run) -> String {
 }
 
 /// A float as CSV: shortest round-trip form; `inf`; empty when absent.
-fn num(v: Option<f64>) -> String {
+pub(crate) fn num(v: Option<f64>) -> String {
     v.map(|v| format!("{v}")).unwrap_or_default()
 }
 

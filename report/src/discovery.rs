@@ -15,6 +15,7 @@ use ugl_types::EnvSpec;
 
 use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
+use crate::data::num;
 use crate::load::Run;
 use crate::output::Output;
 pub use ugl_types::{
@@ -283,11 +284,6 @@ pub fn validity(rows: &[RunRow<'_>]) -> Vec<Check> {
 
 /// The data file, under the report's `data/`.
 pub const FILE: &str = "discovery_by_run.csv";
-
-/// A float as CSV: shortest round-trip form, `inf`; empty when absent.
-fn num(v: Option<f64>) -> String {
-    v.map(|v| format!("{v}")).unwrap_or_default()
-}
 
 /// `data/discovery_by_run.csv`: one row per measured run.
 pub fn write_csv(out: &mut Output, rows: &[RunRow<'_>]) -> Result<(), ReportError> {

@@ -382,10 +382,9 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     let finals = std::fs::read_to_string(out.join("data/final_by_seed.csv")).unwrap();
     let mut lines = finals.lines();
     assert!(
-        lines
-            .next()
-            .unwrap()
-            .starts_with("campaign,env,algo,sampler,latents,variant,seed,exploration,epoch,final_klc")
+        lines.next().unwrap().starts_with(
+            "campaign,env,algo,sampler,latents,variant,seed,exploration,epoch,final_klc"
+        )
     );
     assert_eq!(lines.count(), n_main);
     let curves = std::fs::read_to_string(out.join("data/curves.csv")).unwrap();

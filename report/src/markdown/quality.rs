@@ -63,19 +63,8 @@ pub fn group_r2(m: &Manifest, group: &str) -> Option<(f64, f64)> {
     m.group_r2(group)
 }
 
-pub(crate) fn median(v: &[f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    Some(if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
-    })
-}
+/// The median (None when empty): the one of `ugl_types`, the runner's and the report's.
+pub(crate) use ugl_types::median;
 
 fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
