@@ -279,20 +279,22 @@ fn panel_legend(panel: &Panel<'_>, metric: Metric) -> Vec<(Icon, String)> {
     items
 }
 
-/// The y range shared by the panels of a figure: the data (means, intervals and the paper's
-/// values), from the next 0.5 below their smallest value (KL-coverage; the differences are a few
-/// tenths) or from 0 (coverage, a fraction), to the largest KL-coverage possible or 5% above the
-/// data.
+/// The y range shared by the panels of a figure: what is drawn (the mean curves, the final
+/// intervals and the paper's values), from the next 0.5 below its smallest value (KL-coverage;
+/// the differences are a few tenths) or from 0 (coverage, a fraction), to the largest
+/// KL-coverage possible or 5% above the data.
 fn y_range(env: &str, panels: &[Panel<'_>], metric: Metric) -> (f64, f64) {
     let values = || {
         panels.iter().flat_map(|p| &p.members).flat_map(|c| {
-            metric
-                .curve(c)
+            let curve = metric.curve(c);
+            let last = curve
+                .last()
+                .and_then(|p| p.ci)
+                .map_or([f64::NAN; 2], |ci| [ci.0, ci.1]);
+            curve
                 .iter()
-                .flat_map(|p| {
-                    let (lo, hi) = p.ci.unwrap_or((p.mean, p.mean));
-                    [p.mean, lo, hi]
-                })
+                .map(|p| p.mean)
+                .chain(last)
                 .chain(metric.paper(c))
         })
     };
