@@ -204,7 +204,8 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
     let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
     for needle in [
         "| ArmReach | RGE-PCA † | kde | 2 |",
-        "![ArmReach: KL-coverage vs exploration epochs (ArmReach, 2 latents)](figures/klc_armreach.svg)",
+        "![ArmReach: KL-coverage vs exploration epochs (ArmReach, 2 latents); curves: the mean over repetitions",
+        "](figures/klc_armreach.svg)",
         "### ArmReach",
     ] {
         assert!(md.contains(needle), "no `{needle}` in:\n{md}");
