@@ -241,31 +241,21 @@ mod tests {
     use crate::load::{CurvePoint, Run, Store};
 
     fn run(seed: i64, klc: f64) -> Run {
-        Run {
-            run_id: format!("r.s{seed}.{klc}"),
-            campaign: "paper".into(),
-            key: ConditionKey {
-                env: "armball".into(),
-                algo: "rge-vae".into(),
-                sampler: "kde".into(),
-                latents: 10,
-                variant: "faithful".into(),
-            },
-            seed,
-            curve: vec![CurvePoint {
-                epoch: 100,
-                n_outcomes: 101,
-                klc,
-                n_moved: 10,
-                coverage: 0.1,
-            }],
-            outcomes: Vec::new(),
-            diagnostics: None,
-            manifest: crate::load::test_manifest(serde_json::json!({})),
-            curve_path: Default::default(),
-            outcomes_path: Default::default(),
-            manifest_path: Default::default(),
-        }
+        let key = ConditionKey {
+            env: "armball".into(),
+            algo: "rge-vae".into(),
+            sampler: "kde".into(),
+            latents: 10,
+            variant: "faithful".into(),
+        };
+        let point = CurvePoint {
+            epoch: 100,
+            n_outcomes: 101,
+            klc,
+            n_moved: 10,
+            coverage: 0.1,
+        };
+        crate::load::test_run(format!("r.s{seed}.{klc}"), key, seed, vec![point])
     }
 
     /// Two repetitions with three exploration replicates each: the repetition is the unit. The

@@ -1215,7 +1215,7 @@ pair_on = ["env"]
     /// A store with one condition per `(algo, latents, final KLC per seed)`, on ArmBall; every
     /// run's curve goes linearly from ln 756 at epoch 0 to its final value at epoch 100.
     pub(crate) fn synthetic(conds: &[(&str, i64, &[f64])]) -> (Store, Vec<ConditionSummary>) {
-        use crate::load::{CurvePoint, Run};
+        use crate::load::CurvePoint;
         let mut runs = Vec::new();
         for (algo, latents, finals) in conds {
             for (seed, &f) in finals.iter().enumerate() {
@@ -1229,25 +1229,13 @@ pair_on = ["env"]
                         coverage: 0.0,
                     })
                     .collect();
-                runs.push(Run {
-                    run_id: format!("{algo}.l{latents}.s{seed}"),
-                    campaign: "paper".into(),
-                    key: key(
-                        "armball",
-                        algo,
-                        if *latents == 0 { "uniform" } else { "kde" },
-                        *latents,
-                        "none",
-                    ),
-                    seed: seed as i64,
+                let sampler = if *latents == 0 { "uniform" } else { "kde" };
+                runs.push(crate::load::test_run(
+                    format!("{algo}.l{latents}.s{seed}"),
+                    key("armball", algo, sampler, *latents, "none"),
+                    seed as i64,
                     curve,
-                    outcomes: Vec::new(),
-                    diagnostics: None,
-                    manifest: crate::load::test_manifest(serde_json::json!({})),
-                    curve_path: Default::default(),
-                    outcomes_path: Default::default(),
-                    manifest_path: Default::default(),
-                });
+                ));
             }
         }
         let store = Store {

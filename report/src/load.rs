@@ -102,6 +102,30 @@ pub(crate) fn test_manifest(fields: serde_json::Value) -> Manifest {
     serde_json::from_value(base).expect("a complete manifest")
 }
 
+/// A run for the report's tests: `curve` under `key`, with [`test_manifest`]'s manifest and no
+/// outcomes or files.
+#[cfg(test)]
+pub(crate) fn test_run(
+    run_id: String,
+    key: ConditionKey,
+    seed: i64,
+    curve: Vec<CurvePoint>,
+) -> Run {
+    Run {
+        run_id,
+        campaign: "paper".into(),
+        key,
+        seed,
+        curve,
+        outcomes: Vec::new(),
+        diagnostics: None,
+        manifest: test_manifest(serde_json::json!({})),
+        curve_path: Default::default(),
+        outcomes_path: Default::default(),
+        manifest_path: Default::default(),
+    }
+}
+
 /// One complete run.
 #[derive(Debug, Clone)]
 pub struct Run {

@@ -419,7 +419,7 @@ fn campaigns_are_separated_and_the_neural_sections_are_drawn() {
     );
     // Nine learned cells (AE-10; VAE and RFVAE, two variants, two sizes), seed 0 of each.
     assert!(
-        q.contains("9 runs hold version 2 of the latent-quality measure"),
+        q.contains("9 representations hold version 2 of the latent-quality measure"),
         "{q}"
     );
     assert!(q.contains("did not leave the plateau"), "{q}");

@@ -545,17 +545,20 @@ pub fn klc_curves(
     let _ = writeln!(w, "## KL-coverage during exploration\n");
     let _ = writeln!(
         w,
-        "Mean over seeds (line) with the {:.0}% Student t interval of the mean (shaded: mean ± \
-         t(n − 1) · sd / √n; none where a value is infinite). The paper's notebooks drew \
+        "Lines: the mean over the repetitions (each repetition the mean of its exploration \
+         replicates), without bands: overlapping bands around every curve hid one another. Right of each \
+         panel, one column per condition: the final value's mean and its {:.0}% Student t \
+         interval over the repetitions (mean ± t(n − 1) · sd / √n; none where a value is \
+         infinite), and the paper's final value (hollow star: a single run, read off its plots \
+         at the point labelled 4900) in the same column. The paper's notebooks drew \
          `seaborn.tsplot(ci=90)`, a percentile-bootstrap band, which is too narrow at 5 seeds \
-         (\"The paper's claims\" gives the measured coverage). Lower is better; the y axis spans the data: from just below the lowest value drawn to \
-         the KL-coverage of outcomes all in one cell ({}), not from 0. The baselines appear in \
-         every panel of their environment, as in the paper. Hollow stars: the paper's final values \
-         (single runs, read off its plots at the point labelled 4900), drawn at our last epoch. \
-         As in the paper's figure, only KDE goals for the learned spaces: the Gaussian-goal runs \
-         are in the Figure 4 section. Colour and marker shape identify the algorithm; the \
-         *faithful* variant is solid with filled markers, the *corrected* one dashed with hollow \
-         markers. *n* in the legend: seeds.\n",
+         (\"The paper's claims\" gives the measured coverage). Lower is better; the y axis \
+         spans what is drawn, up to the KL-coverage of outcomes all in one cell ({}), not from \
+         0. The baselines appear in every panel of their environment, as in the paper. As in \
+         the paper's figure, only KDE goals for the learned spaces: the Gaussian-goal runs are \
+         in the Figure 4 section. Colour and marker shape identify the algorithm; the \
+         *faithful* variant is solid with filled markers, the *corrected* one dashed with \
+         hollow markers. *n* in the legend: repetitions × exploration replicates.\n",
         crate::stats::CONFIDENCE * 100.0,
         paper_envs(|e| format!(
             "ln {} = {:.2} for {}",

@@ -274,10 +274,12 @@ pub fn figure4(w: &mut String, inp: &Context<'_>, sampler_figures: &[FigureFile]
         "The paper compared goals sampled from a KDE of the training latents with goals from the \
          VAE's isotropic Gaussian prior N(0, I), and found no significant difference (its Figure \
          4, mean and standard deviation over 5 runs; its notebook's single run on ArmBall with 10 \
-         latents ends at 4.25 with KDE and 3.84 with Gaussian goals). Curves: mean over seeds with \
-         a ±1 sd band; KDE blue circles, Gaussian vermillion triangles; faithful solid with filled \
-         markers, corrected dashed with hollow markers. Table: final KL-coverage, mean ± sd over \
-         seeds (*n* seeds).\n"
+         latents ends at 4.25 with KDE and 3.84 with Gaussian goals). Curves: the mean over the \
+         repetitions, without bands; right of each panel, the final mean ± 1 sd over the \
+         repetitions (the paper's statistic); KDE blue circles, Gaussian vermillion triangles; \
+         faithful solid with filled markers, corrected dashed with hollow markers. Table: final \
+         KL-coverage, mean ± sd over the repetitions (*n* repetitions, each the mean of its \
+         exploration replicates).\n"
     );
     for (algo, name) in crate::SAMPLER_FIGURES {
         let fig = sampler_figures

@@ -15,8 +15,8 @@ struct Row {
     algo: String,
     variant: String,
     latents: i64,
-    runs: usize,
-    /// Runs whose manifest records training evidence / latent quality.
+    representations: usize,
+    /// Representations whose manifest records training evidence / latent quality.
     with_evidence: usize,
     untrained: usize,
     loss_fractions: Vec<f64>,
@@ -75,8 +75,8 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 }
 
 /// Rows of the main campaign's learned goal spaces, one per (env, algo, variant, latents): the
-/// KDE and Gaussian runs of a cell share one representation, so the KDE runs are counted (each
-/// representation once).
+/// KDE and Gaussian runs of a cell, and the exploration replicates of a repetition, share one
+/// representation, so the KDE runs of replicate 0 are counted (each representation once).
 fn rows(inp: &Context<'_>) -> Vec<Row> {
     let mut out: Vec<Row> = Vec::new();
     for c in inp.conditions.iter().filter(|c| c.key.latents > 0) {
@@ -88,7 +88,7 @@ fn rows(inp: &Context<'_>) -> Vec<Row> {
             algo: c.key.algo.clone(),
             variant: c.key.variant.clone(),
             latents: c.key.latents,
-            runs: c.runs.len(),
+            representations: 0,
             with_evidence: 0,
             untrained: 0,
             loss_fractions: Vec::new(),
@@ -103,6 +103,10 @@ fn rows(inp: &Context<'_>) -> Vec<Row> {
         };
         for &i in &c.runs {
             let m = &inp.store.runs[i].manifest;
+            if m.exploration != 0 {
+                continue;
+            }
+            r.representations += 1;
             if let Some((f, trained)) = evidence(m) {
                 r.with_evidence += 1;
                 r.loss_fractions.push(f);
@@ -153,9 +157,10 @@ pub fn section(
     );
     let _ = writeln!(
         w,
-        "For each learned goal space of the main campaign (one representation per cell and seed; \
-         the Gaussian-goal runs share the KDE runs' representation):\n\n\
-         - **untrained**: neural runs whose reconstruction loss after training (the decoder \
+        "For each learned goal space of the main campaign (one representation per cell and \
+         repetition, counted once: the Gaussian-goal runs and the exploration replicates share \
+         it):\n\n\
+         - **untrained**: neural representations whose reconstruction loss after training (the decoder \
          applied to each image's noise-free code, on 2000 training images; no KL or flow term) is \
          not below 0.8 x the *plateau*, the loss of those images' mean image (the best constant \
          prediction, computed exactly); such a goal space is an untrained random projection. \
@@ -197,7 +202,7 @@ pub fn section(
     }
     let _ = writeln!(
         w,
-        "| env | algorithm | variant | latents | runs | untrained | loss / plateau | \
+        "| env | algorithm | variant | latents | representations | untrained | loss / plateau | \
          position R² linear | position R² k-NN | angle R² k-NN | angle mod 120° R² k-NN | \
          position T / C |"
     );
@@ -220,7 +225,7 @@ pub fn section(
             crate::figures::algo_name(&r.algo),
             r.variant,
             r.latents,
-            r.runs,
+            r.representations,
             untrained,
             fmt(median(&r.loss_fractions), 2),
             fmt(mean(&r.position_linear), 3),
@@ -237,7 +242,7 @@ pub fn section(
     if old > 0 {
         let _ = writeln!(
             w,
-            "\n{old} run{} hold the first version of the latent-quality measure (fitted on 2000 \
+            "\n{old} representation{} hold the first version of the latent-quality measure (fitted on 2000 \
              images, no groups) and show \"—\": `ugl campaign --config ... --refresh-diagnostics` \
              brings them up to date without rerunning them.",
             plural(old)
@@ -247,7 +252,7 @@ pub fn section(
     if v2 > 0 {
         let _ = writeln!(
             w,
-            "\n{v2} run{} hold version 2 of the latent-quality measure (no trustworthiness or \
+            "\n{v2} representation{} hold version 2 of the latent-quality measure (no trustworthiness or \
              continuity) and show \"—\" under T / C: `ugl campaign --config ... \
              --refresh-diagnostics` brings them up to date without rerunning them.",
             plural(v2)
