@@ -3,7 +3,7 @@
 //! compared with what the manifests and `report/out/REPORT.md` say. A README edited without the
 //! data, or data committed without the README, fails here.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -77,9 +77,10 @@ fn the_main_campaigns_size_version_and_training_are_those_of_its_manifests() {
     let text = readme();
     let c = captures(
         &text,
-        "`data/results/paper`**, what `make report` renders: the paper's matrix ({} conditions), \
-         {} repetitions x {} exploration, {} runs at **results version {}**, with trained \
-         4900-1200-1200 networks (all {} trainings left the mean-image plateau)",
+        "`data/results/paper`**, what `make report` renders: the paper's matrix with its controls \
+         ({} conditions), {} repetitions x {} exploration replicates, {} runs at **results \
+         version {}**, with trained 4900-1200-1200 networks ({} of the {} trainings left the \
+         mean-image plateau;",
     );
     let runs = manifests("data/results/paper");
     assert_eq!(runs.len(), number(&c[3]), "runs");
@@ -104,18 +105,22 @@ fn the_main_campaigns_size_version_and_training_are_those_of_its_manifests() {
             m["run_id"]
         );
     }
-    // A training is shared by the runs that differ only in their goal sampler.
-    let mut trainings: BTreeSet<String> = BTreeSet::new();
+    // A training is shared by the runs that differ only in their goal sampler or exploration
+    // replicate.
+    let mut trainings: BTreeMap<String, bool> = BTreeMap::new();
     for m in &runs {
         if let Some(trained) = m["train"]["evidence"]["trained"].as_bool() {
-            assert!(trained, "{} did not leave the plateau", m["run_id"]);
-            trainings.insert(format!(
+            let key = format!(
                 "{}/{}/{}/{}/{}",
                 m["env"], m["algo"], m["latents"], m["variant"], m["seed"]
-            ));
+            );
+            let before = trainings.insert(key, trained);
+            assert!(before.is_none_or(|b| b == trained), "{}", m["run_id"]);
         }
     }
-    assert_eq!(trainings.len(), number(&c[5]), "trainings");
+    let left = trainings.values().filter(|t| **t).count();
+    assert_eq!(left, number(&c[5]), "trainings that left the plateau");
+    assert_eq!(trainings.len(), number(&c[6]), "trainings");
 }
 
 #[test]
@@ -124,7 +129,7 @@ fn the_claims_counts_are_those_of_the_committed_report() {
     let c = captures(
         &text,
         "On the committed results: {} of the {} claims reproduced, {} not reproduced, {} \
-         inconclusive at {} seeds",
+         inconclusive at {} repetitions,",
     );
     let report = read("report/out/REPORT.md");
     let r = captures(
@@ -140,7 +145,7 @@ fn the_claims_counts_are_those_of_the_committed_report() {
         .iter()
         .map(|m| m["seed"].to_string())
         .collect();
-    assert_eq!(number(&c[4]), seeds.len(), "seeds");
+    assert_eq!(number(&c[4]), seeds.len(), "repetitions");
 
     let contradicted = captures(&text, "which contradict {} of them");
     let line = captures(
@@ -160,9 +165,9 @@ fn the_rerun_runs_without_a_discovery_record_are_counted_right() {
     let text = readme();
     let c = captures(
         &text,
-        "the first {} runs of the rerun, written before the record was kept, keep theirs",
+        "the first {} runs of `paper`, written before the record was kept, keep theirs",
     );
-    let without: Vec<String> = manifests("data/results-pending/paper")
+    let without: Vec<String> = manifests("data/results/paper")
         .into_iter()
         .filter(|m| m.get("discovery").is_none())
         .map(|m| m["run_id"].as_str().unwrap().to_string())
@@ -170,7 +175,7 @@ fn the_rerun_runs_without_a_discovery_record_are_counted_right() {
     assert_eq!(without.len(), number(&c[0]));
     for id in &without {
         let outcomes = root()
-            .join("data/results-pending/paper")
+            .join("data/results/paper")
             .join(format!("{id}.outcomes.parquet"));
         assert!(
             outcomes.exists(),
@@ -184,10 +189,9 @@ fn the_validity_check_says_what_the_readme_says() {
     let text = readme();
     captures(
         &text,
-        "On the committed runs the final KL-coverage does not tell the goal spaces that encode \
-         the object's position from the controls (it fails the check on ArmArrow and barely \
-         passes on ArmBall), while cell coverage, the goal-reaching error and the KLC of moved \
-         outcomes do.{}",
+        "On the committed runs the final KL-coverage fails the check in both environments (its \
+         median ranks the controls ahead of the goal spaces that encode the object's position), while \
+         cell coverage, the goal-reaching error and the KLC of moved outcomes pass it.{}",
     );
     let report = read("report/out/REPORT.md");
     // `| measure | env | better | first group | controls | P(better) | check |`
@@ -200,13 +204,13 @@ fn the_validity_check_says_what_the_readme_says() {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         (cells[6].parse().unwrap(), cells[7].to_string())
     };
-    let (p, check) = row("final KLC (all outcomes)", "ArmArrow");
-    assert_eq!(check, "**fails**", "final KLC on ArmArrow (P(better) {p})");
-    let (p, check) = row("final KLC (all outcomes)", "ArmBall");
-    assert!(
-        check == "passes" && p < 0.6,
-        "final KLC on ArmBall: {check}, {p}"
-    );
+    for env in ["ArmBall", "ArmArrow"] {
+        let (p, check) = row("final KLC (all outcomes)", env);
+        assert!(
+            check == "**fails**" && p < 0.5,
+            "final KLC on {env}: {check}, {p}"
+        );
+    }
     for measure in [
         "KLC of moved outcomes",
         "cells reached",
@@ -216,7 +220,7 @@ fn the_validity_check_says_what_the_readme_says() {
         for env in ["ArmBall", "ArmArrow"] {
             let (p, check) = row(measure, env);
             assert!(
-                check == "passes" && p >= 0.75,
+                check == "passes" && p > 0.5,
                 "{measure} on {env}: {check}, {p}"
             );
         }

@@ -514,10 +514,10 @@ mod tests {
             "paper/armball.rge-efr.s0",
             "paper/armball.rpe.s1",
             "paper/armball.rge-vae.faithful.kde.l10.s2",
-            "paper/armarrow.rge-efr.s3",
-            "paper/armarrow.rge-pca.kde.l3.s4",
+            "paper/armarrow.rge-efr.s1",
+            "paper/armarrow.rge-pca.kde.l3.s2",
             "compare-random-projection/armarrow.rge-external.kde.l3.s0",
-            "paper-init/armball.rge-ae.kde.l2.s0",
+            "paper-untrained/armball.rge-ae.kde.l2.s0",
             "armballs/armballs.rpe.s0",
             "armballs/armballs.mge-bvae-flat.gaussian.l10.s0",
         ];
@@ -550,9 +550,8 @@ mod tests {
 
     /// The validity check on the committed results: every measure that does not count repeats
     /// ranks the position-encoding goal spaces ahead of the controls in both paper
-    /// environments, with P(better) ≥ 0.8; the runs' own final KLC fails at ArmArrow and
-    /// passes at ArmBall only by its median, at P(better) ≈ 0.5, a coin flip (it mostly
-    /// counts moves).
+    /// environments, with P(better) ≥ 0.8; the runs' own final KLC fails in both, at
+    /// P(better) below 0.5: its median ranks the controls ahead (it mostly counts moves).
     #[test]
     fn the_validity_check_on_the_committed_results() {
         let camps = committed();
@@ -581,7 +580,7 @@ mod tests {
         }
         for c in &checks {
             if c.measure == Measure::FinalKlc {
-                assert!((0.4..0.6).contains(&c.p_better), "{c:?}");
+                assert!(c.p_better < 0.5, "{c:?}");
             } else {
                 assert!(
                     c.p_better >= 0.8,
@@ -592,8 +591,11 @@ mod tests {
                 );
             }
         }
-        // The groups: ArmBall 76 position-encoding runs against 103 controls (10 random
-        // projections, 93 networks on the plateau); ArmArrow 93 against 100.
+        // The groups, in runs: ArmBall 426 position-encoding runs against 663 controls (60
+        // random projections of `paper`, 60 of `compare-random-projection`, 540 untrained twins
+        // and the 3 runs of `paper-long`'s AE, which stays on the plateau); ArmArrow 600 against
+        // 663 (the same, with the 3 runs of `paper`'s AE with 3 latents of repetition 5 on the
+        // plateau).
         let count = |env: &str, g: Group| {
             rows.iter()
                 .filter(|r| r.in_check && r.group == Some(g) && r.run.key.env == env)
@@ -606,7 +608,7 @@ mod tests {
                 count("armarrow", Group::Encodes),
                 count("armarrow", Group::Control)
             ],
-            [76, 103, 93, 100]
+            [426, 663, 600, 663]
         );
     }
 
@@ -640,7 +642,7 @@ mod tests {
 
     /// What the committed data show (measure, environment, passes).
     const EXPECTED: &[(Measure, &str, bool)] = &[
-        (Measure::FinalKlc, "armball", true),
+        (Measure::FinalKlc, "armball", false),
         (Measure::MovedKlc, "armball", true),
         (Measure::Coverage, "armball", true),
         (Measure::GoalErrorMean, "armball", true),

@@ -61,7 +61,9 @@ pub struct Entry {
     pub goal_iqm: Option<(f64, f64, f64)>,
     /// (point, lo, hi) of the IQM of the normalised area under the curve.
     pub auc_iqm: Option<(f64, f64, f64)>,
-    /// (point, lo, hi) of `P(X < RGE-EFR)`; `None` for EFR itself or without EFR runs.
+    /// (point, lo, hi) of `P(X < RGE-EFR)` on the ranking statistic (the normalised
+    /// goal-reaching error where both have it, else the normalised final KLC, as
+    /// [`rank_value`]); `None` for EFR itself or without EFR runs.
     pub poi_vs_efr: Option<(f64, f64, f64)>,
     /// The paper's mean normalised final KLC over the same tasks.
     pub paper: Option<f64>,
@@ -83,6 +85,23 @@ pub struct Entry {
     /// Its normalised final KLC values per task, aligned with `tasks` (a baseline's runs in
     /// each task of their environment): for pairwise probabilities of improvement.
     pub finals_by_task: Vec<Vec<f64>>,
+    /// Its normalised goal-reaching errors per task, aligned with `tasks` (empty where not
+    /// measured).
+    pub goals_by_task: Vec<Vec<f64>>,
+}
+
+impl Entry {
+    /// The per-task values of the ranking statistic shared with `other` for a probability of
+    /// improvement: the normalised goal-reaching error where both have it on every task, else
+    /// the normalised final KLC. The flag says which (true: goal error).
+    pub fn ranking_values<'a>(&'a self, other: &'a Entry) -> (&'a [Vec<f64>], &'a [Vec<f64>], bool) {
+        let has = |e: &Entry| e.goals_by_task.iter().all(|g| !g.is_empty());
+        if has(self) && has(other) {
+            (&self.goals_by_task, &other.goals_by_task, true)
+        } else {
+            (&self.finals_by_task, &other.finals_by_task, false)
+        }
+    }
 }
 
 impl Entry {
@@ -218,13 +237,18 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
         }
     }
 
-    // RGE-EFR of the main campaign, per task, for the probability of improvement.
-    let efr: BTreeMap<usize, Vec<f64>> = groups
+    // RGE-EFR of the main campaign, per task (final KLC, goal error), for the probability of
+    // improvement.
+    let efr: BTreeMap<usize, (Vec<f64>, Vec<f64>)> = groups
         .iter()
         .find(|((camp, algo, _, _), _)| {
             Some(camp.as_str()) == sources.first().map(|s| s.campaign) && algo == "rge-efr"
         })
-        .map(|(_, per)| per.iter().map(|(t, v)| (*t, v.0.clone())).collect())
+        .map(|(_, per)| {
+            per.iter()
+                .map(|(t, v)| (*t, (v.0.clone(), v.4.clone())))
+                .collect()
+        })
         .unwrap_or_default();
 
     let mut entries: Vec<Entry> = groups
@@ -251,6 +275,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             let aucs: Vec<Vec<f64>> = strata.iter().map(|v| v.1.clone()).collect();
             // Probability of improvement: task by task (a baseline against EFR on each task).
             let finals_by_task: Vec<Vec<f64>> = per.values().map(|v| v.0.clone()).collect();
+            let goals_by_task: Vec<Vec<f64>> = per.values().map(|v| v.4.clone()).collect();
             let label = format!("leaderboard|{campaign}|{algo}|{sampler}|{variant}");
             let final_iqm = stratified_bootstrap_ci(
                 &finals,
@@ -281,9 +306,19 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             let poi_vs_efr = if algo == "rge-efr" || !per.keys().all(|t| efr.contains_key(t)) {
                 None
             } else {
-                let ys: Vec<Vec<f64>> = per.keys().map(|t| efr[t].clone()).collect();
+                // On the ranking statistic: the goal error where both have it on every task.
+                let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
+                let on_goals = goals_by_task.iter().chain(&efr_goals).all(|g| !g.is_empty());
+                let (xs, ys) = if on_goals {
+                    (goals_by_task.clone(), efr_goals)
+                } else {
+                    (
+                        finals_by_task.clone(),
+                        per.keys().map(|t| efr[t].0.clone()).collect(),
+                    )
+                };
                 probability_of_improvement_ci(
-                    &finals_by_task,
+                    &xs,
                     &ys,
                     n_boot,
                     alpha,
@@ -316,6 +351,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 reduced_budget: reduced.contains(&key),
                 coverage_mean,
                 finals_by_task,
+                goals_by_task,
             })
         })
         .collect();

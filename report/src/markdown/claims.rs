@@ -467,7 +467,8 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
          discovered* checks it against the controls; the ranking uses it. *Final*: IQM of the \
          normalised final KLC; *speed*: IQM of the normalised area under the KLC curve (the mean \
          KLC during exploration); *P(better than EFR)*: probability that a run beats a run of \
-         RGE-EFR on the same task, averaged over tasks (0.5: no difference). A value is a \
+         RGE-EFR on the same task on the ranking statistic (the goal error; the final KLC for \
+         an entry without it), averaged over tasks (0.5: no difference). A value is a \
          repetition's (the mean over its exploration replicates). Brackets: {:.0}% \
          stratified bootstrap intervals ({} resamples, repetitions resampled within each task, \
          seeded). \

@@ -242,20 +242,22 @@ pub fn section(
     if old > 0 {
         let _ = writeln!(
             w,
-            "\n{old} representation{} hold the first version of the latent-quality measure (fitted on 2000 \
-             images, no groups) and show \"—\": `ugl campaign --config ... --refresh-diagnostics` \
+            "\n{old} representation{} the first version of the latent-quality measure (fitted on 2000 \
+             images, no groups) and show{} \"—\": `ugl campaign --config ... --refresh-diagnostics` \
              brings them up to date without rerunning them.",
-            plural(old)
+            if old == 1 { " holds" } else { "s hold" },
+            if old == 1 { "s" } else { "" }
         );
     }
     let v2: usize = rows.iter().map(|r| r.no_neighbourhoods).sum();
     if v2 > 0 {
         let _ = writeln!(
             w,
-            "\n{v2} representation{} hold version 2 of the latent-quality measure (no trustworthiness or \
-             continuity) and show \"—\" under T / C: `ugl campaign --config ... \
+            "\n{v2} representation{} version 2 of the latent-quality measure (no trustworthiness or \
+             continuity) and show{} \"—\" under T / C: `ugl campaign --config ... \
              --refresh-diagnostics` brings them up to date without rerunning them.",
-            plural(v2)
+            if v2 == 1 { " holds" } else { "s hold" },
+            if v2 == 1 { "s" } else { "" }
         );
     }
     let n_untrained: usize = rows.iter().map(|r| r.untrained).sum();
