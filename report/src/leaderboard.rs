@@ -91,23 +91,25 @@ pub struct Entry {
 }
 
 impl Entry {
+    pub fn is_complete(&self, n_tasks: usize) -> bool {
+        self.tasks.len() == n_tasks
+    }
+
     /// The per-task values of the ranking statistic shared with `other` for a probability of
-    /// improvement: the normalised goal-reaching error where both have it on every task, else
-    /// the normalised final KLC. The flag says which (true: goal error).
-    pub fn ranking_values<'a>(&'a self, other: &'a Entry) -> (&'a [Vec<f64>], &'a [Vec<f64>], bool) {
-        let has = |e: &Entry| e.goals_by_task.iter().all(|g| !g.is_empty());
-        if has(self) && has(other) {
-            (&self.goals_by_task, &other.goals_by_task, true)
+    /// improvement ([`on_goal_error`]).
+    pub fn ranking_values<'a>(&'a self, other: &'a Entry) -> (&'a [Vec<f64>], &'a [Vec<f64>]) {
+        if on_goal_error(&self.goals_by_task, &other.goals_by_task) {
+            (&self.goals_by_task, &other.goals_by_task)
         } else {
-            (&self.finals_by_task, &other.finals_by_task, false)
+            (&self.finals_by_task, &other.finals_by_task)
         }
     }
 }
 
-impl Entry {
-    pub fn is_complete(&self, n_tasks: usize) -> bool {
-        self.tasks.len() == n_tasks
-    }
+/// Whether a probability of improvement between two entries is on the normalised goal-reaching
+/// error (both measured it on every task) rather than on the normalised final KLC.
+fn on_goal_error(a: &[Vec<f64>], b: &[Vec<f64>]) -> bool {
+    a.iter().chain(b).all(|g| !g.is_empty())
 }
 
 /// The leaderboard.
@@ -308,8 +310,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             } else {
                 // On the ranking statistic: the goal error where both have it on every task.
                 let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
-                let on_goals = goals_by_task.iter().chain(&efr_goals).all(|g| !g.is_empty());
-                let (xs, ys) = if on_goals {
+                let (xs, ys) = if on_goal_error(&goals_by_task, &efr_goals) {
                     (goals_by_task.clone(), efr_goals)
                 } else {
                     (

@@ -34,7 +34,7 @@ fn poi(
     alpha: f64,
     seed: u64,
 ) -> Option<(f64, f64, f64, usize)> {
-    let (av, bv, _) = a.ranking_values(b);
+    let (av, bv) = a.ranking_values(b);
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for (t, x) in a.tasks.iter().zip(av) {
