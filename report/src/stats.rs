@@ -13,6 +13,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+pub mod components;
 #[cfg(test)]
 mod coverage;
 pub mod interval;

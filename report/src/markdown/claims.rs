@@ -177,6 +177,9 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
             level = confidence * 100.0
         );
     }
+    if let Some(line) = design_measured(inp) {
+        let _ = writeln!(w, "\n{line}");
+    }
     // Untrained networks: counted, never silently part of a verdict.
     let flags: Vec<bool> = inp
         .store
@@ -574,4 +577,75 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
         }
     );
     let _ = writeln!(w);
+}
+
+/// The design's two levels measured on the main campaign's own runs: the median over its
+/// conditions of the final KLC's spread due to the repetition (data set and fit) and due to the
+/// exploration streams ([`crate::stats::components::one_way`]); None without exploration
+/// replicates.
+fn design_measured(inp: &Context<'_>) -> Option<String> {
+    let mut fitted: Vec<(f64, f64)> = Vec::new();
+    let mut baselines: Vec<(f64, f64)> = Vec::new();
+    let mut baseline_names: Vec<String> = Vec::new();
+    let (mut reps, mut replicates) = (0, 0);
+    for c in inp.conditions.iter().filter(|c| c.replicates >= 2) {
+        let groups: Vec<Vec<f64>> = c
+            .seeds
+            .iter()
+            .map(|&seed| {
+                c.runs
+                    .iter()
+                    .map(|&i| &inp.store.runs[i])
+                    .filter(|r| r.seed == seed)
+                    .map(|r| r.final_point().klc)
+                    .collect()
+            })
+            .collect();
+        let Some(k) = crate::stats::components::one_way(&groups) else {
+            continue;
+        };
+        reps = reps.max(c.seeds.len());
+        replicates = replicates.max(c.replicates);
+        if ugl_types::LearnerInfo::by_algo(&c.key.algo).is_some() {
+            fitted.push((k.between_sd, k.within_sd));
+        } else {
+            baselines.push((k.between_sd, k.within_sd));
+            let name = condition_name(&c.key.algo, &c.key.variant);
+            if !baseline_names.contains(&name) {
+                baseline_names.push(name);
+            }
+        }
+    }
+    if fitted.is_empty() {
+        return None;
+    }
+    let medians = |v: &[(f64, f64)]| {
+        let b: Vec<f64> = v.iter().map(|x| x.0).collect();
+        let e: Vec<f64> = v.iter().map(|x| x.1).collect();
+        Some((ugl_types::median(&b)?, ugl_types::median(&e)?))
+    };
+    let (fb, fe) = medians(&fitted)?;
+    let mut line = format!(
+        "**The design, measured on these runs** (`docs/statistics.md`): over the {} conditions \
+         of fitted goal spaces (the learners and the random projection) with {reps} repetitions x {replicates} exploration replicates, \
+         the final KLC's standard deviation due to the repetition (its data set and fit) has a \
+         median of {fb:.2} nats, and the part due to the exploration streams {fe:.2} \
+         (one-way random-effects analysis per condition, method of moments)",
+        fitted.len()
+    );
+    if let Some((bb, be)) = medians(&baselines) {
+        let _ = write!(
+            line,
+            "; for the {} conditions without a fitted goal space ({}), where a repetition \
+             changes only the exploration streams, {bb:.2} and {be:.2}",
+            baselines.len(),
+            baseline_names.join(", ")
+        );
+    }
+    line.push_str(
+        ". Exploration replicates shrink the exploration part of a condition's mean; only more \
+         repetitions shrink the fit's, and pairing two conditions on the same repetitions \
+         removes what they share.",
+    );
+    Some(line)
 }

@@ -68,7 +68,7 @@ fn uniform(rng: &mut ChaCha8Rng) -> f64 {
 }
 
 /// A standard normal draw (Box-Muller, one of the pair).
-fn normal(rng: &mut ChaCha8Rng) -> f64 {
+pub(crate) fn normal(rng: &mut ChaCha8Rng) -> f64 {
     let u1 = 1.0 - uniform(rng); // (0, 1]
     let u2 = uniform(rng);
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
