@@ -296,7 +296,9 @@ pub struct BudgetPoint {
     /// The median of the repetitions' means: the data are often bimodal (networks that trained
     /// and networks that stayed on the plateau), where a mean describes no run.
     pub median: f64,
-    /// Runs whose network stayed on the plateau.
+    /// Networks (repetitions: a repetition's exploration replicates share its network) whose
+    /// manifests record the evidence of training, and those of them that stayed on the plateau.
+    pub networks: usize,
     pub untrained: usize,
     /// Runs at RPE level (fewer object moves than [`crate::aggregate::RPE_LEVEL_FACTOR`] x the
     /// main campaign's RPE mean); None without RPE runs there.
@@ -348,11 +350,16 @@ fn point(iterations: i64, runs: &[&Run], rpe_moves: Option<f64>) -> BudgetPoint 
         .map(|v| v.1)
         .collect();
     let campaigns: BTreeSet<String> = runs.iter().map(|r| r.campaign.clone()).collect();
+    let networks: BTreeMap<i64, bool> = rows
+        .iter()
+        .filter_map(|r| r.2.map(|trained| (r.0, trained)))
+        .collect();
     BudgetPoint {
         iterations,
         campaigns: campaigns.into_iter().collect(),
         trained: rows.iter().map(|r| r.2).collect(),
-        untrained: rows.iter().filter(|r| r.2 == Some(false)).count(),
+        networks: networks.len(),
+        untrained: networks.values().filter(|trained| !**trained).count(),
         at_rpe_level: rpe_moves.map(|t| rows.iter().filter(|r| (r.3 as f64) < t).count()),
         median: ugl_types::median(&means).unwrap_or(f64::NAN),
         summary: stats::summarize(&means),

@@ -432,18 +432,10 @@ fn budget_row(w: &mut String, p: &BudgetPoint, origin: &str, efr: Option<&[f64]>
         },
     };
     let runs = p.values.len();
-    // A repetition's exploration replicates share its network: count networks, not runs.
-    let mut networks: Vec<(i64, Option<bool>)> = seeds
-        .iter()
-        .copied()
-        .zip(p.trained.iter().copied())
-        .collect();
-    networks.dedup_by_key(|n| n.0);
-    let untrained = if networks.iter().all(|n| n.1.is_none()) {
+    let untrained = if p.networks == 0 {
         "—".to_string()
     } else {
-        let on = networks.iter().filter(|n| n.1 == Some(false)).count();
-        format!("{on} of {}", networks.len())
+        format!("{} of {}", p.untrained, p.networks)
     };
     let at_rpe = p.at_rpe_level.map_or("—".to_string(), |k| {
         format!("{k} of {runs} run{}", plural(runs))
