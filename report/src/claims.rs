@@ -53,6 +53,8 @@ pub enum ClaimsInput<'a> {
         margin: f64,
         /// [`Settings::target_half_width`].
         target_half_width: Option<f64>,
+        /// [`Settings::validated`].
+        validated: Option<&'a Validated>,
         results: &'a [ClaimResult],
     },
     /// No claims file where the report looked.
@@ -84,6 +86,28 @@ pub struct Settings {
     /// claims' KL-coverage comparisons, in nats. The report says whether the results meet it.
     #[serde(default)]
     pub target_half_width: Option<f64>,
+    /// The measures of discovery that pass the validity check, on which each claim of the paper
+    /// stated on the final KLC or the episodes moved is tested again (its *twin*).
+    #[serde(default)]
+    pub validated: Option<Validated>,
+}
+
+/// `[settings.validated]`: the statistics of the twins and their margins.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Validated {
+    /// The statistics a twin is tested on (each comparison of the claim, on each of them).
+    pub statistics: Vec<Statistic>,
+    /// Margin per environment and statistic (`margin.armball.goal_error = 0.02`), in the
+    /// statistic's units; a comparison in an environment without margins is not made.
+    pub margin: std::collections::BTreeMap<String, std::collections::BTreeMap<String, f64>>,
+}
+
+impl Validated {
+    /// The margin of `statistic` in `env`.
+    pub fn margin(&self, env: &str, statistic: Statistic) -> Option<f64> {
+        self.margin.get(env)?.get(statistic.key()).copied()
+    }
 }
 
 /// One claim.
@@ -123,6 +147,25 @@ pub struct Claim {
     /// claims about a disentangled space); the verdict is shown with it.
     #[serde(default)]
     pub premise: Option<Premise>,
+    /// Which of the report's generated findings this claim feeds (None: none).
+    #[serde(default)]
+    pub finding: Option<Finding>,
+}
+
+/// A finding of the report's *Findings* section, read from the claims marked with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Finding {
+    /// Learned goal spaces against random parameter exploration.
+    LearnedVsRpe,
+    /// Learned goal spaces against the engineered one (the paper's main claim), per environment.
+    LearnedVsEfr,
+    /// Learned goal spaces against the controls (random projection, untrained twins).
+    LearnedVsControls,
+    /// Goals from the KDE against goals from the prior (the paper's Figure 4).
+    GoalSamplers,
+    /// Goals that hold the arrow's angle against goals on its position only.
+    Angle,
 }
 
 /// A condition on the results that a claim presupposes.
@@ -312,6 +355,64 @@ pub enum Statistic {
 }
 
 impl Statistic {
+    /// Whether a higher value is the better (or the "more") one: episodes moved, cells
+    /// reached, distance from the centre, the ball's ratio and module share; KL-coverage and
+    /// errors are better lower.
+    pub fn higher_is_better(self) -> bool {
+        matches!(
+            self,
+            Statistic::Moved
+                | Statistic::Coverage
+                | Statistic::Boundary
+                | Statistic::BallRatio
+                | Statistic::BallModuleGoals
+        )
+    }
+
+    /// Its name in `claims.toml`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Statistic::FinalKlc => "final_klc",
+            Statistic::Auc => "auc",
+            Statistic::Moved => "moved",
+            Statistic::Coverage => "coverage",
+            Statistic::Boundary => "boundary",
+            Statistic::MovedKlc => "moved_klc",
+            Statistic::GoalError => "goal_error",
+            Statistic::GoalErrorP90 => "goal_error_p90",
+            Statistic::BallRatio => "ball_ratio",
+            Statistic::BallModuleGoals => "ball_module_goals",
+        }
+    }
+
+    /// Whether a claim on this statistic has a twin on the validated measures
+    /// ([`Validated`]): the final KL-coverage and the episodes that moved the object, the
+    /// paper's measures of what was discovered at the end. The area under the KLC curve is
+    /// the paper's measure of speed, and the validated measures are recorded at the last epoch
+    /// only: such a claim has no twin.
+    pub fn has_twin(self) -> bool {
+        matches!(self, Statistic::FinalKlc | Statistic::Moved)
+    }
+
+    /// The validity check's line that judges this statistic ([`crate::discovery::validity`]):
+    /// the area under the KLC curve is judged by the final KLC's (both count repeated outcomes
+    /// alike); None where the check has no line (episodes moved, distance from the centre, the
+    /// follow-up's statistics).
+    pub fn checked_as(self) -> Option<crate::discovery::Measure> {
+        use crate::discovery::Measure;
+        match self {
+            Statistic::FinalKlc | Statistic::Auc => Some(Measure::FinalKlc),
+            Statistic::MovedKlc => Some(Measure::MovedKlc),
+            Statistic::Coverage => Some(Measure::Coverage),
+            Statistic::GoalError => Some(Measure::GoalErrorMean),
+            Statistic::GoalErrorP90 => Some(Measure::GoalErrorP90),
+            Statistic::Moved
+            | Statistic::Boundary
+            | Statistic::BallRatio
+            | Statistic::BallModuleGoals => None,
+        }
+    }
+
     pub fn label(self) -> &'static str {
         match self {
             Statistic::FinalKlc => "final KLC",
@@ -338,6 +439,8 @@ pub enum Relation {
     Greater,
     /// `d < -margin`.
     MuchLess,
+    /// `d > margin`.
+    MuchGreater,
     /// `d < margin`.
     AtMost,
     /// `d > -margin`.
@@ -353,9 +456,39 @@ impl Relation {
             Relation::Less => (f64::NEG_INFINITY, 0.0),
             Relation::Greater => (0.0, f64::INFINITY),
             Relation::MuchLess => (f64::NEG_INFINITY, -margin),
+            Relation::MuchGreater => (margin, f64::INFINITY),
             Relation::AtMost => (f64::NEG_INFINITY, margin),
             Relation::AtLeast => (-margin, f64::INFINITY),
             Relation::Similar => (-margin, margin),
+        }
+    }
+
+    /// The same statement about a statistic whose better direction is the other one (a claim
+    /// on the final KLC, lower is better, re-stated on the cells reached, higher is better):
+    /// `less` ↔ `greater`, `much_less` ↔ `much_greater`, `at_most` ↔ `at_least`; `similar`
+    /// stays.
+    pub fn mirrored(self) -> Relation {
+        match self {
+            Relation::Less => Relation::Greater,
+            Relation::Greater => Relation::Less,
+            Relation::MuchLess => Relation::MuchGreater,
+            Relation::MuchGreater => Relation::MuchLess,
+            Relation::AtMost => Relation::AtLeast,
+            Relation::AtLeast => Relation::AtMost,
+            Relation::Similar => Relation::Similar,
+        }
+    }
+
+    /// Its name in `claims.toml`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Relation::Less => "less",
+            Relation::Greater => "greater",
+            Relation::MuchLess => "much_less",
+            Relation::MuchGreater => "much_greater",
+            Relation::AtMost => "at_most",
+            Relation::AtLeast => "at_least",
+            Relation::Similar => "similar",
         }
     }
 
@@ -365,6 +498,7 @@ impl Relation {
             Relation::Less => "Δ < 0".into(),
             Relation::Greater => "Δ > 0".into(),
             Relation::MuchLess => format!("Δ < −{margin}"),
+            Relation::MuchGreater => format!("Δ > {margin}"),
             Relation::AtMost => format!("Δ < {margin}"),
             Relation::AtLeast => format!("Δ > −{margin}"),
             Relation::Similar => format!("|Δ| < {margin}"),
@@ -469,6 +603,37 @@ pub fn parse_claims(text: &str, path: &Path) -> Result<ClaimsFile, ReportError> 
         )));
     }
     check_margin(s.margin).map_err(|m| invalid(format!("settings.margin {m}")))?;
+    if let Some(v) = &s.validated {
+        if v.statistics.is_empty() {
+            return Err(invalid("settings.validated.statistics is empty".into()));
+        }
+        if v.margin.is_empty() {
+            return Err(invalid(
+                "settings.validated.margin names no environment".into(),
+            ));
+        }
+        for (env, margins) in &v.margin {
+            for st in &v.statistics {
+                let m = margins.get(st.key()).ok_or_else(|| {
+                    invalid(format!(
+                        "settings.validated.margin.{env} has no margin for `{}`",
+                        st.key()
+                    ))
+                })?;
+                check_margin(*m).map_err(|m| {
+                    invalid(format!("settings.validated.margin.{env}.{} {m}", st.key()))
+                })?;
+            }
+            if let Some(k) = margins
+                .keys()
+                .find(|k| !v.statistics.iter().any(|st| st.key() == k.as_str()))
+            {
+                return Err(invalid(format!(
+                    "settings.validated.margin.{env}.{k} is not one of settings.validated.statistics"
+                )));
+            }
+        }
+    }
     let mut ids = BTreeSet::new();
     for c in &file.claims {
         if c.id.trim().is_empty() {
@@ -567,6 +732,11 @@ impl Verdict {
 pub struct Comparison {
     pub subject: ConditionKey,
     pub reference: ConditionKey,
+    /// The statistic compared (the claim's, or one of the validated measures in a twin).
+    pub statistic: Statistic,
+    /// The relation tested (the claim's, [`Relation::mirrored`] in a twin where the
+    /// statistic's better direction is the other one).
+    pub relation: Relation,
     pub n_subject: usize,
     pub n_reference: usize,
     /// Whether the interval is the paired t interval over the repetitions both sides ran
@@ -596,14 +766,29 @@ impl Comparison {
         self.interval.map(|i| (i.lo, i.hi))
     }
 
+    /// Whether its estimate lies inside its relation's set (an undecided comparison then leans
+    /// reproduced).
+    pub fn leans_reproduced(&self) -> bool {
+        let (a, b) = self.relation.interval(self.margin);
+        self.diff > a && self.diff < b
+    }
+
     /// A power statement for an undecided comparison: the repetitions per side at which its
-    /// interval would exclude the nearest boundary of `set` (the relation's set of differences),
-    /// if the difference and the spread stayed as observed. The interval's half-width shrinks
-    /// as `1/√n` (its t quantile is held at the observed one, so the estimate errs on the
-    /// large side). None without an interval or with a difference on the boundary itself.
-    pub fn repetitions_to_decide(&self, (a, b): (f64, f64)) -> Option<f64> {
+    /// interval at family-wise level `alpha` (the `1 − alpha` interval: `alpha` is
+    /// `1 − confidence`, or smaller where Holm's correction applies) would exclude the nearest
+    /// boundary of `set`, if the difference and the spread stayed as observed. The half-width
+    /// shrinks as `1/√n`, and is widened by the ratio of the t quantiles at `alpha` and at the
+    /// interval's own level (both at the observed degrees of freedom, so the estimate errs on
+    /// the large side). None without an interval or with a difference on the boundary itself.
+    pub fn repetitions_to_decide(&self, (a, b): (f64, f64), alpha: f64) -> Option<f64> {
         let i = self.interval?;
-        let half = (i.hi - i.lo) / 2.0;
+        let widen = if i.se > 0.0 && i.df > 0.0 {
+            stats::student_t_quantile(1.0 - alpha / 2.0, i.df)
+                / stats::student_t_quantile(0.5 + i.level / 2.0, i.df)
+        } else {
+            1.0
+        };
+        let half = widen * (i.hi - i.lo) / 2.0;
         let gap = [a, b]
             .into_iter()
             .filter(|x| x.is_finite())
@@ -664,20 +849,16 @@ impl Quantifier {
 
 /// Applies Holm's correction to the comparisons of one claim where its quantifier needs it
 /// (module docs): sets each [`Comparison::verdict`] from [`Comparison::uncorrected`] at level
-/// `alpha`, the family being the claim's comparisons that have an interval.
-pub fn correct(
-    comparisons: &mut [Comparison],
-    quantifier: Quantifier,
-    relation: Relation,
-    alpha: f64,
-) {
+/// `alpha`, the family being the claim's comparisons that have an interval (each tested against
+/// its own relation and margin).
+pub fn correct(comparisons: &mut [Comparison], quantifier: Quantifier, alpha: f64) {
     let (yes_corrected, no_corrected) = quantifier.corrected();
     // The family: (index, p inside, p outside) of every comparison with an interval.
     let tested: Vec<(usize, f64, f64)> = comparisons
         .iter()
         .enumerate()
         .filter_map(|(i, c)| {
-            let set = relation.interval(c.margin);
+            let set = c.relation.interval(c.margin);
             c.interval
                 .as_ref()
                 .map(|iv| (i, p_inside(iv, set), p_outside(iv, set)))
@@ -713,6 +894,119 @@ pub struct ClaimResult {
     pub paper: Option<PaperCheck>,
     /// The claim's premise, checked on the results (None: it has none).
     pub premise: Option<PremiseCheck>,
+    /// The same statement on the validated measures ([`Validated`]), for a claim of the paper
+    /// whose statistic [`Statistic::has_twin`] (None otherwise, or without validated measures).
+    pub twin: Option<Twin>,
+}
+
+/// A claim of the paper tested again on the validated measures: each of its comparisons on each
+/// measure, with the measure's margin and the claim's relation (mirrored where the measure is
+/// better higher and the claim's statistic lower, or the reverse). One family: the claim's
+/// quantifier and Holm's correction run over all its comparisons on all the measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Twin {
+    pub comparisons: Vec<Comparison>,
+    pub verdict: Verdict,
+}
+
+impl ClaimResult {
+    /// The verdict on the measures that pass the validity check: the claim's own where its
+    /// statistic is one of them, its twin's where it has one, None where it has neither (a claim
+    /// on the speed of exploration, or without validated measures).
+    pub fn validated(&self, validated: Option<&Validated>) -> Option<(Verdict, &[Comparison])> {
+        if let Some(t) = &self.twin {
+            return Some((t.verdict, &t.comparisons));
+        }
+        validated
+            .is_some_and(|v| v.statistics.contains(&self.claim.statistic))
+            .then_some((self.verdict, self.comparisons.as_slice()))
+    }
+}
+
+/// Which way an undecided set of comparisons leans: the verdict the claim's quantifier gives when
+/// each comparison is judged by where its estimate lies (inside its relation's set: it leans
+/// reproduced). None without comparisons.
+pub fn lean(comparisons: &[Comparison], quantifier: Quantifier) -> Option<Verdict> {
+    if comparisons.is_empty() {
+        return None;
+    }
+    let each: Vec<bool> = comparisons
+        .iter()
+        .map(Comparison::leans_reproduced)
+        .collect();
+    Some(if quantifier.holds(&each) {
+        Verdict::Reproduced
+    } else {
+        Verdict::NotReproduced
+    })
+}
+
+/// How many repetitions per condition would decide an undecided claim the way it leans
+/// ([`lean`]), if every difference and spread stayed as observed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToDecide {
+    /// About this many repetitions per condition.
+    Repetitions(f64),
+    /// A difference sits on a boundary of its set: no number of repetitions decides it.
+    Never,
+    /// A comparison has no interval (fewer than 2 repetitions on a side).
+    Unknown,
+}
+
+/// [`ToDecide`] for a claim (or a twin) whose comparisons are `comparisons`, at family-wise
+/// level `alpha`. The comparisons that must be decided are the undecided ones leaning the
+/// claim's way: all of them where the verdict needs every one (leaning reproduced under `all`
+/// or `most`, leaning not reproduced under `any` or `most`), the nearest one where one suffices
+/// (leaning not reproduced under `all`, leaning reproduced under `any`). Each is decided at the
+/// level its verdict is tested at: `alpha / k` where Holm's correction applies to that verdict
+/// (Holm's first step, its strictest, with `k` the comparisons that have an interval), `alpha`
+/// otherwise ([`Comparison::repetitions_to_decide`]).
+pub fn to_decide(comparisons: &[Comparison], quantifier: Quantifier, alpha: f64) -> ToDecide {
+    let Some(way) = lean(comparisons, quantifier) else {
+        return ToDecide::Unknown;
+    };
+    let yes = way == Verdict::Reproduced;
+    let (yes_corrected, no_corrected) = quantifier.corrected();
+    let k = comparisons
+        .iter()
+        .filter(|c| c.interval.is_some())
+        .count()
+        .max(1);
+    let level = if (yes && yes_corrected) || (!yes && no_corrected) {
+        alpha / k as f64
+    } else {
+        alpha
+    };
+    let pending: Vec<&Comparison> = comparisons
+        .iter()
+        .filter(|c| c.verdict == Verdict::Inconclusive && c.leans_reproduced() == yes)
+        .collect();
+    let one_suffices = match quantifier {
+        Quantifier::All => !yes,
+        Quantifier::Any => yes,
+        Quantifier::Most => false,
+    };
+    let mut ns = Vec::new();
+    for c in pending {
+        match (
+            c.interval,
+            c.repetitions_to_decide(c.relation.interval(c.margin), level),
+        ) {
+            (None, _) => return ToDecide::Unknown,
+            (Some(_), None) if !one_suffices => return ToDecide::Never,
+            (Some(_), None) => {}
+            (Some(_), Some(n)) => ns.push(n),
+        }
+    }
+    let pick = if one_suffices {
+        ns.iter().copied().reduce(f64::min)
+    } else {
+        ns.iter().copied().reduce(f64::max)
+    };
+    match pick {
+        Some(n) => ToDecide::Repetitions(n),
+        None => ToDecide::Never,
+    }
 }
 
 /// One comparison of a claim on the paper's own values (single runs, so no interval).
@@ -891,7 +1185,9 @@ pub fn evaluate(
 
 /// Evaluates every claim of `file` on `obs`. Each subject condition is compared with every
 /// reference condition that agrees with it on `pair_on` (a side without values, or with a NaN,
-/// gives no comparison); the comparisons of a claim are then corrected ([`correct`]).
+/// gives no comparison); the comparisons of a claim are then corrected ([`correct`]). A claim
+/// of the paper whose statistic [`Statistic::has_twin`] is evaluated again on the validated
+/// measures of `settings.validated` ([`Twin`]).
 pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult> {
     let alpha = 1.0 - file.settings.confidence;
     let keys = obs.keys();
@@ -899,55 +1195,20 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
         .iter()
         .map(|claim| {
             let margin = claim.margin.unwrap_or(file.settings.margin);
-            let mut comparisons = Vec::new();
-            for s in keys.iter().filter(|k| claim.subject.matches(k)) {
-                let sx = obs.values(s, claim.statistic);
-                for r in keys.iter().filter(|k| {
-                    *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k)
-                }) {
-                    let sy = obs.values(r, claim.statistic);
-                    let unusable =
-                        |v: &[(i64, f64)]| v.is_empty() || v.iter().any(|x| x.1.is_nan());
-                    if unusable(&sx) || unusable(&sy) {
-                        continue;
-                    }
-                    let xs: Vec<f64> = sx.iter().map(|v| v.1).collect();
-                    let ys: Vec<f64> = sy.iter().map(|v| v.1).collect();
-                    let (subject_mean, reference_mean) = (stats::mean(&xs), stats::mean(&ys));
-                    let margin = match claim.relative_margin {
+            let mut comparisons = compare(
+                claim,
+                &keys,
+                obs,
+                claim.statistic,
+                file.settings.confidence,
+                &|_, reference_mean| {
+                    Some(match claim.relative_margin {
                         Some(f) => f * reference_mean.abs(),
                         None => margin,
-                    };
-                    let paired = is_paired(&sx, &sy);
-                    let interval = if paired {
-                        let d: Vec<f64> = xs.iter().zip(&ys).map(|(x, y)| x - y).collect();
-                        stats::t_interval(&d, file.settings.confidence).ok()
-                    } else {
-                        stats::welch_interval(&xs, &ys, file.settings.confidence).ok()
-                    };
-                    let uncorrected = match interval {
-                        Some(i) => {
-                            Verdict::of_interval(i.lo, i.hi, claim.relation.interval(margin))
-                        }
-                        None => Verdict::Inconclusive,
-                    };
-                    comparisons.push(Comparison {
-                        subject: s.clone(),
-                        reference: r.clone(),
-                        n_subject: xs.len(),
-                        n_reference: ys.len(),
-                        paired,
-                        subject_mean,
-                        reference_mean,
-                        diff: subject_mean - reference_mean,
-                        interval,
-                        margin,
-                        uncorrected,
-                        verdict: uncorrected,
-                    });
-                }
-            }
-            correct(&mut comparisons, claim.quantifier, claim.relation, alpha);
+                    })
+                },
+            );
+            correct(&mut comparisons, claim.quantifier, alpha);
             let verdicts: Vec<Verdict> = comparisons.iter().map(|c| c.verdict).collect();
             let premise = claim.premise.as_ref().map(|p| {
                 obs.premise(p).unwrap_or_else(|| PremiseCheck {
@@ -958,6 +1219,28 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
                     ),
                 })
             });
+            let twin = file
+                .settings
+                .validated
+                .as_ref()
+                .filter(|_| !claim.ours && claim.statistic.has_twin())
+                .map(|v| {
+                    let mut comparisons: Vec<Comparison> = v
+                        .statistics
+                        .iter()
+                        .flat_map(|&st| {
+                            compare(claim, &keys, obs, st, file.settings.confidence, &|s, _| {
+                                v.margin(&s.env, st)
+                            })
+                        })
+                        .collect();
+                    correct(&mut comparisons, claim.quantifier, alpha);
+                    let verdicts: Vec<Verdict> = comparisons.iter().map(|c| c.verdict).collect();
+                    Twin {
+                        verdict: claim.quantifier.combine(&verdicts),
+                        comparisons,
+                    }
+                });
             ClaimResult {
                 verdict: claim.quantifier.combine(&verdicts),
                 claim: claim.clone(),
@@ -965,9 +1248,136 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
                 comparisons,
                 paper: None,
                 premise,
+                twin,
             }
         })
         .collect()
+}
+
+/// The comparisons of `claim` on `statistic` (uncorrected): the claim's relation, mirrored
+/// where `statistic` is better in the other direction than the claim's own statistic. `margin`
+/// gives a comparison's margin from its subject condition and its reference mean (None: the
+/// comparison is not made).
+fn compare(
+    claim: &Claim,
+    keys: &[ConditionKey],
+    obs: &dyn Observations,
+    statistic: Statistic,
+    confidence: f64,
+    margin: &dyn Fn(&ConditionKey, f64) -> Option<f64>,
+) -> Vec<Comparison> {
+    let relation = if statistic.higher_is_better() == claim.statistic.higher_is_better() {
+        claim.relation
+    } else {
+        claim.relation.mirrored()
+    };
+    let mut comparisons = Vec::new();
+    for s in keys.iter().filter(|k| claim.subject.matches(k)) {
+        let sx = obs.values(s, statistic);
+        for r in keys
+            .iter()
+            .filter(|k| *k != s && claim.reference.matches(k) && same_on(&claim.pair_on, s, k))
+        {
+            let sy = obs.values(r, statistic);
+            let unusable = |v: &[(i64, f64)]| v.is_empty() || v.iter().any(|x| x.1.is_nan());
+            if unusable(&sx) || unusable(&sy) {
+                continue;
+            }
+            let xs: Vec<f64> = sx.iter().map(|v| v.1).collect();
+            let ys: Vec<f64> = sy.iter().map(|v| v.1).collect();
+            let (subject_mean, reference_mean) = (stats::mean(&xs), stats::mean(&ys));
+            let Some(margin) = margin(s, reference_mean) else {
+                continue;
+            };
+            let paired = is_paired(&sx, &sy);
+            let interval = if paired {
+                let d: Vec<f64> = xs.iter().zip(&ys).map(|(x, y)| x - y).collect();
+                stats::t_interval(&d, confidence).ok()
+            } else {
+                stats::welch_interval(&xs, &ys, confidence).ok()
+            };
+            let uncorrected = match interval {
+                Some(i) => Verdict::of_interval(i.lo, i.hi, relation.interval(margin)),
+                None => Verdict::Inconclusive,
+            };
+            comparisons.push(Comparison {
+                subject: s.clone(),
+                reference: r.clone(),
+                statistic,
+                relation,
+                n_subject: xs.len(),
+                n_reference: ys.len(),
+                paired,
+                subject_mean,
+                reference_mean,
+                diff: subject_mean - reference_mean,
+                interval,
+                margin,
+                uncorrected,
+                verdict: uncorrected,
+            });
+        }
+    }
+    comparisons
+}
+
+/// The data file of the claims' comparisons, under the report's `data/`.
+pub const CSV_FILE: &str = "claims.csv";
+
+/// `data/claims.csv`: one row per comparison of every claim, on the claim's own statistic
+/// (`evaluation` = `claim`) and on its twin's (`twin`), with the claim's and the twin's verdicts.
+pub fn write_csv(
+    out: &mut crate::output::Output,
+    results: &[ClaimResult],
+) -> Result<(), ReportError> {
+    use crate::data::num;
+    use std::fmt::Write as _;
+    let mut s = String::from(
+        "claim,ours,evaluation,evaluation_verdict,statistic,relation,margin,env,subject_algo,\
+         subject_sampler,subject_latents,subject_variant,reference_algo,reference_sampler,\
+         reference_latents,reference_variant,n_subject,n_reference,paired,subject_mean,\
+         reference_mean,diff,lo,hi,uncorrected,verdict\n",
+    );
+    for r in results {
+        let parts = std::iter::once(("claim", r.verdict, &r.comparisons))
+            .chain(r.twin.as_ref().map(|t| ("twin", t.verdict, &t.comparisons)));
+        for (evaluation, verdict, comparisons) in parts {
+            for c in comparisons {
+                let (lo, hi) = c.bounds().unzip();
+                let _ = writeln!(
+                    s,
+                    "{},{},{evaluation},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    r.claim.id,
+                    r.claim.ours,
+                    verdict.label(),
+                    c.statistic.key(),
+                    c.relation.key(),
+                    num(Some(c.margin)),
+                    c.subject.env,
+                    c.subject.algo,
+                    c.subject.sampler,
+                    c.subject.latents,
+                    c.subject.variant,
+                    c.reference.algo,
+                    c.reference.sampler,
+                    c.reference.latents,
+                    c.reference.variant,
+                    c.n_subject,
+                    c.n_reference,
+                    c.paired,
+                    num(Some(c.subject_mean)),
+                    num(Some(c.reference_mean)),
+                    num(Some(c.diff)),
+                    num(lo),
+                    num(hi),
+                    c.uncorrected.label(),
+                    c.verdict.label(),
+                );
+            }
+        }
+    }
+    out.write(Path::new(crate::data::DIR).join(CSV_FILE), s.as_bytes())?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -1451,6 +1861,8 @@ pair_on = ["env"]
             Comparison {
                 subject: k(algo),
                 reference: k("rge-efr"),
+                statistic: Statistic::FinalKlc,
+                relation: Relation::Less,
                 n_subject: 5,
                 n_reference: 5,
                 paired: false,
@@ -1470,13 +1882,13 @@ pair_on = ["env"]
             comparison("c", 0.05),
         ];
         assert_eq!(cs[0].uncorrected, Verdict::Reproduced);
-        correct(&mut cs, Quantifier::All, Relation::Less, 0.05);
+        correct(&mut cs, Quantifier::All, 0.05);
         assert_eq!(
             cs[0].verdict,
             Verdict::Reproduced,
             "all: reproduced needs every one"
         );
-        correct(&mut cs, Quantifier::Any, Relation::Less, 0.05);
+        correct(&mut cs, Quantifier::Any, 0.05);
         assert_eq!(
             cs[0].verdict,
             Verdict::Inconclusive,
@@ -1484,12 +1896,12 @@ pair_on = ["env"]
         );
         // Every comparison fails: "any" is not reproduced without correction.
         let mut fail = vec![comparison("a", 0.5), comparison("b", 0.5)];
-        correct(&mut fail, Quantifier::Any, Relation::Less, 0.05);
+        correct(&mut fail, Quantifier::Any, 0.05);
         assert!(fail.iter().all(|c| c.verdict == Verdict::NotReproduced));
         let vs: Vec<Verdict> = fail.iter().map(|c| c.verdict).collect();
         assert_eq!(Quantifier::Any.combine(&vs), Verdict::NotReproduced);
         // ...while "all" corrects them (two at p ≈ 0.037 > 0.05 / 2 for the first).
-        correct(&mut fail, Quantifier::All, Relation::Less, 0.05);
+        correct(&mut fail, Quantifier::All, 0.05);
         assert!(fail.iter().all(|c| c.verdict == Verdict::Inconclusive));
     }
 
@@ -1581,5 +1993,278 @@ pair_on = ["env"]
                 (100.0 * (756f64.ln() - 4.6)) as i64 as f64
             ]
         );
+    }
+
+    /// Observations given directly: per condition and statistic, values per repetition.
+    struct Given(Vec<(ConditionKey, Statistic, Vec<f64>)>);
+
+    impl Observations for Given {
+        fn keys(&self) -> Vec<ConditionKey> {
+            let mut keys: Vec<ConditionKey> = Vec::new();
+            for (k, _, _) in &self.0 {
+                if !keys.contains(k) {
+                    keys.push(k.clone());
+                }
+            }
+            keys
+        }
+        fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
+            self.0
+                .iter()
+                .find(|(k, s, _)| k == key && *s == statistic)
+                .map(|(_, _, v)| v.iter().enumerate().map(|(i, &x)| (i as i64, x)).collect())
+                .unwrap_or_default()
+        }
+    }
+
+    const VALIDATED: &str = "[settings.validated]\nstatistics = [\"goal_error\", \"coverage\"]\n\
+        [settings.validated.margin.armball]\ngoal_error = 0.02\ncoverage = 0.05\n";
+
+    /// A claim file with the validated measures, one claim `c` (`ours` optional).
+    fn twin_file(statistic: &str, relation: &str, ours: bool) -> ClaimsFile {
+        let text = format!(
+            "[settings]\nconfidence = 0.95\nmargin = 0.2\n{VALIDATED}\n[[claim]]\nid = \"c\"\n\
+             source = \"s\"\nquote = \"q\"\nstatement = \"t\"\nstatistic = \"{statistic}\"\n\
+             relation = \"{relation}\"\nours = {ours}\n\
+             subject = {{ algo = [\"rge-pca\"] }}\nreference = {{ algo = [\"rge-efr\"] }}\n\
+             pair_on = [\"env\"]\n"
+        );
+        parse_claims(&text, Path::new("c.toml")).unwrap()
+    }
+
+    /// RGE-PCA against RGE-EFR on ArmBall (and ArmArrow, which has no validated margins): PCA's
+    /// final KLC is better; its goal error and cells reached are as given.
+    fn pca_vs_efr(goal: [f64; 2], cells: [f64; 2]) -> Given {
+        let jitter = [0.0, 0.004, -0.004, 0.002, -0.002, 0.001];
+        let around = |m: f64| -> Vec<f64> { jitter.iter().map(|j| m + j).collect() };
+        let mut v = Vec::new();
+        for env in ["armball", "armarrow"] {
+            let pca = key(env, "rge-pca", "kde", 10, "none");
+            let efr = key(env, "rge-efr", "uniform", 0, "none");
+            v.push((pca.clone(), Statistic::FinalKlc, around(4.0)));
+            v.push((efr.clone(), Statistic::FinalKlc, around(4.5)));
+            v.push((pca.clone(), Statistic::GoalError, around(goal[0])));
+            v.push((efr.clone(), Statistic::GoalError, around(goal[1])));
+            v.push((pca, Statistic::Coverage, around(cells[0])));
+            v.push((efr, Statistic::Coverage, around(cells[1])));
+        }
+        Given(v)
+    }
+
+    /// The twin of a final-KLC claim on known data, in both directions: a learner better on
+    /// KL-coverage but worse on the validated measures is reproduced on the one and not on the
+    /// other; one as good on them is reproduced on both. The relation is mirrored for the
+    /// cells reached (higher is better), and an environment without margins gives no comparison.
+    #[test]
+    fn twins_on_the_validated_measures_in_both_directions() {
+        let file = twin_file("final_klc", "at_most", false);
+        // Worse: goal error 0.10 vs 0.05 (margin 0.02), cells 0.30 vs 0.55 (margin 0.05).
+        let r = evaluate_on(&file, &pca_vs_efr([0.10, 0.05], [0.30, 0.55])).remove(0);
+        assert_eq!(r.verdict, Verdict::Reproduced, "final KLC: 4.0 vs 4.5");
+        assert_eq!(
+            r.comparisons.len(),
+            2,
+            "both environments on the claim's statistic"
+        );
+        let t = r
+            .twin
+            .as_ref()
+            .expect("a paper claim on final_klc has a twin");
+        assert_eq!(t.verdict, Verdict::NotReproduced);
+        assert_eq!(
+            t.comparisons.len(),
+            2,
+            "ArmBall only (ArmArrow has no margins)"
+        );
+        assert!(t.comparisons.iter().all(|c| c.subject.env == "armball"));
+        let by = |st: Statistic| t.comparisons.iter().find(|c| c.statistic == st).unwrap();
+        assert_eq!(by(Statistic::GoalError).relation, Relation::AtMost);
+        assert_eq!(by(Statistic::Coverage).relation, Relation::AtLeast);
+        assert_eq!(by(Statistic::GoalError).margin, 0.02);
+        assert_eq!(by(Statistic::Coverage).margin, 0.05);
+        assert!(
+            t.comparisons
+                .iter()
+                .all(|c| c.verdict == Verdict::NotReproduced)
+        );
+        assert_eq!(
+            r.validated(file.settings.validated.as_ref()).unwrap().0,
+            Verdict::NotReproduced
+        );
+        // As good: within the margins on both measures.
+        let r = evaluate_on(&file, &pca_vs_efr([0.055, 0.05], [0.54, 0.55])).remove(0);
+        assert_eq!(r.twin.as_ref().unwrap().verdict, Verdict::Reproduced);
+        // Better on cells by a lot: `at_least` holds (mirrored), goal error too.
+        let r = evaluate_on(&file, &pca_vs_efr([0.03, 0.05], [0.80, 0.55])).remove(0);
+        assert_eq!(r.twin.as_ref().unwrap().verdict, Verdict::Reproduced);
+        // `much_less` on KLC becomes `much_greater` on cells: 0.80 vs 0.55 by more than 0.05.
+        let much = twin_file("final_klc", "much_less", false);
+        let r = evaluate_on(&much, &pca_vs_efr([0.035, 0.05], [0.80, 0.55])).remove(0);
+        let t = r.twin.unwrap();
+        let cells = t
+            .comparisons
+            .iter()
+            .find(|c| c.statistic == Statistic::Coverage)
+            .unwrap();
+        assert_eq!(cells.relation, Relation::MuchGreater);
+        assert_eq!(cells.verdict, Verdict::Reproduced);
+        // Goal error 0.035 vs 0.05 is lower, but not by more than the 0.02 margin.
+        let goal = t
+            .comparisons
+            .iter()
+            .find(|c| c.statistic == Statistic::GoalError)
+            .unwrap();
+        assert_eq!(goal.verdict, Verdict::NotReproduced);
+        assert_eq!(t.verdict, Verdict::NotReproduced);
+    }
+
+    /// Which claims get a twin: the paper's, on final KLC or episodes moved; not ours, not the
+    /// speed of exploration; a claim on a validated measure is its own validated verdict.
+    #[test]
+    fn only_the_papers_klc_and_moves_claims_have_twins() {
+        let data = pca_vs_efr([0.10, 0.05], [0.30, 0.55]);
+        assert!(
+            evaluate_on(&twin_file("final_klc", "at_most", true), &data)[0]
+                .twin
+                .is_none()
+        );
+        let auc = twin_file("auc", "at_most", false);
+        let r = evaluate_on(&auc, &data).remove(0);
+        assert!(r.twin.is_none());
+        assert!(r.validated(auc.settings.validated.as_ref()).is_none());
+        let goal = twin_file("goal_error", "at_most", false);
+        let r = evaluate_on(&goal, &data).remove(0);
+        assert!(r.twin.is_none());
+        assert_eq!(
+            r.validated(goal.settings.validated.as_ref()).unwrap().0,
+            r.verdict,
+            "a claim on a validated measure is its own validated verdict"
+        );
+    }
+
+    #[test]
+    fn bad_validated_settings_name_the_problem() {
+        let err = |validated: &str| {
+            let text = format!("[settings]\nconfidence = 0.95\nmargin = 0.2\n{validated}");
+            parse_claims(&text, Path::new("c.toml"))
+                .unwrap_err()
+                .to_string()
+        };
+        let missing = err(
+            "[settings.validated]\nstatistics = [\"goal_error\", \"coverage\"]\n\
+             [settings.validated.margin.armball]\ngoal_error = 0.02\n",
+        );
+        assert!(
+            missing.contains("settings.validated.margin.armball has no margin for `coverage`"),
+            "{missing}"
+        );
+        let extra = err("[settings.validated]\nstatistics = [\"goal_error\"]\n\
+             [settings.validated.margin.armball]\ngoal_error = 0.02\ncoverage = 0.05\n");
+        assert!(extra.contains("armball.coverage is not one of"), "{extra}");
+        let negative = err("[settings.validated]\nstatistics = [\"goal_error\"]\n\
+             [settings.validated.margin.armball]\ngoal_error = -1\n");
+        assert!(
+            negative.contains("must be a finite number >= 0"),
+            "{negative}"
+        );
+        let unknown = err("[settings.validated]\nstatistics = [\"goal_eror\"]\nmargin = {}\n");
+        assert!(unknown.contains("goal_eror"), "{unknown}");
+    }
+
+    /// An undecided comparison of known interval: its lean and the repetitions that would decide
+    /// it, at the claim's level and at Holm's first step.
+    fn undecided(estimate: f64, se: f64, relation: Relation) -> Comparison {
+        let i = crate::stats::t_interval(
+            &[estimate - se * 10f64.sqrt(), estimate + se * 10f64.sqrt()],
+            0.95,
+        )
+        .unwrap();
+        // A hand-made interval: estimate ± t(9) se.
+        let t9 = crate::stats::student_t_quantile(0.975, 9.0);
+        let i = TInterval {
+            estimate,
+            se,
+            df: 9.0,
+            level: 0.95,
+            lo: estimate - t9 * se,
+            hi: estimate + t9 * se,
+            ..i
+        };
+        let v = Verdict::of_interval(i.lo, i.hi, relation.interval(0.2));
+        Comparison {
+            subject: key("armball", "rge-pca", "kde", 10, "none"),
+            reference: key("armball", "rge-efr", "uniform", 0, "none"),
+            statistic: Statistic::FinalKlc,
+            relation,
+            n_subject: 10,
+            n_reference: 10,
+            paired: true,
+            subject_mean: estimate,
+            reference_mean: 0.0,
+            diff: estimate,
+            interval: Some(i),
+            margin: 0.2,
+            uncorrected: v,
+            verdict: v,
+        }
+    }
+
+    #[test]
+    fn undecided_claims_lean_and_say_how_many_repetitions_would_decide_them() {
+        let t9 = crate::stats::student_t_quantile(0.975, 9.0);
+        // Δ = 0.1 on `less`: outside the set, half-width 0.2 → leans not reproduced; at the
+        // same level it would clear 0 at 10 · (0.2 / 0.1)² = 40 repetitions.
+        let c = undecided(0.1, 0.2 / t9, Relation::Less);
+        assert_eq!(c.verdict, Verdict::Inconclusive);
+        assert!(!c.leans_reproduced());
+        assert_eq!(
+            c.repetitions_to_decide(Relation::Less.interval(0.2), 0.05),
+            Some(40.0)
+        );
+        // Holm's first step at k = 2 asks for a wider interval: more repetitions.
+        let holm = c
+            .repetitions_to_decide(Relation::Less.interval(0.2), 0.025)
+            .unwrap();
+        let widen = crate::stats::student_t_quantile(0.9875, 9.0) / t9;
+        assert_eq!(holm, (40.0 * widen * widen).ceil());
+        // One comparison leaning each way under `all`: the claim leans not reproduced, and one
+        // failing comparison suffices, decided at Holm's α / 2.
+        let yes = undecided(-0.05, 0.2 / t9, Relation::Less);
+        assert!(yes.leans_reproduced());
+        let pair = [yes.clone(), c.clone()];
+        assert_eq!(lean(&pair, Quantifier::All), Some(Verdict::NotReproduced));
+        assert_eq!(
+            to_decide(&pair, Quantifier::All, 0.05),
+            ToDecide::Repetitions(holm)
+        );
+        // Both leaning reproduced under `all`: every one must be decided, no correction.
+        let far = undecided(-0.02, 0.2 / t9, Relation::Less);
+        let both = [yes.clone(), far.clone()];
+        assert_eq!(lean(&both, Quantifier::All), Some(Verdict::Reproduced));
+        let need = |x: &Comparison| {
+            x.repetitions_to_decide(Relation::Less.interval(0.2), 0.05)
+                .unwrap()
+        };
+        assert_eq!(
+            to_decide(&both, Quantifier::All, 0.05),
+            ToDecide::Repetitions(need(&yes).max(need(&far)))
+        );
+        // `any` leaning reproduced: one suffices, corrected at α / 2.
+        let any = to_decide(&both, Quantifier::Any, 0.05);
+        let holm_min = [&yes, &far]
+            .iter()
+            .map(|x| {
+                x.repetitions_to_decide(Relation::Less.interval(0.2), 0.025)
+                    .unwrap()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(any, ToDecide::Repetitions(holm_min));
+        // An estimate on the boundary never decides.
+        let edge = undecided(0.0, 0.1, Relation::Less);
+        assert_eq!(
+            to_decide(std::slice::from_ref(&edge), Quantifier::All, 0.05),
+            ToDecide::Never
+        );
+        assert_eq!(lean(&[], Quantifier::All), None);
     }
 }

@@ -5,6 +5,7 @@ use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
 use crate::campaigns::Campaigns;
 use crate::claims::ClaimsInput;
+use crate::discovery::{Check, RunRow};
 use crate::leaderboard::Leaderboard;
 use crate::load::Store;
 use crate::neural::{BudgetAnalysis, LossCurve, VariantPair};
@@ -30,4 +31,8 @@ pub struct Context<'a> {
     pub claims: &'a ClaimsInput<'a>,
     /// Main and `compare` campaigns, ranked.
     pub leaderboard: &'a Leaderboard,
+    /// Every run the report reads, with its discovery measures at the final epoch.
+    pub discovery: &'a [RunRow<'a>],
+    /// The validity check of the discovery measures, per environment.
+    pub validity: &'a [Check],
 }

@@ -140,6 +140,7 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
             confidence: f.settings.confidence,
             margin: f.settings.margin,
             target_half_width: f.settings.target_half_width,
+            validated: f.settings.validated.as_ref(),
             results: &claim_results,
         },
         None => claims::ClaimsInput::Missing(&claims_path),
@@ -185,6 +186,8 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     }
     curve_conditions.sort_by_key(|c| c.key.order_key());
 
+    let measured = discovery::measure_all(&camps)?;
+    let validity = discovery::validity(&measured);
     let ctx = sections::Context {
         opts,
         campaigns: &camps,
@@ -197,6 +200,8 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
         losses: &losses,
         claims: &claims_input,
         leaderboard: &board,
+        discovery: &measured,
+        validity: &validity,
     };
     let mut out = output::Output::open(&opts.out)?;
     let md = sections::render(list, &ctx, &mut out)?;

@@ -37,9 +37,12 @@ pub struct PaperTable {
 
 impl PaperTable {
     /// The paper's value for a condition: same env, algo and sampler, and the same latent size
-    /// (or a row valid for any). Our variants (`faithful`/`corrected`) all compare to the paper's
-    /// single run.
+    /// (or a row valid for any). The `faithful` variant is the paper's; the `corrected` one, whose
+    /// implementation defects we fixed, the paper never ran, and it has no value.
     pub fn lookup(&self, key: &ConditionKey) -> Option<&PaperValue> {
+        if key.variant == "corrected" {
+            return None;
+        }
         self.values.iter().find(|v| {
             v.env == key.env
                 && v.algo == key.algo

@@ -301,14 +301,15 @@ fn has_latents(run: &Run) -> bool {
 
 /// The observations of the main campaign and its `recipe` campaigns: every learned-goal-space
 /// run with a position R² and outcomes measured, replicates of one fit and sampler averaged; in
-/// campaign order, then the report's condition order and seed.
-pub fn observations(camps: &Campaigns) -> Result<Vec<Observation>, ReportError> {
+/// campaign order, then the report's condition order and seed. `measured` is every run the
+/// report reads, measured ([`discovery::measure_all`]).
+pub fn observations(camps: &Campaigns, measured: &[RunRow<'_>]) -> Vec<Observation> {
     let read: Vec<&str> = std::iter::once(&camps.main)
         .chain(&camps.recipe)
         .map(|c| c.name.as_str())
         .collect();
-    let rows: Vec<RunRow<'_>> = discovery::measure_all(camps)?
-        .into_iter()
+    let rows: Vec<&RunRow<'_>> = measured
+        .iter()
         .filter(|r| read.contains(&r.campaign.name.as_str()) && has_latents(r.run))
         .filter(|r| r.discovery.is_some())
         .collect();
@@ -324,12 +325,12 @@ pub fn observations(camps: &Campaigns) -> Result<Vec<Observation>, ReportError> 
         out.push(observe(&rows[i..j]));
         i = j;
     }
-    Ok(out)
+    out
 }
 
 /// The mean over the replicates `reps` (one fit, one sampler; at least one, every one measured
 /// and with a position R²); a mean is None where a replicate lacks the value or it is not finite.
-fn observe(reps: &[RunRow<'_>]) -> Observation {
+fn observe(reps: &[&RunRow<'_>]) -> Observation {
     let mean_of = |f: &dyn Fn(&RunRow<'_>) -> Option<f64>| -> Option<f64> {
         let v: Option<Vec<f64>> = reps
             .iter()
@@ -839,7 +840,8 @@ mod tests {
             &crate::sections::wanted_roles(crate::sections::SECTIONS),
         )
         .unwrap();
-        let obs = observations(&camps).unwrap();
+        let measured = crate::discovery::measure_all(&camps).unwrap();
+        let obs = observations(&camps, &measured);
         let count = |env: &str| obs.iter().filter(|o| o.env == env).count();
         assert_eq!([count("armball"), count("armarrow")], [429, 420]);
         for o in &obs {

@@ -18,7 +18,9 @@ pub mod components;
 mod coverage;
 pub mod interval;
 pub mod rliable;
-pub use interval::{IntervalError, TInterval, t_interval, welch_interval};
+pub use interval::{
+    IntervalError, TInterval, prediction_interval, student_t_quantile, t_interval, welch_interval,
+};
 pub use rliable::{
     AucError, area_under_curve, iqm, probability_of_improvement, probability_of_improvement_ci,
     stratified_bootstrap_ci,

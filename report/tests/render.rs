@@ -217,11 +217,11 @@ fn renders_report_and_figures_with_the_right_numbers() {
         }
     }
     // REPORT.md, 2 KLC and 2 coverage figures, 4 outcome scatters, the paper's 3 illustrations
-    // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 3 CSV files
-    // (final values, curves, discovery measures), the list of files.
+    // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 4 CSV files
+    // (final values, curves, discovery measures, the claims' comparisons), the list of files.
     let env_figures = cfg!(feature = "environment-figures");
     let illustrations = if env_figures { 3 } else { 1 };
-    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 3 + 1);
+    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 4 + 1);
     for (name, drawn) in [
         ("fig1_environments.svg", env_figures),
         ("fig5_radial_flow.svg", true),
@@ -268,14 +268,15 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("| 50.0 % |"));
     // What was run, links, notes, the reduced budget.
     assert!(md.contains("Reduced budget"));
-    // The box names the algorithm and counts every reduced run of every campaign rendered.
+    // The warning counts every reduced run of every campaign rendered; the table under "What
+    // was run" names the algorithm.
     assert!(md.contains("6 of the 12 runs in this report"), "{md}");
     assert!(
-        md.contains("- **RPE**: 500 epochs instead of 5000: 3 runs (paper)"),
+        md.contains("| RPE | 500 epochs instead of 5000 | 3 | paper |"),
         "{md}"
     );
     assert!(
-        md.contains("- **RGE-EFR**: 500 epochs instead of 5000: 3 runs (paper)"),
+        md.contains("| RGE-EFR | 500 epochs instead of 5000 | 3 | paper |"),
         "{md}"
     );
     // One row per campaign: role, runs, conditions, design, reduced runs, a committed tree.

@@ -3,7 +3,9 @@
 use std::fmt::Write as _;
 
 use super::{fmt_klc, plural};
-use crate::claims::{ClaimResult, ClaimsInput, Comparison, Statistic, Verdict};
+use crate::claims::{
+    ClaimResult, ClaimsInput, Comparison, Quantifier, Statistic, ToDecide, Verdict, lean, to_decide,
+};
 use crate::context::Context;
 use crate::figures::outcomes::describe_key;
 use crate::figures::{condition_name, env_name, sampler_name};
@@ -40,10 +42,11 @@ fn signed(statistic: Statistic, v: f64) -> String {
     }
 }
 
-/// One comparison on one line: `ArmBall, RGE-VAE (faithful), KDE goals, 2 latents − RGE-EFR:
+/// One comparison on one line: `ArmBall: RGE-VAE (faithful), KDE goals, 2 latents vs RGE-EFR:
 /// Δ = −0.52 [−0.71, −0.33] ✅`; a mark the multiple-comparison correction changed is followed
 /// by the uncorrected one (`❔ (❌ uncorrected)`); no interval is said in words.
-fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
+fn comparison_line(c: &Comparison) -> String {
+    let statistic = c.statistic;
     let interval = match c.bounds() {
         Some((lo, hi)) => format!("[{}, {}]", signed(statistic, lo), signed(statistic, hi)),
         None if c.n_subject < 2 || c.n_reference < 2 => {
@@ -63,6 +66,80 @@ fn comparison_line(c: &Comparison, statistic: Statistic) -> String {
         describe_key(&c.reference),
         signed(statistic, c.diff),
         mark(c.verdict),
+    )
+}
+
+/// How a measure fared in the validity check, over the environments of some comparisons.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Validity {
+    /// It passes in every environment it is used in.
+    Passes,
+    /// It fails in these environments (display names).
+    Fails(Vec<String>),
+    /// The check has no line for it (or for one of its environments).
+    Unchecked,
+}
+
+/// The validity check's verdict on `statistic` in the environments of `comparisons`.
+pub(crate) fn validity_of(
+    statistic: Statistic,
+    comparisons: &[Comparison],
+    checks: &[crate::discovery::Check],
+) -> Validity {
+    let Some(measure) = statistic.checked_as() else {
+        return Validity::Unchecked;
+    };
+    let mut envs: Vec<&str> = comparisons.iter().map(|c| c.subject.env.as_str()).collect();
+    envs.sort_by_key(|e| (ugl_types::EnvSpec::order(e), e.to_string()));
+    envs.dedup();
+    let mut fails = Vec::new();
+    for env in envs {
+        match checks.iter().find(|c| c.measure == measure && c.env == env) {
+            Some(c) if c.passes => {}
+            Some(_) => fails.push(env_name(env)),
+            None => return Validity::Unchecked,
+        }
+    }
+    if fails.is_empty() {
+        Validity::Passes
+    } else {
+        Validity::Fails(fails)
+    }
+}
+
+/// The label of a verdict on a measure the validity check does not pass.
+fn validity_note(v: &Validity) -> &'static str {
+    match v {
+        Validity::Passes => "",
+        Validity::Fails(_) => " ⚠ fails the validity check",
+        Validity::Unchecked => " ⚠ not in the validity check",
+    }
+}
+
+/// A verdict with, where undecided, the way it leans and the repetitions that would decide it
+/// that way: `❔ leans ❌, ~37 repetitions`.
+fn verdict_cell(v: Verdict, comparisons: &[Comparison], q: Quantifier, alpha: f64) -> String {
+    if v != Verdict::Inconclusive || comparisons.is_empty() {
+        return verdict_mark(v);
+    }
+    let Some(way) = lean(comparisons, q) else {
+        return verdict_mark(v);
+    };
+    let have = comparisons
+        .iter()
+        .map(|c| c.n_subject.min(c.n_reference))
+        .min()
+        .unwrap_or(0);
+    let reps = match to_decide(comparisons, q, alpha) {
+        ToDecide::Repetitions(n) if n > 1000.0 => "over 1000 repetitions".to_string(),
+        ToDecide::Repetitions(n) => format!("~{n:.0} repetitions"),
+        ToDecide::Never => "a Δ on a boundary: never".to_string(),
+        ToDecide::Unknown => "repetitions unknown".to_string(),
+    };
+    format!(
+        "{} leans {}, {reps} to decide ({have} run)",
+        mark(v),
+        mark(way)
     )
 }
 
@@ -104,33 +181,128 @@ pub fn method_text(confidence: f64) -> String {
     )
 }
 
-/// The one-line count of verdicts for the top of the report, if claims were evaluated.
+/// Counts of verdicts: reproduced, not reproduced, undecided leaning reproduced, undecided
+/// leaning not reproduced.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Counts {
+    pub yes: usize,
+    pub no: usize,
+    pub lean_yes: usize,
+    pub lean_no: usize,
+}
+
+impl Counts {
+    fn add(&mut self, v: Verdict, comparisons: &[Comparison], q: Quantifier) {
+        match (v, lean(comparisons, q)) {
+            (Verdict::Reproduced, _) => self.yes += 1,
+            (Verdict::NotReproduced, _) => self.no += 1,
+            (Verdict::Inconclusive, Some(Verdict::Reproduced)) => self.lean_yes += 1,
+            (Verdict::Inconclusive, _) => self.lean_no += 1,
+        }
+    }
+
+    fn words(&self) -> String {
+        format!(
+            "{} reproduced, {} not reproduced, {} undecided ({} leaning ✅, {} leaning ❌)",
+            self.yes,
+            self.no,
+            self.lean_yes + self.lean_no,
+            self.lean_yes,
+            self.lean_no
+        )
+    }
+}
+
+/// The paper's claims counted on the validated measures (`validated`) and on the paper's own
+/// measures (`own`), and the claims without a validated verdict.
+pub(crate) fn counts(
+    results: &[ClaimResult],
+    validated: Option<&crate::claims::Validated>,
+) -> (Counts, Counts, Vec<Statistic>) {
+    let (mut on_validated, mut own, mut none) = (Counts::default(), Counts::default(), Vec::new());
+    for r in results.iter().filter(|r| !r.claim.ours) {
+        own.add(r.verdict, &r.comparisons, r.claim.quantifier);
+        match r.validated(validated) {
+            Some((v, cs)) => on_validated.add(v, cs, r.claim.quantifier),
+            None => none.push(r.claim.statistic),
+        }
+    }
+    (on_validated, own, none)
+}
+
+/// The names of the validated measures, in words.
+fn validated_names(validated: Option<&crate::claims::Validated>) -> String {
+    validated
+        .map(|v| {
+            v.statistics
+                .iter()
+                .map(|s| s.label())
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default()
+}
+
+/// The count of verdicts for the top of the report, if claims were evaluated: first on the
+/// measures that pass the validity check, then on the paper's own.
 pub fn summary_line(w: &mut String, inp: &Context<'_>) {
-    if let ClaimsInput::Evaluated { results, .. } = inp.claims {
-        let papers: Vec<_> = results.iter().filter(|r| !r.claim.ours).collect();
-        let count = |v: Verdict| papers.iter().filter(|r| r.verdict == v).count();
-        let ours = results.len() - papers.len();
-        let _ = writeln!(
-            w,
-            "**The paper's claims** ([details](#the-papers-claims)): {} reproduced, {} not \
-             reproduced, {} inconclusive, of {} claims of the paper evaluated on these results{}.\n",
-            count(Verdict::Reproduced),
-            count(Verdict::NotReproduced),
-            count(Verdict::Inconclusive),
-            papers.len(),
-            if ours > 0 {
-                format!(" ({ours} finding(s) of ours are listed apart)")
-            } else {
-                String::new()
-            }
-        );
+    if let ClaimsInput::Evaluated {
+        results, validated, ..
+    } = inp.claims
+    {
+        let papers = results.iter().filter(|r| !r.claim.ours).count();
+        let ours = match results.len() - papers {
+            0 => String::new(),
+            1 => " (1 finding of ours is listed apart)".to_string(),
+            n => format!(" ({n} findings of ours are listed apart)"),
+        };
+        let (on_validated, own, none) = counts(results, *validated);
+        let own_fails = results.iter().filter(|r| !r.claim.ours).any(|r| {
+            validity_of(r.claim.statistic, &r.comparisons, inp.validity) != Validity::Passes
+        });
+        if validated.is_some() {
+            let _ = writeln!(
+                w,
+                "**The paper's claims** ([details](#the-papers-claims)), {papers} evaluated on \
+                 these results{ours}. On the measures of discovery that pass the validity check \
+                 ({}): {}; {} claim{} no validated measure ({}). \
+                 On the paper's own measures (KL-coverage, episodes that moved the object){}: \
+                 {}.\n",
+                validated_names(*validated),
+                on_validated.words(),
+                none.len(),
+                if none.len() == 1 { " has" } else { "s have" },
+                {
+                    let mut labels: Vec<&str> = Vec::new();
+                    for l in none.iter().map(|s| s.label()) {
+                        if !labels.contains(&l) {
+                            labels.push(l);
+                        }
+                    }
+                    labels.join(", ")
+                },
+                if own_fails {
+                    ", which fail the validity check or are not in it"
+                } else {
+                    ""
+                },
+                own.words(),
+            );
+        } else {
+            let _ = writeln!(
+                w,
+                "**The paper's claims** ([details](#the-papers-claims)), {papers} evaluated on \
+                 these results{ours}: {}.\n",
+                own.words()
+            );
+        }
     }
 }
 
 /// The claims section.
 pub fn claims(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "## The paper's claims\n");
-    let (path, confidence, margin, target, results) = match inp.claims {
+    let (path, confidence, margin, target, validated, results) = match inp.claims {
         ClaimsInput::Missing(p) => {
             let _ = writeln!(
                 w,
@@ -144,8 +316,16 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
             confidence,
             margin,
             target_half_width,
+            validated,
             results,
-        } => (path, *confidence, *margin, *target_half_width, *results),
+        } => (
+            path,
+            *confidence,
+            *margin,
+            *target_half_width,
+            *validated,
+            *results,
+        ),
     };
     let _ = writeln!(
         w,
@@ -158,6 +338,48 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
         path.display(),
         method_text(confidence)
     );
+    if let Some(v) = validated {
+        let margins: Vec<String> = v
+            .margin
+            .iter()
+            .map(|(env, _)| {
+                let each: Vec<String> = v
+                    .statistics
+                    .iter()
+                    .filter_map(|&st| {
+                        v.margin(env, st)
+                            .map(|m| format!("{} {}", st.label(), value(st, m)))
+                    })
+                    .collect();
+                format!("{}: {}", env_name(env), each.join(", "))
+            })
+            .collect();
+        let _ = writeln!(
+            w,
+            "\n**Two verdicts per claim.** The paper measures exploration with KL-coverage, \
+             which fails the validity check of [What the exploration discovered]\
+             (#what-the-exploration-discovered-without-counting-repeats) (it rewards moving the \
+             object often, not discovering much). So each claim of the paper stated on the final \
+             KLC or on the episodes moved is tested again, with the same conditions, relation \
+             and quantifier, on the measures that pass the check ({}), each with its own margin \
+             (one tenth of the gap between RGE-EFR and RPE on the measure; the claims file says \
+             how it was chosen): {}. All its comparisons on all those measures form one family \
+             (quantifier and Holm's correction over them together). A claim on the speed of \
+             exploration (the area under the KLC curve) has no such twin: the validated \
+             measures are recorded at the last epoch only. ⚠ marks a verdict on a measure \
+             that fails the validity check, or that the check does not cover. An undecided \
+             verdict says which way its estimates lean (the verdict if each comparison were \
+             judged by its estimate alone) and how many repetitions per condition would \
+             decide it that way if the differences and spread held: the interval's \
+             half-width shrinks as 1/√n, at the level the verdict is tested at (Holm's \
+             strictest step, α/k, where the correction applies). Every comparison, with both \
+             verdicts: [`data/{}`](data/{}).",
+            validated_names(Some(v)),
+            margins.join("; "),
+            crate::claims::CSV_FILE,
+            crate::claims::CSV_FILE,
+        );
+    }
     if let Some((half, n)) = crate::claims::precision(results) {
         let _ = writeln!(
             w,
@@ -251,173 +473,144 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
         }
     );
     let _ = writeln!(w);
+    let alpha = 1.0 - confidence;
     let (papers, ours): (Vec<&ClaimResult>, Vec<&ClaimResult>) =
         results.iter().partition(|r| !r.claim.ours);
-    claims_table(w, &papers);
+    claims_table(w, &papers, validated, inp.validity, alpha);
     if !ours.is_empty() {
         let _ = writeln!(
             w,
             "### Our findings (not claims of the paper)\n\nStatements of ours, tested the same \
-             way (e.g. a claim of the paper re-tested on the corrected variants); not counted \
-             in the headline.\n"
+             way (e.g. a claim of the paper re-tested on the corrected variants, or a learner \
+             against its controls), each on the measure it names; not counted in the \
+             headline.\n"
         );
-        claims_table(w, &ours);
+        claims_table(w, &ours, validated, inp.validity, alpha);
     }
 }
 
-/// The report's conclusions, generated from the verdicts (nothing is written per result): what
-/// the evidence supports, what it contradicts, and the claims still undecided with the number
-/// of repetitions that would decide them at the observed difference and spread.
-pub fn conclusions(w: &mut String, inp: &Context<'_>) {
-    let ClaimsInput::Evaluated { results, .. } = inp.claims else {
-        return;
-    };
+fn claims_table(
+    w: &mut String,
+    results: &[&ClaimResult],
+    validated: Option<&crate::claims::Validated>,
+    checks: &[crate::discovery::Check],
+    alpha: f64,
+) {
     let _ = writeln!(
         w,
-        "## Conclusions
-"
+        "| claim | testable statement | on the paper's measure | on the validated measures | the paper's own numbers |"
     );
-    let _ = writeln!(
-        w,
-        "Generated from the verdicts above: the claims the results support, those they \
-         contradict, and those they leave undecided. For an undecided claim, *repetitions to \
-         decide* is the number of repetitions per condition at which every undecided \
-         comparison's interval would clear the nearest boundary of its claim, if the observed \
-         differences and spread held (the interval's half-width shrinks as 1/√n); \
-         \"—\" where an observed difference sits on the boundary, which no number of \
-         repetitions decides.\n"
-    );
-    for ours in [false, true] {
-        let part: Vec<&ClaimResult> = results.iter().filter(|r| r.claim.ours == ours).collect();
-        if part.is_empty() {
-            continue;
-        }
+    let _ = writeln!(w, "|---|---|---|---|---|");
+    for r in results {
+        let q = r.claim.quantifier;
+        let own_validity = validity_of(r.claim.statistic, &r.comparisons, checks);
+        let own = format!(
+            "{}<br>{}{}",
+            verdict_cell(r.verdict, &r.comparisons, q, alpha),
+            r.claim.statistic.label(),
+            validity_note(&own_validity)
+        );
+        let on_validated = match r.validated(validated) {
+            Some((v, cs)) if r.twin.is_some() => verdict_cell(v, cs, q, alpha),
+            Some(_) => "(the same: its measure is validated)".to_string(),
+            None if r.claim.statistic == Statistic::Auc => {
+                "— (speed: no validated measure)".to_string()
+            }
+            None => "—".to_string(),
+        };
         let _ = writeln!(
             w,
-            "**{}** ({} claims)\n",
-            if ours {
-                "Our controls and findings"
-            } else {
-                "The paper's claims"
-            },
-            part.len()
+            "| `{}` | {} | {own} | {on_validated} | {} |",
+            r.claim.id,
+            cell(&r.claim.statement),
+            paper_cell(r.paper.as_ref()),
         );
-        for (verdict, title) in [
-            (Verdict::Reproduced, "Supported"),
-            (Verdict::NotReproduced, "Contradicted"),
-            (Verdict::Inconclusive, "Undecided"),
-        ] {
-            let these: Vec<&&ClaimResult> = part.iter().filter(|r| r.verdict == verdict).collect();
-            if these.is_empty() {
-                continue;
+    }
+    let _ = writeln!(w);
+    // The evidence, folded: the paper's words, what the statement requires, every comparison.
+    let _ = writeln!(
+        w,
+        "<details><summary>Evidence: the paper's words and every comparison of these {} \
+         claims</summary>\n",
+        results.len()
+    );
+    for r in results {
+        let requires = match r.claim.quantifier.label() {
+            "" => r.claim.relation.describe(r.margin),
+            q => format!("{} in {q}", r.claim.relation.describe(r.margin)),
+        };
+        let _ = writeln!(
+            w,
+            "**`{}`**: *“{}”* ({}). Requires {requires}, Δ of the {}.\n",
+            r.claim.id,
+            r.claim.quote,
+            r.claim.source,
+            r.claim.statistic.label()
+        );
+        if r.comparisons.is_empty() {
+            let _ = writeln!(w, "- no condition of the main campaign matches");
+        }
+        for c in &r.comparisons {
+            let _ = writeln!(w, "- {}", comparison_line(c));
+        }
+        if let Some(t) = &r.twin {
+            let _ = writeln!(
+                w,
+                "\nOn the validated measures ({}):\n",
+                verdict_mark(t.verdict)
+            );
+            if t.comparisons.is_empty() {
+                let _ = writeln!(w, "- no condition with a validated measure and a margin");
             }
-            let _ = writeln!(w, "- *{title}* ({}):", these.len());
-            for r in these {
-                let extra = if verdict == Verdict::Inconclusive {
-                    let set = r.claim.relation.interval(r.margin);
-                    let undecided: Vec<&Comparison> = r
-                        .comparisons
-                        .iter()
-                        .filter(|c| c.verdict == Verdict::Inconclusive)
-                        .collect();
-                    if r.comparisons.is_empty() {
-                        " (no condition of these results matches)".to_string()
-                    } else {
-                        let ns: Vec<Option<f64>> = undecided
-                            .iter()
-                            .map(|c| c.repetitions_to_decide(set))
-                            .collect();
-                        let have = undecided
-                            .iter()
-                            .map(|c| c.n_subject.min(c.n_reference))
-                            .min()
-                            .unwrap_or(0);
-                        match ns.iter().copied().collect::<Option<Vec<f64>>>() {
-                            Some(v) if !v.is_empty() => {
-                                let n = v.into_iter().fold(0.0, f64::max);
-                                if n > 1000.0 {
-                                    format!(" (repetitions to decide: more than 1000; {have} run)")
-                                } else {
-                                    format!(" (repetitions to decide: about {n:.0}; {have} run)")
-                                }
-                            }
-                            _ => format!(" (repetitions to decide: —; {have} run)"),
-                        }
-                    }
-                } else {
-                    String::new()
-                };
-                let _ = writeln!(w, "  - `{}`: {}{extra}", r.claim.id, r.claim.statement);
+            for c in &t.comparisons {
+                let _ = writeln!(
+                    w,
+                    "- {}, requires {}: {}",
+                    c.statistic.label(),
+                    c.relation.describe(c.margin),
+                    comparison_line(c)
+                );
+            }
+        }
+        if let Some(p) = &r.paper
+            && p.holds == Some(false)
+        {
+            let _ = writeln!(w, "\nThe paper's own values that contradict it:\n");
+            for c in p.comparisons.iter().filter(|c| !c.holds) {
+                let _ = writeln!(
+                    w,
+                    "- {}: {} vs {}: Δ = {}",
+                    env_name(&c.subject.env),
+                    describe_key(&c.subject),
+                    describe_key(&c.reference),
+                    signed(r.claim.statistic, c.diff)
+                );
             }
         }
         let _ = writeln!(w);
     }
+    let _ = writeln!(w, "</details>\n");
 }
 
-fn claims_table(w: &mut String, results: &[&ClaimResult]) {
-    let _ = writeln!(
-        w,
-        "| claim | the paper says | testable statement | requires | evidence | verdict | the paper's own numbers |"
-    );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|");
-    for r in results {
-        let evidence = if r.comparisons.is_empty() {
-            "no condition of the main campaign matches".to_string()
-        } else {
-            r.comparisons
-                .iter()
-                .map(|c| comparison_line(c, r.claim.statistic))
-                .collect::<Vec<_>>()
-                .join("<br>")
-        };
-        let _ = writeln!(
-            w,
-            "| `{}` | *“{}”* ({}) | {} | {}, Δ of the {} | {} | **{}** | {} |",
-            r.claim.id,
-            cell(&r.claim.quote),
-            cell(&r.claim.source),
-            cell(&r.claim.statement),
-            match r.claim.quantifier.label() {
-                "" => r.claim.relation.describe(r.margin),
-                q => format!("{} in {q}", r.claim.relation.describe(r.margin)),
-            },
-            r.claim.statistic.label(),
-            evidence,
-            verdict_mark(r.verdict),
-            paper_cell(r.paper.as_ref(), r.claim.statistic)
-        );
-    }
-    let _ = writeln!(w);
-}
-
-/// The paper's-own-numbers cell: the verdict, then the comparisons that fail (or all, if they
-/// all hold and are few).
-fn paper_cell(check: Option<&crate::claims::PaperCheck>, statistic: Statistic) -> String {
+/// The paper's-own-numbers cell: the verdict and how many comparisons it rests on (the failing
+/// ones are in the evidence).
+fn paper_cell(check: Option<&crate::claims::PaperCheck>) -> String {
     let Some(check) = check else {
         return "—".into();
     };
-    let line = |c: &crate::claims::PaperComparison| {
-        format!(
-            "{} {}: {} vs {}: Δ = {}",
-            if c.holds { "✅" } else { "❌" },
-            env_name(&c.subject.env),
-            describe_key(&c.subject),
-            describe_key(&c.reference),
-            signed(statistic, c.diff)
-        )
-    };
     match check.holds {
         None => "— not reported".into(),
-        Some(true) => format!("✅ satisfy ({} comparisons)", check.comparisons.len()),
-        Some(false) => {
-            let failing: Vec<String> = check
-                .comparisons
-                .iter()
-                .filter(|c| !c.holds)
-                .map(line)
-                .collect();
-            format!("**❌ contradicted**<br>{}", failing.join("<br>"))
-        }
+        Some(true) => format!(
+            "✅ satisfy ({} comparison{})",
+            check.comparisons.len(),
+            plural(check.comparisons.len())
+        ),
+        Some(false) => format!(
+            "**❌ contradicted** ({} of {} comparison{})",
+            check.comparisons.iter().filter(|c| !c.holds).count(),
+            check.comparisons.len(),
+            plural(check.comparisons.len())
+        ),
     }
 }
 

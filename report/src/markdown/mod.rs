@@ -15,6 +15,7 @@ use crate::load::{Run, campaign_display};
 
 pub mod claims;
 pub mod compare;
+pub mod findings;
 pub mod neural;
 pub mod quality;
 pub mod recipe;
@@ -170,37 +171,19 @@ pub fn header(w: &mut String, inp: &Context<'_>) {
         inp.paper.looked_at.display()
     );
 
-    // --- Reduced budget: prominently, before anything else (every campaign rendered).
+    // --- Reduced budget: one line here, the table under "What was run".
     let (used, reduced) = budget_runs(inp);
     if !reduced.is_empty() {
-        // (algorithm, note) -> (runs, campaigns)
-        let mut notes: BTreeMap<(String, String), (usize, BTreeSet<String>)> = BTreeMap::new();
-        for r in &reduced {
-            let e = notes
-                .entry((algo_name(&r.key.algo), r.manifest.budget_note.clone()))
-                .or_default();
-            e.0 += 1;
-            e.1.insert(campaign_name(&r.campaign));
-        }
         let _ = writeln!(
             w,
             "> **⚠ Reduced budget.** {} of the {} runs in this report (every campaign it renders) \
              were run with a budget reduced relative to the paper's; their numbers are not \
              directly comparable with the paper's. Conditions with such runs are marked † in the \
-             tables. By algorithm:",
+             tables; [What was run](#{}) lists the reductions by algorithm.\n",
             reduced.len(),
-            used.len()
+            used.len(),
+            what_was_run_anchor(&inp.campaigns.main.name)
         );
-        for ((algo, note), (n, camps)) in &notes {
-            let camps: Vec<&str> = camps.iter().map(String::as_str).collect();
-            let _ = writeln!(
-                w,
-                ">\n> - **{algo}**: {note}: {n} run{} ({})",
-                plural(*n),
-                camps.join(", ")
-            );
-        }
-        let _ = writeln!(w);
     }
     let mixed: Vec<String> = inp
         .campaigns
@@ -248,6 +231,41 @@ fn budget_runs<'a>(inp: &'a Context<'_>) -> (Vec<&'a Run>, Vec<&'a Run>) {
         .filter(|r| r.manifest.reduced_budget)
         .collect();
     (used, reduced)
+}
+
+/// The anchor of the "What was run" heading for the main campaign `main`.
+fn what_was_run_anchor(main: &str) -> String {
+    format!(
+        "what-was-run-main-campaign-{}",
+        campaign_name(main).to_lowercase()
+    )
+}
+
+/// The runs with a budget reduced from the paper's, by algorithm and reduction.
+fn reduced_table(w: &mut String, inp: &Context<'_>) {
+    let (_, reduced) = budget_runs(inp);
+    if reduced.is_empty() {
+        return;
+    }
+    // (algorithm, note) -> (runs, campaigns)
+    let mut notes: BTreeMap<(String, String), (usize, BTreeSet<String>)> = BTreeMap::new();
+    for r in &reduced {
+        let e = notes
+            .entry((algo_name(&r.key.algo), r.manifest.budget_note.clone()))
+            .or_default();
+        e.0 += 1;
+        e.1.insert(campaign_name(&r.campaign));
+    }
+    let _ = writeln!(
+        w,
+        "**Reduced budgets** (marked † in the tables), from the manifests:\n\n\
+         | algorithm | reduced relative to the paper | runs | campaigns |\n|---|---|---:|---|"
+    );
+    for ((algo, note), (n, camps)) in &notes {
+        let camps: Vec<&str> = camps.iter().map(String::as_str).collect();
+        let _ = writeln!(w, "| {algo} | {note} | {n} | {} |", camps.join(", "));
+    }
+    let _ = writeln!(w);
 }
 
 /// Slugs of the main campaign's conditions with a reduced-budget run (marked † in the tables).
@@ -394,6 +412,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     let reduced_keys = reduced_keys(inp);
     let _ = writeln!(w, "## What was run (main campaign `{main}`)\n");
     campaigns_table(w, inp);
+    reduced_table(w, inp);
     neural::campaigns_line(w, inp);
     let _ = writeln!(
         w,
@@ -622,7 +641,12 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
          number of outcomes; *coverage*: mean fraction of the achievable histogram cells reached; \
          *at RPE level*: runs that moved the object fewer than {} times RPE's mean (a failed \
          exploration; the leaderboard's IQM trims such runs, so they are counted here); \
-         *paper*: the paper's value (one run, ±0.03) and *Δ* = our mean − paper.\n",
+         *paper*: the paper's value (one run, ±0.03) and *Δ* = our mean − paper. The paper's \
+         value is one run, so the yardstick for it is the spread of one of our runs, not the \
+         interval of our mean: *percentile* is the share of our runs of the condition below it \
+         (ties half), and *in PI* says whether it lies in our {level:.0}% prediction interval for \
+         one run (mean ± t(n − 1) · s · √(1 + 1/n) over the condition's runs, pooling its \
+         repetitions and replicates; normal theory).\n",
         crate::aggregate::RPE_LEVEL_FACTOR,
         level = crate::stats::CONFIDENCE * 100.0
     );
@@ -631,10 +655,13 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
         let _ = writeln!(w, "### {}\n", env_name(env));
         let _ = writeln!(
             w,
-            "| condition | n | epochs | KLC mean ± sd | {:.0}% CI | moved | coverage | at RPE level | paper | Δ |",
+            "| condition | n | epochs | KLC mean ± sd | {:.0}% CI | moved | coverage | at RPE level | paper | Δ | percentile | in PI |",
             crate::stats::CONFIDENCE * 100.0
         );
-        let _ = writeln!(w, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(
+            w,
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
+        );
         for c in inp.conditions.iter().filter(|c| c.key.env == *env) {
             let s = &c.final_klc;
             let mean_sd = match s.std {
@@ -656,9 +683,26 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
                 }
                 None => ("—".into(), "—".into()),
             };
+            let (percentile, in_pi) = match (&c.paper, one_run(inp, c)) {
+                (Some(p), Some(o)) => {
+                    let pi = match o.interval {
+                        Some((lo, hi)) if p.klc > lo && p.klc < hi => "yes".to_string(),
+                        Some(_) if p.klc < o.min => {
+                            format!("**no**: below all {} runs", o.n)
+                        }
+                        Some(_) if p.klc > o.max => {
+                            format!("**no**: above all {} runs", o.n)
+                        }
+                        Some(_) => "**no**".to_string(),
+                        None => "—".to_string(),
+                    };
+                    (format!("{:.0}%", o.percentile(p.klc)), pi)
+                }
+                _ => ("—".into(), "—".into()),
+            };
             let _ = writeln!(
                 w,
-                "| {}{} | {} | {} | {} | {} | {:.0} / {:.0} | {:.1} % | {} | {} | {} |",
+                "| {}{} | {} | {} | {} | {} | {:.0} / {:.0} | {:.1} % | {} | {} | {} | {percentile} | {in_pi} |",
                 describe(c),
                 dagger(&reduced_keys, c),
                 c.n_label(),
@@ -683,11 +727,86 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
             .map(|c| c.final_klc.n)
             .min()
             .unwrap_or(0);
+        if let Some(line) = paper_outside(inp, env) {
+            let _ = writeln!(w, "\n{line}");
+        }
         if min_n <= neural::SMALL_N {
             let _ = writeln!(w, "\n{}", neural::small_n_warning(min_n));
         }
         let _ = writeln!(w);
     }
+}
+
+/// The final KLC of one condition's runs, as the yardstick of a single run.
+struct OneRun {
+    sorted: Vec<f64>,
+    n: usize,
+    min: f64,
+    max: f64,
+    /// The 95% prediction interval for one run (None with fewer than 2 finite runs).
+    interval: Option<(f64, f64)>,
+}
+
+impl OneRun {
+    /// The share of the runs below `v`, ties counted half, in percent.
+    fn percentile(&self, v: f64) -> f64 {
+        let below = self.sorted.iter().filter(|&&x| x < v).count() as f64;
+        let ties = self.sorted.iter().filter(|&&x| x == v).count() as f64;
+        100.0 * (below + ties / 2.0) / self.n as f64
+    }
+}
+
+/// The final KLC of every run of `c` (None without runs).
+fn one_run(inp: &Context<'_>, c: &ConditionSummary) -> Option<OneRun> {
+    let mut sorted: Vec<f64> = c
+        .runs
+        .iter()
+        .map(|&i| inp.store.runs[i].final_point().klc)
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    Some(OneRun {
+        n: sorted.len(),
+        min: *sorted.first()?,
+        max: *sorted.last()?,
+        interval: crate::stats::prediction_interval(&sorted, crate::stats::CONFIDENCE).ok(),
+        sorted,
+    })
+}
+
+/// The paper's single-run values outside our 95% prediction interval for one run, in words.
+fn paper_outside(inp: &Context<'_>, env: &str) -> Option<String> {
+    let mut with = 0;
+    let mut outside = Vec::new();
+    for c in inp.conditions.iter().filter(|c| c.key.env == env) {
+        let (Some(p), Some(o)) = (&c.paper, one_run(inp, c)) else {
+            continue;
+        };
+        let Some((lo, hi)) = o.interval else {
+            continue;
+        };
+        with += 1;
+        if !(p.klc > lo && p.klc < hi) {
+            outside.push(format!(
+                "{} (paper {:.2}, our prediction interval [{lo:.2}, {hi:.2}], percentile {:.0}%)",
+                describe(c),
+                p.klc,
+                o.percentile(p.klc)
+            ));
+        }
+    }
+    (with > 0).then(|| {
+        format!(
+            "**The paper's values against one of our runs:** {} of {with} lie outside our {:.0}% \
+             prediction interval for one run{}",
+            outside.len(),
+            crate::stats::CONFIDENCE * 100.0,
+            if outside.is_empty() {
+                ".".to_string()
+            } else {
+                format!(": {}.", outside.join("; "))
+            }
+        )
+    })
 }
 
 /// The outcome scatters (the paper's Figure 3).

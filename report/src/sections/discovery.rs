@@ -20,10 +20,9 @@ impl Section for Discovery {
         &[CampaignRole::Compare, CampaignRole::Recipe]
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
-        let rows = discovery::measure_all(ctx.campaigns)?;
-        discovery::write_csv(out, &rows)?;
+        discovery::write_csv(out, ctx.discovery)?;
         let mut w = String::new();
-        discovery::section(&mut w, &rows, &discovery::validity(&rows));
+        discovery::section(&mut w, ctx.discovery, ctx.validity);
         Ok(w)
     }
 }
@@ -40,7 +39,7 @@ impl Section for Predicts {
         &[CampaignRole::Recipe]
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
-        let obs = predicts::observations(ctx.campaigns)?;
+        let obs = predicts::observations(ctx.campaigns, ctx.discovery);
         let lines = predicts::table(&obs);
         if !lines
             .iter()

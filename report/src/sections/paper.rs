@@ -91,19 +91,29 @@ impl Section for Claims {
     fn wants(&self) -> &'static [CampaignRole] {
         &[CampaignRole::Recipe]
     }
-    fn render(&self, ctx: &Context<'_>, _: &mut Output) -> Result<String, ReportError> {
+    fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
+        if let crate::claims::ClaimsInput::Evaluated { results, .. } = ctx.claims {
+            crate::claims::write_csv(out, results)?;
+        }
         words(|w| claims::claims(w, ctx))
     }
 }
 
-/// What the evidence supports, contradicts and leaves undecided (generated from the verdicts).
-pub struct Conclusions;
-impl Section for Conclusions {
+/// The findings, generated from the claims, the validity check and the budget campaigns.
+pub struct Findings;
+impl Section for Findings {
     fn name(&self) -> &'static str {
-        "conclusions"
+        "findings"
+    }
+    fn wants(&self) -> &'static [CampaignRole] {
+        &[
+            CampaignRole::Budget,
+            CampaignRole::Compare,
+            CampaignRole::Recipe,
+        ]
     }
     fn render(&self, ctx: &Context<'_>, _: &mut Output) -> Result<String, ReportError> {
-        words(|w| claims::conclusions(w, ctx))
+        words(|w| markdown::findings::findings(w, ctx))
     }
 }
 

@@ -1,0 +1,351 @@
+//! The *Findings* at the top of `REPORT.md`: a few sentences, each generated from the verdicts
+//! and numbers of the sections below (the claims marked with a [`Finding`] in the claims file,
+//! the validity check, the training-budget campaigns) and linking to the section that backs it.
+//! Nothing is written per result: change a number below and the sentence that states it changes.
+
+use std::fmt::Write as _;
+
+use super::claims::{Validity, validity_of};
+use crate::claims::{ClaimResult, ClaimsInput, Comparison, Finding, Statistic};
+use crate::context::Context;
+use crate::discovery::{Check, Measure};
+use crate::figures::{condition_name, env_name};
+use crate::stats;
+
+/// Anchors of the sections the findings link to.
+const CLAIMS: &str = "#the-papers-claims";
+const OURS: &str = "#our-findings-not-claims-of-the-paper";
+const VALIDITY: &str = "#what-the-exploration-discovered-without-counting-repeats";
+const BUDGET: &str = "#training-budget-sensitivity";
+
+/// A difference with its sign, in the statistic's units (cells reached in percentage points,
+/// said once after a range by [`unit`]).
+fn signed(statistic: Statistic, v: f64) -> String {
+    match statistic {
+        Statistic::Coverage => format!("{:+.1}", 100.0 * v),
+        Statistic::Moved => format!("{v:+.0}"),
+        _ => format!("{v:+.3}"),
+    }
+}
+
+/// The unit said after a difference or a range of them.
+fn unit(statistic: Statistic) -> &'static str {
+    match statistic {
+        Statistic::Coverage => " points",
+        _ => "",
+    }
+}
+
+/// A value in the statistic's units.
+fn plain(statistic: Statistic, v: f64) -> String {
+    match statistic {
+        Statistic::Coverage => format!("{:.1}%", 100.0 * v),
+        Statistic::Moved => format!("{v:.0}"),
+        _ => format!("{v:.3}"),
+    }
+}
+
+/// Whether the subject is worse (`Some(true)`) or better (`Some(false)`) than the reference in
+/// a comparison whose interval excludes 0; None where it does not (or there is none).
+fn direction(c: &Comparison) -> Option<bool> {
+    let (lo, hi) = c.bounds()?;
+    let higher = if lo > 0.0 {
+        true
+    } else if hi < 0.0 {
+        false
+    } else {
+        return None;
+    };
+    Some(higher != c.statistic.higher_is_better())
+}
+
+/// `goal-reaching error (mean) Δ +0.020 to +0.072, worse in 8 of 8 (intervals excluding 0)`,
+/// per statistic of `comparisons`, in order of appearance.
+fn per_statistic(comparisons: &[Comparison]) -> String {
+    let mut order: Vec<Statistic> = Vec::new();
+    for c in comparisons {
+        if !order.contains(&c.statistic) {
+            order.push(c.statistic);
+        }
+    }
+    order
+        .into_iter()
+        .map(|st| {
+            let these: Vec<&Comparison> =
+                comparisons.iter().filter(|c| c.statistic == st).collect();
+            let lo = these.iter().map(|c| c.diff).fold(f64::INFINITY, f64::min);
+            let hi = these
+                .iter()
+                .map(|c| c.diff)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let range = if these.len() == 1 {
+                format!("Δ {}{}", signed(st, lo), unit(st))
+            } else {
+                format!("Δ {} to {}{}", signed(st, lo), signed(st, hi), unit(st))
+            };
+            let worse = these.iter().filter(|c| direction(c) == Some(true)).count();
+            let better = these.iter().filter(|c| direction(c) == Some(false)).count();
+            format!(
+                "{} {range}: worse in {worse}, better in {better} of {} (intervals excluding 0)",
+                st.label(),
+                these.len()
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// The reference condition's mean of each statistic, where every comparison has one reference
+/// condition: `RGE-EFR 0.054 (goal-reaching error (mean))`.
+fn reference_levels(comparisons: &[Comparison]) -> String {
+    let Some(first) = comparisons.first() else {
+        return String::new();
+    };
+    if comparisons
+        .iter()
+        .any(|c| c.reference.algo != first.reference.algo || c.reference.env != first.reference.env)
+    {
+        return String::new();
+    }
+    let mut seen: Vec<Statistic> = Vec::new();
+    let mut parts = Vec::new();
+    for c in comparisons {
+        if !seen.contains(&c.statistic) {
+            seen.push(c.statistic);
+            parts.push(format!(
+                "{} {}",
+                c.statistic.label(),
+                plain(c.statistic, c.reference_mean)
+            ));
+        }
+    }
+    format!(
+        " ({}: {})",
+        condition_name(&first.reference.algo, &first.reference.variant),
+        parts.join(", ")
+    )
+}
+
+/// The verdict on the claim's own measure, labelled with the validity check's judgement of it.
+fn own_verdict(r: &ClaimResult, checks: &[Check]) -> String {
+    let label = match validity_of(r.claim.statistic, &r.comparisons, checks) {
+        Validity::Passes => String::new(),
+        Validity::Fails(envs) => {
+            format!(", which fails the validity check on {}", envs.join(" and "))
+        }
+        Validity::Unchecked => ", which the validity check does not cover".to_string(),
+    };
+    format!(
+        "**{}** on the {}{label}",
+        r.verdict.label(),
+        r.claim.statistic.label()
+    )
+}
+
+/// One claim of the paper with a twin: the validated verdict and its numbers first, then the
+/// verdict on the paper's measure.
+fn paper_claim(w: &mut String, title: &str, r: &ClaimResult, checks: &[Check], anchor: &str) {
+    match &r.twin {
+        Some(t) => {
+            let _ = writeln!(
+                w,
+                "- **{title}** ([`{}`]({anchor})): **{}** on the measures that pass the validity \
+                 check: {}{}. The same claim is {}.",
+                r.claim.id,
+                t.verdict.label(),
+                per_statistic(&t.comparisons),
+                reference_levels(&t.comparisons),
+                own_verdict(r, checks)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                w,
+                "- **{title}** ([`{}`]({anchor})): {}: {}{}.",
+                r.claim.id,
+                own_verdict(r, checks),
+                per_statistic(&r.comparisons),
+                reference_levels(&r.comparisons),
+            );
+        }
+    }
+}
+
+/// Claims of ours on one measure each: one clause per claim.
+fn our_claims(w: &mut String, title: &str, rs: &[&ClaimResult], checks: &[Check]) {
+    if rs.is_empty() {
+        return;
+    }
+    let parts: Vec<String> = rs
+        .iter()
+        .map(|r| {
+            format!(
+                "`{}` {}: {}",
+                r.claim.id,
+                own_verdict(r, checks),
+                per_statistic(&r.comparisons)
+            )
+        })
+        .collect();
+    let _ = writeln!(w, "- **{title}** ([ours]({OURS})): {}.", parts.join("; "));
+}
+
+/// The training-budget sentence: each budget series' goal-reaching error per budget, against
+/// RGE-EFR's on the same environment (Welch's interval at the largest budget).
+fn budget(w: &mut String, inp: &Context<'_>) {
+    for s in &inp.budget.series {
+        let goal = |campaign: &str, algo: &str| -> Vec<f64> {
+            let values: Vec<(i64, f64)> = inp
+                .discovery
+                .iter()
+                .filter(|r| {
+                    r.campaign.name == campaign
+                        && r.run.key.env == s.key.env
+                        && r.run.key.algo == algo
+                        && (algo != s.key.algo || r.run.key == s.key)
+                })
+                .filter_map(|r| Some((r.run.seed, r.discovery.as_ref()?.goal_error_mean)))
+                .collect();
+            crate::aggregate::seed_means(&values)
+                .into_iter()
+                .map(|v| v.1)
+                .collect()
+        };
+        let main = &inp.campaigns.main.name;
+        let efr = goal(main, "rge-efr");
+        let mut points: Vec<(i64, Vec<f64>)> = Vec::new();
+        for p in s.points.iter().chain(&s.main) {
+            for c in &p.campaigns {
+                let v = goal(c, &s.key.algo);
+                if !v.is_empty() {
+                    points.push((p.iterations, v));
+                }
+            }
+        }
+        points.sort_by_key(|p| p.0);
+        let (Some(last), false) = (points.last(), efr.is_empty()) else {
+            continue;
+        };
+        let listed: Vec<String> = points
+            .iter()
+            .map(|(it, v)| format!("{:.3} at {it} iterations (n = {})", stats::mean(v), v.len()))
+            .collect();
+        let vs_efr = match stats::welch_interval(&last.1, &efr, stats::CONFIDENCE) {
+            Ok(i) => format!(
+                "; at {} iterations it is {:+.3} [{:+.3}, {:+.3}] from RGE-EFR's {:.3}",
+                last.0,
+                i.estimate,
+                i.lo,
+                i.hi,
+                stats::mean(&efr)
+            ),
+            Err(_) => String::new(),
+        };
+        let _ = writeln!(
+            w,
+            "- **The training budget** ([budget]({BUDGET})): {}, {}: goal-reaching error {}{vs_efr} \
+             ({:.0}% Welch interval).",
+            env_name(&s.key.env),
+            crate::figures::outcomes::describe_key(&s.key),
+            listed.join(", "),
+            stats::CONFIDENCE * 100.0
+        );
+    }
+}
+
+/// The validity sentence: where the final KLC fails, and the goal error's P(better).
+fn validity(w: &mut String, checks: &[Check]) {
+    let line = |m: Measure| -> Vec<&Check> { checks.iter().filter(|c| c.measure == m).collect() };
+    let klc = line(Measure::FinalKlc);
+    let goal = line(Measure::GoalErrorMean);
+    if klc.is_empty() {
+        return;
+    }
+    let each = |cs: &[&Check]| -> String {
+        cs.iter()
+            .map(|c| {
+                format!(
+                    "{} {:.2} ({})",
+                    env_name(&c.env),
+                    c.p_better,
+                    if c.passes { "passes" } else { "fails" }
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(
+        w,
+        "- **KL-coverage as a measure of discovery** ([validity check]({VALIDITY})): the \
+         probability that a run of a goal space encoding the object's position beats a control \
+         run (random projection, untrained network) is, on the final KLC, {}; on the \
+         goal-reaching error, {}. A measure that ranks the controls level with or ahead of \
+         position-encoding goal spaces measures how often the object moved, not what was \
+         discovered.",
+        each(&klc),
+        each(&goal)
+    );
+}
+
+/// The Findings section.
+pub fn findings(w: &mut String, inp: &Context<'_>) {
+    let ClaimsInput::Evaluated { results, .. } = inp.claims else {
+        return;
+    };
+    let tagged = |f: Finding| -> Vec<&ClaimResult> {
+        results
+            .iter()
+            .filter(|r| r.claim.finding == Some(f))
+            .collect()
+    };
+    let _ = writeln!(w, "## Findings\n");
+    let _ = writeln!(
+        w,
+        "Generated from the verdicts and numbers of the sections they link to (nothing here is \
+         written by hand per result). Δ is subject − reference of the means over repetitions; \
+         *worse* and *better* count the comparisons whose {:.0}% interval excludes 0.\n",
+        stats::CONFIDENCE * 100.0
+    );
+    for r in tagged(Finding::LearnedVsRpe) {
+        paper_claim(
+            w,
+            "Learned goal spaces vs random exploration",
+            r,
+            inp.validity,
+            CLAIMS,
+        );
+    }
+    for r in tagged(Finding::LearnedVsEfr) {
+        let env = r
+            .comparisons
+            .first()
+            .map(|c| env_name(&c.subject.env))
+            .unwrap_or_default();
+        let title = format!("Learned goal spaces vs RGE-EFR on {env} (the paper's main claim)");
+        paper_claim(w, &title, r, inp.validity, CLAIMS);
+    }
+    our_claims(
+        w,
+        "Learned goal spaces vs the controls",
+        &tagged(Finding::LearnedVsControls),
+        inp.validity,
+    );
+    for r in tagged(Finding::GoalSamplers) {
+        paper_claim(
+            w,
+            "KDE vs Gaussian-prior goals (the paper's Figure 4; subject: Gaussian)",
+            r,
+            inp.validity,
+            CLAIMS,
+        );
+    }
+    our_claims(
+        w,
+        "Goals in the arrow's angle",
+        &tagged(Finding::Angle),
+        inp.validity,
+    );
+    budget(w, inp);
+    validity(w, inp.validity);
+    let _ = writeln!(w);
+}
