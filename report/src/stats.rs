@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 
 pub mod components;
 #[cfg(test)]
-mod coverage;
+pub(crate) mod coverage;
 pub mod interval;
 pub mod rliable;
 pub use interval::{

@@ -594,6 +594,7 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             "data/curves.csv",
             "data/discovery_by_run.csv",
             "data/claims.csv",
+            "data/validity.csv",
             "files.txt",
         ] {
             v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));

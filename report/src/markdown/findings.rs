@@ -253,37 +253,49 @@ fn budget(w: &mut String, inp: &Context<'_>) {
     }
 }
 
-/// The validity sentence: where the final KLC fails, and the goal error's P(better).
+/// The validity sentence: per environment, the final KLC's and the goal error's P(better)
+/// against the controls, and whether each passes.
 fn validity(w: &mut String, checks: &[Check]) {
-    let line = |m: Measure| -> Vec<&Check> { checks.iter().filter(|c| c.measure == m).collect() };
-    let klc = line(Measure::FinalKlc);
-    let goal = line(Measure::GoalErrorMean);
-    if klc.is_empty() {
+    let mut envs: Vec<&str> = checks.iter().map(|c| c.env.as_str()).collect();
+    envs.dedup();
+    if envs.is_empty() {
         return;
     }
-    let each = |cs: &[&Check]| -> String {
-        cs.iter()
-            .map(|c| {
-                format!(
-                    "{} {:.2} ({})",
-                    env_name(&c.env),
-                    c.p_better,
-                    if c.passes { "passes" } else { "fails" }
-                )
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
+    let line = |m: Measure, env: &str| -> Option<String> {
+        let cs: Vec<&Check> = checks
+            .iter()
+            .filter(|c| c.measure == m && c.env == env)
+            .collect();
+        let lo = cs.iter().map(|c| c.p_better).fold(f64::INFINITY, f64::min);
+        let hi = cs
+            .iter()
+            .map(|c| c.p_better)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let passes = crate::discovery::passes(checks, m, env)?;
+        Some(format!(
+            "{} {lo:.2} to {hi:.2} ({})",
+            m.label(),
+            if passes { "passes" } else { "fails" }
+        ))
     };
+    let per_env: Vec<String> = envs
+        .iter()
+        .filter_map(|env| {
+            let klc = line(Measure::FinalKlc, env)?;
+            let goal = line(Measure::GoalErrorMean, env)?;
+            Some(format!("{}: {klc}, {goal}", env_name(env)))
+        })
+        .collect();
     let _ = writeln!(
         w,
         "- **KL-coverage as a measure of discovery** ([validity check]({VALIDITY})): the \
          probability that a run of a goal space encoding the object's position beats a control \
-         run (random projection, untrained network) is, on the final KLC, {}; on the \
-         goal-reaching error, {}. A measure that ranks the controls level with or ahead of \
-         position-encoding goal spaces measures how often the object moved, not what was \
-         discovered.",
-        each(&klc),
-        each(&goal)
+         run, against each kind of control (random projection, untrained networks): {}. A \
+         measure passes when the lower bound of every such interval is above {}; one that \
+         ranks the controls level with or ahead of position-encoding goal spaces measures how \
+         often the object moved, not what was discovered.",
+        per_env.join("; "),
+        crate::discovery::PASS_LOWER_BOUND
     );
 }
 

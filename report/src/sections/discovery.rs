@@ -21,6 +21,7 @@ impl Section for Discovery {
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         discovery::write_csv(out, ctx.discovery)?;
+        discovery::write_validity_csv(out, ctx.validity)?;
         let mut w = String::new();
         discovery::section(&mut w, ctx.discovery, ctx.validity);
         Ok(w)
