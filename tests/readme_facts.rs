@@ -238,7 +238,10 @@ fn the_validity_check_says_what_the_readme_says() {
     let report = read("report/out/REPORT.md");
     // The per-measure verdict line, and the rows
     // `| measure | env | better | control | encodes | control | repetitions | P [CI] | check |`.
-    let verdicts = captures(&report, "**Per measure and environment** (every kind of control): {}");
+    let verdicts = captures(
+        &report,
+        "**Per measure and environment** (every kind of control): {}",
+    );
     let rows = |measure: &str, env: &str| -> Vec<(String, f64)> {
         let prefix = format!("| {measure} | {env} |");
         let rows: Vec<(String, f64)> = report
@@ -263,7 +266,10 @@ fn the_validity_check_says_what_the_readme_says() {
             .into_iter()
             .find(|r| r.0 == "random projection")
             .unwrap();
-        assert!(projection.1 < 1.0 / 3.0, "final KLC on {env}: {projection:?}");
+        assert!(
+            projection.1 < 1.0 / 3.0,
+            "final KLC on {env}: {projection:?}"
+        );
     }
     for measure in [
         "KLC of moved outcomes",

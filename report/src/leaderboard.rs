@@ -88,6 +88,22 @@ pub struct Entry {
     /// Its normalised goal-reaching errors per task, aligned with `tasks` (empty where not
     /// measured).
     pub goals_by_task: Vec<Vec<f64>>,
+    /// The ranking statistic: the mean over its tasks of the per-task IQM of the normalised
+    /// goal-reaching error, (point, lo, hi) with a stratified bootstrap interval. Unlike one IQM
+    /// over all tasks, it does not pool tasks whose errors sit at different floors.
+    pub goal_task_mean: Option<(f64, f64, f64)>,
+    /// The IQM of the normalised goal-reaching error per task, aligned with `tasks`.
+    pub goal_task_iqm: Vec<Option<f64>>,
+    /// The bootstrap replicates of [`Entry::goal_task_mean`] (for the rank interval).
+    pub goal_task_draws: Vec<f64>,
+    /// Its rank's 95% interval over the bootstrap replicates (complete entries only).
+    pub rank_interval: Option<(usize, usize)>,
+    /// The counts behind `poi_vs_efr`: pairs won (ties half) of pairs, summed over tasks; and
+    /// the independent units (the smaller side's repetitions, summed over tasks) for an exact
+    /// bound where every pair goes one way.
+    pub poi_counts: Option<(f64, usize, usize)>,
+    /// Mean final cell coverage per environment (each run once), in environment order.
+    pub coverage_by_env: Vec<(String, f64)>,
 }
 
 impl Entry {
@@ -326,6 +342,52 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                     stats::derive_seed(seed, &format!("{label}|poi")),
                 )
             };
+            let poi_counts = if algo == "rge-efr" || !per.keys().all(|t| efr.contains_key(t)) {
+                None
+            } else {
+                let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
+                let (xs, ys) = if on_goal_error(&goals_by_task, &efr_goals) {
+                    (goals_by_task.clone(), efr_goals)
+                } else {
+                    (
+                        finals_by_task.clone(),
+                        per.keys().map(|t| efr[t].0.clone()).collect(),
+                    )
+                };
+                let (wins, pairs) = stats::improvement_counts(&xs, &ys);
+                let units = xs.iter().zip(&ys).map(|(a, b)| a.len().min(b.len())).sum();
+                Some((wins, pairs, units))
+            };
+            let goal_task_iqm: Vec<Option<f64>> = goals_by_task
+                .iter()
+                .map(|g| (!g.is_empty()).then(|| iqm(g)))
+                .collect();
+            let (goal_task_mean, goal_task_draws) = match stats::per_task_mean_bootstrap(
+                &goals_by_task,
+                iqm,
+                n_boot,
+                stats::derive_seed(seed, &format!("{label}|goal-per-task")),
+            ) {
+                Some((point, draws)) => {
+                    let (lo, hi) = stats::percentile_ci(&draws, alpha);
+                    (Some((point, lo, hi)), draws)
+                }
+                None => (None, Vec::new()),
+            };
+            // Per environment, each run once (a baseline's runs serve both tasks of theirs).
+            let mut coverage_by_env: Vec<(String, f64)> = Vec::new();
+            for (t, _) in &per {
+                let env = &tasks[*t].0;
+                if coverage_by_env.iter().any(|(e, _)| e == env) {
+                    continue;
+                }
+                let values: Vec<f64> = per
+                    .iter()
+                    .filter(|(u, _)| tasks[**u].0 == *env && (!shared.contains(&key) || *u == t))
+                    .flat_map(|(_, w)| w.3.iter().copied())
+                    .collect();
+                coverage_by_env.push((env.clone(), stats::mean(&values)));
+            }
             let untrained = untrained.get(&key).copied();
             let at_rpe_level = at_rpe.get(&key).copied();
             let all: Vec<f64> = finals.iter().flatten().copied().collect();
@@ -353,6 +415,12 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 coverage_mean,
                 finals_by_task,
                 goals_by_task,
+                goal_task_mean,
+                goal_task_iqm,
+                goal_task_draws,
+                rank_interval: None,
+                poi_counts,
+                coverage_by_env,
             })
         })
         .collect();
@@ -370,6 +438,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 ))
             })
     });
+    rank_intervals(&mut entries, n_tasks, alpha);
     Leaderboard {
         tasks,
         entries,
@@ -378,14 +447,129 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     }
 }
 
+/// Each complete entry's rank interval: its rank among the complete entries in every bootstrap
+/// replicate of the ranking statistic (each entry's replicates drawn independently, replicate
+/// `b` of every entry ranked together), and the `1 − alpha` percentiles of those ranks.
+fn rank_intervals(entries: &mut [Entry], n_tasks: usize, alpha: f64) {
+    let ranked: Vec<usize> = (0..entries.len())
+        .filter(|&i| entries[i].is_complete(n_tasks) && !entries[i].goal_task_draws.is_empty())
+        .collect();
+    let Some(n_boot) = ranked
+        .iter()
+        .map(|&i| entries[i].goal_task_draws.len())
+        .min()
+    else {
+        return;
+    };
+    let mut ranks: Vec<Vec<f64>> = vec![Vec::with_capacity(n_boot); ranked.len()];
+    for b in 0..n_boot {
+        for (a, &i) in ranked.iter().enumerate() {
+            let v = entries[i].goal_task_draws[b];
+            let better = ranked
+                .iter()
+                .filter(|&&j| entries[j].goal_task_draws[b] < v)
+                .count();
+            ranks[a].push((better + 1) as f64);
+        }
+    }
+    for (a, &i) in ranked.iter().enumerate() {
+        let (lo, hi) = stats::percentile_ci(&ranks[a], alpha);
+        entries[i].rank_interval = Some((lo.floor() as usize, hi.ceil() as usize));
+    }
+}
+
 /// What the leaderboard ranks by: the IQM of the normalised goal-reaching error, which does
 /// not count repeated outcomes (entries without it, e.g. runs without outcomes, after those
 /// with it, by final KLC).
 fn rank_value(e: &Entry) -> f64 {
-    match e.goal_iqm {
+    match e.goal_task_mean {
         Some(g) => g.0,
         None => 10.0 + e.final_iqm.0,
     }
+}
+
+/// The leaderboard's data file, under the report's `data/`.
+pub const CSV_FILE: &str = "leaderboard.csv";
+
+/// `data/leaderboard.csv`: one row per entry, in rank order, with every number of both tables.
+pub fn write_csv(
+    out: &mut crate::output::Output,
+    lb: &Leaderboard,
+) -> Result<(), crate::ReportError> {
+    use crate::data::num;
+    use std::fmt::Write as _;
+    let task_cols: Vec<String> = lb
+        .tasks
+        .iter()
+        .map(|(env, l)| format!("goal_iqm_{env}_{l}"))
+        .collect();
+    let mut s = format!(
+        "rank,rank_lo,rank_hi,campaign,algo,sampler,variant,tasks,repetitions,untrained,\
+         at_rpe_level,goal_task_mean,goal_task_mean_lo,goal_task_mean_hi,{},final_iqm,\
+         final_iqm_lo,final_iqm_hi,auc_iqm,auc_iqm_lo,auc_iqm_hi,coverage_by_env,poi_vs_efr,\
+         poi_lo,poi_hi,poi_wins,poi_pairs,poi_repetitions,paper\n",
+        task_cols.join(",")
+    );
+    let n = lb.tasks.len();
+    for (i, e) in lb.entries.iter().enumerate() {
+        let per_task: Vec<String> = lb
+            .tasks
+            .iter()
+            .map(|t| {
+                num(e
+                    .tasks
+                    .iter()
+                    .position(|x| x == t)
+                    .and_then(|j| e.goal_task_iqm.get(j).copied().flatten()))
+            })
+            .collect();
+        let triple = |t: Option<(f64, f64, f64)>| {
+            format!(
+                "{},{},{}",
+                num(t.map(|x| x.0)),
+                num(t.map(|x| x.1)),
+                num(t.map(|x| x.2))
+            )
+        };
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            if e.is_complete(n) {
+                (i + 1).to_string()
+            } else {
+                String::new()
+            },
+            e.rank_interval.map(|r| r.0.to_string()).unwrap_or_default(),
+            e.rank_interval.map(|r| r.1.to_string()).unwrap_or_default(),
+            e.campaign,
+            e.algo,
+            e.sampler,
+            e.variant,
+            e.tasks.len(),
+            e.n_reps,
+            e.untrained.map(|k| k.to_string()).unwrap_or_default(),
+            e.at_rpe_level.map(|k| k.to_string()).unwrap_or_default(),
+            triple(e.goal_task_mean),
+            per_task.join(","),
+            triple(Some(e.final_iqm)),
+            triple(e.auc_iqm),
+            e.coverage_by_env
+                .iter()
+                .map(|(env, c)| format!("{env}:{c}"))
+                .collect::<Vec<_>>()
+                .join(";"),
+            triple(e.poi_vs_efr),
+            e.poi_counts.map(|c| c.0.to_string()).unwrap_or_default(),
+            e.poi_counts.map(|c| c.1.to_string()).unwrap_or_default(),
+            e.poi_counts.map(|c| c.2.to_string()).unwrap_or_default(),
+            num(e.paper),
+        );
+    }
+    out.write(
+        std::path::Path::new(crate::data::DIR).join(CSV_FILE),
+        s.as_bytes(),
+    )?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -22,8 +22,9 @@ pub use interval::{
     IntervalError, TInterval, prediction_interval, student_t_quantile, t_interval, welch_interval,
 };
 pub use rliable::{
-    AucError, area_under_curve, iqm, probability_of_improvement, probability_of_improvement_ci,
-    stratified_bootstrap_ci,
+    AucError, area_under_curve, exact_bound_at_extreme, improvement_counts, iqm,
+    per_task_mean_bootstrap, percentile_ci, probability_of_improvement,
+    probability_of_improvement_ci, stratified_bootstrap_ci,
 };
 
 /// The confidence level of every interval of the report: the tables, the figures' bands, the

@@ -595,6 +595,7 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             "data/discovery_by_run.csv",
             "data/claims.csv",
             "data/validity.csv",
+            "data/leaderboard.csv",
             "files.txt",
         ] {
             v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));
@@ -731,7 +732,7 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     assert_eq!(s.unused_campaigns, ["baselines"]);
     let md = read(&out);
     // The largest drop of the store: ranked first, marked new, with its campaign.
-    let row = line(&md, "| 1 |", "RGE-RANDOM-PROJECTION");
+    let row = line(&md, "| 1 [", "RGE-RANDOM-PROJECTION");
     assert!(
         row.contains("(new)") && row.contains("compare-random-projection"),
         "{row}"
@@ -739,7 +740,10 @@ fn a_compare_campaign_is_ranked_in_the_leaderboard_and_drawn() {
     // A compare campaign has no RPE of its own: "at RPE level" uses the main campaign's.
     let cells: Vec<&str> = row.split('|').map(str::trim).collect();
     assert_eq!(cells[8], "**6**", "at RPE level: {row}");
-    assert!(cells[12].ends_with('%'), "coverage: {row}");
+    assert!(cells[12].ends_with('%'), "coverage per environment: {row}");
+    // Its rank comes with an interval; its per-task IQMs are in their own table.
+    assert!(cells[1].starts_with("1 [1, "), "rank interval: {row}");
+    assert!(md.contains("**Per task**"));
     assert!(md.contains("1 `compare-*` campaign in the store"));
     // Its one-page summary: rank, failures, coverage, latent R², PoI against each algorithm.
     let page_path = out.join("compare_compare-random-projection.md");

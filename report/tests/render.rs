@@ -218,11 +218,12 @@ fn renders_report_and_figures_with_the_right_numbers() {
     }
     // REPORT.md, 2 KLC and 2 coverage figures, 4 outcome scatters, the paper's 3 illustrations
     // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 5 CSV files
-    // (final values, curves, discovery measures, the validity check, the claims' comparisons),
-    // the list of files.
+    // (final values, curves, discovery measures, the validity check, the claims' comparisons;
+    // no leaderboard without a learned goal space), the list of files.
     let env_figures = cfg!(feature = "environment-figures");
     let illustrations = if env_figures { 3 } else { 1 };
     assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 5 + 1);
+    assert!(!out.join("data/leaderboard.csv").exists());
     for (name, drawn) in [
         ("fig1_environments.svg", env_figures),
         ("fig5_radial_flow.svg", true),

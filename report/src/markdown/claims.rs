@@ -669,12 +669,33 @@ fn tasks_cell(e: &Entry, all: usize) -> String {
     }
 }
 
+/// The probability of improvement over RGE-EFR with its counts: the bootstrap interval, or at
+/// 0 or 1 (every pair one way, where the bootstrap interval is degenerate) the exact bound.
+fn poi_cell(e: &Entry, alpha: f64) -> String {
+    let (Some((p, lo, hi)), Some((wins, pairs, units))) = (e.poi_vs_efr, e.poi_counts) else {
+        return "—".into();
+    };
+    let counts = format!("{wins} of {pairs} pairs");
+    // At an extreme, every pair goes one way: so does every repetition.
+    let extreme = match wins {
+        w if w == 0.0 => Some(0.0),
+        w if w == pairs as f64 => Some(units as f64),
+        _ => None,
+    };
+    match extreme.and_then(|k| crate::stats::exact_bound_at_extreme(k, units, alpha)) {
+        Some((0.0, b)) => format!("{p:.3}, {counts}; exact bound ≤ {b:.3} ({units} repetitions)"),
+        Some((b, _)) => format!("{p:.3}, {counts}; exact bound ≥ {b:.3} ({units} repetitions)"),
+        None => format!("{p:.3} [{lo:.3}, {hi:.3}], {counts}"),
+    }
+}
+
 /// The leaderboard section.
 pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
     let lb = inp.leaderboard;
     if lb.entries.is_empty() {
         return;
     }
+    let alpha = 1.0 - lb.confidence;
     let _ = writeln!(w, "## Leaderboard (rliable statistics)\n");
     let tasks: Vec<String> = lb
         .tasks
@@ -684,73 +705,70 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(
         w,
         "Every algorithm of the main campaign, and every learner added with `ugl compare` \
-         (campaigns `compare-*`, run on the same cells and seeds), ranked over the {} tasks ({}) \
-         with the statistics of Agarwal et al. (2021, *rliable*). Scores are normalised so that \
-         tasks pool: KLC divided by the KLC of outcomes all in one cell ({}), so 0 is a \
-         perfect cover and 1 is \"the object never moved\"; \
-         lower is better. *Goal error*: interquartile mean (IQM) over all repetitions of all \
-         tasks of the normalised goal-reaching error (the mean distance from a fixed grid of \
-         test goals over the achievable outcomes to the nearest outcome reached, divided by the \
+         (campaigns `compare-*`, run on the same cells and seeds), over the {} tasks ({}), with \
+         the statistics of Agarwal et al. (2021, *rliable*). A value is a repetition's (the mean \
+         over its exploration replicates). **Ranked by the goal-reaching error**, which passes \
+         the validity check: per task, the interquartile mean (IQM) of the normalised error (the \
+         mean distance from a fixed grid of test goals to the nearest outcome, divided by the \
          error of an exploration that never moved the object: 0 reaches every goal, 1 never \
-         moved it). It does not count repeated outcomes, and the section *What the explorations \
-         discovered* checks it against the controls; the ranking uses it. *Final*: IQM of the \
-         normalised final KLC; *speed*: IQM of the normalised area under the KLC curve (the mean \
-         KLC during exploration); *P(better than EFR)*: probability that a run beats a run of \
-         RGE-EFR on the same task on the ranking statistic (the goal error; the final KLC for \
-         an entry without it), averaged over tasks (0.5: no difference). A value is a \
-         repetition's (the mean over its exploration replicates). Brackets: {:.0}% \
-         stratified bootstrap intervals ({} resamples, repetitions resampled within each task, \
-         seeded). \
-         Baselines do not depend on the latent size: their runs serve both tasks of an \
-         environment for the probability of improvement, and count once in their own IQM, mean \
-         and run count (one stratum per environment). *Paper*: the mean of the paper's normalised single-run final values on the \
-         same tasks, where it gives all of them. *Untrained*: runs whose network did not leave \
-         the mean-image plateau (\"Did the goal spaces learn?\"); their scores are those of an \
-         untrained random projection and are counted in, not hidden. *At RPE level*: runs that \
-         moved the object fewer than twice as often as RPE (failed explorations, which the IQM \
-         trims); *mean*: the untrimmed mean of the normalised final KLC, which they do weigh \
-         on. *Coverage*: the mean fraction of the achievable histogram cells its outcomes \
-         reached (each run once). KL-coverage also rewards moving the object often (every \
-         episode that leaves it in place adds to one cell), so an entry can rank high here \
-         with little coverage: read the two together. †: trained or explored below the paper's budget (\"What was run\"). Ranked by *goal error*; entries missing a task come last.\n",
+         moved it), then the **mean of the per-task IQMs**, which does not pool tasks whose \
+         errors sit at different floors (RGE-EFR's is lower on ArmBall than on ArmArrow). \
+         *Rank*: with its {level:.0}% interval over the bootstrap replicates (every entry's \
+         replicate ranked together; entries whose intervals overlap are not told apart). \
+         *Final*: IQM of the final KLC normalised by the KLC of outcomes all in one cell ({}; \
+         0 a perfect cover, 1 the object never moved), pooled over the tasks; *speed*: likewise \
+         for the area under the KLC curve; KL-coverage fails the validity check, so neither \
+         ranks. *P(better than EFR)*: the probability that a repetition of the entry beats one \
+         of RGE-EFR on the same task, on the goal error (the final KLC for an entry without \
+         it), averaged over tasks, with the pairs it counts; where every pair goes one way the \
+         bootstrap interval is degenerate, and the exact (Clopper-Pearson) bound is given over \
+         the independent repetitions (the smaller side's, summed over tasks) instead. Brackets: \
+         {level:.0}% stratified bootstrap intervals ({} resamples, repetitions resampled within \
+         each task, seeded). *Coverage*: the mean fraction of the achievable cells reached, per \
+         environment (each run once). *Untrained*: runs whose network did not leave the \
+         mean-image plateau, counted in; *at RPE level*: runs that moved the object fewer than \
+         twice as often as RPE. *Paper*: the mean of the paper's normalised single-run final \
+         values on the same tasks, where it gives all of them (never for the corrected variants, \
+         which the paper did not run). Baselines do not depend on the latent size: their runs \
+         serve both tasks of an environment. †: trained or explored below the paper's budget \
+         (\"What was run\"); entries missing a task come last. Every number: \
+         [`data/{}`](data/{}).\n",
         lb.tasks.len(),
         tasks.join(", "),
         super::paper_envs(|e| format!("ln {} on {}", e.klc.achievable_cells, e.display)),
-        lb.confidence * 100.0,
-        lb.n_boot
+        lb.n_boot,
+        crate::leaderboard::CSV_FILE,
+        crate::leaderboard::CSV_FILE,
+        level = lb.confidence * 100.0,
+    );
+    let envs: Vec<&str> = {
+        let mut v: Vec<&str> = lb.tasks.iter().map(|t| t.0.as_str()).collect();
+        v.dedup();
+        v
+    };
+    let _ = writeln!(
+        w,
+        "| rank | algorithm | goal sampler | campaign | tasks | repetitions | untrained | at RPE level | goal error (mean of task IQMs) | final (IQM) | speed (IQM) | coverage ({}) | P(better than EFR) | paper |",
+        envs.iter()
+            .map(|e| env_name(e))
+            .collect::<Vec<_>>()
+            .join(" / ")
     );
     let _ = writeln!(
         w,
-        "| rank | algorithm | goal sampler | campaign | tasks | repetitions | untrained | at RPE level | goal error (IQM) | final (IQM) | final (mean) | coverage | speed (IQM) | P(better than EFR) | paper |"
-    );
-    let _ = writeln!(
-        w,
-        "|---:|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|"
     );
     let n = lb.tasks.len();
     for (i, e) in lb.entries.iter().enumerate() {
-        let new = e.campaign != inp.campaigns.main.name;
-        let name = condition_name(&e.algo, &e.variant);
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.1}% | {} | {} | {} |",
-            if e.is_complete(n) {
-                (i + 1).to_string()
-            } else {
-                "—".into()
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            match (e.is_complete(n), e.rank_interval) {
+                (true, Some((lo, hi))) => format!("{} [{lo}, {hi}]", i + 1),
+                (true, None) => (i + 1).to_string(),
+                (false, _) => "—".into(),
             },
-            {
-                let name = if e.reduced_budget {
-                    format!("{name} †")
-                } else {
-                    name
-                };
-                if new {
-                    format!("**{name}** (new)")
-                } else {
-                    name
-                }
-            },
+            entry_name(e, inp),
             sampler_name(&e.sampler),
             super::campaign_name(&e.campaign),
             tasks_cell(e, n),
@@ -765,15 +783,64 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
                 Some(k) => format!("**{k}**"),
                 None => "—".into(),
             },
-            e.goal_iqm.map(ci3).unwrap_or_else(|| "—".into()),
+            e.goal_task_mean.map(ci3).unwrap_or_else(|| "—".into()),
             ci3(e.final_iqm),
-            e.final_mean,
-            100.0 * e.coverage_mean,
             e.auc_iqm.map(ci3).unwrap_or_else(|| "—".into()),
-            e.poi_vs_efr.map(ci3).unwrap_or_else(|| "—".into()),
+            envs.iter()
+                .map(|env| {
+                    e.coverage_by_env
+                        .iter()
+                        .find(|(x, _)| x == env)
+                        .map(|(_, c)| format!("{:.1}%", 100.0 * c))
+                        .unwrap_or_else(|| "—".into())
+                })
+                .collect::<Vec<_>>()
+                .join(" / "),
+            poi_cell(e, alpha),
             e.paper
                 .map(|p| format!("{p:.3}"))
                 .unwrap_or_else(|| "—".into())
+        );
+    }
+    // Per task: the IQM of the normalised goal error and the rank within the task.
+    let _ = writeln!(
+        w,
+        "\n**Per task**: the IQM of the normalised goal-reaching error, and (in brackets) the \
+         entry's rank among the entries with that task.\n"
+    );
+    let _ = writeln!(
+        w,
+        "| algorithm | goal sampler | campaign | {} |\n|---|---|---|{}",
+        tasks.join(" | "),
+        "---:|".repeat(lb.tasks.len())
+    );
+    let value = |e: &Entry, t: &crate::leaderboard::Task| -> Option<f64> {
+        let i = e.tasks.iter().position(|x| x == t)?;
+        e.goal_task_iqm.get(i).copied().flatten()
+    };
+    for e in &lb.entries {
+        let cells: Vec<String> = lb
+            .tasks
+            .iter()
+            .map(|t| match value(e, t) {
+                Some(v) => {
+                    let rank = 1 + lb
+                        .entries
+                        .iter()
+                        .filter(|o| value(o, t).is_some_and(|x| x < v))
+                        .count();
+                    format!("{v:.3} ({rank})")
+                }
+                None => "—".into(),
+            })
+            .collect();
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} |",
+            entry_name(e, inp),
+            sampler_name(&e.sampler),
+            super::campaign_name(&e.campaign),
+            cells.join(" | ")
         );
     }
     let new = inp.campaigns.compare.len();
@@ -803,6 +870,22 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
         }
     );
     let _ = writeln!(w);
+}
+
+/// An entry's name in the leaderboard: † for a reduced budget, bold and "(new)" for a
+/// `compare-*` learner.
+fn entry_name(e: &Entry, inp: &Context<'_>) -> String {
+    let name = condition_name(&e.algo, &e.variant);
+    let name = if e.reduced_budget {
+        format!("{name} †")
+    } else {
+        name
+    };
+    if e.campaign != inp.campaigns.main.name {
+        format!("**{name}** (new)")
+    } else {
+        name
+    }
 }
 
 /// The design's two levels measured on the main campaign's own runs: the median over its

@@ -126,7 +126,10 @@ impl Section for Leaderboard {
     fn wants(&self) -> &'static [CampaignRole] {
         &[CampaignRole::Compare]
     }
-    fn render(&self, ctx: &Context<'_>, _: &mut Output) -> Result<String, ReportError> {
+    fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
+        if !ctx.leaderboard.entries.is_empty() {
+            crate::leaderboard::write_csv(out, ctx.leaderboard)?;
+        }
         words(|w| claims::leaderboard(w, ctx))
     }
 }

@@ -102,6 +102,81 @@ pub fn stratified_bootstrap_ci(
     Some((point, lo, hi))
 }
 
+/// The mean over tasks of a per-task statistic (`stat` of each task's runs), which does not
+/// pool tasks whose scores sit at different floors, and `n_boot` bootstrap replicates of it
+/// (runs resampled within each task): `(point, replicates in draw order)`. None when a task has
+/// no run or `n_boot == 0`. Deterministic for a `seed`, drawn replicate by replicate, task by task.
+pub fn per_task_mean_bootstrap(
+    runs: &[Vec<f64>],
+    stat: impl Fn(&[f64]) -> f64,
+    n_boot: usize,
+    seed: u64,
+) -> Option<(f64, Vec<f64>)> {
+    if n_boot == 0 || runs.is_empty() || runs.iter().any(Vec::is_empty) {
+        return None;
+    }
+    let mean_of =
+        |tasks: &[Vec<f64>]| tasks.iter().map(|t| stat(t)).sum::<f64>() / tasks.len() as f64;
+    let point = mean_of(runs);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut samplers: Vec<IndexSampler> = runs.iter().map(|r| IndexSampler::new(r.len())).collect();
+    let mut buf: Vec<Vec<f64>> = runs.to_vec();
+    let mut reps = Vec::with_capacity(n_boot);
+    for _ in 0..n_boot {
+        for ((task, sampler), out) in runs.iter().zip(samplers.iter_mut()).zip(buf.iter_mut()) {
+            resample_into(task, sampler, &mut rng, out);
+        }
+        reps.push(mean_of(&buf));
+    }
+    Some((point, reps))
+}
+
+/// The `1 − alpha` percentile interval of bootstrap replicates (`alpha` in (0, 1), `reps`
+/// non-empty).
+pub fn percentile_ci(reps: &[f64], alpha: f64) -> (f64, f64) {
+    let mut r = reps.to_vec();
+    percentile_interval(&mut r, alpha)
+}
+
+/// Pairwise wins of `x` over `y` on a lower-is-better score (ties half) and the number of
+/// pairs, summed over tasks: the counts behind [`probability_of_improvement`] (which averages the
+/// per-task fractions).
+pub fn improvement_counts(x: &[Vec<f64>], y: &[Vec<f64>]) -> (f64, usize) {
+    let (mut wins, mut pairs) = (0.0, 0);
+    for (a, b) in x.iter().zip(y) {
+        for &u in a {
+            for &v in b {
+                wins += if u < v {
+                    1.0
+                } else if u == v {
+                    0.5
+                } else {
+                    0.0
+                };
+                pairs += 1;
+            }
+        }
+    }
+    (wins, pairs)
+}
+
+/// The exact (Clopper-Pearson) two-sided `1 − alpha` bound for a proportion observed at 0 or
+/// at 1 in `n` independent trials: `(0, 1 − (alpha/2)^(1/n))` or `((alpha/2)^(1/n), 1)`; None
+/// otherwise or with `n = 0`.
+pub fn exact_bound_at_extreme(successes: f64, n: usize, alpha: f64) -> Option<(f64, f64)> {
+    if n == 0 {
+        return None;
+    }
+    let b = (alpha / 2.0).powf(1.0 / n as f64);
+    if successes == 0.0 {
+        Some((0.0, 1.0 - b))
+    } else if successes == n as f64 {
+        Some((b, 1.0))
+    } else {
+        None
+    }
+}
+
 /// Probability of improvement of algorithm X over algorithm Y for a lower-is-better score:
 /// `P(X < Y)`, averaged over tasks (rliable's `probability_of_improvement`, with the comparison
 /// flipped because lower KLC is better).
