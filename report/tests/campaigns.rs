@@ -596,6 +596,7 @@ fn rendering_the_neural_store_twice_gives_identical_bytes() {
             "data/claims.csv",
             "data/validity.csv",
             "data/leaderboard.csv",
+            "outcomes.md",
             "files.txt",
         ] {
             v.push((f.into(), std::fs::read(dir.join(f)).unwrap()));

@@ -219,10 +219,11 @@ fn renders_report_and_figures_with_the_right_numbers() {
     // REPORT.md, 2 KLC and 2 coverage figures, 4 outcome scatters, the paper's 3 illustrations
     // (Figures 1, 5, 6; Figures 1 and 6 need the `environment-figures` feature), 5 CSV files
     // (final values, curves, discovery measures, the validity check, the claims' comparisons;
-    // no leaderboard without a learned goal space), the list of files.
+    // no leaderboard without a learned goal space), the page of the outcome scatters the paper
+    // did not draw (ArmArrow's here), the list of files.
     let env_figures = cfg!(feature = "environment-figures");
     let illustrations = if env_figures { 3 } else { 1 };
-    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 5 + 1);
+    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 5 + 1 + 1);
     assert!(!out.join("data/leaderboard.csv").exists());
     for (name, drawn) in [
         ("fig1_environments.svg", env_figures),
@@ -298,7 +299,11 @@ fn renders_report_and_figures_with_the_right_numbers() {
     assert!(md.contains("No `budget-*` campaign in the store"));
     assert!(!out.join("figures/budget_vae.svg").exists());
     assert!(md.contains("(figures/klc_armball.svg)"));
-    assert!(md.contains("(figures/outcomes_armarrow_rge-efr_uniform_0_none.svg)"));
+    // ArmArrow's scatters are not the paper's Figures 3, 8, 9: on their own page, linked.
+    assert!(!md.contains("(figures/outcomes_armarrow_rge-efr_uniform_0_none.svg)"));
+    assert!(md.contains("[`outcomes.md`](outcomes.md)"));
+    let page = std::fs::read_to_string(out.join("outcomes.md")).unwrap();
+    assert!(page.contains("(figures/outcomes_armarrow_rge-efr_uniform_0_none.svg)"));
     assert!(md.contains(ugl_report::markdown::EPOCH_NOTE));
     assert!(md.contains("single runs"));
     assert!(md.contains("`abc1234` (12 runs)"));

@@ -809,22 +809,60 @@ fn paper_outside(inp: &Context<'_>, env: &str) -> Option<String> {
     })
 }
 
-/// The outcome scatters (the paper's Figure 3).
-pub fn outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
-    let envs = envs(inp);
-    let _ = writeln!(w, "## Object positions reached\n");
+/// The page of the outcome scatters the paper did not draw.
+pub const OUTCOMES_PAGE: &str = "outcomes.md";
+
+/// What an outcome scatter shows, for REPORT.md and the page of the others.
+const OUTCOMES_METHOD: &str = "For each condition, the outcomes of its median run (by final \
+KL-coverage, among the runs whose outcomes file the store keeps; the title names its seed) at three \
+epochs: every episode that moved the object is a dot at the object's final (x, y), for ArmArrow a \
+short stroke from the arrow's position to its tip, with a barb at the tip (angles grouped in 30° \
+sectors); the circle is the reachable unit disk and the red mark the initial position (0.6, 0.6), \
+where every other episode ends. Panel titles count the episodes that moved the object.";
+
+/// The outcome scatters of the paper's Figures 3, 8 and 9 (`figures`), and a link to the page
+/// of the `others`.
+pub fn outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile], others: usize) {
     let _ = writeln!(
         w,
-        "For each condition, the outcomes of its median run (by final KL-coverage, among the \
-         runs whose outcomes file the store keeps; the title names its seed) at three epochs: every episode that moved the object is a dot at the \
-         object's final (x, y), for ArmArrow a short stroke from the arrow's position to its \
-         tip, with a barb at the tip (angles grouped in 30° sectors); the circle is the reachable unit disk and the red \
-         mark the initial position (0.6, 0.6), where every other episode ends. Panel titles \
-         count the episodes that moved the object.\n"
+        "## Object positions reached
+"
     );
-    for env in &envs {
-        let _ = writeln!(w, "### {}\n", env_name(env));
+    let _ = writeln!(
+        w,
+        "The conditions of the paper's Figures 3, 8 and 9 (ArmBall, the paper's variants, KDE \
+         goals). {OUTCOMES_METHOD}{}\n",
+        if others > 0 {
+            format!(
+                " The other {others} conditions (ArmArrow, Gaussian goals, corrected variants, \
+                 controls): [`{OUTCOMES_PAGE}`]({OUTCOMES_PAGE})."
+            )
+        } else {
+            String::new()
+        }
+    );
+    for env in &envs(inp) {
         for f in figures.iter().filter(|f| f.env == *env) {
+            let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
+        }
+    }
+}
+
+/// The page of the outcome scatters the paper did not draw.
+pub fn other_outcome_scatters(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
+    let _ = writeln!(
+        w,
+        "# Object positions reached: the conditions the paper did not draw\n\n\
+         Beside [REPORT.md](REPORT.md#object-positions-reached), which keeps the conditions of the \
+         paper's Figures 3, 8 and 9. {OUTCOMES_METHOD}\n"
+    );
+    for env in &envs(inp) {
+        let these: Vec<&FigureFile> = figures.iter().filter(|f| f.env == *env).collect();
+        if these.is_empty() {
+            continue;
+        }
+        let _ = writeln!(w, "## {}\n", env_name(env));
+        for f in these {
             let _ = writeln!(w, "![{}]({})\n", f.caption, f.link);
         }
     }

@@ -239,7 +239,23 @@ impl Section for Outcomes {
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         let figs = figures::outcomes::draw_all(ctx.store, ctx.conditions, &out.figures_dir())?;
         let figs = out.figures(figs)?;
-        words(|w| markdown::outcome_scatters(w, ctx, &figs))
+        // REPORT.md keeps the conditions of the paper's Figures 3, 8 and 9 (ArmBall, the
+        // paper's variants with KDE goals: those the paper gives a value for); the others are
+        // on a page of their own.
+        let in_paper: Vec<String> = ctx
+            .conditions
+            .iter()
+            .filter(|c| c.key.env == "armball" && c.paper.is_some() && c.key.sampler != "gaussian")
+            .map(|c| format!("figures/outcomes_{}.svg", figures::file_safe(&c.key.slug())))
+            .collect();
+        let (paper, rest): (Vec<_>, Vec<_>) =
+            figs.into_iter().partition(|f| in_paper.contains(&f.link));
+        if !rest.is_empty() {
+            let mut page = String::new();
+            markdown::other_outcome_scatters(&mut page, ctx, &rest);
+            out.write(markdown::OUTCOMES_PAGE, page.as_bytes())?;
+        }
+        words(|w| markdown::outcome_scatters(w, ctx, &paper, rest.len()))
     }
 }
 
