@@ -223,7 +223,10 @@ fn renders_report_and_figures_with_the_right_numbers() {
     // did not draw (ArmArrow's here), the list of files.
     let env_figures = cfg!(feature = "environment-figures");
     let illustrations = if env_figures { 3 } else { 1 };
-    assert_eq!(summary.files.len(), 1 + 2 + 2 + 4 + illustrations + 5 + 1 + 1);
+    assert_eq!(
+        summary.files.len(),
+        1 + 2 + 2 + 4 + illustrations + 5 + 1 + 1
+    );
     assert!(!out.join("data/leaderboard.csv").exists());
     for (name, drawn) in [
         ("fig1_environments.svg", env_figures),

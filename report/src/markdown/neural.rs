@@ -58,6 +58,18 @@ pub fn campaigns_line(w: &mut String, inp: &Context<'_>) {
     if !c.recipe.is_empty() {
         parts.push(format!("training recipes {}", listed(&c.recipe)));
     }
+    if !c.compare.is_empty() {
+        parts.push(format!(
+            "new learners (`ugl compare`) {}",
+            listed(&c.compare)
+        ));
+    }
+    if !c.followup.is_empty() {
+        parts.push(format!(
+            "the follow-up paper's setting {}",
+            listed(&c.followup)
+        ));
+    }
     if !c.unused.is_empty() {
         let u: Vec<String> = c
             .unused
