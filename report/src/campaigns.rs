@@ -92,6 +92,9 @@ pub struct Campaigns {
     /// The follow-up paper's campaign (the first `followup` campaign that varies no other) and
     /// its variants, sorted by name.
     pub followup: Vec<Campaign>,
+    /// `validation` campaigns varying the main campaign (held-out repetitions for the validity
+    /// check), sorted by name.
+    pub validation: Vec<Campaign>,
     /// Everything else, sorted by name.
     pub unused: Vec<Unused>,
 }
@@ -104,6 +107,7 @@ impl Campaigns {
             .chain(&self.compare)
             .chain(&self.recipe)
             .chain(&self.followup)
+            .chain(&self.validation)
     }
 
     /// Runs the report uses (main, budget and compare campaigns).
@@ -115,6 +119,7 @@ impl Campaigns {
                 .chain(&self.compare)
                 .chain(&self.recipe)
                 .chain(&self.followup)
+                .chain(&self.validation)
                 .map(|c| c.store.runs.len())
                 .sum::<usize>()
     }
@@ -190,6 +195,7 @@ pub fn load_campaigns(
     let mut compare = Vec::new();
     let mut recipe = Vec::new();
     let mut followup = Vec::new();
+    let mut validation = Vec::new();
     let mut unused = Vec::new();
     let varies_main = |decl: &CampaignDecl| decl.variant_of.as_deref().is_none_or(|v| v == main);
     for d in &dirs {
@@ -216,6 +222,13 @@ pub fn load_campaigns(
                 recipe.push(read(d, decl.unwrap_or_default())?)
             }
             Some(CampaignRole::Followup) => followup.push(read(d, decl.unwrap_or_default())?),
+            Some(CampaignRole::Validation)
+                if decl
+                    .as_ref()
+                    .is_some_and(|decl| decl.variant_of.as_deref() == Some(main)) =>
+            {
+                validation.push(read(d, decl.unwrap_or_default())?)
+            }
             _ => unused.push(Unused {
                 name: d.name.clone(),
                 complete: d.n_complete(),
@@ -251,6 +264,7 @@ pub fn load_campaigns(
         compare,
         recipe,
         followup,
+        validation,
         unused,
     })
 }

@@ -94,8 +94,8 @@ pub struct RunRow<'a> {
     /// Its measures at the final epoch (None: no outcomes).
     pub discovery: Option<Discovery>,
     pub group: Option<Group>,
-    /// Whether the validity check reads it: runs of the main, `compare` and `recipe`
-    /// campaigns (the main campaign's cells and seeds); not the budget or follow-up ones.
+    /// Whether the validity check reads it: runs of the `validation` campaigns where the store
+    /// has them, else of the main, `compare` and `recipe` campaigns ([`held_out_or_claimed`]).
     pub in_check: bool,
     /// ln(achievable cells): the moved-only KLC of a run that never moved the object.
     pub max_klc: f64,
@@ -110,9 +110,8 @@ pub struct RunRow<'a> {
 /// Every run the report reads, measured at its final epoch: the main campaign, then by role
 /// ([`Campaigns::used`]), runs in the report's condition order.
 pub fn measure_all(camps: &Campaigns) -> Result<Vec<RunRow<'_>>, ReportError> {
-    let checked: Vec<&str> = std::iter::once(&camps.main)
-        .chain(&camps.compare)
-        .chain(&camps.recipe)
+    let checked: Vec<&str> = held_out_or_claimed(camps)
+        .iter()
         .map(|c| c.name.as_str())
         .collect();
     let mut rows = Vec::new();
@@ -157,6 +156,20 @@ pub fn measure_all(camps: &Campaigns) -> Result<Vec<RunRow<'_>>, ReportError> {
     Ok(rows)
 }
 
+/// The campaigns the validity check reads: the `validation` campaigns (held-out repetitions)
+/// where the store has them, else the main, `compare` and `recipe` campaigns (the runs the
+/// claims use).
+pub fn held_out_or_claimed(camps: &Campaigns) -> Vec<&Campaign> {
+    if camps.validation.is_empty() {
+        std::iter::once(&camps.main)
+            .chain(&camps.compare)
+            .chain(&camps.recipe)
+            .collect()
+    } else {
+        camps.validation.iter().collect()
+    }
+}
+
 /// A measure of the validity check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Measure {
@@ -181,6 +194,17 @@ impl Measure {
         Measure::GoalErrorMean,
         Measure::GoalErrorP90,
     ];
+
+    /// Its name in the data files.
+    pub fn key(self) -> &'static str {
+        match self {
+            Measure::FinalKlc => "final_klc",
+            Measure::MovedKlc => "moved_klc",
+            Measure::Coverage => "coverage",
+            Measure::GoalErrorMean => "goal_error_mean",
+            Measure::GoalErrorP90 => "goal_error_p90",
+        }
+    }
 
     /// Its name in the report.
     pub fn label(self) -> &'static str {
@@ -475,7 +499,7 @@ pub fn write_validity_csv(out: &mut Output, checks: &[Check]) -> Result<(), Repo
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             c.env,
-            c.measure.label(),
+            c.measure.key(),
             c.control.label(),
             c.encodes.len(),
             c.controls.len(),
@@ -547,7 +571,7 @@ pub fn write_csv(out: &mut Output, rows: &[RunRow<'_>]) -> Result<(), ReportErro
 }
 
 /// The report's section: what the measures are, and the validity table.
-pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
+pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check], camps: &Campaigns) {
     let _ = writeln!(
         w,
         "\n## What the exploration discovered, without counting repeats\n\n\
@@ -620,10 +644,7 @@ pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
          the mean-image plateau ({} runs); the *controls* are the random projections of the \
          pixels and the networks that stayed on the plateau (the untrained twins of the recipe \
          campaigns; {} runs). Learned spaces with a lower R² are in neither group: they encode \
-         the position in part, so a measure may rank them either way. Runs of the main, compare \
-         and recipe campaigns, every goal sampler; **the same runs carry the claims**, so the \
-         check is not independent of the verdicts that use it (a held-out validation campaign \
-         is not in this store). Per environment, measure and kind of control: *P(better)*, the \
+         the position in part, so a measure may rank them either way. {} Per environment, measure and kind of control: *P(better)*, the \
          probability that a random position-encoding run beats a random control run (ties \
          half; 0.5: the measure does not tell them apart), with its {:.0}% interval from a \
          bootstrap that resamples repetitions ({N_BOOT} resamples, seeded; a repetition's runs \
@@ -635,6 +656,7 @@ pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
          alone. Every line: [`data/{VALIDITY_FILE}`](data/{VALIDITY_FILE}).\n",
         n(Group::Encodes),
         n(Group::Control),
+        data_used(camps),
         crate::stats::CONFIDENCE * 100.0,
     );
     let _ = writeln!(
@@ -712,6 +734,29 @@ pub fn section(w: &mut String, rows: &[RunRow<'_>], checks: &[Check]) {
     }
     w.push('\n');
     position_and_rest(w, rows);
+}
+
+/// Which runs the validity check reads, in words.
+pub fn data_used(camps: &Campaigns) -> String {
+    let names: Vec<String> = held_out_or_claimed(camps)
+        .iter()
+        .map(|c| format!("`{}`", crate::load::campaign_display(&c.name)))
+        .collect();
+    if camps.validation.is_empty() {
+        format!(
+            "Runs of {}, every goal sampler; **the same runs carry the claims**, so the check \
+             is not independent of the verdicts that use it (no held-out `validation` campaign \
+             is in this store).",
+            names.join(", ")
+        )
+    } else {
+        format!(
+            "Runs of the held-out validation campaign{} {} (repetitions no claim uses), every \
+             goal sampler.",
+            if names.len() == 1 { "" } else { "s" },
+            names.join(", ")
+        )
+    }
 }
 
 /// Where an environment measures more than the position (ArmArrow's angle): per condition of
@@ -918,7 +963,7 @@ mod tests {
         println!("measured {} runs in {:.2?}", rows.len(), t.elapsed());
         let checks = validity(&rows);
         let mut table = String::new();
-        section(&mut table, &rows, &checks);
+        section(&mut table, &rows, &checks, &camps);
         println!("{table}");
         let verdict = |m: Measure, env: &str| {
             passes(&checks, m, env).unwrap_or_else(|| panic!("no check of {m:?} in {env}"))

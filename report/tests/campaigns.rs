@@ -826,3 +826,51 @@ fn a_malformed_claims_file_is_an_error_naming_it() {
     let md = read(&tmp.path().join("out"));
     assert!(md.contains("No claims file at"), "{md}");
 }
+
+/// A `validation` campaign (held-out repetitions) replaces the claims' runs in the validity
+/// check, and the report says so; without one, it says the check uses the claims' runs.
+#[test]
+fn a_validation_campaign_is_what_the_validity_check_reads() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    neural_store(&results);
+    let out = tmp.path().join("out");
+    render_report(&opts(&results, &out)).unwrap();
+    let md = read(&out);
+    assert!(md.contains("**the same runs carry the claims**"), "{md}");
+    let before = std::fs::read_to_string(out.join("data/validity.csv")).unwrap();
+    // The main campaign's runs, copied as a held-out campaign of their own.
+    let val = results.join("paper-validation");
+    std::fs::create_dir_all(&val).unwrap();
+    for e in std::fs::read_dir(results.join("paper")).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_file() && p.file_name().unwrap() != ugl_types::RECORD_FILE {
+            std::fs::copy(&p, val.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    common::write_record(&val, ugl_types::CampaignRole::Validation, Some("paper"));
+    let out2 = tmp.path().join("out2");
+    let s = render_report(&opts(&results, &out2)).unwrap();
+    assert!(!s.unused_campaigns.contains(&"paper-validation".to_string()));
+    let md = read(&out2);
+    assert!(
+        md.contains("Runs of the held-out validation campaign `paper-validation`"),
+        "{md}"
+    );
+    assert!(!md.contains("**the same runs carry the claims**"));
+    // Only the validation campaign's runs are checked: the main campaign's copies give the same
+    // lines, without the recipe and compare campaigns' runs.
+    let after = std::fs::read_to_string(out2.join("data/validity.csv")).unwrap();
+    assert_eq!(before.lines().next(), after.lines().next());
+    let runs = |csv: &str, col: usize| -> usize {
+        csv.lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(col).unwrap().parse::<usize>().unwrap())
+            .sum()
+    };
+    assert!(runs(&after, 3) > 0 && runs(&after, 4) > 0, "{after}");
+    // Every row has the same 13 fields (no comma inside a field).
+    assert!(after.lines().all(|l| l.split(',').count() == 13), "{after}");
+    // The recipe campaign's untrained twins are no longer read: fewer control runs.
+    assert!(runs(&after, 4) < runs(&before, 4), "{before}\n{after}");
+}

@@ -28,15 +28,20 @@ pub enum CampaignRole {
     Recipe,
     /// The follow-up paper's setting (ArmBalls, modular goal exploration).
     Followup,
+    /// Held-out repetitions of the main campaign's matrix and controls (another campaign seed),
+    /// on which the report runs the validity check of its measures of discovery, so that the
+    /// runs that validate a measure are not those the claims use.
+    Validation,
 }
 
 impl CampaignRole {
-    pub const ALL: [CampaignRole; 5] = [
+    pub const ALL: [CampaignRole; 6] = [
         CampaignRole::Main,
         CampaignRole::Budget,
         CampaignRole::Compare,
         CampaignRole::Recipe,
         CampaignRole::Followup,
+        CampaignRole::Validation,
     ];
 
     pub fn name(self) -> &'static str {
@@ -46,6 +51,7 @@ impl CampaignRole {
             CampaignRole::Compare => "compare",
             CampaignRole::Recipe => "recipe",
             CampaignRole::Followup => "followup",
+            CampaignRole::Validation => "validation",
         }
     }
 }

@@ -404,10 +404,9 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
         if !status.is_empty() {
             let _ = writeln!(
                 w,
-                "\nIn the validity check: {}. It is run on the runs of the main, compare and \
-                 recipe campaigns, the same runs these claims use: no held-out validation \
-                 campaign is in this store.",
-                status.join("; ")
+                "\nIn the validity check: {}. {}",
+                status.join("; "),
+                crate::discovery::data_used(inp.campaigns)
             );
         }
     }
@@ -514,9 +513,15 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
             "### Our findings (not claims of the paper)\n\nStatements of ours, tested the same \
              way (e.g. a claim of the paper re-tested on the corrected variants, or a learner \
              against its controls), each on the measure it names; not counted in the \
-             headline. The claims that a trained network beats its untrained twin, or a learned \
-             space the random projection, rest on the runs the validity check also uses: they \
-             are not independent of it.\n"
+             headline.{}\n",
+            if inp.campaigns.validation.is_empty() {
+                " The claims that a trained network beats its untrained twin, or a learned \
+                 space the random projection, rest on the runs the validity check also uses: \
+                 they are not independent of it."
+            } else {
+                " The validity check runs on held-out repetitions: the claims against the \
+                 controls are independent of it."
+            }
         );
         claims_table(w, &ours, validated, inp.validity, alpha);
     }

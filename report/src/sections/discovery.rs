@@ -17,13 +17,17 @@ impl Section for Discovery {
         "discovery measures"
     }
     fn wants(&self) -> &'static [CampaignRole] {
-        &[CampaignRole::Compare, CampaignRole::Recipe]
+        &[
+            CampaignRole::Compare,
+            CampaignRole::Recipe,
+            CampaignRole::Validation,
+        ]
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         discovery::write_csv(out, ctx.discovery)?;
         discovery::write_validity_csv(out, ctx.validity)?;
         let mut w = String::new();
-        discovery::section(&mut w, ctx.discovery, ctx.validity);
+        discovery::section(&mut w, ctx.discovery, ctx.validity, ctx.campaigns);
         Ok(w)
     }
 }
