@@ -273,9 +273,9 @@ impl Control {
         {
             Some(Control::RandomProjection)
         } else if m.trained() == Some(false) {
-            Some(Control::Untrained(
-                crate::claims::untagged(&run.key.algo).to_string(),
-            ))
+            // A store's keys carry no variant tag (the claims add `@untrained` when they pair a
+            // recipe campaign's conditions with the main campaign's).
+            Some(Control::Untrained(run.key.algo.clone()))
         } else {
             None
         }

@@ -321,43 +321,34 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 alpha,
                 stats::derive_seed(seed, &format!("{label}|auc")),
             );
-            let poi_vs_efr = if algo == "rge-efr" || !per.keys().all(|t| efr.contains_key(t)) {
-                None
-            } else {
-                // On the ranking statistic: the goal error where both have it on every task.
-                let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
-                let (xs, ys) = if on_goal_error(&goals_by_task, &efr_goals) {
-                    (goals_by_task.clone(), efr_goals)
-                } else {
-                    (
-                        finals_by_task.clone(),
-                        per.keys().map(|t| efr[t].0.clone()).collect(),
-                    )
-                };
+            // Against RGE-EFR on the ranking statistic: the goal error where both have it on
+            // every task, else the final KLC. The probability with its interval, and its counts.
+            let vs_efr: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)> =
+                (algo != "rge-efr" && per.keys().all(|t| efr.contains_key(t))).then(|| {
+                    let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
+                    if on_goal_error(&goals_by_task, &efr_goals) {
+                        (goals_by_task.clone(), efr_goals)
+                    } else {
+                        (
+                            finals_by_task.clone(),
+                            per.keys().map(|t| efr[t].0.clone()).collect(),
+                        )
+                    }
+                });
+            let poi_vs_efr = vs_efr.as_ref().and_then(|(xs, ys)| {
                 probability_of_improvement_ci(
-                    &xs,
-                    &ys,
+                    xs,
+                    ys,
                     n_boot,
                     alpha,
                     stats::derive_seed(seed, &format!("{label}|poi")),
                 )
-            };
-            let poi_counts = if algo == "rge-efr" || !per.keys().all(|t| efr.contains_key(t)) {
-                None
-            } else {
-                let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
-                let (xs, ys) = if on_goal_error(&goals_by_task, &efr_goals) {
-                    (goals_by_task.clone(), efr_goals)
-                } else {
-                    (
-                        finals_by_task.clone(),
-                        per.keys().map(|t| efr[t].0.clone()).collect(),
-                    )
-                };
-                let (wins, pairs) = stats::improvement_counts(&xs, &ys);
-                let units = xs.iter().zip(&ys).map(|(a, b)| a.len().min(b.len())).sum();
-                Some((wins, pairs, units))
-            };
+            });
+            let poi_counts = vs_efr.as_ref().map(|(xs, ys)| {
+                let (wins, pairs) = stats::improvement_counts(xs, ys);
+                let units = xs.iter().zip(ys).map(|(a, b)| a.len().min(b.len())).sum();
+                (wins, pairs, units)
+            });
             let goal_task_iqm: Vec<Option<f64>> = goals_by_task
                 .iter()
                 .map(|g| (!g.is_empty()).then(|| iqm(g)))
