@@ -121,11 +121,17 @@ pub fn draw_all(
             path,
             link: format!("figures/{name}"),
             caption: format!(
-                "{}, {}: outcomes of {} at epochs {:?}",
+                "{}, {}: outcomes of {} at epochs {:?}, the median by final KL-coverage of the {} \
+                 of its {} runs whose outcomes file the store keeps",
                 env_name(&c.key.env),
                 describe(c),
                 run.run_id,
-                epochs
+                epochs,
+                c.runs
+                    .iter()
+                    .filter(|&&i| store.runs[i].has_outcomes())
+                    .count(),
+                c.runs.len()
             ),
             env: c.key.env.clone(),
         });

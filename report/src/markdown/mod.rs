@@ -828,7 +828,10 @@ KL-coverage, among the runs whose outcomes file the store keeps; the title names
 epochs: every episode that moved the object is a dot at the object's final (x, y), for ArmArrow a \
 short stroke from the arrow's position to its tip, with a barb at the tip (angles grouped in 30° \
 sectors); the circle is the reachable unit disk and the red mark the initial position (0.6, 0.6), \
-where every other episode ends. Panel titles count the episodes that moved the object.";
+where every other episode ends. Panel titles count the episodes that moved the object. The pool \
+the median run is taken from differs between conditions (the store keeps every run's outcomes file \
+for its first runs, then those of repetitions 0-2, first replicate): each caption says how many runs \
+it is.";
 
 /// The outcome scatters of the paper's Figures 3, 8 and 9 (`figures`), and a link to the page
 /// of the `others`.

@@ -8,7 +8,7 @@
 //! fraction of the mean-image plateau, the iteration where the training loss left the plateau),
 //! the latent quality (k-NN R² of the object's position) and the paired final KL-coverage.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
 use super::quality::{evidence, group_r2, median};
@@ -238,6 +238,42 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
                 String::new()
             }
         );
+        // A pairing across results versions, or with runs no commit reproduces, is flagged.
+        let versions = |c: &Campaign| -> BTreeSet<u64> {
+            c.store
+                .runs
+                .iter()
+                .filter_map(|r| r.manifest.results_version())
+                .collect()
+        };
+        let (theirs, ours) = (versions(camp), versions(main));
+        let dirty = camp
+            .store
+            .runs
+            .iter()
+            .filter(|r| r.manifest.git_revision.ends_with("-dirty"))
+            .count();
+        if theirs != ours || dirty > 0 {
+            let list =
+                |v: &BTreeSet<u64>| v.iter().map(u64::to_string).collect::<Vec<_>>().join(", ");
+            let _ = writeln!(
+                w,
+                "⚠ **Not a clean pairing**: these runs are results version {} against `{}`'s {}{}; \
+                 the pairing assumes the data sets and streams of a seed did not change between \
+                 versions, which a version change does not guarantee.\n",
+                list(&theirs),
+                main.name,
+                list(&ours),
+                if dirty > 0 {
+                    format!(
+                        ", and {dirty} of them come from trees with uncommitted changes \
+                         (`-dirty`), which no commit reproduces"
+                    )
+                } else {
+                    String::new()
+                }
+            );
+        }
         recipe_lines(w, &camp.store.runs, &main.store.runs, &main.name, true);
         let _ = writeln!(w);
         if cells.is_empty() {
