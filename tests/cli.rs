@@ -305,6 +305,151 @@ fn a_run_records_its_discovery_and_its_outcomes_file_may_be_left_out() {
     }
 }
 
+/// The audit's forged discovery records: a manifest's record is covered by the hash beside it,
+/// checked for range and against the summary, and recomputed where the outcomes file is kept.
+/// `ugl status --require-complete` and `ugl report` name the damaged run, and the report refuses
+/// it, for each of: a better goal error and coverage written in (hash kept, or dropped as in an
+/// older manifest), a coverage of -5, an error of 1e300, a moved count that disagrees with the
+/// summary.
+#[test]
+fn a_forged_discovery_record_is_detected() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("tiny.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 200\neval_every = 100\n",
+    )
+    .unwrap();
+    let store = dir.path().join("res");
+    let out = store.join("tiny");
+    let campaign = ugl(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&out),
+        "--jobs",
+        "1",
+        "--quiet",
+    ]);
+    assert!(campaign.status.success(), "{}", stderr(&campaign));
+    let id = "armball.rge-efr.s0";
+    let json_path = out.join(format!("{id}.json"));
+    let outcomes = out.join(format!("{id}.outcomes.parquet"));
+    let (original, outcome_bytes) = (
+        std::fs::read_to_string(&json_path).unwrap(),
+        std::fs::read(&outcomes).unwrap(),
+    );
+    let status = || {
+        ugl(&[
+            "status",
+            "--config",
+            p(&cfg),
+            "--out",
+            p(&out),
+            "--require-complete",
+        ])
+    };
+    let report = || {
+        ugl(&[
+            "report",
+            "--results",
+            p(&store),
+            "--main",
+            "tiny",
+            "--out",
+            p(&dir.path().join("report")),
+        ])
+    };
+    assert!(status().status.success(), "{}", stderr(&status()));
+    assert!(report().status.success(), "{}", stderr(&report()));
+    let forge = |edit: &dyn Fn(&mut serde_json::Value), keep_outcomes: bool| {
+        let mut m: serde_json::Value = serde_json::from_str(&original).unwrap();
+        edit(&mut m);
+        std::fs::write(&json_path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+        if keep_outcomes {
+            std::fs::write(&outcomes, &outcome_bytes).unwrap();
+        } else if outcomes.exists() {
+            std::fs::remove_file(&outcomes).unwrap();
+        }
+    };
+    let better = |m: &mut serde_json::Value| {
+        m["discovery"]["final"]["goal_error_mean"] = 0.001.into();
+        m["discovery"]["final"]["coverage"] = 0.5.into();
+        m["summary"]["coverage"] = 0.5.into();
+    };
+    let drop_hash = |m: &mut serde_json::Value| {
+        m.as_object_mut().unwrap().remove("discovery_blake3");
+    };
+    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, bool)> = vec![
+        ("hash", Box::new(better), false),
+        (
+            "the outcomes file gives",
+            Box::new(move |m| {
+                drop_hash(m);
+                m["discovery"]["final"]["goal_error_mean"] = 0.001.into();
+            }),
+            true,
+        ),
+        (
+            "final.coverage",
+            Box::new(move |m| {
+                drop_hash(m);
+                m["discovery"]["final"]["coverage"] = (-5.0).into();
+            }),
+            false,
+        ),
+        (
+            "final.goal_error_mean",
+            Box::new(move |m| {
+                drop_hash(m);
+                m["discovery"]["final"]["goal_error_mean"] = 1e300.into();
+            }),
+            false,
+        ),
+        (
+            "final.n_moved",
+            Box::new(move |m| {
+                drop_hash(m);
+                let n = m["summary"]["n_moved"].as_u64().unwrap();
+                m["summary"]["n_moved"] = (n + 1).into();
+            }),
+            false,
+        ),
+    ];
+    assert!(
+        serde_json::from_str::<serde_json::Value>(&original).unwrap()["discovery_blake3"]
+            .is_string(),
+        "a run records the hash of its record"
+    );
+    for (why, edit, keep) in &cases {
+        forge(edit.as_ref(), *keep);
+        // `ugl status` reads manifests, not data files: a record without its hash that only the
+        // outcomes file contradicts is the report's to find.
+        let st = status();
+        if *why != "the outcomes file gives" {
+            assert!(
+                !st.status.success(),
+                "{why}: status counts the run complete"
+            );
+            let text = format!("{}{}", stdout(&st), stderr(&st));
+            assert!(text.contains(id), "{why}: status names the run: {text}");
+        }
+        let r = report();
+        assert!(!r.status.success(), "{why}: the report renders");
+        assert!(
+            stderr(&r).contains(id) && stderr(&r).contains(why),
+            "{why}: the report names the run and the field: {}",
+            stderr(&r)
+        );
+    }
+    // The record without its hash, untouched, is still read (an older manifest).
+    forge(&drop_hash, false);
+    assert!(status().status.success(), "{}", stdout(&status()));
+    assert!(report().status.success(), "{}", stderr(&report()));
+}
+
 /// Results written into a checkout's data/ are the committed ones: a campaign refuses to write
 /// there while tracked files have uncommitted changes (one line, exit 2, nothing written),
 /// unless `--allow-dirty`, which the runs then record as a `-dirty` revision. Elsewhere it
@@ -1744,6 +1889,154 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
         scripts.join("bin/ugl").is_file(),
         "the tasks run the binary submit.sh copied"
     );
+}
+
+/// The audit's injection cases: every path `ugl slurm` writes into its scripts (the checkout,
+/// the campaign file, `--out`, `--scripts`, `--report-out`) holds `$(...)`, backticks, quotes, a
+/// backslash and a newline followed by an `#SBATCH` line and a command. The three scripts run (a
+/// fake `sbatch` and `cargo`, a `ugl` that records its arguments): no command in a path runs,
+/// every `#SBATCH` line is the scripts' own and comes before the first command, and `ugl` gets
+/// each path exactly.
+#[cfg(unix)]
+#[test]
+fn slurm_scripts_are_safe_for_hostile_paths() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+    let hostile = |tag: &str| {
+        format!(
+            "x $(touch {t}/PWNED-{tag}-a) `touch {t}/PWNED-{tag}-b` \\ \" ' ;\n\
+             #SBATCH --wrap=x\ntouch {t}/PWNED-{tag}-c ; y",
+            t = t.display()
+        )
+    };
+    let root = t.join(hostile("root"));
+    let (bin, work) = (t.join("bin"), root.join(hostile("work")));
+    for d in [&bin, &work.join("data")] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    std::os::unix::fs::symlink(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/paper"),
+        work.join("data/paper"),
+    )
+    .unwrap();
+    // A hostile name holds `/` (its `touch` paths): its directories are made.
+    let config = root.join(format!("{}.toml", hostile("config")));
+    std::fs::create_dir_all(config.parent().unwrap()).unwrap();
+    std::fs::write(
+        &config,
+        "[campaign]\nname = \"tiny\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 60\neval_every = 20\n",
+    )
+    .unwrap();
+    let exe = |f: &Path, text: &str| {
+        std::fs::write(f, text).unwrap();
+        std::fs::set_permissions(f, std::fs::Permissions::from_mode(0o755)).unwrap();
+    };
+    exe(
+        &bin.join("cargo"),
+        "#!/usr/bin/env bash\n[ \"$1\" = build ] || exit 1\n\
+         echo '{\"reason\":\"compiler-artifact\",\"executable\":\"'\"$UGL_BIN\"'\",\"fresh\":true}'\n",
+    );
+    // Runs task 0 of an array, or the script; prints a job id.
+    exe(
+        &bin.join("sbatch"),
+        "#!/usr/bin/env bash\nscript=\"${@: -1}\"\nSLURM_ARRAY_TASK_ID=0 bash \"$script\" || exit 1\necho 42\n",
+    );
+    // The `ugl` the tasks run: records its arguments, NUL-separated, one call per record.
+    let recorder = t.join("ugl");
+    exe(
+        &recorder,
+        "#!/usr/bin/env bash\nfor a in \"$@\"; do printf '%s\\0' \"$a\"; done >> \"$RECORD\"\n\
+         printf 'END\\0' >> \"$RECORD\"\n",
+    );
+    let results = root.join(hostile("results"));
+    let (out, scripts, report) = (
+        results.join("tiny"),
+        root.join(hostile("scripts")),
+        root.join(hostile("report")),
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_ugl"))
+        .args(["slurm", "--config"])
+        .arg(&config)
+        .args(["--shards", "2", "--scripts"])
+        .arg(&scripts)
+        .arg("--out")
+        .arg(&out)
+        .arg("--report-out")
+        .arg(&report)
+        .current_dir(&work)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["array.sh", "report.sh"] {
+        let text = std::fs::read_to_string(scripts.join(f)).unwrap();
+        let (head, body) = text.split_at(text.find("set -euo").unwrap());
+        assert!(
+            head.lines().all(|l| l.starts_with('#')),
+            "{f}: only comments and directives before the first command:\n{head}"
+        );
+        assert!(
+            !head
+                .lines()
+                .any(|l| l.starts_with("#SBATCH") && l.contains("--wrap")),
+            "{f}: no directive from a path:\n{head}"
+        );
+        // (After the first command, a line of a quoted path that reads `#SBATCH` is text, and
+        // Slurm reads no directive there.)
+        assert!(body.starts_with("set -euo"), "{f}");
+    }
+    let record = t.join("record");
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+    let o = Command::new("bash")
+        .arg(scripts.join("submit.sh"))
+        .env("PATH", path)
+        .env("UGL_BIN", &recorder)
+        .env("RECORD", &record)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).starts_with("submitted array job 42 (0-1 of 2 tasks)"),
+        "{}",
+        stdout(&o)
+    );
+    let pwned: Vec<_> = std::fs::read_dir(t)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("PWNED"))
+        .collect();
+    assert!(pwned.is_empty(), "a path ran as a command: {pwned:?}");
+    let record = std::fs::read(&record).unwrap();
+    let args: Vec<String> = record
+        .strip_suffix(b"\0")
+        .unwrap()
+        .split(|&b| b == 0)
+        .map(|a| String::from_utf8(a.to_vec()).unwrap())
+        .collect();
+    let calls: Vec<&[String]> = args
+        .split(|a| a == "END")
+        .filter(|c| !c.is_empty())
+        .collect();
+    let value = |call: &[String], flag: &str| {
+        let i = call.iter().position(|a| a == flag).unwrap();
+        call[i + 1].clone()
+    };
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    assert_eq!(
+        calls.len(),
+        3,
+        "campaign (task 0), status, report: {calls:?}"
+    );
+    assert_eq!(calls[0][0], "campaign");
+    assert_eq!(value(calls[0], "--config"), s(&config));
+    assert_eq!(value(calls[0], "--out"), s(&out));
+    assert_eq!(calls[1][0], "status");
+    assert_eq!(value(calls[1], "--out"), s(&out));
+    assert_eq!(calls[2][0], "report");
+    assert_eq!(value(calls[2], "--results"), s(&results));
+    assert_eq!(value(calls[2], "--paper"), s(&work.join("data/paper")));
+    assert_eq!(value(calls[2], "--out"), s(&report));
 }
 
 /// An external learner whose fit fails is started once per cell, not once per run, and the

@@ -484,6 +484,9 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
 
     let mut key = key;
     reconcile_identity(&mut key, seed, &manifest, &manifest_path)?;
+    if let Some(recorded) = &manifest.discovery {
+        check_discovery(recorded, &key.env, &curve, &outcomes, &manifest_path)?;
+    }
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     let diagnostics =
         ugl_types::Diagnostics::read(dir, &run_id).map_err(|e| ReportError::Invalid {
@@ -508,6 +511,49 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         outcomes_path,
         manifest_path,
     })
+}
+
+/// A manifest's discovery record (already checked against its hash and the summary,
+/// [`ugl_types::verify_files`]) against the run's data files: its counts, KL-coverage and
+/// coverage against the curve's last point, and, where the outcomes file is kept, every measure
+/// against the same measures recomputed from it. A record that differs is an error naming the
+/// manifest and the field: the leaderboard and the validity check rank runs by these numbers.
+fn check_discovery(
+    recorded: &ugl_types::RunDiscovery,
+    env: &str,
+    curve: &[CurvePoint],
+    outcomes: &[Outcome],
+    manifest_path: &Path,
+) -> Result<(), ReportError> {
+    let invalid = |why: String| ReportError::Invalid {
+        path: manifest_path.to_path_buf(),
+        problem: format!("{why}; resume the campaign to recompute the run"),
+    };
+    let a = &recorded.at_end;
+    if let Some(last) = curve.last() {
+        let same = i64::try_from(a.n_moved).is_ok_and(|n| n == last.n_moved)
+            && (a.klc == last.klc || (a.klc - last.klc).abs() <= 1e-9 * a.klc.abs())
+            && (a.coverage - last.coverage).abs() <= 1e-9;
+        if !same {
+            return Err(invalid(format!(
+                "its discovery record (n_moved {}, klc {}, coverage {}) is not the curve's last \
+                 point (n_moved {}, klc {}, coverage {})",
+                a.n_moved, a.klc, a.coverage, last.n_moved, last.klc, last.coverage
+            )));
+        }
+    }
+    if outcomes.is_empty() {
+        return Ok(());
+    }
+    let spec = ugl_types::EnvSpec::by_name(env)
+        .ok_or_else(|| invalid(format!("unknown environment {env}")))?;
+    match ugl_types::RunDiscovery::measure(spec, outcomes) {
+        Ok(Some(computed)) => recorded
+            .check_against(&computed)
+            .map_err(|e| invalid(e.to_string())),
+        Ok(None) => Ok(()),
+        Err(e) => Err(invalid(e.to_string())),
+    }
 }
 
 /// Reads a run's outcomes file, whose `run_id` column must be the curve file's `run_id`.

@@ -618,6 +618,268 @@ impl RunDiscovery {
     }
 }
 
+/// Why a recorded [`RunDiscovery`] cannot be what the run measured: a value out of its range, a
+/// count or measure that disagrees with the run's summary or with itself, or, where the outcomes
+/// file is kept, with the measures recomputed from it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("its discovery record is not what the run measured: {field} {why}")]
+pub struct RecordMismatch {
+    /// The record's field (`final.coverage`, `error_at_rest`, ...).
+    pub field: String,
+    pub why: String,
+}
+
+/// Relative tolerance of a recorded measure against the same measure computed again (the
+/// summary's, or the outcomes file's): the same code gives the same bits, this only absorbs a
+/// last-bit difference of an older build.
+const RECORD_TOLERANCE: f64 = 1e-9;
+
+fn close(a: f64, b: f64) -> bool {
+    a == b || (a - b).abs() <= RECORD_TOLERANCE * a.abs().max(b.abs())
+}
+
+impl Discovery {
+    /// Each field in its range: counts ordered, KL-coverages non-negative (+inf allowed),
+    /// coverage a fraction, goal errors finite, non-negative and at most `max_error`, a moved-only
+    /// KL-coverage exactly when the object moved.
+    fn check_ranges(&self, at: &str, max_error: f64) -> Result<(), RecordMismatch> {
+        let bad = |field: &str, why: String| {
+            Err(RecordMismatch {
+                field: format!("{at}.{field}"),
+                why,
+            })
+        };
+        if self.n_outcomes == 0 || self.n_moved > self.n_outcomes {
+            return bad(
+                "n_moved",
+                format!("{} of {} outcomes", self.n_moved, self.n_outcomes),
+            );
+        }
+        if self.klc.is_nan() || self.klc < 0.0 {
+            return bad("klc", format!("= {} is not a KL-coverage (>= 0)", self.klc));
+        }
+        match self.moved_klc {
+            Some(k) if k.is_nan() || k < 0.0 || self.n_moved == 0 => {
+                return bad(
+                    "moved_klc",
+                    format!("= {k} with {} moved outcomes", self.n_moved),
+                );
+            }
+            None if self.n_moved > 0 => {
+                return bad(
+                    "moved_klc",
+                    format!("is missing with {} moved outcomes", self.n_moved),
+                );
+            }
+            _ => {}
+        }
+        if !(0.0..=1.0).contains(&self.coverage) {
+            return bad(
+                "coverage",
+                format!("= {} is not a fraction of the cells", self.coverage),
+            );
+        }
+        for (field, e) in [
+            ("goal_error_mean", self.goal_error_mean),
+            ("goal_error_p90", self.goal_error_p90),
+        ] {
+            if !(0.0..=max_error).contains(&e) {
+                return bad(
+                    field,
+                    format!("= {e} is not a distance in the goal space (0 to {max_error:.3})"),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Field by field equal to `other` (within [`RECORD_TOLERANCE`]); the first that differs.
+    fn mismatch(&self, other: &Discovery, at: &str) -> Option<RecordMismatch> {
+        let field = |name: &str, recorded: String, computed: String| {
+            Some(RecordMismatch {
+                field: format!("{at}.{name}"),
+                why: format!("= {recorded}, the outcomes file gives {computed}"),
+            })
+        };
+        if (self.n_outcomes, self.n_moved) != (other.n_outcomes, other.n_moved) {
+            return field(
+                "n_outcomes/n_moved",
+                format!("{}/{}", self.n_outcomes, self.n_moved),
+                format!("{}/{}", other.n_outcomes, other.n_moved),
+            );
+        }
+        let pairs = [
+            ("klc", Some(self.klc), Some(other.klc)),
+            ("moved_klc", self.moved_klc, other.moved_klc),
+            ("coverage", Some(self.coverage), Some(other.coverage)),
+            (
+                "goal_error_mean",
+                Some(self.goal_error_mean),
+                Some(other.goal_error_mean),
+            ),
+            (
+                "goal_error_p90",
+                Some(self.goal_error_p90),
+                Some(other.goal_error_p90),
+            ),
+        ];
+        for (name, a, b) in pairs {
+            let same = match (a, b) {
+                (Some(a), Some(b)) => close(a, b),
+                (None, None) => true,
+                _ => false,
+            };
+            if !same {
+                return field(name, format!("{a:?}"), format!("{b:?}"));
+            }
+        }
+        None
+    }
+}
+
+impl RunDiscovery {
+    /// The BLAKE3 hash (hex) of the record as JSON, which the manifest keeps beside it
+    /// (`Manifest::discovery_blake3`) so that an edited record is detected like a damaged data
+    /// file. JSON writes an f64 in its shortest exact form, so the hash of a record read back is
+    /// the hash of the record written.
+    pub fn digest(&self) -> String {
+        let json = serde_json::to_vec(self).expect("a discovery record serialises");
+        blake3::hash(&json).to_hex().to_string()
+    }
+
+    /// Checks the record against itself and the run's summary, without its outcomes: every
+    /// field in its range; the counts, KL-coverage and coverage equal to the summary's (the same
+    /// measures of the same outcomes); the goal-reaching error at most that of the resting
+    /// position (the resting outcome is one of the outcomes, so no goal is farther from them
+    /// than from it); the error at rest present exactly when an outcome did not move the object,
+    /// the moved radius exactly when one did. `env` bounds the distances (its goal space's
+    /// diameter); an environment not in this build's registry is bounded by the summary only.
+    pub fn check(&self, env: &str, summary: &crate::Summary) -> Result<(), RecordMismatch> {
+        let bad = |field: &str, why: String| {
+            Err(RecordMismatch {
+                field: field.into(),
+                why,
+            })
+        };
+        // Every measured coordinate lies in [-1, 1] (ArmArrow's angle is scaled to it), so no
+        // two points of the goal space are farther apart than 2 sqrt(d).
+        let dims = EnvSpec::by_name(env).map_or(3, |s| s.metric_dims().count());
+        let diameter = 2.0 * (dims as f64).sqrt();
+        let a = &self.at_end;
+        a.check_ranges("final", diameter)?;
+        if let Some(p) = &self.position {
+            p.check_ranges("position", 2.0 * 2f64.sqrt())?;
+            if (p.n_outcomes, p.n_moved) != (a.n_outcomes, a.n_moved) {
+                return bad(
+                    "position.n_moved",
+                    format!(
+                        "{} of {} outcomes, the final record {} of {}",
+                        p.n_moved, p.n_outcomes, a.n_moved, a.n_outcomes
+                    ),
+                );
+            }
+        }
+        if a.n_moved != summary.n_moved {
+            return bad(
+                "final.n_moved",
+                format!("= {}, the summary's = {}", a.n_moved, summary.n_moved),
+            );
+        }
+        if !close(a.klc, summary.final_klc) {
+            return bad(
+                "final.klc",
+                format!(
+                    "= {}, the summary's final_klc = {}",
+                    a.klc, summary.final_klc
+                ),
+            );
+        }
+        if !close(a.coverage, summary.coverage) {
+            return bad(
+                "final.coverage",
+                format!("= {}, the summary's = {}", a.coverage, summary.coverage),
+            );
+        }
+        let rests = a.n_moved < a.n_outcomes;
+        match self.error_at_rest {
+            Some(e) if !rests || !(0.0..=diameter).contains(&e) => {
+                return bad(
+                    "error_at_rest",
+                    format!(
+                        "= {e} with {} of {} outcomes moved",
+                        a.n_moved, a.n_outcomes
+                    ),
+                );
+            }
+            Some(e) if a.goal_error_mean > e * (1.0 + RECORD_TOLERANCE) => {
+                return bad(
+                    "final.goal_error_mean",
+                    format!(
+                        "= {} exceeds the error at rest {e}, which no exploration can",
+                        a.goal_error_mean
+                    ),
+                );
+            }
+            None if rests => {
+                return bad(
+                    "error_at_rest",
+                    format!(
+                        "is missing with {} of {} outcomes moved",
+                        a.n_moved, a.n_outcomes
+                    ),
+                );
+            }
+            _ => {}
+        }
+        match self.moved_radius_mean {
+            Some(r) if a.n_moved == 0 || !(0.0..=2f64.sqrt()).contains(&r) => bad(
+                "moved_radius_mean",
+                format!("= {r} with {} moved outcomes", a.n_moved),
+            ),
+            None if a.n_moved > 0 => bad(
+                "moved_radius_mean",
+                format!("is missing with {} moved outcomes", a.n_moved),
+            ),
+            _ => Ok(()),
+        }
+    }
+
+    /// Where the outcomes file is kept: the record against the measures recomputed from it
+    /// (`computed`, by [`RunDiscovery::measure`]); the first field that differs. A record written
+    /// before the position measures were kept is compared on the rest.
+    pub fn check_against(&self, computed: &RunDiscovery) -> Result<(), RecordMismatch> {
+        if let Some(m) = self.at_end.mismatch(&computed.at_end, "final") {
+            return Err(m);
+        }
+        if let (Some(a), Some(b)) = (&self.position, &computed.position)
+            && let Some(m) = a.mismatch(b, "position")
+        {
+            return Err(m);
+        }
+        for (field, a, b) in [
+            ("error_at_rest", self.error_at_rest, computed.error_at_rest),
+            (
+                "moved_radius_mean",
+                self.moved_radius_mean,
+                computed.moved_radius_mean,
+            ),
+        ] {
+            let same = match (a, b) {
+                (Some(a), Some(b)) => close(a, b),
+                (None, None) => true,
+                _ => false,
+            };
+            if !same {
+                return Err(RecordMismatch {
+                    field: field.into(),
+                    why: format!("= {a:?}, the outcomes file gives {b:?}"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -662,6 +924,71 @@ mod tests {
             angle: None,
             moved,
         }
+    }
+
+    #[test]
+    fn a_record_is_checked_against_its_summary_and_its_outcomes() {
+        let mut outcomes = vec![outcome(0, 0.0, 0.5, false)];
+        outcomes.extend((1..40).map(|i| outcome(i, 0.9 - 0.04 * i as f64, 0.1, true)));
+        let spec = EnvSpec::by_name("armball").unwrap();
+        let d = RunDiscovery::measure(spec, &outcomes).unwrap().unwrap();
+        let summary = crate::Summary {
+            run: "r".into(),
+            final_klc: d.at_end.klc,
+            n_moved: d.at_end.n_moved,
+            coverage: d.at_end.coverage,
+        };
+        d.check("armball", &summary).unwrap();
+        d.check_against(&d.clone()).unwrap();
+        // The hash survives a round trip through JSON, and changes with any field.
+        let back: RunDiscovery = serde_json::from_str(&serde_json::to_string(&d).unwrap()).unwrap();
+        assert_eq!(back.digest(), d.digest());
+        let mut better = d.clone();
+        better.at_end.goal_error_mean *= 0.5;
+        assert_ne!(better.digest(), d.digest());
+        // Without outcomes, a smaller error passes the checks; the outcomes file refutes it.
+        better.check("armball", &summary).unwrap();
+        let e = better.check_against(&d).unwrap_err();
+        assert_eq!(e.field, "final.goal_error_mean");
+        let field = |f: &dyn Fn(&mut RunDiscovery), s: &crate::Summary| {
+            let mut x = d.clone();
+            f(&mut x);
+            x.check("armball", s).unwrap_err().field
+        };
+        assert_eq!(
+            field(&|x| x.at_end.coverage = -5.0, &summary),
+            "final.coverage"
+        );
+        assert_eq!(
+            field(&|x| x.at_end.goal_error_mean = 1e300, &summary),
+            "final.goal_error_mean"
+        );
+        assert_eq!(
+            field(
+                &|x| x.at_end.goal_error_mean = x.error_at_rest.unwrap() * 1.01,
+                &summary
+            ),
+            "final.goal_error_mean"
+        );
+        assert_eq!(field(&|x| x.at_end.klc = f64::NAN, &summary), "final.klc");
+        assert_eq!(
+            field(&|x| x.moved_radius_mean = None, &summary),
+            "moved_radius_mean"
+        );
+        assert_eq!(
+            field(&|x| x.error_at_rest = None, &summary),
+            "error_at_rest"
+        );
+        let other = crate::Summary {
+            n_moved: summary.n_moved + 1,
+            ..summary.clone()
+        };
+        assert_eq!(field(&|_| {}, &other), "final.n_moved");
+        let other = crate::Summary {
+            coverage: 0.5,
+            ..summary
+        };
+        assert_eq!(field(&|_| {}, &other), "final.coverage");
     }
 
     #[test]

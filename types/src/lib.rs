@@ -33,7 +33,7 @@ pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, Reco
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
 pub use discovery::{
     Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Grid,
-    Outcome, RunDiscovery, median, quantile_sorted,
+    Outcome, RecordMismatch, RunDiscovery, median, quantile_sorted,
 };
 pub use env::{
     ARMARROW, ARMBALL, ARMBALLS, BUILT_IN, DISK, EnvSpec, EnvSpecError, KlcGrid, ObjectSpec,

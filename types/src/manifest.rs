@@ -121,6 +121,11 @@ pub struct Manifest {
     /// file, which the committed stores keep only for some runs (`data/results/README.md`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub discovery: Option<crate::RunDiscovery>,
+    /// [`crate::RunDiscovery::digest`] of `discovery` as written, so that an edited record is
+    /// detected like a damaged data file ([`crate::verify_files`]). Absent in manifests written
+    /// before it was recorded: their records are checked for range and against `summary` only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub discovery_blake3: Option<String>,
     /// The run's data files as written: name, length and BLAKE3 hash. A run is complete only
     /// if its files still match (checked on resume, merge and report). Absent in manifests
     /// written before it was recorded.

@@ -69,6 +69,10 @@ pub enum DigestError {
     },
     #[error("{} does not match the BLAKE3 hash its manifest records (damaged)", path.display())]
     Hash { path: PathBuf },
+    /// The manifest's discovery record (`path` is the manifest) does not match the hash beside
+    /// it, or is not what the run measured ([`crate::RunDiscovery::check`]).
+    #[error("{}: {why}", path.display())]
+    Discovery { path: PathBuf, why: String },
 }
 
 impl DigestError {
@@ -78,7 +82,8 @@ impl DigestError {
             DigestError::Missing { path }
             | DigestError::Io { path, .. }
             | DigestError::Length { path, .. }
-            | DigestError::Hash { path } => path,
+            | DigestError::Hash { path }
+            | DigestError::Discovery { path, .. } => path,
         }
     }
 }
@@ -121,5 +126,28 @@ pub fn verify_files(dir: &Path, manifest: &Manifest) -> Result<(), DigestError> 
             return Err(DigestError::Hash { path });
         }
     }
-    Ok(())
+    verify_discovery(dir, manifest)
+}
+
+/// The manifest's discovery record against the hash recorded beside it, and against itself and
+/// the run's summary ([`crate::RunDiscovery::check`]).
+fn verify_discovery(dir: &Path, manifest: &Manifest) -> Result<(), DigestError> {
+    let Some(d) = &manifest.discovery else {
+        return Ok(());
+    };
+    let path = || run_paths(dir, &manifest.run_id).manifest;
+    if let Some(h) = &manifest.discovery_blake3
+        && d.digest() != *h
+    {
+        return Err(DigestError::Discovery {
+            path: path(),
+            why: "its discovery record does not match the BLAKE3 hash recorded beside it (edited)"
+                .into(),
+        });
+    }
+    d.check(&manifest.env, &manifest.summary)
+        .map_err(|e| DigestError::Discovery {
+            path: path(),
+            why: e.to_string(),
+        })
 }

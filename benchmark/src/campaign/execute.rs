@@ -301,6 +301,7 @@ pub fn execute(
         summary: summary.clone(),
         discovery,
         // Filled in by `write_run` from the bytes it writes.
+        discovery_blake3: None,
         files: None,
     };
     store::write_run(out, spec, &log, &manifest)?;

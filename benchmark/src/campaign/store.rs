@@ -209,6 +209,7 @@ pub fn write_run(
     }
     let manifest = Manifest {
         files: Some(digests),
+        discovery_blake3: manifest.discovery.as_ref().map(|d| d.digest()),
         ..manifest.clone()
     };
     write_manifest(dir, &manifest)
