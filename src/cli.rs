@@ -97,6 +97,10 @@ pub(crate) enum Command {
         /// [learners.external] name, else `external`).
         #[arg(long)]
         name: Option<String>,
+        /// Write into the checkout's data/ although tracked files have uncommitted changes
+        /// (the run then records a `-dirty` git revision, which no commit reproduces exactly).
+        #[arg(long)]
+        allow_dirty: bool,
         #[command(flatten)]
         cache: CacheArgs,
     },

@@ -122,6 +122,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             out,
             command,
             name,
+            allow_dirty,
             cache,
         } => run(
             RunRequest {
@@ -140,6 +141,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             &profile,
             &out,
             &cache,
+            allow_dirty,
         ),
         Command::Plan { config } => {
             let cfg = CampaignConfig::load(&config)?;

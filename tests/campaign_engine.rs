@@ -347,7 +347,7 @@ fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_ru
         &cfg,
         "[campaign]\nname = \"diag\"\nreps = 2\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
          algos = [\"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
-         variants = [\"corrected\"]\n[ugl]\nimages = 300\n[explore]\nepochs = 100\n\
+         variants = [\"corrected\"]\n[ugl]\nimages = 300\n[explore]\nbootstrap_epochs = 10\nepochs = 100\n\
          eval_every = 50\n[learners.vae]\niterations = 20\nhidden = [16, 8]\n",
     )
     .unwrap();

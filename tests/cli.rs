@@ -450,10 +450,161 @@ fn a_forged_discovery_record_is_detected() {
     assert!(report().status.success(), "{}", stderr(&report()));
 }
 
+/// The audit's refusals, each one line and exit 2, nothing run: a position-only goal space where
+/// the outcome is the position already (the run would be RGE-EFR's under another label); a
+/// bootstrap that leaves no epoch to goal exploration (an RPE run under a goal label), in `ugl
+/// run` and in a campaign file; a shard count beyond the campaign's groups (it once allocated
+/// until the OOM killer came); an exploration count too large; an `init` that is a number; a
+/// grid that needs more memory than the address-space limit (it once aborted on allocation).
+#[test]
+fn the_audit_refusals_are_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x");
+    let run = |extra: &[&str]| {
+        let mut a = vec!["run", "--env", "armball", "--out", p(&out)];
+        a.extend_from_slice(extra);
+        ugl(&a)
+    };
+    assert_one_line_error(
+        &run(&["--algo", "rge-efr-position", "--epochs", "300"]),
+        "use --algo rge-efr",
+    );
+    assert_one_line_error(
+        &run(&["--algo", "rge-efr", "--epochs", "100"]),
+        "--epochs 100: explore.bootstrap_epochs = 100",
+    );
+    assert!(!out.join("armball.rge-efr.s0.json").exists());
+    let file = |name: &str, text: &str| {
+        let f = dir.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        f
+    };
+    let short = file(
+        "short.toml",
+        "[campaign]\nname = \"short\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rge-efr\"]\n[explore]\nepochs = 60\n",
+    );
+    assert_one_line_error(&ugl(&["plan", "--config", p(&short)]), "bootstrap_epochs");
+    assert_one_line_error(
+        &ugl(&[
+            "status",
+            "--config",
+            "data/campaigns/baselines.toml",
+            "--out",
+            p(&out),
+            "--shards",
+            "18446744073709551615",
+        ]),
+        "--shards 18446744073709551615: must be between 1 and",
+    );
+    let many = file(
+        "many.toml",
+        "[campaign]\nname = \"many\"\nreps = 1\nexplorations = 18446744073709551615\n\
+         [matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n",
+    );
+    assert_one_line_error(
+        &ugl(&["plan", "--config", p(&many)]),
+        "must be between 1 and 4294967295, got 18446744073709551615",
+    );
+    let init = file(
+        "init.toml",
+        "[campaign]\nname = \"init\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rge-vae\"]\n[learners.vae]\ninit = 1\n",
+    );
+    assert_one_line_error(
+        &ugl(&["plan", "--config", p(&init)]),
+        "learners.vae.init: invalid type: integer `1`, expected one of \"paper\", \"he\", \"glorot\"",
+    );
+    let o = Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 2097152 && exec \"$0\" embed --env armball --learner pca --latents 2 \
+             --profile data/campaigns/smoke.toml --grid 600 --out {}",
+            dir.path().join("e.npy").display()
+        ))
+        .arg(env!("CARGO_BIN_EXE_ugl"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&o, "address-space limit");
+}
+
+/// `ugl run` honours a store's one configuration: into a campaign's store it adds a run only
+/// with the campaign's profile and options; a run of another configuration is never replaced
+/// (the audit's 301-epoch run over a finished 300-epoch one); the same run again is fine.
+#[test]
+fn ugl_run_keeps_a_store_to_one_configuration() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("tiny.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\"]\n[explore]\nepochs = 200\neval_every = 100\n",
+    )
+    .unwrap();
+    let store = dir.path().join("tiny");
+    let o = ugl(&[
+        "campaign",
+        "--config",
+        p(&cfg),
+        "--out",
+        p(&store),
+        "--jobs",
+        "1",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let manifest = store.join("armball.rpe.s0.json");
+    let before = std::fs::read(&manifest).unwrap();
+    let run = |out: &Path, epochs: &str| {
+        ugl(&[
+            "run",
+            "--env",
+            "armball",
+            "--algo",
+            "rpe",
+            "--profile",
+            p(&cfg),
+            "--epochs",
+            epochs,
+            "--out",
+            p(out),
+        ])
+    };
+    assert_one_line_error(&run(&store, "201"), "another configuration");
+    assert_eq!(std::fs::read(&manifest).unwrap(), before, "the run is kept");
+    // Another campaign's profile.
+    let o = ugl(&[
+        "run",
+        "--env",
+        "armball",
+        "--algo",
+        "rpe",
+        "--profile",
+        "smoke",
+        "--out",
+        p(&store),
+    ]);
+    assert_one_line_error(&o, "holds campaign `tiny`");
+    // A directory of single runs: the same run again is fine, another configuration is not.
+    let single = dir.path().join("single");
+    assert!(run(&single, "200").status.success());
+    assert!(run(&single, "200").status.success());
+    assert_one_line_error(
+        &run(&single, "300"),
+        "holds run armball.rpe.s0 of another configuration",
+    );
+    assert!(
+        !single.join(ugl_types::RECORD_FILE).exists(),
+        "ugl run records no campaign"
+    );
+}
+
 /// Results written into a checkout's data/ are the committed ones: a campaign refuses to write
 /// there while tracked files have uncommitted changes (one line, exit 2, nothing written),
 /// unless `--allow-dirty`, which the runs then record as a `-dirty` revision. Elsewhere it
 /// writes whatever the tree's state.
+#[cfg(unix)]
 #[test]
 fn a_campaign_refuses_a_dirty_checkout_for_its_data() {
     let repo = tempfile::tempdir().unwrap();
@@ -476,7 +627,7 @@ fn a_campaign_refuses_a_dirty_checkout_for_its_data() {
     git(&["init", "-q"]);
     std::fs::write(
         repo.path().join("tiny.toml"),
-        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n[explore]\nepochs = 50\neval_every = 50\n",
+        "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n[explore]\nbootstrap_epochs = 10\nepochs = 50\neval_every = 50\n",
     )
     .unwrap();
     git(&["add", "tiny.toml"]);
@@ -516,6 +667,49 @@ fn a_campaign_refuses_a_dirty_checkout_for_its_data() {
     // Outside the checkout's data/: allowed.
     let o = campaign("elsewhere", &[]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // The audit's bypasses: a working directory outside the checkout, a symlink into its data/,
+    // and `ugl run`, which had no check. Refused alike; allowed, the revision recorded is the
+    // checkout's, never `unknown`.
+    let outside = tempfile::tempdir().unwrap();
+    let config = repo.path().join("tiny.toml");
+    let from_outside = |out: &Path, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_ugl"))
+            .args([
+                "campaign",
+                "--config",
+                p(&config),
+                "--out",
+                p(out),
+                "--quiet",
+            ])
+            .args(extra)
+            .current_dir(outside.path())
+            .output()
+            .expect("ugl runs")
+    };
+    let h = repo.path().join("data/results/h");
+    assert_one_line_error(&from_outside(&h, &[]), "--allow-dirty");
+    std::fs::create_dir_all(repo.path().join("data/results")).unwrap();
+    let link = outside.path().join("link");
+    std::os::unix::fs::symlink(repo.path().join("data/results"), &link).unwrap();
+    assert_one_line_error(&from_outside(&link.join("h"), &[]), "--allow-dirty");
+    let single = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_ugl"))
+            .args([
+                "run", "--env", "armball", "--algo", "rpe", "--epochs", "50", "--out",
+            ])
+            .arg(repo.path().join("data/results/single"))
+            .args(extra)
+            .current_dir(outside.path())
+            .output()
+            .expect("ugl runs")
+    };
+    assert_one_line_error(&single(&[]), "--allow-dirty");
+    let o = from_outside(&h, &["--allow-dirty"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(revision("data/results/h").ends_with("-dirty"));
+    assert!(single(&["--allow-dirty"]).status.success());
+    assert!(revision("data/results/single").ends_with("-dirty"));
 }
 
 #[test]
@@ -713,7 +907,7 @@ fn run_with_an_external_learner() {
         "--seed",
         "1",
         "--epochs",
-        "100",
+        "150",
         "--images",
         "200",
         "--profile",
@@ -733,7 +927,7 @@ fn run_with_an_external_learner() {
         "--seed",
         "1",
         "--epochs",
-        "100",
+        "150",
         "--images",
         "200",
         "--profile",
@@ -882,7 +1076,7 @@ fn status_counts_complete_missing_and_damaged_runs() {
     std::fs::write(
         &cfg,
         "[campaign]\nname = \"st\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\", \"rge-efr\"]\n\
-         [explore]\nepochs = 60\neval_every = 20\n",
+         [explore]\nbootstrap_epochs = 10\nepochs = 60\neval_every = 20\n",
     )
     .unwrap();
     let out = dir.path().join("st");
@@ -1554,7 +1748,7 @@ fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
     std::fs::write(
         &cfg,
         "[campaign]\nname = \"ckpt\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
-         [ugl]\nimages = 300\n[explore]\nepochs = 100\n\
+         [ugl]\nimages = 300\n[explore]\nbootstrap_epochs = 10\nepochs = 100\n\
          [learners.vae]\niterations = 600\nhidden = [32, 16]\ninit = \"he\"\n",
     )
     .unwrap();
@@ -1815,7 +2009,7 @@ fn slurm_scripts_run_end_to_end_with_spaces_and_another_campaign() {
     std::fs::write(
         &config,
         "[campaign]\nname = \"tiny-camp\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
-         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 60\neval_every = 20\n",
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nbootstrap_epochs = 10\nepochs = 60\neval_every = 20\n",
     )
     .unwrap();
     let exe = |name: &str, text: &str| {
@@ -1926,7 +2120,7 @@ fn slurm_scripts_are_safe_for_hostile_paths() {
     std::fs::write(
         &config,
         "[campaign]\nname = \"tiny\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
-         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 60\neval_every = 20\n",
+         algos = [\"rpe\", \"rge-efr\"]\n[explore]\nbootstrap_epochs = 10\nepochs = 60\neval_every = 20\n",
     )
     .unwrap();
     let exe = |f: &Path, text: &str| {
@@ -2051,7 +2245,7 @@ fn a_failing_external_fit_is_started_once_per_cell() {
         format!(
             "[campaign]\nname = \"ext-fail\"\nreps = 3\n[matrix]\nenvs = [\"armball\"]\n\
              algos = [\"rge-external\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [2]\n\
-             [ugl]\nimages = 50\n[explore]\nepochs = 20\n\
+             [ugl]\nimages = 50\n[explore]\nbootstrap_epochs = 10\nepochs = 20\n\
              [learners.external]\nname = \"broken\"\ncommand = \"sh -c 'echo start >> {}; echo boom >&2; exit 3'\"\n",
             starts.display()
         ),
@@ -2199,7 +2393,7 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
     std::fs::write(
         &cfg,
         "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-external\"]\n\
-         [ugl]\nimages = 60\n[explore]\nepochs = 20\n\
+         [ugl]\nimages = 60\n[explore]\nbootstrap_epochs = 10\nepochs = 20\n\
          [learners.external]\nname = \"slow\"\ncommand = \"sleep 1000\"\nready_timeout_s = 1.5\n",
     )
     .unwrap();
@@ -2547,37 +2741,34 @@ fn messages_name_the_algorithm_the_flag_and_the_key_given() {
     );
 }
 
-/// The position-only EFR draws RGE-EFR's exploration streams (paired): on ArmBall, whose
-/// outcome is the position, it is RGE-EFR itself; on ArmArrow it explores without the angle
-/// and the runs differ.
+/// The position-only EFR draws RGE-EFR's exploration streams (paired): on ArmArrow it explores
+/// without the angle and the runs differ. On ArmBall, whose outcome is the position, it would be
+/// RGE-EFR itself under another label: refused.
 #[test]
 fn the_position_only_efr_is_paired_with_efr_and_drops_only_the_angle() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("runs");
-    for env in ["armball", "armarrow"] {
-        for algo in ["rge-efr", "rge-efr-position"] {
-            let o = ugl(&[
-                "run",
-                "--env",
-                env,
-                "--algo",
-                algo,
-                "--epochs",
-                "300",
-                "--profile",
-                "smoke",
-                "--out",
-                p(&out),
-            ]);
-            assert!(o.status.success(), "{}", stderr(&o));
-        }
+    let run = |env: &str, algo: &str| {
+        ugl(&[
+            "run",
+            "--env",
+            env,
+            "--algo",
+            algo,
+            "--epochs",
+            "300",
+            "--profile",
+            "smoke",
+            "--out",
+            p(&out),
+        ])
+    };
+    for algo in ["rge-efr", "rge-efr-position"] {
+        let o = run("armarrow", algo);
+        assert!(o.status.success(), "{}", stderr(&o));
     }
+    assert_one_line_error(&run("armball", "rge-efr-position"), "use --algo rge-efr");
     let m = |id: &str| manifest(&out.join(format!("{id}.json")));
-    let (ball, ball_pos) = (m("armball.rge-efr.s0"), m("armball.rge-efr-position.s0"));
-    assert_eq!(ball["run_seed"], ball_pos["run_seed"]);
-    for k in ["final_klc", "n_moved", "coverage"] {
-        assert_eq!(ball["summary"][k], ball_pos["summary"][k], "{k}");
-    }
     let (arrow, arrow_pos) = (m("armarrow.rge-efr.s0"), m("armarrow.rge-efr-position.s0"));
     assert_eq!(arrow["run_seed"], arrow_pos["run_seed"]);
     assert_ne!(
@@ -2585,4 +2776,30 @@ fn the_position_only_efr_is_paired_with_efr_and_drops_only_the_angle() {
         arrow_pos["summary"]["final_klc"]
     );
     assert_ne!(arrow["config_hash"], arrow_pos["config_hash"]);
+}
+
+/// The lock a campaign, compare or run leaves in its results directory is never committed: git
+/// ignores it in every results directory of the checkout (the audit found it untracked).
+#[test]
+fn the_store_lock_is_git_ignored() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let in_repo = Command::new("git")
+        .args(["-C", root, "rev-parse", "--is-inside-work-tree"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !in_repo {
+        eprintln!("SKIPPED: {root} is not a git checkout");
+        return;
+    }
+    for path in [
+        "data/results/paper/.ugl-store.lock",
+        "data/results/compare-x/.ugl-store.lock",
+        "data/results-pending/x/.ugl-store.lock",
+    ] {
+        let o = Command::new("git")
+            .args(["-C", root, "check-ignore", "-q", "--no-index", path])
+            .status()
+            .unwrap();
+        assert!(o.success(), "{path} is not git-ignored");
+    }
 }

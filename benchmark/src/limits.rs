@@ -19,21 +19,77 @@ pub fn total_memory() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
-/// The memory a configuration may plan for: the machine's, or 1 TiB where it is unknown.
-fn budget() -> f64 {
-    total_memory().unwrap_or(1024.0 * 1024.0 * 1024.0 * 1024.0)
+/// The soft limit of this process's address space (`ulimit -v`, `prlimit --as`, from
+/// `/proc/self/limits`); None where unlimited or unknown.
+pub fn address_space_limit() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+    line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// The tightest memory limit of this process's control group and its ancestors (cgroup v2
+/// `memory.max`, or v1 `memory.limit_in_bytes`); None where there is none or it is unknown.
+pub fn cgroup_memory_limit() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let mut limits = Vec::new();
+    for line in text.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (_, controllers, path) = (parts.next()?, parts.next()?, parts.next()?);
+        let (root, file) = match controllers {
+            "" => ("/sys/fs/cgroup", "memory.max"),
+            c if c.split(',').any(|c| c == "memory") => {
+                ("/sys/fs/cgroup/memory", "memory.limit_in_bytes")
+            }
+            _ => continue,
+        };
+        let mut dir = std::path::PathBuf::from(format!("{root}{path}"));
+        loop {
+            if let Ok(v) = std::fs::read_to_string(dir.join(file))
+                && let Ok(bytes) = v.trim().parse::<f64>()
+            {
+                limits.push(bytes);
+            }
+            if dir.as_os_str().len() <= root.len() || !dir.pop() {
+                break;
+            }
+        }
+    }
+    limits.into_iter().reduce(f64::min)
+}
+
+/// The memory a configuration may plan for, and what sets it: the least of the machine's
+/// memory, this process's address-space limit and its control group's memory limit; 1 TiB
+/// where none is known.
+fn budget() -> (f64, &'static str) {
+    [
+        (total_memory(), "this machine's memory"),
+        (
+            address_space_limit(),
+            "this process's address-space limit (ulimit -v)",
+        ),
+        (cgroup_memory_limit(), "this control group's memory limit"),
+    ]
+    .into_iter()
+    .filter_map(|(b, what)| Some((b?, what)))
+    .reduce(|a, b| if b.0 < a.0 { b } else { a })
+    .unwrap_or((1024.0 * 1024.0 * 1024.0 * 1024.0, "1 TiB"))
 }
 
 fn gib(bytes: f64) -> String {
     format!("{:.1} GiB", bytes / (1024.0 * 1024.0 * 1024.0))
 }
 
-/// Refuse `key = value` if it needs `bytes` (estimated) and that exceeds the machine's memory.
+/// Refuse `key = value` if it needs `bytes` (estimated) and that exceeds the memory this
+/// process may use ([`budget`]).
 pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Result<(), String> {
-    let have = budget();
+    let (have, what) = budget();
     if !bytes.is_finite() || bytes > have {
         return Err(format!(
-            "{key} = {value} needs about {} of memory, more than this machine's {}",
+            "{key} = {value} needs about {} of memory, more than {what} ({})",
             gib(bytes),
             gib(have)
         ));

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use ugl_bench::campaign::config::CampaignConfig;
-use ugl_bench::campaign::plan::parse_shard;
+use ugl_bench::campaign::plan::{parse_shard, shard_groups};
 use ugl_bench::campaign::{CampaignOptions, Harness, Progress, plan, run_campaign};
 
 use crate::cli::{CacheArgs, SlurmArgs};
@@ -85,34 +85,28 @@ pub(crate) fn refresh_config(
     Ok(())
 }
 
-/// Results written into the checkout's `data/` are the ones that get committed: refused while
-/// tracked files of the checkout (the working directory's repository, whose revision every
-/// manifest records) have uncommitted changes, since the manifests would record a `-dirty`
-/// revision that no commit reproduces. `--allow-dirty` overrides; results written elsewhere are
-/// never refused.
-fn check_clean_tree(out: &Path) -> Result<()> {
-    let revision = ugl_bench::campaign::provenance::git_revision();
-    if !revision.ends_with("-dirty") {
-        return Ok(());
-    }
-    let Some(top) = std::process::Command::new("git")
-        .args(["rev-parse", "--show-toplevel"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))
-    else {
+/// Results written into a checkout's `data/` are the ones that get committed: refused while
+/// tracked files of that checkout (the one holding `out`'s real path, symlinks followed, whose
+/// revision every manifest written there records) have uncommitted changes, since the manifests
+/// would record a `-dirty` revision that no commit reproduces. `--allow-dirty` overrides;
+/// results written outside a checkout's `data/` are never refused.
+pub(crate) fn check_clean_tree(out: &Path) -> Result<()> {
+    use ugl_bench::campaign::provenance::{checkout_of, real_path, revision_of};
+    let real = real_path(out);
+    let Some(top) = checkout_of(&real) else {
         return Ok(());
     };
-    let data = top.canonicalize().unwrap_or(top).join("data");
-    let cwd = std::env::current_dir().context("cannot read the current directory")?;
-    if ugl_bench::campaign::slurm::resolve(out, &cwd).starts_with(&data) {
+    if !real.starts_with(top.join("data")) {
+        return Ok(());
+    }
+    let revision = revision_of(Some(&top));
+    if revision.ends_with("-dirty") {
         bail!(
             "--out {}: the checkout {} has uncommitted changes to tracked files, and runs written \
              into its data/ would record the revision {revision}, which no commit reproduces: \
              commit or stash the changes, write elsewhere with --out, or pass --allow-dirty",
             out.display(),
-            data.parent().unwrap_or(&data).display(),
+            top.display(),
         );
     }
     Ok(())
@@ -216,7 +210,6 @@ pub(crate) fn run_config(
 }
 
 pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
-    use ugl_bench::campaign::plan::shard_groups;
     use ugl_bench::campaign::slurm::{SlurmJob, resolve, scripts as slurm_scripts, write_scripts};
     let cfg = CampaignConfig::load(&a.config)?;
     let cwd = std::env::current_dir().context("cannot read the current directory")?;
@@ -282,8 +275,17 @@ pub(crate) fn status(
 ) -> Result<()> {
     use ugl_bench::campaign::status::{RunState, store_status};
     let cfg = CampaignConfig::load(config)?;
-    if shards == 0 {
-        bail!("--shards must be at least 1");
+    // At most one shard per group of runs that share a fit, as `ugl slurm` writes them (a huge
+    // count would only allocate empty shards).
+    let n_groups = shard_groups(&plan(&cfg), cfg.ugl.images)
+        .into_iter()
+        .max()
+        .map_or(1, |g| g + 1);
+    if shards == 0 || shards > n_groups {
+        bail!(
+            "--shards {shards}: must be between 1 and {n_groups}, the campaign's groups of runs \
+             that share a fit"
+        );
     }
     let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
     let st = store_status(&cfg, &out, shards)?;

@@ -15,14 +15,24 @@ use crate::cli::{CacheArgs, EmbedArgs};
 use crate::output::outln;
 use crate::progress::{learner_lines, progress_area, training_bars};
 
-pub(crate) fn run(a: RunRequest, profile: &str, out: &Path, cache: &CacheArgs) -> Result<()> {
+pub(crate) fn run(
+    a: RunRequest,
+    profile: &str,
+    out: &Path,
+    cache: &CacheArgs,
+    allow_dirty: bool,
+) -> Result<()> {
     let path = resolve_profile(profile)?;
     let mut cfg = CampaignConfig::load(&path)?;
     let spec = a.resolve(&mut cfg, &path).map_err(anyhow::Error::msg)?;
+    if !allow_dirty {
+        crate::commands::campaign::check_clean_tree(out)?;
+    }
     check_out_dir(out)?;
     let model_cache = cache.resolve(out);
     let mp = progress_area();
     let ctx = single_context(&cfg, profile, model_cache.as_ref(), cache, out, &mp);
+    ugl_bench::campaign::check_single_run(&cfg, &spec.run_id(), &ctx.config_hash(&spec), out)?;
     let summary = ugl_bench::campaign::execute(&spec, &ctx, out, None)?;
     outln!("{}", serde_json::to_string(&summary)?)?;
     Ok(())

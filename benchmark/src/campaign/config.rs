@@ -334,7 +334,8 @@ impl CampaignConfig {
         }
         if self.campaign.explorations == 0 || self.campaign.explorations > u32::MAX as usize {
             return Err(format!(
-                "campaign.explorations must be at least 1, got {}",
+                "campaign.explorations must be between 1 and {}, got {}",
+                u32::MAX,
                 self.campaign.explorations
             ));
         }
@@ -439,6 +440,12 @@ impl CampaignConfig {
             ));
         }
         self.explore.validate()?;
+        self.explore.check_goal_epochs(
+            self.matrix
+                .algos
+                .iter()
+                .any(|a| a.strategy() != crate::explore::Strategy::Rpe),
+        )?;
         self.env.validate()
     }
 }
@@ -556,13 +563,13 @@ reps = 2
 envs = ["armball"]
 algos = ["rpe", "rge-efr"]
 [explore]
-epochs = 50
+epochs = 500
 "#;
 
     #[test]
     fn parses_with_paper_defaults() {
         let c = CampaignConfig::from_toml(GOOD, Path::new("t.toml")).unwrap();
-        assert_eq!(c.explore.epochs, 50);
+        assert_eq!(c.explore.epochs, 500);
         assert_eq!(c.explore.bootstrap_epochs, 100);
         assert_eq!(c.explore.random_ratio, 0.2);
         assert_eq!(c.env, EnvConfig::default());
@@ -573,14 +580,14 @@ epochs = 50
         let cases = [
             (GOOD.replace("reps = 2", "reps = 0"), "campaign.reps"),
             (
-                GOOD.replace("epochs = 50", "epochs = 50\nbogus = 1"),
+                GOOD.replace("epochs = 500", "epochs = 500\nbogus = 1"),
                 "bogus",
             ),
             (GOOD.replace("\"rpe\"", "\"rge-foo\""), "rge-foo"),
-            (GOOD.replace("epochs = 50", "epochs = -5"), "epochs"),
-            (GOOD.replace("epochs = 50", "epochs = \"many\""), "epochs"),
+            (GOOD.replace("epochs = 500", "epochs = -5"), "epochs"),
+            (GOOD.replace("epochs = 500", "epochs = \"many\""), "epochs"),
             (
-                GOOD.replace("epochs = 50", "random_ratio = 1.5"),
+                GOOD.replace("epochs = 500", "random_ratio = 1.5"),
                 "explore.random_ratio",
             ),
             (GOOD.replace("\"rpe\", ", "\"rge-efr\", "), "matrix.algos"),

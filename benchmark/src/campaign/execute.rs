@@ -21,7 +21,7 @@ use ugl_types::RunDiscovery;
 use super::context::RunContext;
 use super::error::RunError;
 use super::fit::{Representation, fit_representation};
-use super::provenance::{crate_versions, git_revision};
+use super::provenance::{crate_versions, git_revision_for};
 
 /// What an exploration produced, with its timings.
 pub struct Explored {
@@ -281,7 +281,7 @@ pub fn execute(
             .map(|_| serde_json::to_value(ctx.ugl).expect("serialisable")),
         reduced_budget: !notes.is_empty(),
         budget_note: notes.join("; "),
-        git_revision: git_revision().into(),
+        git_revision: git_revision_for(out),
         crate_versions: crate_versions(),
         toolchain: env!("UGL_RUSTC_VERSION").into(),
         threads: ctx.threads,

@@ -24,5 +24,5 @@ pub use context::{Harness, RunContext};
 pub use error::RunError;
 pub use execute::{execute, explore};
 pub use plan::{RunSpec, plan};
-pub use runner::{CampaignOptions, Progress, run_campaign};
+pub use runner::{CampaignOptions, Progress, check_single_run, run_campaign};
 pub use store::{Manifest, Summary};

@@ -76,19 +76,7 @@ pub const STORE_LOCK: &str = ".ugl-store.lock";
 /// campaigns started together cannot both pass. A store whose record predates the configuration
 /// hash is checked against its manifests of the current results version instead.
 pub fn write_campaign_record(cfg: &CampaignConfig, out: &Path) -> Result<(), StoreError> {
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| StoreError::Io { path, source }
-    };
-    std::fs::create_dir_all(out).map_err(io(out))?;
-    let lock_path = out.join(STORE_LOCK);
-    let lock = std::fs::OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(&lock_path)
-        .map_err(io(&lock_path))?;
-    lock.lock().map_err(io(&lock_path))?;
+    let _lock = lock_store(out)?;
     let configuration = cfg.configuration_hash();
     let refused = |message: String| StoreError::Refused {
         path: out.to_path_buf(),
@@ -126,6 +114,76 @@ pub fn write_campaign_record(cfg: &CampaignConfig, out: &Path) -> Result<(), Sto
     let record = CampaignRecord::new(&cfg.campaign.name, &cfg.campaign.decl())
         .with_configuration(&configuration);
     store::write_atomic(&CampaignRecord::path(out), record.to_text().as_bytes())
+}
+
+/// Creates `out` and takes the exclusive lock on `out/.ugl-store.lock` (released when the file
+/// is dropped).
+fn lock_store(out: &Path) -> Result<std::fs::File, StoreError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| StoreError::Io { path, source }
+    };
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let lock_path = out.join(STORE_LOCK);
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(io(&lock_path))?;
+    lock.lock().map_err(io(&lock_path))?;
+    Ok(lock)
+}
+
+/// `ugl run` into `out`, under the store's lock: where `out` is a campaign's store (it holds a
+/// [`CampaignRecord`]), the run's profile must be that campaign with its configuration (the
+/// overrides of `ugl run` included), so that one store never mixes two configurations; and a run
+/// of the same id already there must be of this run's configuration (`config_hash`), never
+/// replaced by another's. Nothing is recorded: a directory of single runs stays one.
+pub fn check_single_run(
+    cfg: &CampaignConfig,
+    run_id: &str,
+    config_hash: &str,
+    out: &Path,
+) -> Result<(), StoreError> {
+    let _lock = lock_store(out)?;
+    let refused = |message: String| StoreError::Refused {
+        path: out.to_path_buf(),
+        message,
+    };
+    let advice = "use another --out";
+    let record = CampaignRecord::read(out).map_err(|e| StoreError::Read {
+        path: CampaignRecord::path(out),
+        message: e.to_string(),
+    })?;
+    if let Some(theirs) = &record {
+        if theirs.name != cfg.campaign.name {
+            return Err(refused(format!(
+                "holds campaign `{}`, and this run's profile is campaign `{}`: {advice}",
+                theirs.name, cfg.campaign.name
+            )));
+        }
+        if let Some(c) = &theirs.configuration
+            && *c != cfg.configuration_hash()
+        {
+            return Err(refused(format!(
+                "holds campaign `{}` with another configuration than this run's profile and \
+                 options: the results of two configurations would mix; {advice}",
+                theirs.name
+            )));
+        }
+    }
+    let manifest = store::run_paths(out, run_id).manifest;
+    if let Ok(m) = store::read_manifest(&manifest)
+        && m.config_hash != config_hash
+    {
+        return Err(refused(format!(
+            "holds run {run_id} of another configuration, which this run would replace: {advice} \
+             (or remove {})",
+            manifest.display()
+        )));
+    }
+    Ok(())
 }
 
 /// A store without a configuration hash: its runs of the current results version must have

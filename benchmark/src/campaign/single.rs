@@ -43,6 +43,23 @@ impl RunRequest {
                 .validate()
                 .map_err(|m| format!("--epochs: {m}"))?;
         }
+        let goal_directed = self.algo.strategy() != crate::explore::Strategy::Rpe;
+        cfg.explore
+            .check_goal_epochs(goal_directed)
+            .map_err(|m| match self.epochs {
+                Some(e) => format!("--epochs {e}: {m}"),
+                None => m,
+            })?;
+        if self.algo.space() == crate::explore::GoalSpaceKind::EngineeredPosition
+            && !self.env.spec().has_orientation()
+        {
+            return Err(format!(
+                "--algo {}: the outcome of {} is the objects' positions already, so its \
+                 position-only goal space is rge-efr's (use --algo rge-efr)",
+                self.algo,
+                self.env.name()
+            ));
+        }
         set_images(cfg, self.images)?;
         let spec = match self.algo.learner() {
             None => RunSpec::baseline(self.env, self.algo, self.seed),
@@ -321,13 +338,13 @@ mod tests {
         let mut c = cfg();
         let spec = RunRequest {
             images: Some(300),
-            epochs: Some(50),
+            epochs: Some(150),
             ..request("rge-pca")
         }
         .resolve(&mut c, Path::new("base.toml"))
         .unwrap();
         assert_eq!(spec.run_id(), "armball.rge-pca.kde.l2.s0");
-        assert_eq!((c.ugl.images, c.explore.epochs), (300, 50));
+        assert_eq!((c.ugl.images, c.explore.epochs), (300, 150));
         let err = |r: RunRequest| r.resolve(&mut cfg(), Path::new("base.toml")).unwrap_err();
         assert!(
             err(RunRequest {

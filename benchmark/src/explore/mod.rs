@@ -95,6 +95,20 @@ impl ExploreConfig {
         Ok(())
     }
 
+    /// For goal exploration (`goal_directed`): at least one epoch after the bootstrap, else
+    /// every epoch is random and the run is RPE under another label.
+    pub fn check_goal_epochs(&self, goal_directed: bool) -> Result<(), String> {
+        if goal_directed && self.bootstrap_epochs >= self.epochs {
+            return Err(format!(
+                "explore.bootstrap_epochs = {} leaves none of the {} epochs to goal exploration \
+                 (every epoch would be random: an RPE run under a goal-exploration label); \
+                 give more epochs than bootstrap_epochs",
+                self.bootstrap_epochs, self.epochs
+            ));
+        }
+        Ok(())
+    }
+
     /// The epochs at which the curve is evaluated: every `eval_every`, and the last.
     pub fn eval_epochs(&self) -> Vec<usize> {
         let mut v: Vec<usize> = (1..=self.epochs / self.eval_every)

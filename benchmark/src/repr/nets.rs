@@ -36,7 +36,7 @@ pub const INIT_STD: f64 = 0.001;
 
 /// How the weights of a network are drawn (`init` in `[learners.ae|vae|rfvae]`). Biases start
 /// at 0 in every scheme. Every draw comes from the learner's stream.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Init {
     /// The original code's: TF `truncated_normal(stddev = 0.001)` for every layer
@@ -51,6 +51,12 @@ pub enum Init {
     /// Glorot (Xavier) uniform: `U(-a, a)`, `a = sqrt(6 / (fan_in + fan_out))` (Glorot and
     /// Bengio 2010, eq. 16); `fan_out` is the width of the block being drawn.
     Glorot,
+}
+
+impl<'de> Deserialize<'de> for Init {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        super::neural_config::named_choice(d, &Init::ALL, Init::name)
+    }
 }
 
 impl Init {

@@ -35,7 +35,7 @@ pub fn training_device() -> Device {
 /// What runs the training iterations (`engine` in `[learners.ae|vae|rfvae]`). Both train the
 /// same networks with the same stream draws, loss and update rules; they differ in summation
 /// order (so in the last bits) and in speed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Engine {
     /// Hand-written forward and backward passes on the `gemm` crate, with the sparse first
@@ -62,6 +62,50 @@ impl Engine {
     fn before_v3() -> Engine {
         Engine::Burn
     }
+}
+
+impl<'de> Deserialize<'de> for Engine {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named_choice(d, &Engine::ALL, Engine::name)
+    }
+}
+
+/// One of `all`, read by its `name`: anything else (another word, a number, a table) is an error
+/// that says what it got and lists the names (`invalid type: integer `1`, expected one of
+/// "paper", "he", "glorot"`), where serde's derived enums read from a TOML table say only
+/// `invalid type: unit variant, expected string only`.
+pub(crate) fn named_choice<'de, D, T>(
+    d: D,
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Copy + 'static,
+{
+    struct Names<T: 'static> {
+        all: &'static [T],
+        name: fn(T) -> &'static str,
+    }
+    impl<T: Copy> serde::de::Visitor<'_> for Names<T> {
+        type Value = T;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            let names: Vec<String> = self
+                .all
+                .iter()
+                .map(|&x| format!("\"{}\"", (self.name)(x)))
+                .collect();
+            write!(f, "one of {}", names.join(", "))
+        }
+        fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<T, E> {
+            self.all
+                .iter()
+                .copied()
+                .find(|&x| (self.name)(x) == s)
+                .ok_or_else(|| E::invalid_value(serde::de::Unexpected::Str(s), &self))
+        }
+    }
+    d.deserialize_any(Names { all, name })
 }
 
 /// Which network.
