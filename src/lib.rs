@@ -20,7 +20,7 @@ use ugl_bench::campaign::plan;
 use ugl_bench::campaign::single::RunRequest;
 
 use crate::cli::{Cli, Command};
-use crate::commands::campaign::{campaign, merge, slurm, status};
+use crate::commands::campaign::{RunOptions, campaign, merge, slurm, status};
 use crate::commands::compare::{compare, learners};
 use crate::commands::environment::{klc, render, rollout};
 use crate::commands::single::{embed, run};
@@ -161,13 +161,15 @@ fn dispatch(cmd: Command) -> Result<()> {
             cache,
         } => campaign(
             &config,
-            out,
-            jobs,
-            quiet,
-            shard.as_deref(),
             refresh_diagnostics,
-            allow_dirty,
-            &cache,
+            RunOptions {
+                out,
+                jobs,
+                quiet,
+                shard: shard.as_deref(),
+                allow_dirty,
+                cache: &cache,
+            },
         ),
         Command::Slurm(a) => slurm(a),
         Command::Status {

@@ -14,16 +14,26 @@ use crate::cli::{CacheArgs, SlurmArgs};
 use crate::commands::single::check_out_dir;
 use crate::progress::{learner_lines, stop_on_ctrl_c, training_bars};
 
+/// How a campaign runs (`ugl campaign`, `ugl compare`): the options of the command line.
+pub(crate) struct RunOptions<'a> {
+    /// Results directory (default: `data/results/<campaign name>`).
+    pub(crate) out: Option<PathBuf>,
+    /// Runs in parallel (default: the number of cores).
+    pub(crate) jobs: Option<usize>,
+    /// No progress bar.
+    pub(crate) quiet: bool,
+    /// `--shard i/n`.
+    pub(crate) shard: Option<&'a str>,
+    /// Write into a checkout's `data/` with uncommitted changes.
+    pub(crate) allow_dirty: bool,
+    pub(crate) cache: &'a CacheArgs,
+}
+
 /// `ugl campaign`: run the campaign, or with `--refresh-diagnostics` refresh its diagnostics.
 pub(crate) fn campaign(
     config: &Path,
-    out: Option<PathBuf>,
-    jobs: Option<usize>,
-    quiet: bool,
-    shard: Option<&str>,
     refresh_diagnostics: bool,
-    allow_dirty: bool,
-    cache: &CacheArgs,
+    opts: RunOptions<'_>,
 ) -> Result<()> {
     let cfg = CampaignConfig::load(config)?;
     let profile = config
@@ -32,9 +42,9 @@ pub(crate) fn campaign(
         .unwrap_or("custom")
         .to_string();
     if refresh_diagnostics {
-        refresh_config(&cfg, &profile, out, jobs, shard, cache)
+        refresh_config(&cfg, &profile, opts.out, opts.jobs, opts.shard, opts.cache)
     } else {
-        run_config(&cfg, &profile, out, jobs, quiet, shard, allow_dirty, cache)
+        run_config(&cfg, &profile, opts)
     }
 }
 
@@ -139,13 +149,16 @@ pub(crate) fn campaign_args(
 pub(crate) fn run_config(
     cfg: &CampaignConfig,
     profile: &str,
-    out: Option<PathBuf>,
-    jobs: Option<usize>,
-    quiet: bool,
-    shard: Option<&str>,
-    allow_dirty: bool,
-    cache: &CacheArgs,
+    opts: RunOptions<'_>,
 ) -> Result<()> {
+    let RunOptions {
+        out,
+        jobs,
+        quiet,
+        shard,
+        allow_dirty,
+        cache,
+    } = opts;
     // Every argument is checked before anything touches the disk.
     let (shard, out, jobs) = campaign_args(cfg, shard, out, jobs)?;
     if !allow_dirty {

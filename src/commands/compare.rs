@@ -9,7 +9,7 @@ use ugl_bench::campaign::single::{self};
 use ugl_bench::explore::Learner;
 
 use crate::cli::CompareArgs;
-use crate::commands::campaign::{refresh_config, run_config};
+use crate::commands::campaign::{RunOptions, refresh_config, run_config};
 use crate::output::outln;
 
 /// `ugl learners`: the registry as a table.
@@ -63,12 +63,14 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
     run_config(
         &cfg,
         &cfg.campaign.name.clone(),
-        Some(out.clone()),
-        a.jobs,
-        a.quiet,
-        None,
-        a.allow_dirty,
-        &a.cache,
+        RunOptions {
+            out: Some(out.clone()),
+            jobs: a.jobs,
+            quiet: a.quiet,
+            shard: None,
+            allow_dirty: a.allow_dirty,
+            cache: &a.cache,
+        },
     )?;
     print_compare_page(&out, &cfg.campaign.name, &base)
 }
