@@ -11,16 +11,21 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test test-cargo test-slurm campaign bench verify verify-update check-toolchain check-shared-build
+.PHONY: help report test test-cargo test-slurm lint campaign bench verify verify-update check-toolchain check-shared-build
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
 	@echo "make test                the test suite (what CI runs): make test-cargo, then make test-slurm"
 	@echo "make test-cargo          cargo test --workspace (no cluster needed)"
 	@echo "make test-slurm          the cluster path on a private single-node Slurm (root; slurm-wlm, munge)"
+	@echo "make lint                cargo fmt --check and cargo clippy -D warnings (CI runs it first)"
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
 	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC, Isomap)"
 	@echo "make verify              rerun the smoke campaign; compare result checksums with data/checksums/smoke.sha256"
+
+lint: check-toolchain
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 
 check-toolchain:
 	@command -v $(CARGO) >/dev/null 2>&1 || { echo "error: cargo not found. Install Rust $(MIN_RUST) or newer: https://rustup.rs" >&2; exit 1; }

@@ -352,7 +352,7 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             };
             // Per environment, each run once (a baseline's runs serve both tasks of theirs).
             let mut coverage_by_env: Vec<(String, f64)> = Vec::new();
-            for (t, _) in &per {
+            for t in per.keys() {
                 let env = &tasks[*t].0;
                 if coverage_by_env.iter().any(|(e, _)| e == env) {
                     continue;
@@ -581,7 +581,7 @@ mod tests {
         let pca = &lb.entries[0];
         let max = 756f64.ln();
         // IQM of the 8 pooled runs: drop the 2 lowest and the 2 highest.
-        let mut v = vec![4.0, 4.1, 3.9, 4.05, 4.0, 4.1, 3.9, 4.05];
+        let mut v = [4.0, 4.1, 3.9, 4.05, 4.0, 4.1, 3.9, 4.05];
         v.sort_by(f64::total_cmp);
         let expect = v[2..6].iter().sum::<f64>() / 4.0 / max;
         assert!((pca.final_iqm.0 - expect).abs() < 1e-12);

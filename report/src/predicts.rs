@@ -321,7 +321,7 @@ pub fn observations(camps: &Campaigns, measured: &[RunRow<'_>]) -> Vec<Observati
     let mut out = Vec::new();
     let mut i = 0;
     while i < rows.len() {
-        let j = i + rows[i..].iter().take_while(|r| same(r, &rows[i])).count();
+        let j = i + rows[i..].iter().take_while(|r| same(r, rows[i])).count();
         out.push(observe(&rows[i..j]));
         i = j;
     }

@@ -224,8 +224,8 @@ fn write_campaign(dir: &Path, conds: &[Cond], reps: i64, budget: Option<i64>) {
                     .insert("reduced_budget".into(), true.into());
             }
             manifest["env"] = c.env.into();
-            common::complete_manifest(&mut manifest, &dir);
-            common::write_conventional_record(&dir);
+            common::complete_manifest(&mut manifest, dir);
+            common::write_conventional_record(dir);
             std::fs::write(dir.join(format!("{id}.json")), manifest.to_string()).unwrap();
         }
     }

@@ -138,7 +138,7 @@ impl Grid {
             env: env.to_string(),
             why,
         };
-        if dims < 2 || bins < 2 || bins % 2 != 0 {
+        if dims < 2 || bins < 2 || !bins.is_multiple_of(2) {
             return Err(bad(format!(
                 "a KL-coverage grid of {dims} coordinates and {bins} bins is not a disk grid"
             )));
@@ -1126,7 +1126,10 @@ mod tests {
         let d = RunDiscovery::measure(ball, &run).unwrap().unwrap();
         assert_eq!(d.at_end, env.measure(&run, None).unwrap().unwrap());
         assert_eq!(d.moved_radius_mean, Some(0.5));
-        let at_rest = env.measure(&[rest.clone()], None).unwrap().unwrap();
+        let at_rest = env
+            .measure(std::slice::from_ref(&rest), None)
+            .unwrap()
+            .unwrap();
         assert_eq!(d.error_at_rest, Some(at_rest.goal_error_mean));
         // Never moved: no radius; always moved: no rest error; nothing: None.
         let still = RunDiscovery::measure(ball, &[rest]).unwrap().unwrap();

@@ -263,6 +263,10 @@ pub(crate) mod inf_as_string {
     }
 }
 
+fn is_zero(n: &u32) -> bool {
+    *n == 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,8 +311,4 @@ mod tests {
         assert_eq!(serde_json::from_str::<Summary>(&j).unwrap(), s);
         assert!(serde_json::from_str::<Summary>(&j.replace("inf", "nan")).is_err());
     }
-}
-
-fn is_zero(n: &u32) -> bool {
-    *n == 0
 }

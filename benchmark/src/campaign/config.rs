@@ -551,6 +551,23 @@ pub fn resolve_profile(name: &str) -> Result<PathBuf, ConfigError> {
     }
 }
 
+/// A `[learners.NAME]` message with its table's path: a message that starts with the key
+/// (`warmup: ...`, as [`ParamGuard::check`](crate::repr::registry::ParamGuard) writes them)
+/// becomes `learners.NAME.warmup: ...`, any other `learners.NAME: ...`.
+fn prefix_key(name: &str, msg: &str) -> String {
+    match msg.split_once(": ") {
+        Some((key, rest))
+            if !key.is_empty()
+                && key.chars().all(|c| {
+                    c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '[' | ']')
+                }) =>
+        {
+            format!("learners.{name}.{key}: {rest}")
+        }
+        _ => format!("learners.{name}: {msg}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -599,22 +616,5 @@ epochs = 500
             assert!(e.contains(key), "{e} should name {key}");
             assert!(!e.contains('\n'), "one line: {e}");
         }
-    }
-}
-
-/// A `[learners.NAME]` message with its table's path: a message that starts with the key
-/// (`warmup: ...`, as [`ParamGuard::check`](crate::repr::registry::ParamGuard) writes them)
-/// becomes `learners.NAME.warmup: ...`, any other `learners.NAME: ...`.
-fn prefix_key(name: &str, msg: &str) -> String {
-    match msg.split_once(": ") {
-        Some((key, rest))
-            if !key.is_empty()
-                && key.chars().all(|c| {
-                    c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '[' | ']')
-                }) =>
-        {
-            format!("learners.{name}.{key}: {rest}")
-        }
-        _ => format!("learners.{name}: {msg}"),
     }
 }

@@ -59,8 +59,7 @@ pub fn checkout_of(p: &Path) -> Option<PathBuf> {
     let real = real_path(p);
     let dir = real.ancestors().find(|a| a.is_dir())?;
     git(Some(dir), &["rev-parse", "--show-toplevel"])
-        .map(|t| PathBuf::from(t).canonicalize().ok())
-        .flatten()
+        .and_then(|t| PathBuf::from(t).canonicalize().ok())
 }
 
 /// HEAD of the checkout at `top` (the working directory's for None), `-dirty` if tracked files

@@ -185,7 +185,7 @@ pub fn check_modules(algo: Algo, latents: usize, module_size: usize) -> Result<(
         && algo
             .modules()
             .is_some_and(|m| m != crate::explore::Modules::Flat);
-    if modular && module_size > 0 && latents % module_size != 0 {
+    if modular && module_size > 0 && !latents.is_multiple_of(module_size) {
         return Err(format!(
             "--latents {latents}: {algo} splits its latents into modules of \
              mge.module_size = {module_size}, and {latents} is not a multiple of {module_size}"

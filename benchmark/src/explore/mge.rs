@@ -163,7 +163,7 @@ pub fn goal_modules(
             })
             .collect());
     }
-    if module_size == 0 || dim % module_size != 0 || spread.len() != dim {
+    if module_size == 0 || !dim.is_multiple_of(module_size) || spread.len() != dim {
         return Err(format!(
             "{dim} latents cannot be split into modules of {module_size} (mge.module_size)"
         ));

@@ -51,7 +51,7 @@ pub fn f64_bytes(values: &[f64]) -> Vec<u8> {
 
 /// The `f64`s of [`f64_bytes`]; `Err` if the length is not a multiple of 8.
 pub fn f64s(bytes: &[u8]) -> Result<Vec<f64>, String> {
-    if bytes.len() % 8 != 0 {
+    if !bytes.len().is_multiple_of(8) {
         return Err(format!("{} payload bytes are not f64 values", bytes.len()));
     }
     Ok(bytes

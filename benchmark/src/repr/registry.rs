@@ -90,17 +90,17 @@ pub static LEARNERS: [LearnerEntry; 9] = [
     LearnerEntry {
         info: &learners::VAE,
         kind: Kind::Neural(Model::Vae),
-        params: neural::<VAE>,
+        params: neural::<Vae>,
     },
     LearnerEntry {
         info: &learners::RFVAE,
         kind: Kind::Neural(Model::Rfvae),
-        params: neural::<RFVAE>,
+        params: neural::<Rfvae>,
     },
     LearnerEntry {
         info: &learners::BVAE,
         kind: Kind::Neural(Model::Bvae),
-        params: neural::<BVAE>,
+        params: neural::<Bvae>,
     },
     LearnerEntry {
         info: &learners::GAUSSIAN_PROJECTION,
@@ -208,19 +208,19 @@ trait ModelOf {
     const MODEL: Model;
 }
 struct AE;
-struct VAE;
-struct RFVAE;
-struct BVAE;
-impl ModelOf for BVAE {
+struct Vae;
+struct Rfvae;
+struct Bvae;
+impl ModelOf for Bvae {
     const MODEL: Model = Model::Bvae;
 }
 impl ModelOf for AE {
     const MODEL: Model = Model::Ae;
 }
-impl ModelOf for VAE {
+impl ModelOf for Vae {
     const MODEL: Model = Model::Vae;
 }
-impl ModelOf for RFVAE {
+impl ModelOf for Rfvae {
     const MODEL: Model = Model::Rfvae;
 }
 

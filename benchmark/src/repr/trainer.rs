@@ -62,12 +62,15 @@ pub fn draw_batch(perm: &mut [usize], k: usize, rng: &mut Stream) {
 
 /// The engine-specific part of a [`Trainer`]: the weights and the optimiser state.
 pub(crate) enum EngineState {
-    Burn {
-        device: Device,
-        net: Option<DenseNet>,
-        opt: ModuleOptimizer,
-    },
+    Burn(Box<BurnState>),
     Host(Box<HostTrainer>),
+}
+
+/// burn's module and optimiser on its device.
+pub(crate) struct BurnState {
+    device: Device,
+    net: Option<DenseNet>,
+    opt: ModuleOptimizer,
 }
 
 /// A training run in progress: the weights, their optimiser and the batch sampler. [`train`]
@@ -99,11 +102,11 @@ impl<'a> Trainer<'a> {
         let state = match cfg.engine {
             Engine::Burn => {
                 let device = training_device();
-                EngineState::Burn {
+                EngineState::Burn(Box::new(BurnState {
                     net: Some(host.to_module(&device)),
                     device,
                     opt: optimizer(model),
-                }
+                }))
             }
             Engine::Host => {
                 let opt = HostOptimizer::new(model, &host);
@@ -156,7 +159,8 @@ impl<'a> Trainer<'a> {
             EngineState::Host(host) => {
                 host.step(self.model, &self.cfg, &self.xbuf, k, self.step, rng)?
             }
-            EngineState::Burn { device, net, opt } => {
+            EngineState::Burn(burn) => {
+                let BurnState { device, net, opt } = &mut **burn;
                 let x = tensor2(self.xbuf.clone(), k, dim, device);
                 let module = net.take().expect("the module is present between steps");
                 let input = StepInput {
@@ -199,7 +203,8 @@ impl<'a> Trainer<'a> {
     /// permutation.
     pub fn resume_state(&self) -> ([u64; 12], &[usize]) {
         let ids = match &self.state {
-            EngineState::Burn { net, .. } => net
+            EngineState::Burn(burn) => burn
+                .net
                 .as_ref()
                 .expect("the module is present between steps")
                 .param_ids(),
@@ -213,7 +218,7 @@ impl<'a> Trainer<'a> {
         let fail =
             |e: String| ReprError::Io(format!("saving optimiser state {}: {e}", path.display()));
         match &self.state {
-            EngineState::Burn { opt, .. } => opt.save(path).map_err(|e| fail(format!("{e:?}"))),
+            EngineState::Burn(burn) => burn.opt.save(path).map_err(|e| fail(format!("{e:?}"))),
             EngineState::Host(host) => crate::fsio::write_atomic(path, &host.opt.to_bytes())
                 .map_err(|e| fail(e.to_string())),
         }
@@ -253,11 +258,11 @@ impl<'a> Trainer<'a> {
                 let opt = optimizer(model)
                     .load(state.optimizer)
                     .map_err(|e| fail(format!("{e:?}")))?;
-                EngineState::Burn {
+                EngineState::Burn(Box::new(BurnState {
                     device,
                     net: Some(net),
                     opt,
-                }
+                }))
             }
             Engine::Host => {
                 let bytes = std::fs::read(state.optimizer).map_err(|e| fail(e.to_string()))?;
@@ -279,8 +284,9 @@ impl<'a> Trainer<'a> {
     /// The current weights on the host.
     pub fn host_net(&self) -> Result<HostNet, ReprError> {
         match &self.state {
-            EngineState::Burn { net, .. } => {
-                let net = net
+            EngineState::Burn(burn) => {
+                let net = burn
+                    .net
                     .as_ref()
                     .expect("the module is present between steps")
                     .valid();

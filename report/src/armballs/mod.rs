@@ -146,7 +146,7 @@ mod tests {
             }
         }
         runs::separate_conditions(&mut rs);
-        rs.sort_by(|a, b| labels::algo_order(&a.algo).cmp(&labels::algo_order(&b.algo)));
+        rs.sort_by_key(|r| labels::algo_order(&r.algo));
         assert_eq!(runs::algos(&rs).len(), 5, "{:?}", runs::algos(&rs));
         assert!(
             rs.iter().any(|r| r.algo == "rpe"),

@@ -213,7 +213,7 @@ fn draw_panel(
                 .iter()
                 .map(|p| p.mean)
                 .chain([lo, hi])
-                .chain(paper_value(m).into_iter())
+                .chain(paper_value(m))
         })
         .filter(|v| v.is_finite());
     let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {

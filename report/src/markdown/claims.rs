@@ -340,9 +340,7 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
     );
     if let Some(v) = validated {
         let margins: Vec<String> = v
-            .margin
-            .iter()
-            .map(|(env, _)| {
+            .margin.keys().map(|env| {
                 let each: Vec<String> = v
                     .statistics
                     .iter()
@@ -682,10 +680,12 @@ fn poi_cell(e: &Entry, alpha: f64) -> String {
     };
     let counts = format!("{wins} of {pairs} pairs");
     // At an extreme, every pair goes one way: so does every repetition.
-    let extreme = match wins {
-        w if w == 0.0 => Some(0.0),
-        w if w == pairs as f64 => Some(units as f64),
-        _ => None,
+    let extreme = if wins == 0.0 {
+        Some(0.0)
+    } else if wins == pairs as f64 {
+        Some(units as f64)
+    } else {
+        None
     };
     match extreme.and_then(|k| crate::stats::exact_bound_at_extreme(k, units, alpha)) {
         Some((0.0, b)) => format!("{p:.3}, {counts}; exact bound ≤ {b:.3} ({units} repetitions)"),

@@ -123,7 +123,7 @@ fn fmt_epochs(e: &[i64]) -> String {
 fn compute_line(w: &mut String, runs: &[crate::load::Run]) {
     let explore: f64 = runs
         .iter()
-        .filter_map(|r| Some(r.manifest.wall_s + r.manifest.encode_s.unwrap_or(0.0)))
+        .map(|r| r.manifest.wall_s + r.manifest.encode_s.unwrap_or(0.0))
         .sum();
     let mut fits: BTreeMap<String, f64> = BTreeMap::new();
     for r in runs {
@@ -464,7 +464,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     );
     let walls: Vec<f64> = runs
         .iter()
-        .filter_map(|r| Some(r.manifest.wall_s))
+        .map(|r| r.manifest.wall_s)
         .collect();
     if walls.is_empty() {
         let _ = writeln!(w, "- **Exploration wall time:** not recorded.");
@@ -533,7 +533,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
         let ws: Vec<f64> = c
             .runs
             .iter()
-            .filter_map(|&i| Some(runs[i].manifest.wall_s))
+            .map(|&i| runs[i].manifest.wall_s)
             .collect();
         let wall = if ws.is_empty() {
             "—".to_string()
