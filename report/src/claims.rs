@@ -1597,10 +1597,7 @@ pair_on = ["env"]
             (GOOD.replace("\"less\"", "\"smaller\""), "smaller"),
             (GOOD.replace("\"true\"", "\"ten\""), "latents"),
             (GOOD.replace("pair_on", "pair_with"), "pair_with"),
-            (
-                GOOD.replace("\"rge-efr\"", ""),
-                "reference.algo",
-            ),
+            (GOOD.replace("\"rge-efr\"", ""), "reference.algo"),
             (
                 format!("{GOOD}{}", &GOOD[GOOD.find("[[claim]]").unwrap()..]),
                 "twice",

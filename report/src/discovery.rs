@@ -133,7 +133,7 @@ pub fn measure_all(camps: &Campaigns) -> Result<Vec<RunRow<'_>>, ReportError> {
                 (Some(d), Some(p)) if p.coverage > 0.0 => {
                     let spec = EnvSpec::by_name(&run.key.env)
                         .ok_or_else(|| invalid(DiscoveryError::UnknownEnv(run.key.env.clone())))?;
-                    
+
                     env.position(spec).map_err(invalid)?.map(|pe| {
                         d.at_end.coverage * env.grid().n_achievable() as f64
                             / (p.coverage * pe.grid().n_achievable() as f64)

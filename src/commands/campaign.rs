@@ -146,11 +146,7 @@ pub(crate) fn campaign_args(
     Ok((shard, out, jobs))
 }
 
-pub(crate) fn run_config(
-    cfg: &CampaignConfig,
-    profile: &str,
-    opts: RunOptions<'_>,
-) -> Result<()> {
+pub(crate) fn run_config(cfg: &CampaignConfig, profile: &str, opts: RunOptions<'_>) -> Result<()> {
     let RunOptions {
         out,
         jobs,

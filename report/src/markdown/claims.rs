@@ -340,7 +340,9 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
     );
     if let Some(v) = validated {
         let margins: Vec<String> = v
-            .margin.keys().map(|env| {
+            .margin
+            .keys()
+            .map(|env| {
                 let each: Vec<String> = v
                     .statistics
                     .iter()

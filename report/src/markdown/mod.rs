@@ -462,10 +462,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
         "- **Profile:** {}.",
         distinct(runs.iter().map(|r| Some(r.manifest.profile.clone())))
     );
-    let walls: Vec<f64> = runs
-        .iter()
-        .map(|r| r.manifest.wall_s)
-        .collect();
+    let walls: Vec<f64> = runs.iter().map(|r| r.manifest.wall_s).collect();
     if walls.is_empty() {
         let _ = writeln!(w, "- **Exploration wall time:** not recorded.");
     } else {
@@ -530,11 +527,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     );
     let _ = writeln!(w, "|---|---|---|---:|---|---|---:|---:|");
     for c in inp.conditions {
-        let ws: Vec<f64> = c
-            .runs
-            .iter()
-            .map(|&i| runs[i].manifest.wall_s)
-            .collect();
+        let ws: Vec<f64> = c.runs.iter().map(|&i| runs[i].manifest.wall_s).collect();
         let wall = if ws.is_empty() {
             "—".to_string()
         } else {
