@@ -120,37 +120,46 @@ pub fn measure_all(camps: &Campaigns) -> Result<Vec<RunRow<'_>>, ReportError> {
         runs.sort_by(|a, b| {
             (a.key.order_key(), a.seed, &a.run_id).cmp(&(b.key.order_key(), b.seed, &b.run_id))
         });
-        for run in runs {
-            let invalid = |e: DiscoveryError| ReportError::Invalid {
-                path: run.outcomes_path.clone(),
-                problem: e.to_string(),
-            };
-            let env = EnvMeasures::by_name(&run.key.env).map_err(invalid)?;
-            let found = run.discovery().map_err(invalid)?;
-            let position = found.as_ref().and_then(|d| d.position.clone());
-            // reached cells / reached position cells
-            let rest_per_position_cell = match (&found, &position) {
-                (Some(d), Some(p)) if p.coverage > 0.0 => {
-                    let spec = EnvSpec::by_name(&run.key.env)
-                        .ok_or_else(|| invalid(DiscoveryError::UnknownEnv(run.key.env.clone())))?;
+        // Each run on its own, on every core, in this order (the first error in it is reported).
+        use rayon::prelude::*;
+        let measured: Vec<Result<RunRow<'_>, ReportError>> = runs
+            .par_iter()
+            .map(|&run| {
+                let invalid = |e: DiscoveryError| ReportError::Invalid {
+                    path: run.outcomes_path.clone(),
+                    problem: e.to_string(),
+                };
+                let env = EnvMeasures::by_name(&run.key.env).map_err(invalid)?;
+                let found = run.discovery().map_err(invalid)?;
+                let position = found.as_ref().and_then(|d| d.position.clone());
+                // reached cells / reached position cells
+                let rest_per_position_cell = match (&found, &position) {
+                    (Some(d), Some(p)) if p.coverage > 0.0 => {
+                        let spec = EnvSpec::by_name(&run.key.env).ok_or_else(|| {
+                            invalid(DiscoveryError::UnknownEnv(run.key.env.clone()))
+                        })?;
 
-                    env.position(spec).map_err(invalid)?.map(|pe| {
-                        d.at_end.coverage * env.grid().n_achievable() as f64
-                            / (p.coverage * pe.grid().n_achievable() as f64)
-                    })
-                }
-                _ => None,
-            };
-            rows.push(RunRow {
-                campaign: camp,
-                run,
-                discovery: found.map(|d| d.at_end),
-                group: group_of(run),
-                in_check: checked.contains(&camp.name.as_str()),
-                max_klc: (env.grid().n_achievable() as f64).ln(),
-                position,
-                rest_per_position_cell,
-            });
+                        env.position(spec).map_err(invalid)?.map(|pe| {
+                            d.at_end.coverage * env.grid().n_achievable() as f64
+                                / (p.coverage * pe.grid().n_achievable() as f64)
+                        })
+                    }
+                    _ => None,
+                };
+                Ok(RunRow {
+                    campaign: camp,
+                    run,
+                    discovery: found.map(|d| d.at_end),
+                    group: group_of(run),
+                    in_check: checked.contains(&camp.name.as_str()),
+                    max_klc: (env.grid().n_achievable() as f64).ln(),
+                    position,
+                    rest_per_position_cell,
+                })
+            })
+            .collect();
+        for row in measured {
+            rows.push(row?);
         }
     }
     Ok(rows)

@@ -91,6 +91,20 @@ pub struct ReportSummary {
 /// [`sections::SECTIONS`] into `out` (`REPORT.md`, its pages, `figures/`, `data/`); files of the
 /// previous render that this one did not write are removed ([`output::Output`]).
 pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError> {
+    // The runs are read and measured on every core. Reading a parquet file (polars, built
+    // without optimisation in the one dev profile) needs more stack than a rayon worker's
+    // default 2 MiB; the stack is reserved, not committed.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .stack_size(REPORT_STACK)
+        .build()
+        .map_err(|e| ReportError::Options(format!("cannot start the report's threads: {e}")))?;
+    pool.install(|| render_report_on_pool(opts))
+}
+
+/// Stack of the report's worker threads.
+const REPORT_STACK: usize = 64 << 20;
+
+fn render_report_on_pool(opts: &ReportOptions) -> Result<ReportSummary, ReportError> {
     if opts.n_boot == 0 {
         return Err(ReportError::Options("n_boot must be at least 1".into()));
     }

@@ -123,6 +123,7 @@ pub(crate) fn test_run(
         curve_path: Default::default(),
         outcomes_path: Default::default(),
         manifest_path: Default::default(),
+        measured: Default::default(),
     }
 }
 
@@ -149,6 +150,10 @@ pub struct Run {
     pub curve_path: PathBuf,
     pub outcomes_path: PathBuf,
     pub manifest_path: PathBuf,
+    /// [`Run::discovery`], computed once (a run without a record is measured from its outcomes
+    /// file: the claims, the leaderboard and the validity check each ask for it).
+    pub(crate) measured:
+        std::sync::OnceLock<Result<Option<ugl_types::RunDiscovery>, ugl_types::DiscoveryError>>,
 }
 
 impl Run {
@@ -163,9 +168,13 @@ impl Run {
         if let Some(d) = &self.manifest.discovery {
             return Ok(Some(d.clone()));
         }
-        let spec = ugl_types::EnvSpec::by_name(&self.key.env)
-            .ok_or_else(|| ugl_types::DiscoveryError::UnknownEnv(self.key.env.clone()))?;
-        ugl_types::RunDiscovery::measure(spec, &self.outcomes)
+        self.measured
+            .get_or_init(|| {
+                let spec = ugl_types::EnvSpec::by_name(&self.key.env)
+                    .ok_or_else(|| ugl_types::DiscoveryError::UnknownEnv(self.key.env.clone()))?;
+                ugl_types::RunDiscovery::measure(spec, &self.outcomes)
+            })
+            .clone()
     }
 
     /// Whether its outcomes were read (the outcomes file is kept).
@@ -226,6 +235,7 @@ impl CampaignDir {
     pub fn load(&self) -> Result<Store, ReportError> {
         let mut runs = Vec::new();
         let mut incomplete = Vec::new();
+        let mut stems = Vec::new();
         for (stem, present) in &self.stems {
             let [curve, _, manifest] = *present;
             if !complete(*present) {
@@ -238,7 +248,17 @@ impl CampaignDir {
                 incomplete.push((stem.clone(), missing));
                 continue;
             }
-            runs.push(load_run(stem, self.name.clone())?);
+            stems.push(stem);
+        }
+        // Every run is read (and its files and discovery record checked) on its own, on every
+        // core; the first error in stem order is the one reported, whatever the threads.
+        use rayon::prelude::*;
+        let loaded: Vec<Result<Run, ReportError>> = stems
+            .par_iter()
+            .map(|stem| load_run(stem, self.name.clone()))
+            .collect();
+        for run in loaded {
+            runs.push(run?);
         }
         check_unique_run_ids(
             runs.iter()
@@ -498,7 +518,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         manifest.latent_quality = Some(d.latent_quality.clone());
     }
 
-    Ok(Run {
+    let run = Run {
         run_id,
         campaign,
         key,
@@ -510,7 +530,13 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         curve_path,
         outcomes_path,
         manifest_path,
-    })
+        measured: Default::default(),
+    };
+    // A run without a record is measured here, on the loader's thread (every core).
+    if run.manifest.discovery.is_none() {
+        let _ = run.discovery();
+    }
+    Ok(run)
 }
 
 /// A manifest's discovery record (already checked against its hash and the summary,
@@ -646,7 +672,9 @@ pub fn read_parquet(path: &Path) -> Result<DataFrame, ReportError> {
         source,
     })?;
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        ParquetReader::new(file).finish()
+        ParquetReader::new(file)
+            .read_parallel(ParallelStrategy::None)
+            .finish()
     }));
     match result {
         Ok(Ok(df)) => Ok(df),

@@ -407,6 +407,7 @@ mod tests {
             curve_path: PathBuf::new(),
             outcomes_path: PathBuf::new(),
             manifest_path: PathBuf::new(),
+            measured: Default::default(),
         }
     }
 
