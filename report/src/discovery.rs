@@ -19,8 +19,8 @@ use crate::data::num;
 use crate::load::Run;
 use crate::output::Output;
 pub use ugl_types::{
-    Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Grid,
-    median, quantile_sorted,
+    Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, median,
+    quantile_sorted,
 };
 
 /// The measures of a run at its final epoch (None: a run without outcomes).
@@ -868,8 +868,9 @@ mod tests {
         .unwrap()
     }
 
-    /// The re-implemented KL-coverage and cell coverage equal what the runs recorded, at every
-    /// evaluation epoch and in the manifest's summary, on runs of every environment.
+    /// The KL-coverage and cell coverage computed again from the kept outcomes equal what the
+    /// runs recorded, at every evaluation epoch and in the manifest's summary, on runs of every
+    /// environment.
     #[test]
     fn the_klc_on_all_outcomes_equals_the_runs_own() {
         let stems = [

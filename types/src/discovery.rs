@@ -6,11 +6,11 @@
 //! adds weight to one cell: a run that moves the object more often scores better whatever it
 //! found. Beside it:
 //!
-//! - **KL-coverage of all outcomes**, re-implemented from `benchmark/src/metrics/klc.rs` (numpy
+//! - **KL-coverage of all outcomes**, the explorer's own measure ([`crate::klc`]: numpy
 //!   `histogramdd` bins over [-1, 1], achievable cells = the (x, y) bins meeting the open unit
 //!   disk times every other bin; KLC = Σ p ln(p / q), +inf when an outcome lies outside the
-//!   achievable set). Its only role is to prove the re-implementation: it equals the runs' own
-//!   `klc` (the report's tests).
+//!   achievable set), computed again from the outcomes: it equals the runs' recorded `klc` at
+//!   every evaluation epoch (the report's tests).
 //! - **KL-coverage of the moved outcomes only** (`moved`: the object moved in the episode), the
 //!   same histogram and formula over the episodes that changed something.
 //! - **Cell coverage**: the fraction of achievable cells holding at least one outcome (it
@@ -36,6 +36,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::EnvSpec;
+use crate::klc::{KlCoverage, KlcError};
 
 /// One outcome of an exploration (a row of `<run_id>.outcomes.parquet`): the controllable
 /// object's state at the end of an episode.
@@ -102,173 +103,25 @@ impl Coord {
     }
 }
 
-/// The KL-coverage histogram grid of an environment, as `benchmark/src/metrics/klc.rs` builds
-/// it: `bins` per measured coordinate over [-1, 1]; the first two coordinates are the position,
-/// whose achievable bins meet the open unit disk (exact integer test), every bin of the others
-/// is achievable.
-#[derive(Debug, Clone)]
-pub struct Grid {
-    dims: usize,
-    bins: usize,
-    edges: Vec<f64>,
-    achievable: Vec<bool>,
-    n_achievable: usize,
-}
-
-impl Grid {
-    /// The grid of `spec`, checked against the number of achievable cells it declares.
-    pub fn for_env(spec: &EnvSpec) -> Result<Self, DiscoveryError> {
-        let grid = Self::disk(spec.name, spec.klc.dims, spec.klc.bins)?;
-        if grid.n_achievable != spec.klc.achievable_cells {
-            return Err(DiscoveryError::Grid {
-                env: spec.name.to_string(),
-                why: format!(
-                    "the disk grid has {} achievable cells, the registry declares {}",
-                    grid.n_achievable, spec.klc.achievable_cells
-                ),
-            });
-        }
-        Ok(grid)
+/// The KL-coverage grid of `spec` ([`KlCoverage::disk`]), checked against the number of
+/// achievable cells the registry declares.
+fn grid_for_env(spec: &EnvSpec) -> Result<KlCoverage, DiscoveryError> {
+    let grid =
+        KlCoverage::disk(spec.klc.dims, spec.klc.bins).map_err(|e| DiscoveryError::Grid {
+            env: spec.name.to_string(),
+            why: e.to_string(),
+        })?;
+    if grid.n_achievable() != spec.klc.achievable_cells {
+        return Err(DiscoveryError::Grid {
+            env: spec.name.to_string(),
+            why: format!(
+                "the disk grid has {} achievable cells, the registry declares {}",
+                grid.n_achievable(),
+                spec.klc.achievable_cells
+            ),
+        });
     }
-
-    /// The grid of `bins` per coordinate over [-1, 1]^dims whose first two coordinates are a
-    /// position in the unit disk (`env` names the environment in errors).
-    fn disk(env: &str, dims: usize, bins: usize) -> Result<Self, DiscoveryError> {
-        let bad = |why: String| DiscoveryError::Grid {
-            env: env.to_string(),
-            why,
-        };
-        if dims < 2 || bins < 2 || !bins.is_multiple_of(2) {
-            return Err(bad(format!(
-                "a KL-coverage grid of {dims} coordinates and {bins} bins is not a disk grid"
-            )));
-        }
-        let n_cells = bins
-            .checked_pow(dims as u32)
-            .filter(|&n| n <= 1 << 26)
-            .ok_or_else(|| bad(format!("{bins}^{dims} cells is too many")))?;
-        // np.linspace(-1, 1, bins + 1), as the runs' measure computes it.
-        let step = 2.0 / bins as f64;
-        let mut edges: Vec<f64> = (0..=bins).map(|i| i as f64 * step + -1.0).collect();
-        edges[bins] = 1.0;
-        let half = (bins / 2) as i64;
-        let near = |i: usize| -> i64 {
-            let (lo, hi) = (i as i64 - half, i as i64 - half + 1);
-            if lo <= 0 && 0 <= hi {
-                0
-            } else {
-                lo.abs().min(hi.abs())
-            }
-        };
-        let per_pair = n_cells / (bins * bins);
-        let mut achievable = Vec::with_capacity(n_cells);
-        for ix in 0..bins {
-            for iy in 0..bins {
-                let (dx, dy) = (near(ix), near(iy));
-                let ok = dx * dx + dy * dy < half * half;
-                achievable.extend(std::iter::repeat_n(ok, per_pair));
-            }
-        }
-        let n_achievable = achievable.iter().filter(|&&a| a).count();
-        Ok(Grid {
-            dims,
-            bins,
-            edges,
-            achievable,
-            n_achievable,
-        })
-    }
-
-    /// Achievable cells.
-    pub fn n_achievable(&self) -> usize {
-        self.n_achievable
-    }
-
-    /// Bin of one coordinate (numpy `histogramdd`: closed on the left, the last bin also on the
-    /// right); None outside [-1, 1].
-    fn bin(&self, v: f64) -> Option<usize> {
-        if !(-1.0..=1.0).contains(&v) {
-            return None;
-        }
-        if v == 1.0 {
-            return Some(self.bins - 1);
-        }
-        Some(self.edges.partition_point(|&e| e <= v) - 1)
-    }
-
-    /// Cell of a point (C order); None outside [-1, 1]^dims.
-    fn cell(&self, p: &[f64]) -> Option<usize> {
-        let mut idx = 0;
-        for &v in p {
-            idx = idx * self.bins + self.bin(v)?;
-        }
-        Some(idx)
-    }
-}
-
-/// A histogram of outcomes over a [`Grid`].
-struct Histogram<'g> {
-    grid: &'g Grid,
-    counts: Vec<u32>,
-    touched: Vec<usize>,
-    total: u64,
-    outside: u64,
-    reached: usize,
-}
-
-impl<'g> Histogram<'g> {
-    fn new(grid: &'g Grid) -> Self {
-        Histogram {
-            grid,
-            counts: vec![0; grid.achievable.len()],
-            touched: Vec::new(),
-            total: 0,
-            outside: 0,
-            reached: 0,
-        }
-    }
-
-    fn add(&mut self, p: &[f64]) {
-        self.total += 1;
-        match self.grid.cell(p) {
-            None => self.outside += 1,
-            Some(c) => {
-                if !self.grid.achievable[c] {
-                    self.outside += 1;
-                }
-                if self.counts[c] == 0 {
-                    self.touched.push(c);
-                    if self.grid.achievable[c] {
-                        self.reached += 1;
-                    }
-                }
-                self.counts[c] += 1;
-            }
-        }
-    }
-
-    /// KL(visited ‖ uniform on achievable), summed in cell order as the runs' measure does;
-    /// +inf with an outcome outside the achievable set; None without outcomes.
-    fn klc(&self) -> Option<f64> {
-        if self.total == 0 {
-            return None;
-        }
-        if self.outside > 0 {
-            return Some(f64::INFINITY);
-        }
-        let n = self.total as f64;
-        let q = 1.0 / self.grid.n_achievable as f64;
-        let mut cells = self.touched.clone();
-        cells.sort_unstable();
-        Some(cells.iter().fold(0.0, |s, &c| {
-            let p = self.counts[c] as f64 / n;
-            s + p * (p / q).ln()
-        }))
-    }
-
-    fn coverage(&self) -> f64 {
-        self.reached as f64 / self.grid.n_achievable as f64
-    }
+    Ok(grid)
 }
 
 /// The fixed test goals of an environment: the centres of a coarser grid's cells
@@ -403,7 +256,7 @@ impl<'p> KdTree<'p> {
 #[derive(Debug, Clone)]
 pub struct EnvMeasures {
     coords: Vec<Coord>,
-    grid: Grid,
+    grid: KlCoverage,
     goals: GoalGrid,
 }
 
@@ -444,18 +297,18 @@ impl EnvMeasures {
                 }),
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let grid = Grid::for_env(spec)?;
-        if coords.len() != grid.dims {
+        let grid = grid_for_env(spec)?;
+        if coords.len() != grid.dim() {
             return Err(DiscoveryError::Grid {
                 env: spec.name.to_string(),
                 why: format!(
                     "the grid measures {} coordinates, the controllable objects have {}",
-                    grid.dims,
+                    grid.dim(),
                     coords.len()
                 ),
             });
         }
-        let goals = GoalGrid::new(grid.dims);
+        let goals = GoalGrid::new(grid.dim());
         Ok(EnvMeasures {
             coords,
             grid,
@@ -472,7 +325,10 @@ impl EnvMeasures {
         }
         Ok(Some(EnvMeasures {
             coords: self.coords[..2].to_vec(),
-            grid: Grid::disk(spec.name, 2, spec.klc.bins)?,
+            grid: KlCoverage::disk(2, spec.klc.bins).map_err(|e| DiscoveryError::Grid {
+                env: spec.name.to_string(),
+                why: e.to_string(),
+            })?,
             goals: GoalGrid::new(2),
         }))
     }
@@ -489,7 +345,7 @@ impl EnvMeasures {
     }
 
     /// The KL-coverage grid.
-    pub fn grid(&self) -> &Grid {
+    pub fn grid(&self) -> &KlCoverage {
         &self.grid
     }
 
@@ -502,8 +358,14 @@ impl EnvMeasures {
     ) -> Result<Option<Discovery>, DiscoveryError> {
         let d = self.coords.len();
         let mut points = Vec::with_capacity(outcomes.len() * d);
-        let mut all = Histogram::new(&self.grid);
-        let mut moved = Histogram::new(&self.grid);
+        let mut all = self.grid.histogram();
+        let mut moved = self.grid.histogram();
+        // The coordinates are checked above (no NaN, as many as the grid's): the histogram
+        // cannot refuse them.
+        let klc_error = |e: KlcError| DiscoveryError::Grid {
+            env: "?".into(),
+            why: e.to_string(),
+        };
         let mut p = vec![0.0; d];
         for o in outcomes
             .iter()
@@ -515,23 +377,25 @@ impl EnvMeasures {
                     column: c.name().to_string(),
                 })?;
             }
-            all.add(&p);
+            all.add(&p).map_err(klc_error)?;
             if o.moved {
-                moved.add(&p);
+                moved.add(&p).map_err(klc_error)?;
             }
             points.extend_from_slice(&p);
         }
-        let Some(klc) = all.klc() else {
-            return Ok(None);
+        let klc = match all.klc() {
+            Ok(k) => k,
+            Err(KlcError::Empty) => return Ok(None),
+            Err(e) => return Err(klc_error(e)),
         };
         let tree = KdTree::new(&points, d);
         let mut errors: Vec<f64> = self.goals.goals().filter_map(|g| tree.nearest(g)).collect();
         errors.sort_by(f64::total_cmp);
         Ok(Some(Discovery {
-            n_outcomes: all.total as usize,
-            n_moved: moved.total as usize,
+            n_outcomes: all.total() as usize,
+            n_moved: moved.total() as usize,
             klc,
-            moved_klc: moved.klc(),
+            moved_klc: moved.klc().ok(),
             coverage: all.coverage(),
             goal_error_mean: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
             goal_error_p90: quantile_sorted(&errors, 0.9).unwrap_or(f64::NAN),

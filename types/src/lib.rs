@@ -25,6 +25,7 @@ mod diagnostics;
 mod discovery;
 mod env;
 mod goal_space;
+pub mod klc;
 mod learner;
 mod manifest;
 mod paths;
@@ -32,8 +33,8 @@ mod paths;
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
 pub use discovery::{
-    Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Grid,
-    Outcome, RecordMismatch, RunDiscovery, median, quantile_sorted,
+    Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Outcome,
+    RecordMismatch, RunDiscovery, median, quantile_sorted,
 };
 pub use env::{
     ARMARROW, ARMBALL, ARMBALLS, BUILT_IN, DISK, EnvSpec, EnvSpecError, KlcGrid, ObjectSpec,

@@ -247,21 +247,49 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
     runs
 }
 
+/// Runs that share a trained representation, in one group each: `items` (each with its run,
+/// `spec_of`) grouped by [`RunSpec::representation_identity`], groups in order of first
+/// appearance and items in their order. A run without a representation (RPE, RGE-EFR) is a
+/// group of its own, with key None. The one grouping of the runner (a representation is fitted
+/// once, then its runs run one after the other), the shards ([`shard_groups`]) and
+/// `--refresh-diagnostics`.
+pub fn representation_groups<'s, T>(
+    items: impl IntoIterator<Item = T>,
+    spec_of: impl Fn(&T) -> &'s RunSpec,
+    images: usize,
+) -> Vec<(Option<String>, Vec<T>)> {
+    let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    let mut groups: Vec<(Option<String>, Vec<T>)> = Vec::new();
+    for item in items {
+        match spec_of(&item).representation_identity(images) {
+            Some(key) => match index.get(&key) {
+                Some(&g) => groups[g].1.push(item),
+                None => {
+                    index.insert(key.clone(), groups.len());
+                    groups.push((Some(key), vec![item]));
+                }
+            },
+            None => groups.push((None, vec![item])),
+        }
+    }
+    groups
+}
+
 /// The representation group of every run of `runs`, numbered in plan order of first
-/// appearance: runs that share a trained representation share a group; every other run is a
-/// group of its own. Shards deal these groups round-robin ([`shard`]), so a campaign has at most
-/// `groups` non-empty shards.
+/// appearance ([`representation_groups`]): runs that share a trained representation share a
+/// group; every other run is a group of its own. Shards deal these groups round-robin
+/// ([`shard`]), so a campaign has at most `groups` non-empty shards.
 pub fn shard_groups(runs: &[RunSpec], images: usize) -> Vec<usize> {
-    let mut keys: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    runs.iter()
-        .map(|spec| {
-            let key = spec
-                .representation_identity(images)
-                .unwrap_or_else(|| spec.identity());
-            let next = keys.len();
-            *keys.entry(key).or_insert(next)
-        })
-        .collect()
+    let mut of = vec![0; runs.len()];
+    for (g, (_, members)) in representation_groups(0..runs.len(), |&i| &runs[i], images)
+        .into_iter()
+        .enumerate()
+    {
+        for i in members {
+            of[i] = g;
+        }
+    }
+    of
 }
 
 /// A deterministic slice `index` of `count` (0-based) of the plan, for spreading a campaign over

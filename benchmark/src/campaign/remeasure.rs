@@ -70,7 +70,7 @@ pub fn refresh_diagnostics(
     };
     let mut done = Remeasured::default();
     // Per representation: its finished runs, each with its manifest when the measure is old.
-    let mut groups: Vec<(String, Vec<(&RunSpec, Option<Manifest>)>)> = Vec::new();
+    let mut entries: Vec<(&RunSpec, Option<Manifest>)> = Vec::new();
     for spec in all.iter().filter(|s| s.algo.learner().is_some()) {
         if !store::is_complete(out, &spec.run_id(), &ctx.config_hash(spec)) {
             done.unfinished += 1;
@@ -83,15 +83,9 @@ pub fn refresh_diagnostics(
         });
         let stale = measure_version(&manifest, sidecar.as_ref()) < u64::from(MEASURE_VERSION);
         done.current += usize::from(!stale);
-        let key = spec
-            .representation_identity(cfg.ugl.images)
-            .expect("a learned goal space has a representation");
-        let entry = (spec, stale.then_some(manifest));
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, g)) => g.push(entry),
-            None => groups.push((key, vec![entry])),
-        }
+        entries.push((spec, stale.then_some(manifest)));
     }
+    let mut groups = super::plan::representation_groups(entries, |e| e.0, cfg.ugl.images);
     // Only the representations with something to do.
     groups.retain(|(_, runs)| {
         let first = runs[0].0;

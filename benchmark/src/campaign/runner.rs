@@ -304,15 +304,8 @@ pub fn run_campaign(
         skipped: all.len() - todo.len(),
     });
     // Runs sharing a representation form one group: fitted once, then run one after the other.
-    let mut groups: Vec<(Option<String>, Vec<&RunSpec>)> = Vec::new();
     let n_todo = todo.len();
-    for spec in todo {
-        let key = spec.representation_identity(cfg.ugl.images);
-        match groups.iter_mut().find(|(k, _)| key.is_some() && *k == key) {
-            Some((_, g)) => g.push(spec),
-            None => groups.push((key, vec![spec])),
-        }
-    }
+    let mut groups = super::plan::representation_groups(todo, |s| *s, cfg.ugl.images);
     // Expensive groups (learned representations) first, for a better load balance.
     groups.sort_by_key(|(k, _)| k.is_none());
     // External-learner cells whose fit failed: (env, learner, latents) -> the failed run.
