@@ -285,13 +285,12 @@ fn a_campaign_killed_mid_way_resumes_to_the_same_bytes() {
 #[test]
 fn a_full_disk_gives_a_clear_error_and_touches_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("disk.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "disk.toml",
         "[campaign]\nname = \"disk\"\nreps = 20\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
          algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 2000\n",
-    )
-    .unwrap();
+    );
     let mnt = dir.path().join("tiny");
     std::fs::create_dir(&mnt).unwrap();
     let script = format!(
@@ -342,15 +341,14 @@ fn a_full_disk_gives_a_clear_error_and_touches_nothing() {
 #[test]
 fn refresh_diagnostics_rebuilds_old_measures_and_figure_data_without_touching_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("diag.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "diag.toml",
         "[campaign]\nname = \"diag\"\nreps = 2\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\n\
          algos = [\"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
          variants = [\"corrected\"]\n[ugl]\nimages = 300\n[explore]\nbootstrap_epochs = 10\nepochs = 100\n\
          eval_every = 50\n[learners.vae]\niterations = 20\nhidden = [16, 8]\n",
-    )
-    .unwrap();
+    );
     let out = dir.path().join("res");
     let campaign = |extra: &[&str]| {
         let mut args = vec!["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"];

@@ -314,13 +314,12 @@ fn a_run_records_its_discovery_and_its_outcomes_file_may_be_left_out() {
 #[test]
 fn a_forged_discovery_record_is_detected() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("tiny.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "tiny.toml",
         "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 200\neval_every = 100\n",
-    )
-    .unwrap();
+    );
     let store = dir.path().join("res");
     let out = store.join("tiny");
     let campaign = ugl(&[
@@ -364,9 +363,20 @@ fn a_forged_discovery_record_is_detected() {
     };
     assert!(status().status.success(), "{}", stderr(&status()));
     assert!(report().status.success(), "{}", stderr(&report()));
-    let forge = |edit: &dyn Fn(&mut serde_json::Value), keep_outcomes: bool| {
+    // A forgery: fields set to values (a path into the manifest's JSON), with or without the
+    // record's hash, with or without the outcomes file.
+    let forge = |edits: &[(&[&str], serde_json::Value)], drop_hash: bool, keep_outcomes: bool| {
         let mut m: serde_json::Value = serde_json::from_str(&original).unwrap();
-        edit(&mut m);
+        for (path, value) in edits {
+            let mut at = &mut m;
+            for key in *path {
+                at = &mut at[*key];
+            }
+            *at = value.clone();
+        }
+        if drop_hash {
+            m.as_object_mut().unwrap().remove("discovery_blake3");
+        }
         std::fs::write(&json_path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
         if keep_outcomes {
             std::fs::write(&outcomes, &outcome_bytes).unwrap();
@@ -374,47 +384,47 @@ fn a_forged_discovery_record_is_detected() {
             std::fs::remove_file(&outcomes).unwrap();
         }
     };
-    let better = |m: &mut serde_json::Value| {
-        m["discovery"]["final"]["goal_error_mean"] = 0.001.into();
-        m["discovery"]["final"]["coverage"] = 0.5.into();
-        m["summary"]["coverage"] = 0.5.into();
-    };
-    let drop_hash = |m: &mut serde_json::Value| {
-        m.as_object_mut().unwrap().remove("discovery_blake3");
-    };
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, bool)> = vec![
-        ("hash", Box::new(better), false),
+    let n_moved =
+        serde_json::from_str::<serde_json::Value>(&original).unwrap()["summary"]["n_moved"]
+            .as_u64()
+            .unwrap();
+    let error: &[&str] = &["discovery", "final", "goal_error_mean"];
+    let coverage: &[&str] = &["discovery", "final", "coverage"];
+    type Edits<'a> = Vec<(&'a [&'a str], serde_json::Value)>;
+    // (what the report names, the edits, drop the hash, keep the outcomes file)
+    let cases: Vec<(&str, Edits, bool, bool)> = vec![
+        (
+            "hash",
+            vec![
+                (error, 0.001.into()),
+                (coverage, 0.5.into()),
+                (&["summary", "coverage"], 0.5.into()),
+            ],
+            false,
+            false,
+        ),
         (
             "the outcomes file gives",
-            Box::new(move |m| {
-                drop_hash(m);
-                m["discovery"]["final"]["goal_error_mean"] = 0.001.into();
-            }),
+            vec![(error, 0.001.into())],
+            true,
             true,
         ),
         (
             "final.coverage",
-            Box::new(move |m| {
-                drop_hash(m);
-                m["discovery"]["final"]["coverage"] = (-5.0).into();
-            }),
+            vec![(coverage, (-5.0).into())],
+            true,
             false,
         ),
         (
             "final.goal_error_mean",
-            Box::new(move |m| {
-                drop_hash(m);
-                m["discovery"]["final"]["goal_error_mean"] = 1e300.into();
-            }),
+            vec![(error, 1e300.into())],
+            true,
             false,
         ),
         (
             "final.n_moved",
-            Box::new(move |m| {
-                drop_hash(m);
-                let n = m["summary"]["n_moved"].as_u64().unwrap();
-                m["summary"]["n_moved"] = (n + 1).into();
-            }),
+            vec![(&["summary", "n_moved"], (n_moved + 1).into())],
+            true,
             false,
         ),
     ];
@@ -423,8 +433,8 @@ fn a_forged_discovery_record_is_detected() {
             .is_string(),
         "a run records the hash of its record"
     );
-    for (why, edit, keep) in &cases {
-        forge(edit.as_ref(), *keep);
+    for (why, edits, drop_hash, keep) in &cases {
+        forge(edits, *drop_hash, *keep);
         // `ugl status` reads manifests, not data files: a record without its hash that only the
         // outcomes file contradicts is the report's to find.
         let st = status();
@@ -445,7 +455,7 @@ fn a_forged_discovery_record_is_detected() {
         );
     }
     // The record without its hash, untouched, is still read (an older manifest).
-    forge(&drop_hash, false);
+    forge(&[], true, false);
     assert!(status().status.success(), "{}", stdout(&status()));
     assert!(report().status.success(), "{}", stderr(&report()));
 }
@@ -535,13 +545,12 @@ fn the_audit_refusals_are_one_line() {
 #[test]
 fn ugl_run_keeps_a_store_to_one_configuration() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("tiny.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "tiny.toml",
         "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rpe\"]\n[explore]\nepochs = 200\neval_every = 100\n",
-    )
-    .unwrap();
+    );
     let store = dir.path().join("tiny");
     let o = ugl(&[
         "campaign",
@@ -774,12 +783,11 @@ fn run_errors() {
 #[test]
 fn campaign_plan_and_resume() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("tiny.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "tiny.toml",
         "[campaign]\nname = \"tiny\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\", \"rge-efr\"]\n[explore]\nepochs = 150\neval_every = 50\n",
-    )
-    .unwrap();
+    );
     let o = ugl(&["plan", "--config", p(&cfg)]);
     assert_eq!(
         stdout(&o).lines().collect::<Vec<_>>(),
@@ -850,14 +858,13 @@ fn run_with_an_external_learner() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("ext.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "ext.toml",
         "[campaign]\nname = \"ext\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-external\"]\n\
          [ugl]\nimages = 200\n[explore]\nepochs = 200\n\
          [learners.external]\nname = \"random-projection\"\ncommand = \"python3 scripts/external_learners/random_projection.py\"\n",
-    )
-    .unwrap();
+    );
     let out = dir.path().join("res");
     let o = ugl(&[
         "run",
@@ -990,13 +997,12 @@ fn run_with_an_external_learner() {
 #[test]
 fn shards_merge_into_the_whole_campaign() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("sh.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "sh.toml",
         "[campaign]\nname = \"sh\"\nreps = 2\n[matrix]\nenvs = [\"armball\", \"armarrow\"]\nalgos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\n\
          samplers = [\"kde\", \"gaussian\"]\nlatents = [3]\n[ugl]\nimages = 100\n[explore]\nepochs = 120\neval_every = 40\n",
-    )
-    .unwrap();
+    );
     let whole = dir.path().join("whole");
     assert!(
         ugl(&[
@@ -1072,13 +1078,12 @@ fn shards_merge_into_the_whole_campaign() {
 #[test]
 fn status_counts_complete_missing_and_damaged_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("st.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "st.toml",
         "[campaign]\nname = \"st\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\", \"rge-efr\"]\n\
          [explore]\nbootstrap_epochs = 10\nepochs = 60\neval_every = 20\n",
-    )
-    .unwrap();
+    );
     let out = dir.path().join("st");
     let status = |extra: &[&str]| {
         let mut args = vec!["status", "--config", p(&cfg), "--out", p(&out)];
@@ -1251,17 +1256,15 @@ fn slurm_refuses_bad_options_before_writing() {
 
 /// A tiny profile with the neural learners.
 fn neural_profile(dir: &Path) -> std::path::PathBuf {
-    let path = dir.join("tiny-neural.toml");
-    std::fs::write(
-        &path,
+    common::write_file(
+        dir,
+        "tiny-neural.toml",
         "[campaign]\nname = \"tiny\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
          [ugl]\nimages = 200\n[explore]\nepochs = 300\neval_every = 100\n\
          [learners.ae]\niterations = 15\nhidden = [16, 8]\n\
          [learners.vae]\niterations = 15\nhidden = [16, 8]\n\
          [learners.rfvae]\niterations = 15\nhidden = [16, 8]\nwarmup = 5\n",
     )
-    .unwrap();
-    path
 }
 
 fn manifest(path: &Path) -> serde_json::Value {
@@ -1460,14 +1463,13 @@ fn neural_run_errors() {
 #[test]
 fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
     let dir = tempfile::tempdir().unwrap();
-    let base = dir.path().join("base.toml");
-    std::fs::write(
-        &base,
+    let base = common::write_file(
+        dir.path(),
+        "base.toml",
         "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rpe\", \"rge-pca\", \"rge-vae\"]\nsamplers = [\"kde\", \"gaussian\"]\nlatents = [\"true\"]\n\
          [ugl]\nimages = 200\n[explore]\nepochs = 200\n",
-    )
-    .unwrap();
+    );
     let out = dir.path().join("cmp");
     let o = ugl(&[
         "compare",
@@ -1541,15 +1543,14 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
 #[test]
 fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
     let dir = tempfile::tempdir().unwrap();
-    let base = dir.path().join("base.toml");
-    std::fs::write(
-        &base,
+    let base = common::write_file(
+        dir.path(),
+        "base.toml",
         "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rpe\", \"rge-efr\", \"rge-pca\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
          [ugl]\nimages = 200\n[explore]\nepochs = 150\n\
          [learners.gaussian-projection]\nstd = 0.5\n",
-    )
-    .unwrap();
+    );
     let o = ugl(&["learners"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
@@ -1744,14 +1745,13 @@ fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
 fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
     use std::time::{Duration, Instant};
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("ckpt.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "ckpt.toml",
         "[campaign]\nname = \"ckpt\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
          [ugl]\nimages = 300\n[explore]\nbootstrap_epochs = 10\nepochs = 100\n\
          [learners.vae]\niterations = 600\nhidden = [32, 16]\ninit = \"he\"\n",
-    )
-    .unwrap();
+    );
     let args = |out: &Path| -> Vec<String> {
         [
             "run",
@@ -2389,14 +2389,13 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
 
-    let cfg = dir.path().join("timeout.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "timeout.toml",
         "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-external\"]\n\
          [ugl]\nimages = 60\n[explore]\nbootstrap_epochs = 10\nepochs = 20\n\
          [learners.external]\nname = \"slow\"\ncommand = \"sleep 1000\"\nready_timeout_s = 1.5\n",
-    )
-    .unwrap();
+    );
     let t0 = std::time::Instant::now();
     let o = ugl(&[
         "run",
@@ -2420,15 +2419,14 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     // A tiny follow-up campaign: RPE, flat and learning-progress goal exploration with
     // engineered features, and the same in a learned (PCA) goal space, 3 seeds.
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("armballs.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "armballs.toml",
         "[campaign]\nname = \"armballs\"\nreps = 3\nrole = \"followup\"\n[matrix]\nenvs = [\"armballs\"]\n\
          algos = [\"rpe\", \"mge-efr-flat\", \"mge-efr-lp\", \"mge-pca-lp\"]\n\
          samplers = [\"kde\"]\nlatents = [4]\n[ugl]\nimages = 300\n\
          [explore]\nepochs = 400\nbootstrap_epochs = 50\n[mge]\ninterest_window = 20.0\n",
-    )
-    .unwrap();
+    );
     // Modules of 2 latents need an even latent count: a one-line error naming the keys.
     let odd = dir.path().join("odd.toml");
     std::fs::write(
@@ -2525,14 +2523,13 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
         );
     }
     // The report needs a main campaign: a tiny ArmBall one.
-    let main = dir.path().join("main.toml");
-    std::fs::write(
-        &main,
+    let main = common::write_file(
+        dir.path(),
+        "main.toml",
         "[campaign]\nname = \"base\"\nreps = 2\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rpe\", \"rge-efr\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
          [explore]\nepochs = 150\n",
-    )
-    .unwrap();
+    );
     let o = ugl(&[
         "campaign",
         "--config",
@@ -2725,13 +2722,12 @@ fn messages_name_the_algorithm_the_flag_and_the_key_given() {
     ]);
     assert_one_line_error(&o, "choose one with --main NAME");
     assert!(!stderr(&o).contains("ReportOptions"), "{}", stderr(&o));
-    let cfg = dir.path().join("bvae.toml");
-    std::fs::write(
-        &cfg,
+    let cfg = common::write_file(
+        dir.path(),
+        "bvae.toml",
         "[campaign]\nname = \"t\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
          algos = [\"rge-bvae\"]\n[learners.bvae]\nbeta = 4.0\ninit = 1\n",
-    )
-    .unwrap();
+    );
     let o = ugl(&["plan", "--config", p(&cfg)]);
     assert_one_line_error(&o, "learners.bvae.init: invalid type");
     assert!(

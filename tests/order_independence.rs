@@ -55,7 +55,6 @@ fn list(items: &[&str], reverse: bool) -> String {
 }
 
 fn write_config(dir: &Path, name: &str, reverse: bool) -> PathBuf {
-    let cfg = dir.join(format!("{name}.toml"));
     let text = format!(
         "[campaign]\nname = \"order\"\nreps = 1\n[matrix]\nenvs = [{}]\nalgos = [{}]\n\
          samplers = [{}]\nlatents = [\"true\"]\nvariants = [{}]\n\
@@ -68,8 +67,7 @@ fn write_config(dir: &Path, name: &str, reverse: bool) -> PathBuf {
         list(&SAMPLERS, reverse),
         list(&VARIANTS, reverse),
     );
-    std::fs::write(&cfg, text).unwrap();
-    cfg
+    common::write_file(dir, &format!("{name}.toml"), &text)
 }
 
 /// `ugl run` arguments of a run id (`armball.rge-vae.faithful.kde.l2.s0`, `armball.rpe.s0`).

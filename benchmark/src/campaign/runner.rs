@@ -78,15 +78,9 @@ pub const STORE_LOCK: &str = ".ugl-store.lock";
 pub fn write_campaign_record(cfg: &CampaignConfig, out: &Path) -> Result<(), StoreError> {
     let _lock = lock_store(out)?;
     let configuration = cfg.configuration_hash();
-    let refused = |message: String| StoreError::Refused {
-        path: out.to_path_buf(),
-        message,
-    };
+    let refused = |message| refused(out, message);
     let advice = "use another --out (or remove that store to start over)";
-    let ours = CampaignRecord::read(out).map_err(|e| StoreError::Read {
-        path: CampaignRecord::path(out),
-        message: e.to_string(),
-    })?;
+    let ours = read_record(out)?;
     if let Some(theirs) = &ours {
         if theirs.name != cfg.campaign.name {
             return Err(refused(format!(
@@ -114,6 +108,22 @@ pub fn write_campaign_record(cfg: &CampaignConfig, out: &Path) -> Result<(), Sto
     let record = CampaignRecord::new(&cfg.campaign.name, &cfg.campaign.decl())
         .with_configuration(&configuration);
     store::write_atomic(&CampaignRecord::path(out), record.to_text().as_bytes())
+}
+
+/// The campaign record of the store `out`, if it has one.
+fn read_record(out: &Path) -> Result<Option<CampaignRecord>, StoreError> {
+    CampaignRecord::read(out).map_err(|e| StoreError::Read {
+        path: CampaignRecord::path(out),
+        message: e.to_string(),
+    })
+}
+
+/// The store `out` refuses this campaign or run, saying why.
+fn refused(out: &Path, message: String) -> StoreError {
+    StoreError::Refused {
+        path: out.to_path_buf(),
+        message,
+    }
 }
 
 /// Creates `out` and takes the exclusive lock on `out/.ugl-store.lock` (released when the file
@@ -147,15 +157,9 @@ pub fn check_single_run(
     out: &Path,
 ) -> Result<(), StoreError> {
     let _lock = lock_store(out)?;
-    let refused = |message: String| StoreError::Refused {
-        path: out.to_path_buf(),
-        message,
-    };
+    let refused = |message| refused(out, message);
     let advice = "use another --out";
-    let record = CampaignRecord::read(out).map_err(|e| StoreError::Read {
-        path: CampaignRecord::path(out),
-        message: e.to_string(),
-    })?;
+    let record = read_record(out)?;
     if let Some(theirs) = &record {
         if theirs.name != cfg.campaign.name {
             return Err(refused(format!(
