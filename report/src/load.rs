@@ -11,6 +11,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
+use ugl_types::columns::{curve, outcomes};
 
 use crate::ReportError;
 
@@ -445,22 +446,26 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         df: &df,
         path: &curve_path,
     };
-    let run_id = c.constant_str("run_id")?;
+    let run_id = c.constant_str(curve::RUN_ID)?;
     let key = ConditionKey {
-        env: c.constant_str("env")?,
-        algo: c.constant_str("algo")?,
-        sampler: c.constant_str("sampler")?,
-        latents: c.constant_i64("latents")?,
-        variant: c.constant_str("variant")?,
+        env: c.constant_str(curve::ENV)?,
+        algo: c.constant_str(curve::ALGO)?,
+        sampler: c.constant_str(curve::SAMPLER)?,
+        latents: c.constant_i64(curve::LATENTS)?,
+        variant: c.constant_str(curve::VARIANT)?,
     };
-    let seed = c.constant_i64("seed")?;
-    let epoch = c.i64s("epoch")?;
-    let n_outcomes = c.i64s("n_outcomes")?;
-    let klc = c.f64s("klc")?;
-    let n_moved = c.i64s("n_moved")?;
-    let coverage = c.f64s("coverage")?;
+    let seed = c.constant_i64(curve::SEED)?;
+    let epoch = c.i64s(curve::EPOCH)?;
+    let n_outcomes = c.i64s(curve::N_OUTCOMES)?;
+    let klc = c.f64s(curve::KLC)?;
+    let n_moved = c.i64s(curve::N_MOVED)?;
+    let coverage = c.f64s(curve::COVERAGE)?;
     if let Some(i) = klc.iter().position(|k| k.is_nan()) {
-        return Err(column_error(&curve_path, "klc", format!("NaN at row {i}")));
+        return Err(column_error(
+            &curve_path,
+            curve::KLC,
+            format!("NaN at row {i}"),
+        ));
     }
     let mut curve: Vec<CurvePoint> = (0..df.height())
         .map(|i| CurvePoint {
@@ -475,7 +480,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
     if let Some(w) = curve.windows(2).find(|w| w[0].epoch == w[1].epoch) {
         return Err(column_error(
             &curve_path,
-            "epoch",
+            curve::EPOCH,
             format!("epoch {} appears twice", w[0].epoch),
         ));
     }
@@ -483,7 +488,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
     if run_id != expected_stem {
         return Err(column_error(
             &curve_path,
-            "run_id",
+            curve::RUN_ID,
             format!("holds `{run_id}` but the file is named `{expected_stem}`"),
         ));
     }
@@ -587,23 +592,23 @@ fn read_outcomes(path: &Path, run_id: &str) -> Result<Vec<Outcome>, ReportError>
     let odf = read_parquet(path)?;
     let o = Cols { df: &odf, path };
     if odf.height() > 0 {
-        let orun = o.constant_str("run_id")?;
+        let orun = o.constant_str(outcomes::RUN_ID)?;
         if orun != *run_id {
             return Err(column_error(
                 path,
-                "run_id",
+                outcomes::RUN_ID,
                 format!("holds `{orun}`, the curve file holds `{run_id}`"),
             ));
         }
     } else {
-        o.require("run_id")?;
+        o.require(outcomes::RUN_ID)?;
     }
-    let index = o.i64s("index")?;
-    let oepoch = o.i64s("epoch")?;
-    let x = o.f64s("x")?;
-    let y = o.f64s("y")?;
-    let angle = o.f64s_nullable("angle")?;
-    let moved = o.bools("moved")?;
+    let index = o.i64s(outcomes::INDEX)?;
+    let oepoch = o.i64s(outcomes::EPOCH)?;
+    let x = o.f64s(outcomes::X)?;
+    let y = o.f64s(outcomes::Y)?;
+    let angle = o.f64s_nullable(outcomes::ANGLE)?;
+    let moved = o.bools(outcomes::MOVED)?;
     Ok((0..odf.height())
         .map(|i| Outcome {
             index: index[i],

@@ -21,6 +21,7 @@
 //! ```
 
 mod campaign;
+pub mod columns;
 mod diagnostics;
 mod discovery;
 mod env;

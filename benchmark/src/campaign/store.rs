@@ -13,6 +13,7 @@ use thiserror::Error;
 
 use super::plan::RunSpec;
 use crate::explore::ExplorationLog;
+use ugl_types::columns::{curve, interest, outcomes};
 pub use ugl_types::{
     Diagnostics, DigestError, FileDigest, Manifest, Outcome, RunPaths, Summary, run_paths,
     verify_files,
@@ -41,18 +42,18 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
     let n = log.checkpoints.len();
     let c = &log.checkpoints;
     let mut df = df!(
-        "run_id" => vec![spec.run_id(); n],
-        "env" => vec![spec.env.name(); n],
-        "algo" => vec![spec.algo.to_string(); n],
-        "sampler" => vec![spec.sampler.name(); n],
-        "latents" => vec![spec.latents as i64; n],
-        "variant" => vec![spec.variant.map(|v| v.name()).unwrap_or("none"); n],
-        "seed" => vec![spec.seed as i64; n],
-        "epoch" => c.iter().map(|p| p.epoch as i64).collect::<Vec<_>>(),
-        "n_outcomes" => c.iter().map(|p| p.n_outcomes as i64).collect::<Vec<_>>(),
-        "klc" => c.iter().map(|p| p.klc).collect::<Vec<_>>(),
-        "n_moved" => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
-        "coverage" => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
+        curve::RUN_ID => vec![spec.run_id(); n],
+        curve::ENV => vec![spec.env.name(); n],
+        curve::ALGO => vec![spec.algo.to_string(); n],
+        curve::SAMPLER => vec![spec.sampler.name(); n],
+        curve::LATENTS => vec![spec.latents as i64; n],
+        curve::VARIANT => vec![spec.variant.map(|v| v.name()).unwrap_or("none"); n],
+        curve::SEED => vec![spec.seed as i64; n],
+        curve::EPOCH => c.iter().map(|p| p.epoch as i64).collect::<Vec<_>>(),
+        curve::N_OUTCOMES => c.iter().map(|p| p.n_outcomes as i64).collect::<Vec<_>>(),
+        curve::KLC => c.iter().map(|p| p.klc).collect::<Vec<_>>(),
+        curve::N_MOVED => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
+        curve::COVERAGE => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
     )?;
     if c.iter().any(|p| p.control.is_some()) {
         let control = |f: fn((f64, f64)) -> f64| {
@@ -60,8 +61,11 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
                 .map(|p| p.control.map(f))
                 .collect::<Vec<Option<f64>>>()
         };
-        df.with_column(Column::new("control_klc".into(), control(|v| v.0)))?;
-        df.with_column(Column::new("control_coverage".into(), control(|v| v.1)))?;
+        df.with_column(Column::new(curve::CONTROL_KLC.into(), control(|v| v.0)))?;
+        df.with_column(Column::new(
+            curve::CONTROL_COVERAGE.into(),
+            control(|v| v.1),
+        ))?;
     }
     Ok(df)
 }
@@ -94,16 +98,16 @@ pub fn outcomes_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Data
         .map(|s| if log.dim == 3 { Some(s[2]) } else { None })
         .collect();
     let mut df = df!(
-        "run_id" => vec![spec.run_id(); n],
-        "index" => (0..n as i64).collect::<Vec<_>>(),
-        "epoch" => log.epochs.iter().map(|&e| e as i64).collect::<Vec<_>>(),
-        "x" => log.outcomes.iter().map(|s| s[0]).collect::<Vec<_>>(),
-        "y" => log.outcomes.iter().map(|s| s[1]).collect::<Vec<_>>(),
-        "angle" => angle,
-        "moved" => log.moved.clone(),
+        outcomes::RUN_ID => vec![spec.run_id(); n],
+        outcomes::INDEX => (0..n as i64).collect::<Vec<_>>(),
+        outcomes::EPOCH => log.epochs.iter().map(|&e| e as i64).collect::<Vec<_>>(),
+        outcomes::X => log.outcomes.iter().map(|s| s[0]).collect::<Vec<_>>(),
+        outcomes::Y => log.outcomes.iter().map(|s| s[1]).collect::<Vec<_>>(),
+        outcomes::ANGLE => angle,
+        outcomes::MOVED => log.moved.clone(),
     )?;
     if log.dim == 4 {
-        for (name, k) in [("distractor_x", 2), ("distractor_y", 3)] {
+        for (name, k) in [(outcomes::DISTRACTOR_X, 2), (outcomes::DISTRACTOR_Y, 3)] {
             let v: Vec<f64> = log.outcomes.iter().map(|s| s[k]).collect();
             df.with_column(Column::new(name.into(), v))?;
         }
@@ -138,13 +142,13 @@ pub fn interest_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<Opti
             .unwrap_or_default()
     };
     df!(
-        "run_id" => vec![spec.run_id(); n],
-        "epoch" => p.iter().map(|q| q.epoch as i64).collect::<Vec<_>>(),
-        "module" => p.iter().map(|q| q.module as i64).collect::<Vec<_>>(),
-        "module_name" => p.iter().map(|q| name(q.module)).collect::<Vec<_>>(),
-        "dims" => p.iter().map(|q| dims(q.module)).collect::<Vec<_>>(),
-        "interest" => p.iter().map(|q| q.interest).collect::<Vec<_>>(),
-        "n_chosen" => p.iter().map(|q| q.n_chosen as i64).collect::<Vec<_>>(),
+        interest::RUN_ID => vec![spec.run_id(); n],
+        interest::EPOCH => p.iter().map(|q| q.epoch as i64).collect::<Vec<_>>(),
+        interest::MODULE => p.iter().map(|q| q.module as i64).collect::<Vec<_>>(),
+        interest::MODULE_NAME => p.iter().map(|q| name(q.module)).collect::<Vec<_>>(),
+        interest::DIMS => p.iter().map(|q| dims(q.module)).collect::<Vec<_>>(),
+        interest::INTEREST => p.iter().map(|q| q.interest).collect::<Vec<_>>(),
+        interest::N_CHOSEN => p.iter().map(|q| q.n_chosen as i64).collect::<Vec<_>>(),
     )
     .map(Some)
 }

@@ -12,6 +12,7 @@ use crate::ReportError;
 use crate::campaigns::Campaign;
 use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
 use crate::stats::mean;
+use ugl_types::columns::{curve, interest};
 
 /// ArmBalls' ball's KL-coverage grid (the registry's).
 pub(super) fn ball_grid() -> ugl_types::KlcGrid {
@@ -113,15 +114,15 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
             path: &run.curve_path,
         };
         let has = |name: &str| df.get_column_names().iter().any(|n| n.as_str() == name);
-        let (dcov, dklc) = if has("control_coverage") {
+        let (dcov, dklc) = if has(curve::CONTROL_COVERAGE) {
             (
-                c.f64s_nullable("control_coverage")?,
-                c.f64s_nullable("control_klc")?,
+                c.f64s_nullable(curve::CONTROL_COVERAGE)?,
+                c.f64s_nullable(curve::CONTROL_KLC)?,
             )
         } else {
             (vec![None; df.height()], vec![None; df.height()])
         };
-        let epochs = c.i64s("epoch")?;
+        let epochs = c.i64s(curve::EPOCH)?;
         let mut order: Vec<usize> = (0..epochs.len()).collect();
         order.sort_by_key(|&i| epochs[i]);
         let quality = run.manifest.latent_quality.as_ref();
@@ -210,12 +211,12 @@ pub(super) fn load_interest(curve: &Path) -> Result<Interest, ReportError> {
         path: &path,
     };
     let (epoch, module, interest, chosen) = (
-        c.i64s("epoch")?,
-        c.i64s("module")?,
-        c.f64s("interest")?,
-        c.i64s("n_chosen")?,
+        c.i64s(interest::EPOCH)?,
+        c.i64s(interest::MODULE)?,
+        c.f64s(interest::INTEREST)?,
+        c.i64s(interest::N_CHOSEN)?,
     );
-    let (names, dims) = (c.strs("module_name")?, c.strs("dims")?);
+    let (names, dims) = (c.strs(interest::MODULE_NAME)?, c.strs(interest::DIMS)?);
     let mut modules = BTreeMap::new();
     for i in 0..df.height() {
         let d: Vec<usize> = dims[i]
