@@ -11,7 +11,7 @@ use ugl_bench::campaign::plan::{parse_shard, shard_groups};
 use ugl_bench::campaign::{CampaignOptions, Harness, Progress, plan, run_campaign};
 
 use crate::cli::{CacheArgs, SlurmArgs};
-use crate::commands::single::check_out_dir;
+use crate::commands::single::{check_clean_tree, check_out_dir};
 use crate::progress::{learner_lines, stop_on_ctrl_c, training_bars};
 
 /// How a campaign runs (`ugl campaign`, `ugl compare`): the options of the command line.
@@ -92,33 +92,6 @@ pub(crate) fn refresh_config(
         t0.elapsed().as_secs_f64(),
         out.display()
     );
-    Ok(())
-}
-
-/// Results written into a checkout's `data/` are the ones that get committed: refused while
-/// tracked files of that checkout (the one holding `out`'s real path, symlinks followed, whose
-/// revision every manifest written there records) have uncommitted changes, since the manifests
-/// would record a `-dirty` revision that no commit reproduces. `--allow-dirty` overrides;
-/// results written outside a checkout's `data/` are never refused.
-pub(crate) fn check_clean_tree(out: &Path) -> Result<()> {
-    use ugl_bench::campaign::provenance::{checkout_of, real_path, revision_of};
-    let real = real_path(out);
-    let Some(top) = checkout_of(&real) else {
-        return Ok(());
-    };
-    if !real.starts_with(top.join("data")) {
-        return Ok(());
-    }
-    let revision = revision_of(Some(&top));
-    if revision.ends_with("-dirty") {
-        bail!(
-            "--out {}: the checkout {} has uncommitted changes to tracked files, and runs written \
-             into its data/ would record the revision {revision}, which no commit reproduces: \
-             commit or stash the changes, write elsewhere with --out, or pass --allow-dirty",
-            out.display(),
-            top.display(),
-        );
-    }
     Ok(())
 }
 

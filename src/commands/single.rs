@@ -26,7 +26,7 @@ pub(crate) fn run(
     let mut cfg = CampaignConfig::load(&path)?;
     let spec = a.resolve(&mut cfg, &path).map_err(anyhow::Error::msg)?;
     if !allow_dirty {
-        crate::commands::campaign::check_clean_tree(out)?;
+        check_clean_tree(out)?;
     }
     check_out_dir(out)?;
     let model_cache = cache.resolve(out);
@@ -66,6 +66,33 @@ pub(crate) fn check_out_dir(out: &Path) -> Result<()> {
         bail!("--out {}: exists and is not a directory", out.display());
     }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))
+}
+
+/// Results written into a checkout's `data/` are the ones that get committed: refused while
+/// tracked files of that checkout (the one holding `out`'s real path, symlinks followed, whose
+/// revision every manifest written there records) have uncommitted changes, since the manifests
+/// would record a `-dirty` revision that no commit reproduces. `--allow-dirty` overrides;
+/// results written outside a checkout's `data/` are never refused.
+pub(crate) fn check_clean_tree(out: &Path) -> Result<()> {
+    use ugl_bench::campaign::provenance::{checkout_of, real_path, revision_of};
+    let real = real_path(out);
+    let Some(top) = checkout_of(&real) else {
+        return Ok(());
+    };
+    if !real.starts_with(top.join("data")) {
+        return Ok(());
+    }
+    let revision = revision_of(Some(&top));
+    if revision.ends_with("-dirty") {
+        bail!(
+            "--out {}: the checkout {} has uncommitted changes to tracked files, and runs written \
+             into its data/ would record the revision {revision}, which no commit reproduces: \
+             commit or stash the changes, write elsewhere with --out, or pass --allow-dirty",
+            out.display(),
+            top.display(),
+        );
+    }
+    Ok(())
 }
 
 /// `ugl embed`: the latents of one fitted goal space.

@@ -53,9 +53,47 @@ pub enum Init {
     Glorot,
 }
 
+/// One of `all`, read by its `name`: anything else (another word, a number, a table) is an error
+/// that says what it got and lists the names (`invalid type: integer `1`, expected one of
+/// "paper", "he", "glorot"`), where serde's derived enums read from a TOML table say only
+/// `invalid type: unit variant, expected string only`.
+pub(crate) fn named_choice<'de, D, T>(
+    d: D,
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Copy + 'static,
+{
+    struct Names<T: 'static> {
+        all: &'static [T],
+        name: fn(T) -> &'static str,
+    }
+    impl<T: Copy> serde::de::Visitor<'_> for Names<T> {
+        type Value = T;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            let names: Vec<String> = self
+                .all
+                .iter()
+                .map(|&x| format!("\"{}\"", (self.name)(x)))
+                .collect();
+            write!(f, "one of {}", names.join(", "))
+        }
+        fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<T, E> {
+            self.all
+                .iter()
+                .copied()
+                .find(|&x| (self.name)(x) == s)
+                .ok_or_else(|| E::invalid_value(serde::de::Unexpected::Str(s), &self))
+        }
+    }
+    d.deserialize_any(Names { all, name })
+}
+
 impl<'de> Deserialize<'de> for Init {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        super::neural_config::named_choice(d, &Init::ALL, Init::name)
+        named_choice(d, &Init::ALL, Init::name)
     }
 }
 
