@@ -16,18 +16,19 @@ pub fn git_revision() -> &'static str {
 /// The revision a run written into `out` records: that of the checkout holding `out` (its real
 /// path: symlinks followed), so that results written into a checkout's `data/` name that
 /// checkout's revision whatever the working directory; else the working directory's
-/// ([`git_revision`]). Computed once per checkout.
+/// ([`git_revision`]). Computed once per results directory (a campaign writes hundreds of runs
+/// into one).
 pub fn git_revision_for(out: &Path) -> String {
     static REVS: OnceLock<Mutex<HashMap<PathBuf, String>>> = OnceLock::new();
-    let Some(top) = checkout_of(out) else {
-        return git_revision().to_string();
-    };
     let mut revs = REVS
         .get_or_init(Default::default)
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    revs.entry(top.clone())
-        .or_insert_with(|| revision_of(Some(&top)))
+    revs.entry(out.to_path_buf())
+        .or_insert_with(|| match checkout_of(out) {
+            Some(top) => revision_of(Some(&top)),
+            None => git_revision().to_string(),
+        })
         .clone()
 }
 
