@@ -411,6 +411,48 @@ fn campaigns_table(w: &mut String, inp: &Context<'_>) {
         );
     }
     let _ = writeln!(w);
+    discovery_checks(w, inp);
+}
+
+/// How the discovery measures of the runs above were checked (`ugl_types::verify_files` and the
+/// loader): how many carry the hash of their record, how many were compared with their kept
+/// outcomes file, how many were measured from it, and how many rest on their record alone.
+fn discovery_checks(w: &mut String, inp: &Context<'_>) {
+    let runs: Vec<&crate::load::Run> = inp
+        .campaigns
+        .used()
+        .flat_map(|c| c.store.runs.iter())
+        .collect();
+    let recorded = |r: &&&crate::load::Run| r.manifest.discovery.is_some();
+    let hashed = runs
+        .iter()
+        .filter(|r| r.manifest.discovery_blake3.is_some())
+        .count();
+    let recomputed = runs
+        .iter()
+        .filter(recorded)
+        .filter(|r| r.has_outcomes())
+        .count();
+    let record_only = runs
+        .iter()
+        .filter(recorded)
+        .filter(|r| !r.has_outcomes())
+        .count();
+    let measured = runs
+        .iter()
+        .filter(|r| r.manifest.discovery.is_none())
+        .count();
+    let _ = writeln!(
+        w,
+        "The discovery measures of these {} runs (goal-reaching error, cells reached, moved-only \
+         KL-coverage): {measured} measured here from their outcomes files (no record); \
+         {recomputed} recorded and checked against the same measures recomputed from their kept \
+         outcomes files; {record_only} read from their record alone, checked for range and \
+         against the run's summary and curve (their outcomes files are not committed). \
+         {hashed} of the records carry the hash that detects an edited record (written by the runs \
+         of this code on; [`data/results/README.md`](../../data/results/README.md)).\n",
+        runs.len()
+    );
 }
 
 /// What was run: campaigns, runs, seeds, epochs, compute and provenance, the table of conditions.
