@@ -9,7 +9,7 @@
 //! `label`) and recorded beside its runs (`campaign.toml`, [`ugl_types::CampaignRecord`]); the
 //! report reads the record and never infers a role from a directory name.
 //!
-//! - The **main** campaign ([`crate::ReportOptions::main_campaign`], default `paper`) feeds the
+//! - The **main** campaign ([`crate::options::ReportOptions::main_campaign`], default `paper`) feeds the
 //!   sections that reproduce the paper: the KL-coverage curves (its Figure 2), the outcome
 //!   scatters (Figure 3), Figure 4 (RGE-VAE with KDE vs Gaussian goals), the faithful-vs-corrected
 //!   comparison and the final table against the paper's values.
@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 use ugl_types::{CampaignDecl, CampaignRecord, CampaignRole};
 
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::load::{CampaignDir, Store, campaign_display, scan_store};
 
 /// A campaign that was read.

@@ -1,7 +1,6 @@
 //! What every report section reads: the campaigns, and the statistics computed once from them
-//! ([`crate::render_report`] builds it; [`crate::sections`] and [`crate::markdown`] read it).
+//! ([`crate::render::render_report`] builds it; [`crate::sections`] and [`crate::markdown`] read it).
 
-use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
 use crate::campaigns::Campaigns;
 use crate::claims::ClaimsInput;
@@ -9,6 +8,7 @@ use crate::discovery::{Check, RunRow};
 use crate::leaderboard::Leaderboard;
 use crate::load::Store;
 use crate::neural::{BudgetAnalysis, LossCurve, VariantPair};
+use crate::options::ReportOptions;
 use crate::paper::PaperTable;
 
 /// What every section reads: the campaigns and the statistics computed once from them.

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use polars::prelude::*;
 use ugl_types::columns::{curve, outcomes};
 
-use crate::ReportError;
+use crate::error::ReportError;
 
 /// Modular explorations' interest per module (`armballs.rs` reads it; not a run of its own).
 pub use ugl_types::INTEREST_SUFFIX;

@@ -270,7 +270,7 @@ pub fn variant_pairs(conditions: &[ConditionSummary]) -> Vec<VariantPair<'_>> {
         .collect();
     out.sort_by_key(|p| {
         (
-            crate::figures::panel_order(&p.env, p.latents),
+            crate::names::panel_order(&p.env, p.latents),
             rank(&p.algo, &variant_algos()),
             rank(&p.sampler, &["kde", "gaussian"]),
             p.sampler.clone(),

@@ -9,7 +9,7 @@
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
 
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::figures::FigureFile;
 
 /// The list of the files the last render wrote, relative to the output directory, one per line.

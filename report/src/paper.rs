@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::load::ConditionKey;
 
 pub const KLC_FILE: &str = "klc_final.csv";

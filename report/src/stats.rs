@@ -14,6 +14,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 pub mod components;
+pub mod correlation;
 #[cfg(test)]
 pub(crate) mod coverage;
 pub mod interval;

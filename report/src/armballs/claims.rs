@@ -8,8 +8,8 @@ use std::fmt::Write as _;
 use super::labels::{f3, tag};
 use super::runs::{FollowupRun, display, role};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
-use crate::figures::learner_name;
 use crate::load::ConditionKey;
+use crate::names::learner_name;
 
 /// The claims file of the follow-up, in the paper directory.
 pub const FILE: &str = "followup_claims.toml";

@@ -12,7 +12,7 @@ use plotters::style::RGBColor;
 use super::labels::{parts, tag};
 use super::runs::{FollowupRun, algos, ball_cells, display, of};
 use super::{COVERAGE_FIGURE, INTEREST_FIGURE};
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::figures::lines::{
     Curve, LegendPlace, LineFigure, LinePanel, YScale, draw_line_figure, followup_request,
 };

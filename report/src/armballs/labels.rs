@@ -5,7 +5,7 @@
 //! variant campaign its runs come from (`mge-efr-flat@still`), and, when the campaigns ran one
 //! algorithm with several goal samplers or latent sizes, which one (`mge-vae-lp~kde~4`).
 
-use crate::figures::{learner_name, sampler_name};
+use crate::names::{learner_name, sampler_name};
 
 /// `ALGO[@TAG]` and the `(sampler, latents)` suffix of a condition, if any.
 pub(super) fn split_condition(cond: &str) -> (&str, Option<(&str, &str)>) {

@@ -23,9 +23,9 @@ pub use claims::{FILE as CLAIMS_FILE, FollowupObservations};
 pub use labels::label;
 pub use runs::{FollowupRun, load};
 
-use crate::ReportError;
 use crate::campaigns::Campaign;
 use crate::claims::ClaimResult;
+use crate::error::ReportError;
 use crate::figures::FigureFile;
 
 /// The page this section writes.

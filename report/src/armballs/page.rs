@@ -9,7 +9,8 @@ use super::runs::{
 };
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
-use crate::figures::{FigureFile, learner_name};
+use crate::figures::FigureFile;
+use crate::names::learner_name;
 use crate::stats::{CONFIDENCE, mean, t_interval};
 
 /// The page, and the section of `REPORT.md` (its claims and a link to the page).

@@ -8,8 +8,8 @@ use std::path::Path;
 use serde_json::Value;
 
 use super::labels::{label, split_condition, suffix_label};
-use crate::ReportError;
 use crate::campaigns::Campaign;
+use crate::error::ReportError;
 use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
 use crate::stats::mean;
 use ugl_types::columns::{curve, interest};

@@ -17,7 +17,7 @@ use super::{
     FONT, FigureFile, Icon, colour, condition_name, env_name, legend_height, legend_strip, marker,
     marker_points, sampler_name, star_points, write_svg,
 };
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::load::campaign_display;
 use crate::neural::{BudgetPoint, BudgetSeries};
 

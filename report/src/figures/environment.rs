@@ -15,7 +15,7 @@ use super::{
     FIG1, FIG6, FONT, FigureFile, Icon, LineStyle, PanelChart, draw_curve, legend_height,
     legend_strip, marker_points, plain_panel, write_svg,
 };
-use crate::ReportError;
+use crate::error::ReportError;
 
 const PANEL: u32 = 340;
 const TITLE_H: u32 = 36;

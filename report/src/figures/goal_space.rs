@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 
 use super::{FONT, FigureFile, condition_name, env_name, file_safe, write_svg};
-use crate::ReportError;
+use crate::error::ReportError;
 
 /// One representation's figure data, as the campaign writes it.
 pub use ugl_types::{GOAL_SPACE_DIR as DIR_NAME, GoalSpaceSample as Sample};
@@ -237,7 +237,7 @@ pub fn draw_all(
             path: src.clone(),
             source,
         })?;
-        crate::write_file(&path, &bytes)?;
+        crate::figures::write_file(&path, &bytes)?;
         recon.push(FigureFile {
             path,
             link: format!("figures/{name}"),

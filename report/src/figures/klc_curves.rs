@@ -24,8 +24,8 @@ use super::{
     env_name, file_safe, fmt_epoch, klc_max, legend_height, legend_strip, marker, marker_points,
     paper_star_item, sampler_name, write_svg,
 };
-use crate::ReportError;
 use crate::aggregate::{ConditionSummary, CurveStat};
+use crate::error::ReportError;
 
 const PANEL_W: u32 = 820;
 /// Width of a panel's final-value strip, out of [`PANEL_W`].

@@ -17,7 +17,7 @@ use super::{
     FONT, Icon, LineStyle, OffScaleMarks, StyleRequest, draw_curve, draw_off_scale, fmt_log_tick,
     legend_height, legend_strip, right_margin, tick_decimals, write_svg,
 };
-use crate::ReportError;
+use crate::error::ReportError;
 
 /// One curve: its legend label, its style, its points and, optionally, a shaded interval
 /// `(x, lo, hi)` under it.

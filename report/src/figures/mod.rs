@@ -32,9 +32,12 @@ use plotters::element::ComposedElement;
 use plotters::prelude::*;
 use plotters::style::RGBColor;
 
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::load::rank;
-use ugl_types::LearnerInfo;
+pub use crate::names::{
+    algo_name, algos, condition_name, env_name, klc_max, learner_name, panel_order, sampler_name,
+    style_algos, true_latents,
+};
 
 /// A figure written by the report, with what the markdown needs to show it.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,26 +59,6 @@ pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<
 
 pub const FONT: &str = "sans-serif";
 
-/// The paper's algorithms, in the report's order: RPE, RGE-EFR, then the registry's learners
-/// that the paper evaluated (PCA, Isomap, AE, VAE, RFVAE).
-pub fn algos() -> Vec<&'static str> {
-    let mut v = vec!["rpe", "rge-efr"];
-    v.extend(LearnerInfo::paper_algos());
-    v
-}
-
-/// The algorithms with a fixed colour and marker, in slot order: the paper's ([`algos`]), the
-/// position-only EFR, then the registry's other learners in its order (the β-VAE, the random
-/// projection, ...). They index [`ALGO_COLOURS`] and the marker shapes, so that an algorithm
-/// looks the same in every figure and environment; an algorithm outside the registry takes the
-/// following slots.
-pub fn style_algos() -> Vec<&'static str> {
-    let mut v = algos();
-    v.push("rge-efr-position");
-    v.extend(LearnerInfo::all().filter(|l| !l.in_paper).map(|l| l.algo));
-    v
-}
-
 /// Okabe–Ito without its yellow (too pale on white), one per algorithm of [`style_algos`].
 pub const ALGO_COLOURS: [RGBColor; 13] = [
     RGBColor(0x00, 0x00, 0x00), // rpe: black
@@ -92,70 +75,6 @@ pub const ALGO_COLOURS: [RGBColor; 13] = [
     RGBColor(0x44, 0xAA, 0x99), // external: teal
     RGBColor(0x99, 0x99, 0x33), // others: olive
 ];
-
-/// Display name of an environment.
-pub fn env_name(env: &str) -> String {
-    ugl_types::EnvSpec::display_of(env)
-}
-
-/// Display name of an algorithm (`rge-vae` → `RGE-VAE`): `RGE-` and the registry's display
-/// name of the learner; unknown names in capitals.
-pub fn algo_name(algo: &str) -> String {
-    match algo {
-        "rpe" => "RPE".into(),
-        "rge-efr" => "RGE-EFR".into(),
-        "rge-efr-position" => "RGE-EFR (position only)".into(),
-        other => match LearnerInfo::by_algo(other) {
-            Some(l) => format!("RGE-{}", l.display),
-            None => other.to_uppercase(),
-        },
-    }
-}
-
-/// An algorithm with its variant: `RGE-VAE (corrected)`; `RGE-AE` for variant `none`.
-/// *faithful* is the original code's behaviour, defects included (docs/original-code.md section 5);
-/// *corrected* has those defects fixed.
-pub fn condition_name(algo: &str, variant: &str) -> String {
-    let a = algo_name(algo);
-    match variant {
-        "" | "none" => a,
-        v => format!("{a} ({v})"),
-    }
-}
-
-/// Display name of a goal sampler: `KDE`, `Gaussian` (the VAE's isotropic prior), `uniform`
-/// (EFR), `none` (RPE).
-pub fn sampler_name(sampler: &str) -> String {
-    match sampler {
-        "kde" => "KDE".into(),
-        "gaussian" => "Gaussian".into(),
-        other => other.to_string(),
-    }
-}
-
-/// Display name of a learner (`vae` → `VAE`): the registry's, else in capitals.
-pub fn learner_name(learner: &str) -> String {
-    match LearnerInfo::by_name(learner) {
-        Some(l) => l.display.to_string(),
-        None => learner.to_uppercase(),
-    }
-}
-
-/// The environment's true latent dimension (the paper's "complete" representation): 2 for
-/// ArmBall (ball x, y), 3 for ArmArrow (x, y, angle).
-pub fn true_latents(env: &str) -> Option<i64> {
-    ugl_types::EnvSpec::by_name(env).map(|e| e.true_latents as i64)
-}
-
-/// The paper's panel order for one algorithm's conditions: environments in the report's order,
-/// then the over-complete 10 latents before the true dimension (larger latents first).
-pub fn panel_order(env: &str, latents: i64) -> impl Ord + use<> {
-    (
-        ugl_types::EnvSpec::order(env),
-        env.to_string(),
-        std::cmp::Reverse(latents),
-    )
-}
 
 /// Colours of the goal samplers where they are what a figure compares: KDE blue, Gaussian
 /// vermillion (Okabe–Ito; 30% and 45% luminance, apart in greyscale too).
@@ -584,12 +503,6 @@ where
     Ok(())
 }
 
-/// The fixed KLC axis range of an environment: 0 .. ln(number of achievable cells), which is the
-/// KLC of outcomes all in one cell (docs/original-code.md section 4). `None` for unknown environments.
-pub fn klc_max(env: &str) -> Option<f64> {
-    ugl_types::EnvSpec::by_name(env).map(|e| e.klc.max_klc())
-}
-
 /// Colour and marker slot of an algorithm: its position among the known ones; unknown algorithms
 /// take the following slots in the order given by `unknown_index`.
 pub fn algo_slot(algo: &str, unknown_index: usize) -> usize {
@@ -825,7 +738,7 @@ pub fn write_svg(
         draw(&root).map_err(|e| plot_err(&e))?;
         root.present().map_err(|e| plot_err(&e))?;
     }
-    crate::write_file(path, compact_svg(&svg).as_bytes())
+    crate::figures::write_file(path, compact_svg(&svg).as_bytes())
 }
 
 /// Drops attributes plotters writes with their SVG default values (`opacity="1"`, and the stroke
@@ -1079,6 +992,15 @@ pub fn dedup_legend(items: Vec<(Icon, String)>) -> Vec<(Icon, String)> {
         .into_iter()
         .filter(|(_, l)| seen.insert(l.clone()))
         .collect()
+}
+
+/// Writes a file (figures are drawn into memory, then written here and recorded by their
+/// section through [`output::Output`]).
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+    std::fs::write(path, bytes).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

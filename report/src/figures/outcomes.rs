@@ -9,13 +9,11 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{
-    FONT, FigureFile, algo_slot, colour, condition_name, env_name, file_safe, sampler_name,
-    write_svg,
-};
-use crate::ReportError;
+use super::{FONT, FigureFile, algo_slot, colour, env_name, file_safe, write_svg};
 use crate::aggregate::ConditionSummary;
+use crate::error::ReportError;
 use crate::load::{Run, Store};
+use crate::names::{describe_key, object_word};
 
 const PANEL_W: u32 = 360;
 const PANEL_H: u32 = 380;
@@ -100,7 +98,7 @@ pub fn draw_all(
         let title = format!(
             "{}, {}: {} positions, median run {} (seed {})",
             env_name(&c.key.env),
-            describe(c),
+            describe_key(&c.key),
             object,
             run.run_id,
             run.seed
@@ -124,7 +122,7 @@ pub fn draw_all(
                 "{}, {}: outcomes of {} at epochs {:?}, the median by final KL-coverage of the {} \
                  of its {} runs whose outcomes file the store keeps",
                 env_name(&c.key.env),
-                describe(c),
+                describe_key(&c.key),
                 run.run_id,
                 epochs,
                 c.runs
@@ -137,28 +135,6 @@ pub fn draw_all(
         });
     }
     Ok(out)
-}
-
-/// What the object is called in titles (the registry's controllable object).
-fn object_word(env: &str) -> &'static str {
-    ugl_types::EnvSpec::by_name(env).map_or("object", |e| e.controllable_object())
-}
-
-/// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.
-pub fn describe(c: &ConditionSummary) -> String {
-    describe_key(&c.key)
-}
-
-/// [`describe`] of a condition key.
-pub fn describe_key(k: &crate::load::ConditionKey) -> String {
-    let mut s = condition_name(&k.algo, &k.variant);
-    if !matches!(k.sampler.as_str(), "none" | "uniform") {
-        s.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
-    }
-    if k.latents != 0 {
-        s.push_str(&format!(", {} latents", k.latents));
-    }
-    s
 }
 
 fn draw_panel(

@@ -11,7 +11,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::{FONT, FigureFile, plain_panel, write_svg};
-use crate::ReportError;
+use crate::error::ReportError;
 
 pub const FILE: &str = "fig5_radial_flow.svg";
 const SAMPLES: usize = 1000;

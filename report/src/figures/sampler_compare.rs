@@ -19,9 +19,9 @@ use super::{
     legend_height, legend_strip, marker_points, panel_order, paper_star_item, sampler_colour,
     sampler_marker_slot, sampler_name, variant_dash, variant_filled, write_svg,
 };
-use crate::ReportError;
 use crate::aggregate::ConditionSummary;
-use crate::figures::algo_name;
+use crate::error::ReportError;
+use crate::names::algo_name;
 
 const PANEL_W: u32 = 720;
 /// Width of a panel's final-value strip, out of [`PANEL_W`].

@@ -22,7 +22,7 @@ use super::{
     FONT, FigureFile, Icon, LineStyle, draw_curve, env_name, learner_name, legend_height,
     legend_strip, marker_points, variant_dash, variant_filled, write_svg,
 };
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::load::rank;
 use crate::neural::{self, LossCurve};
 

@@ -18,7 +18,7 @@ use super::{
     FONT, FigureFile, Icon, KeyedAxis, algo_name, colour, env_name, legend_height, legend_strip,
     marker, marker_points, panel_order, sampler_name, write_svg,
 };
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::neural::VariantPair;
 use crate::stats::CONFIDENCE;
 

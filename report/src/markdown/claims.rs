@@ -7,9 +7,9 @@ use crate::claims::{
     ClaimResult, ClaimsInput, Comparison, Quantifier, Statistic, ToDecide, Verdict, lean, to_decide,
 };
 use crate::context::Context;
-use crate::figures::outcomes::describe_key;
-use crate::figures::{condition_name, env_name, sampler_name};
 use crate::leaderboard::Entry;
+use crate::names::describe_key;
+use crate::names::{condition_name, env_name, sampler_name};
 
 /// The symbol of a verdict.
 fn mark(v: Verdict) -> &'static str {
@@ -376,8 +376,8 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
              verdicts: [`data/{}`](data/{}).",
             validated_names(Some(v)),
             margins.join("; "),
-            crate::claims::CSV_FILE,
-            crate::claims::CSV_FILE,
+            crate::data::claims::CSV_FILE,
+            crate::data::claims::CSV_FILE,
         );
         let status: Vec<String> = v
             .statistics
@@ -406,7 +406,7 @@ pub fn claims(w: &mut String, inp: &Context<'_>) {
                 w,
                 "\nIn the validity check: {}. {}",
                 status.join("; "),
-                crate::discovery::data_used(inp.campaigns)
+                crate::markdown::discovery::data_used(inp.campaigns)
             );
         }
     }
@@ -744,8 +744,8 @@ pub fn leaderboard(w: &mut String, inp: &Context<'_>) {
         tasks.join(", "),
         super::paper_envs(|e| format!("ln {} on {}", e.klc.achievable_cells, e.display)),
         lb.n_boot,
-        crate::leaderboard::CSV_FILE,
-        crate::leaderboard::CSV_FILE,
+        crate::data::leaderboard::CSV_FILE,
+        crate::data::leaderboard::CSV_FILE,
         level = lb.confidence * 100.0,
     );
     let envs: Vec<&str> = {

@@ -6,9 +6,9 @@
 use std::fmt::Write;
 
 use super::campaign_name;
-use crate::figures::{condition_name, env_name, sampler_name};
 use crate::leaderboard::{Entry, Leaderboard, Task};
 use crate::load::Store;
+use crate::names::{condition_name, env_name, sampler_name};
 use crate::stats::{self, rliable::probability_of_improvement_ci};
 
 /// The file name of a compare campaign's page.

@@ -9,7 +9,7 @@ use super::claims::{Validity, validity_of};
 use crate::claims::{ClaimResult, ClaimsInput, Comparison, Finding, Statistic};
 use crate::context::Context;
 use crate::discovery::{Check, Measure};
-use crate::figures::{condition_name, env_name};
+use crate::names::{condition_name, env_name};
 use crate::stats;
 
 /// Anchors of the sections the findings link to.
@@ -246,7 +246,7 @@ fn budget(w: &mut String, inp: &Context<'_>) {
             "- **The training budget** ([budget]({BUDGET})): {}, {}: goal-reaching error {}{vs_efr} \
              ({:.0}% Welch interval).",
             env_name(&s.key.env),
-            crate::figures::outcomes::describe_key(&s.key),
+            crate::names::describe_key(&s.key),
             listed.join(", "),
             stats::CONFIDENCE * 100.0
         );

@@ -6,17 +6,19 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
-use crate::ReportOptions;
 use crate::aggregate::ConditionSummary;
 use crate::context::Context;
-use crate::figures::outcomes::describe;
-use crate::figures::{FigureFile, algo_name, env_name};
+use crate::figures::FigureFile;
 use crate::load::{Run, campaign_display};
+use crate::names::{algo_name, describe_key, env_name};
+use crate::options::ReportOptions;
 
 pub mod claims;
 pub mod compare;
+pub mod discovery;
 pub mod findings;
 pub mod neural;
+pub mod predicts;
 pub mod quality;
 pub mod recipe;
 
@@ -579,7 +581,7 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
             w,
             "| {} | {}{} | {} | {} | {} | {} ({}) | {} | {} |",
             env_name(&c.key.env),
-            crate::figures::algo_name(&c.key.algo),
+            crate::names::algo_name(&c.key.algo),
             dagger(&reduced_keys, c),
             c.key.sampler,
             if c.key.latents == 0 {
@@ -748,7 +750,7 @@ pub fn final_table(w: &mut String, inp: &Context<'_>) {
             let _ = writeln!(
                 w,
                 "| {}{} | {} | {} | {} | {} | {:.0} / {:.0} | {:.1} % | {} | {} | {} | {percentile} | {in_pi} |",
-                describe(c),
+                describe_key(&c.key),
                 dagger(&reduced_keys, c),
                 c.n_label(),
                 fmt_epochs(&c.final_epochs),
@@ -833,7 +835,7 @@ fn paper_outside(inp: &Context<'_>, env: &str) -> Option<String> {
         if !(p.klc > lo && p.klc < hi) {
             outside.push(format!(
                 "{} (paper {:.2}, our prediction interval [{lo:.2}, {hi:.2}], percentile {:.0}%)",
-                describe(c),
+                describe_key(&c.key),
                 p.klc,
                 o.percentile(p.klc)
             ));
@@ -993,7 +995,7 @@ pub fn deviations(w: &mut String, inp: &Context<'_>) {
         .conditions
         .iter()
         .filter(|c| c.final_klc.n_inf > 0)
-        .map(|c| format!("{} {}", env_name(&c.key.env), describe(c)))
+        .map(|c| format!("{} {}", env_name(&c.key.env), describe_key(&c.key)))
         .collect();
     if !infinite.is_empty() {
         let _ = writeln!(
@@ -1011,7 +1013,7 @@ pub fn deviations(w: &mut String, inp: &Context<'_>) {
             format!(
                 "{} {} ({})",
                 env_name(&c.key.env),
-                describe(c),
+                describe_key(&c.key),
                 fmt_epochs(&c.final_epochs)
             )
         })
@@ -1027,7 +1029,7 @@ pub fn deviations(w: &mut String, inp: &Context<'_>) {
         .conditions
         .iter()
         .filter(|c| c.paper.is_none())
-        .map(|c| format!("{} {}", env_name(&c.key.env), describe(c)))
+        .map(|c| format!("{} {}", env_name(&c.key.env), describe_key(&c.key)))
         .collect();
     if !no_paper.is_empty() && inp.paper.path.is_some() {
         let _ = writeln!(w, "- No paper value for: {}.", no_paper.join("; "));

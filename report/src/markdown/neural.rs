@@ -9,10 +9,11 @@ use std::fmt::Write as _;
 use super::{fmt_klc, fmt_seeds, plural};
 use crate::aggregate::ConditionSummary;
 use crate::context::Context;
+use crate::figures::FigureFile;
 use crate::figures::budget::series_title;
 use crate::figures::sampler_compare::{self, SAMPLERS};
-use crate::figures::{FigureFile, algo_name, condition_name, env_name, learner_name, sampler_name};
 use crate::load::campaign_display;
+use crate::names::{algo_name, condition_name, env_name, learner_name, sampler_name};
 use crate::neural::{self, BudgetPoint, paper_training};
 use crate::stats::{self, Summary};
 
@@ -293,7 +294,7 @@ pub fn figure4(w: &mut String, inp: &Context<'_>, sampler_figures: &[FigureFile]
          KL-coverage, mean ± sd over the repetitions (*n* repetitions, each the mean of its \
          exploration replicates).\n"
     );
-    for (algo, name) in crate::SAMPLER_FIGURES {
+    for (algo, name) in crate::names::SAMPLER_FIGURES {
         let fig = sampler_figures
             .iter()
             .find(|f| f.link == format!("figures/{name}"));
@@ -666,7 +667,7 @@ pub fn deviations(w: &mut String, inp: &Context<'_>) {
             format!(
                 "{} {} ({})",
                 env_name(&c.key.env),
-                crate::figures::outcomes::describe(c),
+                crate::names::describe_key(&c.key),
                 c.seeds.len()
             )
         })

@@ -222,7 +222,7 @@ pub fn section(
             w,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             env_name(&r.env),
-            crate::figures::algo_name(&r.algo),
+            crate::names::algo_name(&r.algo),
             r.variant,
             r.latents,
             r.representations,

@@ -15,8 +15,8 @@ use super::quality::{evidence, group_r2, median};
 use super::{fmt_klc, plural};
 use crate::campaigns::Campaign;
 use crate::context::Context;
-use crate::figures::{algo_name, env_name};
 use crate::load::{ConditionKey, Run};
+use crate::names::{algo_name, env_name};
 use crate::neural::{learner, training};
 
 /// The threshold of "left the plateau" when a manifest does not record it (the runner's

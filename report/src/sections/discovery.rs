@@ -4,10 +4,9 @@
 use ugl_types::CampaignRole;
 
 use super::{Context, Section};
-use crate::ReportError;
-use crate::discovery;
+use crate::error::ReportError;
 use crate::output::Output;
-use crate::predicts;
+use crate::{data, markdown, predicts};
 
 /// The discovery measures of every run, and whether each ranks position-encoding goal spaces
 /// ahead of the controls.
@@ -24,10 +23,10 @@ impl Section for Discovery {
         ]
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
-        discovery::write_csv(out, ctx.discovery)?;
-        discovery::write_validity_csv(out, ctx.validity)?;
+        data::discovery::write_csv(out, ctx.discovery)?;
+        data::discovery::write_validity_csv(out, ctx.validity)?;
         let mut w = String::new();
-        discovery::section(&mut w, ctx.discovery, ctx.validity, ctx.campaigns);
+        markdown::discovery::section(&mut w, ctx.discovery, ctx.validity, ctx.campaigns);
         Ok(w)
     }
 }
@@ -52,9 +51,9 @@ impl Section for Predicts {
         {
             return Ok(String::new());
         }
-        predicts::write_csv(out, &lines)?;
+        data::predicts::write_csv(out, &lines)?;
         let mut w = String::new();
-        predicts::section(&mut w, &obs, &lines, &ctx.campaigns.main.name);
+        markdown::predicts::section(&mut w, &obs, &lines, &ctx.campaigns.main.name);
         Ok(w)
     }
 }

@@ -4,8 +4,8 @@
 use ugl_types::CampaignRole;
 
 use super::{Context, Section};
-use crate::ReportError;
 use crate::armballs;
+use crate::error::ReportError;
 use crate::output::Output;
 
 /// `armballs.md` and the follow-up claims.

@@ -1,7 +1,7 @@
 //! The report as a list of sections (criterion's `Report` / `Reports` pattern): each
 //! [`Section`] declares the campaign roles it reads, draws its figures and writes its pages
 //! through the one [`Output`], and returns its part of `REPORT.md`. [`SECTIONS`] is the list, in
-//! the order of `REPORT.md`; [`crate::render_report`] computes the shared statistics once
+//! the order of `REPORT.md`; [`crate::render::render_report`] computes the shared statistics once
 //! ([`Context`]) and fans out over it.
 //!
 //! Adding a section: one type implementing [`Section`] and one entry in [`SECTIONS`].
@@ -15,8 +15,8 @@ use std::collections::BTreeSet;
 
 use ugl_types::CampaignRole;
 
-use crate::ReportError;
 pub use crate::context::Context;
+use crate::error::ReportError;
 use crate::output::Output;
 
 /// One part of the report.

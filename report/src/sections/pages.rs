@@ -3,7 +3,7 @@
 use ugl_types::CampaignRole;
 
 use super::{Context, Section};
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::markdown::compare;
 use crate::output::Output;
 

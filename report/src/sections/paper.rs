@@ -5,7 +5,7 @@
 use ugl_types::CampaignRole;
 
 use super::{Context, Section};
-use crate::ReportError;
+use crate::error::ReportError;
 use crate::figures;
 use crate::markdown::{self, claims, neural, quality, recipe};
 use crate::output::Output;
@@ -93,7 +93,7 @@ impl Section for Claims {
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         if let crate::claims::ClaimsInput::Evaluated { results, .. } = ctx.claims {
-            crate::claims::write_csv(out, results)?;
+            crate::data::claims::write_csv(out, results)?;
         }
         words(|w| claims::claims(w, ctx))
     }
@@ -128,7 +128,7 @@ impl Section for Leaderboard {
     }
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         if !ctx.leaderboard.entries.is_empty() {
-            crate::leaderboard::write_csv(out, ctx.leaderboard)?;
+            crate::data::leaderboard::write_csv(out, ctx.leaderboard)?;
         }
         words(|w| claims::leaderboard(w, ctx))
     }
@@ -143,7 +143,7 @@ impl Section for Figure4 {
     fn render(&self, ctx: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         let dir = out.figures_dir();
         let mut figs = Vec::new();
-        for (algo, name) in crate::SAMPLER_FIGURES {
+        for (algo, name) in crate::names::SAMPLER_FIGURES {
             let fig = figures::sampler_compare::draw(ctx.conditions, algo, name, &dir)?;
             figs.extend(out.figure(fig)?);
         }

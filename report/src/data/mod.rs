@@ -3,11 +3,16 @@
 //! latent quality where recorded) and one row per run and evaluated epoch (the whole curves). The
 //! main campaign and every `compare-*` campaign; rows in the report's condition order, then seed.
 
+pub mod claims;
+pub mod discovery;
+pub mod leaderboard;
+pub mod predicts;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::ReportError;
 use crate::campaigns::{Campaign, Campaigns};
+use crate::error::ReportError;
 use crate::load::Run;
 use crate::output::Output;
 
