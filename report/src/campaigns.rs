@@ -157,7 +157,7 @@ pub fn relabel_external(store: &mut Store) {
             && let Some(name) = run.manifest.learner.as_deref()
             && !name.is_empty()
         {
-            run.key.algo = format!("rge-{name}");
+            run.key.algo = format!("rge-{name}").into();
         }
     }
 }

@@ -234,7 +234,7 @@ impl TaggedObservations<'_> {
     fn tagged(tag: &Option<String>, key: &ConditionKey) -> ConditionKey {
         match tag {
             Some(t) => ConditionKey {
-                algo: format!("{}@{t}", key.algo),
+                algo: format!("{}@{t}", key.algo).into(),
                 ..key.clone()
             },
             None => key.clone(),
@@ -252,7 +252,7 @@ impl Observations for TaggedObservations<'_> {
     fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
         let tag = key.algo.split_once('@').map(|(_, t)| t.to_string());
         let plain = ConditionKey {
-            algo: untagged(&key.algo).to_string(),
+            algo: untagged(&key.algo).to_string().into(),
             ..key.clone()
         };
         self.parts

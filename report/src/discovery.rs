@@ -280,7 +280,7 @@ impl Control {
         } else if m.trained() == Some(false) {
             // A store's keys carry no variant tag (the claims add `@untrained` when they pair a
             // recipe campaign's conditions with the main campaign's).
-            Some(Control::Untrained(run.key.algo.clone()))
+            Some(Control::Untrained(run.key.algo.to_string()))
         } else {
             None
         }

@@ -181,9 +181,9 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 *at_rpe
                     .entry((
                         src.campaign.to_string(),
-                        c.key.algo.clone(),
-                        c.key.sampler.clone(),
-                        c.key.variant.clone(),
+                        c.key.algo.to_string(),
+                        c.key.sampler.to_string(),
+                        c.key.variant.to_string(),
                     ))
                     .or_default() += k;
             }
@@ -196,17 +196,17 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
                 *untrained
                     .entry((
                         src.campaign.to_string(),
-                        c.key.algo.clone(),
-                        c.key.sampler.clone(),
-                        c.key.variant.clone(),
+                        c.key.algo.to_string(),
+                        c.key.sampler.to_string(),
+                        c.key.variant.to_string(),
                     ))
                     .or_default() += flags.iter().filter(|t| !**t).count();
             }
             let key: EntryKey = (
                 src.campaign.to_string(),
-                c.key.algo.clone(),
-                c.key.sampler.clone(),
-                c.key.variant.clone(),
+                c.key.algo.to_string(),
+                c.key.sampler.to_string(),
+                c.key.variant.to_string(),
             );
             let finals: Vec<f64> = claims::values(src.store, c, Statistic::FinalKlc)
                 .iter()

@@ -19,48 +19,9 @@ use crate::error::ReportError;
 pub use ugl_types::INTEREST_SUFFIX;
 use ugl_types::{CURVE_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX};
 
-/// A condition: everything that identifies a curve in the figures, except the seed.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ConditionKey {
-    pub env: String,
-    pub algo: String,
-    pub sampler: String,
-    pub latents: i64,
-    pub variant: String,
-}
-
-impl ConditionKey {
-    /// A stable canonical string, used for file names and bootstrap seeds.
-    pub fn slug(&self) -> String {
-        format!(
-            "{}_{}_{}_{}_{}",
-            self.env, self.algo, self.sampler, self.latents, self.variant
-        )
-    }
-
-    /// The order of conditions everywhere in the report: environments, then latent sizes, then
-    /// the paper's algorithm order, samplers and variants; unknown names after known ones,
-    /// alphabetically.
-    pub fn order_key(&self) -> impl Ord + use<> {
-        (
-            ugl_types::EnvSpec::order(&self.env),
-            self.env.clone(),
-            self.latents,
-            rank(
-                &self.algo,
-                &["rpe", "rge-efr"]
-                    .into_iter()
-                    .chain(ugl_types::LearnerInfo::paper_algos())
-                    .collect::<Vec<_>>(),
-            ),
-            self.algo.clone(),
-            rank(&self.sampler, &["none", "uniform", "kde", "gaussian"]),
-            self.sampler.clone(),
-            rank(&self.variant, &["none", "faithful", "corrected"]),
-            self.variant.clone(),
-        )
-    }
-}
+/// A condition: everything that identifies a curve in the figures, except the seed
+/// (`ugl-types`' typed key, ordered by its registries).
+pub use ugl_types::{Algo, ConditionKey, Sampler, Variant};
 
 /// Position of `name` in `known`, or `known.len()` for unknown names.
 pub fn rank(name: &str, known: &[&str]) -> usize {
@@ -449,10 +410,10 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
     let run_id = c.constant_str(curve::RUN_ID)?;
     let key = ConditionKey {
         env: c.constant_str(curve::ENV)?,
-        algo: c.constant_str(curve::ALGO)?,
-        sampler: c.constant_str(curve::SAMPLER)?,
+        algo: c.constant_str(curve::ALGO)?.into(),
+        sampler: c.constant_str(curve::SAMPLER)?.into(),
         latents: c.constant_i64(curve::LATENTS)?,
-        variant: c.constant_str(curve::VARIANT)?,
+        variant: c.constant_str(curve::VARIANT)?.into(),
     };
     let seed = c.constant_i64(curve::SEED)?;
     let epoch = c.i64s(curve::EPOCH)?;
@@ -639,12 +600,12 @@ pub fn reconcile_identity(
         problem: format!("field `{field}` is `{man}` but the curve file's column holds `{curve}`"),
     };
     for (field, value, m) in [
-        ("env", &key.env, &manifest.env),
-        ("algo", &key.algo, &manifest.algo),
-        ("sampler", &key.sampler, &manifest.sampler),
+        ("env", key.env.as_str(), manifest.env.as_str()),
+        ("algo", key.algo.as_str(), manifest.algo.as_str()),
+        ("sampler", key.sampler.as_str(), manifest.sampler.as_str()),
     ] {
         if m != value {
-            return Err(mismatch(field, value.clone(), m.clone()));
+            return Err(mismatch(field, value.to_string(), m.to_string()));
         }
     }
     for (field, value, m) in [
@@ -657,11 +618,11 @@ pub fn reconcile_identity(
     }
     if manifest.variant != key.variant {
         if key.variant == "none" {
-            key.variant = manifest.variant.clone();
+            key.variant = manifest.variant.clone().into();
         } else {
             return Err(mismatch(
                 "variant",
-                key.variant.clone(),
+                key.variant.to_string(),
                 manifest.variant.clone(),
             ));
         }

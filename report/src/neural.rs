@@ -215,8 +215,8 @@ pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
 #[derive(Debug, Clone)]
 pub struct VariantPair<'a> {
     pub env: String,
-    pub algo: String,
-    pub sampler: String,
+    pub algo: crate::load::Algo,
+    pub sampler: crate::load::Sampler,
     pub latents: i64,
     pub faithful: Option<&'a ConditionSummary>,
     pub corrected: Option<&'a ConditionSummary>,
@@ -229,7 +229,7 @@ pub struct VariantPair<'a> {
 
 /// Every cell of [`variant_algos`] with a faithful or corrected condition, in the report's order.
 pub fn variant_pairs(conditions: &[ConditionSummary]) -> Vec<VariantPair<'_>> {
-    type Cell = (String, String, String, i64);
+    type Cell = (String, crate::load::Algo, crate::load::Sampler, i64);
     let mut cells: BTreeMap<Cell, (Option<&ConditionSummary>, Option<&ConditionSummary>)> =
         BTreeMap::new();
     for c in conditions {
@@ -472,7 +472,12 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
             .and_then(|e| e.get("plateau_loss"))
             .and_then(|v| v.as_f64());
         groups
-            .entry((r.key.env.clone(), l, r.key.variant.clone(), r.key.latents))
+            .entry((
+                r.key.env.clone(),
+                l,
+                r.key.variant.to_string(),
+                r.key.latents,
+            ))
             .or_default()
             .entry(key)
             .or_insert((t.losses, plateau));

@@ -158,9 +158,9 @@ fn observe(reps: &[&RunRow<'_>]) -> Observation {
     Observation {
         campaign: first.campaign.name.clone(),
         env: key.env.clone(),
-        algo: key.algo.clone(),
-        variant: key.variant.clone(),
-        sampler: key.sampler.clone(),
+        algo: key.algo.to_string(),
+        variant: key.variant.to_string(),
+        sampler: key.sampler.to_string(),
         latents: key.latents,
         seed: first.run.seed,
         n_runs: reps.len(),

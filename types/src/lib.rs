@@ -9,6 +9,10 @@
 //! - [`CampaignRole`] and [`CampaignRecord`]: what a campaign is for, declared in its TOML and
 //!   recorded beside its runs, so that the report never infers it from a directory name;
 //! - [`LearnerInfo`]: the representation learners' names, display names and paper training;
+//! - [`SamplerInfo`], [`StrategyInfo`], [`VariantInfo`]: the goal samplers, the strategies
+//!   without a learned goal space (RPE, RGE-EFR) and the learners' variants;
+//! - [`ConditionKey`]: a condition of the results, of typed names ([`Algo`], [`Sampler`],
+//!   [`Variant`]) that know their registry entries;
 //! - [`Diagnostics`]: measures taken after a run, beside it (manifests are immutable);
 //! - [`RunDiscovery`]: what a run discovered (KL-coverage, cells, goal-reaching error), measured
 //!   from its [`Outcome`]s by [`EnvMeasures`], recorded in its manifest;
@@ -22,6 +26,7 @@
 
 mod campaign;
 pub mod columns;
+mod condition;
 mod diagnostics;
 mod discovery;
 mod env;
@@ -30,8 +35,11 @@ pub mod klc;
 mod learner;
 mod manifest;
 mod paths;
+mod sampler;
+mod strategy;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
+pub use condition::{Algo, AlgoInfo, ConditionKey, Sampler, Variant};
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
 pub use discovery::{
     Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Outcome,
@@ -49,8 +57,17 @@ pub mod learners {
         AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
     };
 }
+pub use sampler::{SAMPLERS, SamplerInfo};
+/// Each goal sampler's entry, by name (`ugl_types::samplers::KDE`).
+pub mod samplers {
+    pub use crate::sampler::{GAUSSIAN, KDE, NONE, UNIFORM};
+}
 pub use manifest::{CpuInfo, FileDigest, FutureResults, Manifest, RESULTS_VERSION, Summary};
 pub use paths::{
     CURVE_SUFFIX, DigestError, INTEREST_SUFFIX, MANIFEST_SUFFIX, OUTCOMES_SUFFIX, RunPaths,
     run_paths, verify_files,
+};
+pub use strategy::{
+    CORRECTED, FAITHFUL, NO_VARIANT, RGE_EFR, RGE_EFR_POSITION, RPE, STRATEGIES, StrategyInfo,
+    VARIANTS, VariantInfo,
 };

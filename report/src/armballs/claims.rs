@@ -27,10 +27,10 @@ pub struct FollowupObservations<'a> {
 fn key(r: &FollowupRun) -> ConditionKey {
     ConditionKey {
         env: ENV.into(),
-        algo: r.base.clone(),
-        sampler: r.sampler.clone(),
+        algo: r.base.clone().into(),
+        sampler: r.sampler.clone().into(),
         latents: r.latents,
-        variant: String::new(),
+        variant: String::new().into(),
     }
 }
 
@@ -39,7 +39,7 @@ fn name(runs: &[FollowupRun], k: &ConditionKey) -> String {
     runs.iter()
         .find(|r| key(r) == *k)
         .map(|r| display(runs, &r.algo))
-        .unwrap_or_else(|| k.algo.clone())
+        .unwrap_or_else(|| k.algo.to_string())
 }
 
 impl Observations for FollowupObservations<'_> {

@@ -159,12 +159,12 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
         let (modules, interest) = load_interest(&run.curve_path)?;
         let base = match tag {
             Some(t) => format!("{}@{t}", run.key.algo),
-            None => run.key.algo.clone(),
+            None => run.key.algo.to_string(),
         };
         out.push(FollowupRun {
             algo: base.clone(),
             base,
-            sampler: run.key.sampler.clone(),
+            sampler: run.key.sampler.to_string(),
             latents: run.key.latents,
             seed: run.seed,
             epochs: order.iter().map(|&i| epochs[i]).collect(),

@@ -85,8 +85,8 @@ fn rows(inp: &Context<'_>) -> Vec<Row> {
         }
         let mut r = Row {
             env: c.key.env.clone(),
-            algo: c.key.algo.clone(),
-            variant: c.key.variant.clone(),
+            algo: c.key.algo.to_string(),
+            variant: c.key.variant.to_string(),
             latents: c.key.latents,
             representations: 0,
             with_evidence: 0,

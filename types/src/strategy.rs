@@ -1,0 +1,107 @@
+//! The exploration strategies that are not a learned goal space (paper Section 3): random
+//! parameter exploration and goal exploration in the engineered features. A learned goal space
+//! is the strategy `rge-<learner>` of a [`crate::LearnerInfo`]; the two together name every
+//! algorithm of the results.
+
+use crate::sampler::{self, SamplerInfo};
+
+/// One exploration strategy without a learned goal space.
+#[derive(Debug, PartialEq)]
+pub struct StrategyInfo {
+    /// Name in campaign files and results (`rge-efr`).
+    pub algo: &'static str,
+    /// Name in the report (`RGE-EFR`).
+    pub display: &'static str,
+    /// One line for `--help` and the docs.
+    pub description: &'static str,
+    /// The goal sampler its runs record.
+    pub sampler: &'static SamplerInfo,
+    /// Whether the paper evaluated it (the paper's algorithms come first, with fixed styles).
+    pub in_paper: bool,
+}
+
+/// Random parameter exploration: the floor.
+pub static RPE: StrategyInfo = StrategyInfo {
+    algo: "rpe",
+    display: "RPE",
+    description: "random parameter exploration: motor parameters uniform in their box",
+    sampler: &sampler::NONE,
+    in_paper: true,
+};
+/// Random goal exploration in the engineered features (the object's true state).
+pub static RGE_EFR: StrategyInfo = StrategyInfo {
+    algo: "rge-efr",
+    display: "RGE-EFR",
+    description: "random goal exploration in the engineered features (the object's state)",
+    sampler: &sampler::UNIFORM,
+    in_paper: true,
+};
+/// RGE-EFR with the object's position alone (ArmArrow without its angle).
+pub static RGE_EFR_POSITION: StrategyInfo = StrategyInfo {
+    algo: "rge-efr-position",
+    display: "RGE-EFR (position only)",
+    description: "RGE-EFR on the object's position alone, without the angle (ArmArrow)",
+    sampler: &sampler::UNIFORM,
+    in_paper: false,
+};
+
+/// Every strategy without a learned goal space, in the report's order.
+pub static STRATEGIES: [&StrategyInfo; 3] = [&RPE, &RGE_EFR, &RGE_EFR_POSITION];
+
+impl StrategyInfo {
+    /// Every strategy, in the registry's order.
+    pub fn all() -> impl Iterator<Item = &'static StrategyInfo> {
+        STRATEGIES.iter().copied()
+    }
+
+    /// The strategy whose algorithm is `algo`.
+    pub fn by_algo(algo: &str) -> Option<&'static StrategyInfo> {
+        StrategyInfo::all().find(|s| s.algo == algo)
+    }
+}
+
+/// A learner's variant: the original code's behaviour, or its defects fixed
+/// (docs/original-code.md section 5).
+#[derive(Debug, PartialEq)]
+pub struct VariantInfo {
+    /// Name in campaign files and results (`corrected`).
+    pub name: &'static str,
+    /// One line for `--help` and the docs.
+    pub description: &'static str,
+    /// Whether a figure that compares variants draws it dashed with hollow markers.
+    pub dashed: bool,
+}
+
+/// A learner without variants.
+pub static NO_VARIANT: VariantInfo = VariantInfo {
+    name: "none",
+    description: "a learner without variants",
+    dashed: false,
+};
+/// The original code's behaviour, defects included.
+pub static FAITHFUL: VariantInfo = VariantInfo {
+    name: "faithful",
+    description: "the original code's behaviour, defects included",
+    dashed: false,
+};
+/// The original code's defects fixed.
+pub static CORRECTED: VariantInfo = VariantInfo {
+    name: "corrected",
+    description: "the original code's defects fixed",
+    dashed: true,
+};
+
+/// Every variant, in the report's order.
+pub static VARIANTS: [&VariantInfo; 3] = [&NO_VARIANT, &FAITHFUL, &CORRECTED];
+
+impl VariantInfo {
+    /// Every variant, in the registry's order.
+    pub fn all() -> impl Iterator<Item = &'static VariantInfo> {
+        VARIANTS.iter().copied()
+    }
+
+    /// The variant called `name`.
+    pub fn by_name(name: &str) -> Option<&'static VariantInfo> {
+        VariantInfo::all().find(|v| v.name == name)
+    }
+}
