@@ -101,7 +101,7 @@ fn mark_rpe_level(store: &Store, conditions: &mut [ConditionSummary]) {
 fn rpe_thresholds(conditions: &[ConditionSummary]) -> Vec<(String, f64)> {
     conditions
         .iter()
-        .filter(|c| c.key.algo == "rpe")
+        .filter(|c| c.key.algo == ugl_types::Algo::RPE)
         .map(|c| (c.key.env.clone(), RPE_LEVEL_FACTOR * c.final_moved_mean))
         .collect()
 }
@@ -111,7 +111,10 @@ fn apply_rpe_level(
     conditions: &mut [ConditionSummary],
     thresholds: &[(String, f64)],
 ) {
-    for c in conditions.iter_mut().filter(|c| c.key.algo != "rpe") {
+    for c in conditions
+        .iter_mut()
+        .filter(|c| c.key.algo != ugl_types::Algo::RPE)
+    {
         c.at_rpe_level = thresholds
             .iter()
             .find(|(env, _)| *env == c.key.env)

@@ -153,7 +153,7 @@ pub fn natural_key(name: &str) -> Vec<(String, u128)> {
 /// `rge-<learner>` (the manifest's `learner`), so that two compared programs stay apart.
 pub fn relabel_external(store: &mut Store) {
     for run in &mut store.runs {
-        if run.key.algo == "rge-external"
+        if run.key.algo == ugl_types::Algo::of_learner(&ugl_types::learners::EXTERNAL)
             && let Some(name) = run.manifest.learner.as_deref()
             && !name.is_empty()
         {

@@ -1046,7 +1046,7 @@ pub fn check_on_paper(
     let mut comparisons = Vec::new();
     if claim.statistic == Statistic::FinalKlc {
         let paper_value = |k: &ConditionKey| {
-            (k.variant != "corrected")
+            (k.variant != ugl_types::Variant::CORRECTED)
                 .then(|| paper.lookup(k).map(|v| v.klc))
                 .flatten()
         };

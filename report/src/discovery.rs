@@ -41,7 +41,12 @@ pub const POSITION_R2: f64 = 0.99;
 
 /// Learners whose goal space is a random projection of the image (a control, whatever its
 /// latent quality): the external random projection and the Rust `gaussian-projection`.
-pub const RANDOM_PROJECTIONS: &[&str] = &["random-projection", "gaussian-projection"];
+pub const RANDOM_PROJECTIONS: &[&str] = &[
+    // The external learner of the committed `compare-random-projection` campaign (no registry
+    // member: a program run through the external-learner protocol).
+    "random-projection",
+    ugl_types::learners::GAUSSIAN_PROJECTION.name,
+];
 
 /// The side of the validity check a run is on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -74,7 +79,7 @@ pub fn group_of(run: &Run) -> Option<Group> {
     {
         return Some(Group::Control);
     }
-    if run.key.algo == "rge-efr" {
+    if run.key.algo == ugl_types::Algo::RGE_EFR {
         return Some(Group::Encodes);
     }
     m.group_r2("position")

@@ -257,7 +257,8 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
     let efr: BTreeMap<usize, (Vec<f64>, Vec<f64>)> = groups
         .iter()
         .find(|((camp, algo, _, _), _)| {
-            Some(camp.as_str()) == sources.first().map(|s| s.campaign) && algo == "rge-efr"
+            Some(camp.as_str()) == sources.first().map(|s| s.campaign)
+                && *algo == ugl_types::Algo::RGE_EFR
         })
         .map(|(_, per)| {
             per.iter()
@@ -308,18 +309,19 @@ pub fn build(sources: &[Source<'_>], confidence: f64, n_boot: usize, seed: u64) 
             );
             // Against RGE-EFR on the ranking statistic: the goal error where both have it on
             // every task, else the final KLC. The probability with its interval, and its counts.
-            let vs_efr: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)> =
-                (algo != "rge-efr" && per.keys().all(|t| efr.contains_key(t))).then(|| {
-                    let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
-                    if on_goal_error(&goals_by_task, &efr_goals) {
-                        (goals_by_task.clone(), efr_goals)
-                    } else {
-                        (
-                            finals_by_task.clone(),
-                            per.keys().map(|t| efr[t].0.clone()).collect(),
-                        )
-                    }
-                });
+            let vs_efr: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)> = (algo != ugl_types::Algo::RGE_EFR
+                && per.keys().all(|t| efr.contains_key(t)))
+            .then(|| {
+                let efr_goals: Vec<Vec<f64>> = per.keys().map(|t| efr[t].1.clone()).collect();
+                if on_goal_error(&goals_by_task, &efr_goals) {
+                    (goals_by_task.clone(), efr_goals)
+                } else {
+                    (
+                        finals_by_task.clone(),
+                        per.keys().map(|t| efr[t].0.clone()).collect(),
+                    )
+                }
+            });
             let poi_vs_efr = vs_efr.as_ref().and_then(|(xs, ys)| {
                 probability_of_improvement_ci(
                     xs,

@@ -617,7 +617,7 @@ pub fn reconcile_identity(
         }
     }
     if manifest.variant != key.variant {
-        if key.variant == "none" {
+        if key.variant == ugl_types::Variant::NONE {
             key.variant = manifest.variant.clone().into();
         } else {
             return Err(mismatch(

@@ -2,23 +2,21 @@
 //! learners, samplers and variants, read from `ugl-types`' registries. Analysis, figures and
 //! prose all name things through here, so that a name is spelt once.
 
-use ugl_types::LearnerInfo;
+use ugl_types::{LearnerInfo, SamplerInfo, VariantInfo};
 
-use crate::load::ConditionKey;
+use crate::load::{Algo, ConditionKey, Variant};
 
 /// The KDE-vs-Gaussian figures: the paper's Figure 4 (RGE-VAE), and the same for RGE-RFVAE,
 /// which the paper did not plot (drawn when its Gaussian-goal runs exist).
-pub const SAMPLER_FIGURES: [(&str, &str); 2] = [
-    ("rge-vae", "fig4_vae_kde_vs_gaussian.svg"),
-    ("rge-rfvae", "rfvae_kde_vs_gaussian.svg"),
+pub const SAMPLER_FIGURES: [(Algo, &str); 2] = [
+    (Algo::RGE_VAE, "fig4_vae_kde_vs_gaussian.svg"),
+    (Algo::RGE_RFVAE, "rfvae_kde_vs_gaussian.svg"),
 ];
 
 /// The paper's algorithms, in the report's order: RPE, RGE-EFR, then the registry's learners
 /// that the paper evaluated (PCA, Isomap, AE, VAE, RFVAE).
 pub fn algos() -> Vec<&'static str> {
-    let mut v = vec!["rpe", "rge-efr"];
-    v.extend(LearnerInfo::paper_algos());
-    v
+    Algo::paper_names()
 }
 
 /// The algorithms with a fixed colour and marker, in slot order: the paper's ([`algos`]), the
@@ -27,10 +25,7 @@ pub fn algos() -> Vec<&'static str> {
 /// looks the same in every figure and environment; an algorithm outside the registry takes the
 /// following slots.
 pub fn style_algos() -> Vec<&'static str> {
-    let mut v = algos();
-    v.push("rge-efr-position");
-    v.extend(LearnerInfo::all().filter(|l| !l.in_paper).map(|l| l.algo));
-    v
+    Algo::styled_names()
 }
 
 /// Display name of an environment.
@@ -41,15 +36,7 @@ pub fn env_name(env: &str) -> String {
 /// Display name of an algorithm (`rge-vae` → `RGE-VAE`): `RGE-` and the registry's display
 /// name of the learner; unknown names in capitals.
 pub fn algo_name(algo: &str) -> String {
-    match algo {
-        "rpe" => "RPE".into(),
-        "rge-efr" => "RGE-EFR".into(),
-        "rge-efr-position" => "RGE-EFR (position only)".into(),
-        other => match LearnerInfo::by_algo(other) {
-            Some(l) => format!("RGE-{}", l.display),
-            None => other.to_uppercase(),
-        },
-    }
+    Algo::from(algo).display()
 }
 
 /// An algorithm with its variant: `RGE-VAE (corrected)`; `RGE-AE` for variant `none`.
@@ -57,20 +44,17 @@ pub fn algo_name(algo: &str) -> String {
 /// *corrected* has those defects fixed.
 pub fn condition_name(algo: &str, variant: &str) -> String {
     let a = algo_name(algo);
-    match variant {
-        "" | "none" => a,
-        v => format!("{a} ({v})"),
+    if variant.is_empty() || variant == Variant::NONE {
+        a
+    } else {
+        format!("{a} ({variant})")
     }
 }
 
 /// Display name of a goal sampler: `KDE`, `Gaussian` (the VAE's isotropic prior), `uniform`
 /// (EFR), `none` (RPE).
 pub fn sampler_name(sampler: &str) -> String {
-    match sampler {
-        "kde" => "KDE".into(),
-        "gaussian" => "Gaussian".into(),
-        other => other.to_string(),
-    }
+    SamplerInfo::by_name(sampler).map_or_else(|| sampler.to_string(), |s| s.display.to_string())
 }
 
 /// Display name of a learner (`vae` → `VAE`): the registry's, else in capitals.
@@ -111,11 +95,27 @@ pub fn object_word(env: &str) -> &'static str {
 /// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.
 pub fn describe_key(k: &ConditionKey) -> String {
     let mut s = condition_name(&k.algo, &k.variant);
-    if !matches!(k.sampler.as_str(), "none" | "uniform") {
+    if k.sampler.is_learned() {
         s.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
     }
     if k.latents != 0 {
         s.push_str(&format!(", {} latents", k.latents));
     }
     s
+}
+
+/// Colour (RGB) of a goal sampler where samplers are what a figure compares (the registry's;
+/// grey outside it).
+pub fn sampler_rgb(sampler: &str) -> [u8; 3] {
+    SamplerInfo::by_name(sampler).map_or([0x77, 0x77, 0x77], |s| s.colour)
+}
+
+/// Marker slot of a goal sampler where samplers are compared (the registry's; 3 outside it).
+pub fn sampler_marker_slot(sampler: &str) -> usize {
+    SamplerInfo::by_name(sampler).map_or(3, |s| s.marker)
+}
+
+/// Whether a figure that compares variants draws this one dashed, with hollow markers.
+pub fn variant_dashed(variant: &str) -> bool {
+    VariantInfo::by_name(variant).is_some_and(|v| v.dashed)
 }

@@ -239,10 +239,10 @@ pub fn variant_pairs(conditions: &[ConditionSummary]) -> Vec<VariantPair<'_>> {
         }
         let cell = (k.env.clone(), k.algo.clone(), k.sampler.clone(), k.latents);
         let e = cells.entry(cell).or_default();
-        match k.variant.as_str() {
-            "faithful" => e.0 = Some(c),
-            "corrected" => e.1 = Some(c),
-            _ => {}
+        if k.variant == ugl_types::Variant::FAITHFUL {
+            e.0 = Some(c);
+        } else if k.variant == ugl_types::Variant::CORRECTED {
+            e.1 = Some(c);
         }
     }
     let mut out: Vec<VariantPair<'_>> = cells
@@ -272,7 +272,12 @@ pub fn variant_pairs(conditions: &[ConditionSummary]) -> Vec<VariantPair<'_>> {
         (
             crate::names::panel_order(&p.env, p.latents),
             rank(&p.algo, &variant_algos()),
-            rank(&p.sampler, &["kde", "gaussian"]),
+            rank(
+                &p.sampler,
+                &ugl_types::SamplerInfo::learned()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>(),
+            ),
             p.sampler.clone(),
         )
     });
@@ -394,7 +399,7 @@ pub fn budget_analysis(
         .map(|(key, by_it)| {
             let rpe_moves = main_conditions
                 .iter()
-                .find(|c| c.key.env == key.env && c.key.algo == "rpe")
+                .find(|c| c.key.env == key.env && c.key.algo == ugl_types::Algo::RPE)
                 .map(|c| crate::aggregate::RPE_LEVEL_FACTOR * c.final_moved_mean);
             let points = by_it
                 .iter()
@@ -410,7 +415,7 @@ pub fn budget_analysis(
                 .iter()
                 .map(|(&it, runs)| point(it, runs, rpe_moves))
                 .collect();
-            let references = ["rge-efr", "rpe"]
+            let references = [ugl_types::Algo::RGE_EFR, ugl_types::Algo::RPE]
                 .iter()
                 .filter_map(|algo| {
                     main_conditions
@@ -513,7 +518,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
             rank(&c.learner, &learners()),
             c.learner.clone(),
             std::cmp::Reverse(c.latents),
-            rank(&c.variant, &["none", "faithful", "corrected"]),
+            rank(&c.variant, &ugl_types::VARIANTS.map(|v| v.name)),
             c.variant.clone(),
         )
     });

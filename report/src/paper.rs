@@ -40,7 +40,7 @@ impl PaperTable {
     /// (or a row valid for any). The `faithful` variant is the paper's; the `corrected` one, whose
     /// implementation defects we fixed, the paper never ran, and it has no value.
     pub fn lookup(&self, key: &ConditionKey) -> Option<&PaperValue> {
-        if key.variant == "corrected" {
+        if key.variant == ugl_types::Variant::CORRECTED {
             return None;
         }
         self.values.iter().find(|v| {

@@ -29,7 +29,7 @@ pub const MEASURES: [(Measure, &str); 4] = [
 
 /// Goal spaces without latents (no latent quality): random parameter exploration and the
 /// engineered features.
-pub const WITHOUT_LATENTS: &[&str] = &["rpe", "rge-efr"];
+pub const WITHOUT_LATENTS: [ugl_types::Algo; 2] = [ugl_types::Algo::RPE, ugl_types::Algo::RGE_EFR];
 
 // ---------------------------------------------------------------------------------------------
 // Least squares, correlation, Fisher's z.
@@ -111,7 +111,7 @@ pub struct Observation {
 
 /// Whether a run is in a learned goal space with a recorded position R².
 fn has_latents(run: &Run) -> bool {
-    !WITHOUT_LATENTS.contains(&run.key.algo.as_str()) && run.manifest.group_r2("position").is_some()
+    !WITHOUT_LATENTS.contains(&run.key.algo) && run.manifest.group_r2("position").is_some()
 }
 
 /// The observations of the main campaign and its `recipe` campaigns: every learned-goal-space
@@ -448,7 +448,7 @@ mod tests {
         }
         assert!(
             obs.iter()
-                .all(|o| !WITHOUT_LATENTS.contains(&o.algo.as_str()))
+                .all(|o| !WITHOUT_LATENTS.iter().any(|a| *a == o.algo))
         );
         let lines = table(&obs);
         let mut w = String::new();

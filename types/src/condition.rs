@@ -161,33 +161,51 @@ impl Algo {
     /// The paper's algorithms, in the report's order: its strategies (RPE, RGE-EFR), then the
     /// registry's learners that the paper evaluated.
     pub fn paper() -> Vec<Algo> {
+        Algo::paper_names()
+            .into_iter()
+            .map(Algo::borrowed)
+            .collect()
+    }
+
+    /// [`Algo::paper`], as names.
+    pub fn paper_names() -> Vec<&'static str> {
         StrategyInfo::all()
             .filter(|s| s.in_paper)
-            .map(|s| Algo(Cow::Borrowed(s.algo)))
-            .chain(
-                LearnerInfo::all()
-                    .filter(|l| l.in_paper)
-                    .map(Algo::of_learner),
-            )
+            .map(|s| s.algo)
+            .chain(LearnerInfo::all().filter(|l| l.in_paper).map(|l| l.algo))
             .collect()
+    }
+
+    /// [`Algo::styled`], as names.
+    pub fn styled_names() -> Vec<&'static str> {
+        let mut v = Algo::paper_names();
+        v.extend(StrategyInfo::all().filter(|s| !s.in_paper).map(|s| s.algo));
+        v.extend(LearnerInfo::all().filter(|l| !l.in_paper).map(|l| l.algo));
+        v
+    }
+
+    const fn borrowed(name: &'static str) -> Algo {
+        Algo(Cow::Borrowed(name))
+    }
+
+    /// Its name in the report: the strategy's (`RGE-EFR`), `RGE-` and the learner's
+    /// (`RGE-VAE`), or the name in capitals outside the registries.
+    pub fn display(&self) -> String {
+        match self.info() {
+            Some(AlgoInfo::Strategy(s)) => s.display.to_string(),
+            Some(AlgoInfo::Learner(l)) => format!("RGE-{}", l.display),
+            None => self.to_uppercase(),
+        }
     }
 
     /// The algorithms with a fixed style, in slot order: the paper's ([`Algo::paper`]), the
     /// other strategies, then the registry's other learners. An algorithm looks the same in
     /// every figure; one outside the registries takes the following slots.
     pub fn styled() -> Vec<Algo> {
-        let mut v = Algo::paper();
-        v.extend(
-            StrategyInfo::all()
-                .filter(|s| !s.in_paper)
-                .map(|s| Algo(Cow::Borrowed(s.algo))),
-        );
-        v.extend(
-            LearnerInfo::all()
-                .filter(|l| !l.in_paper)
-                .map(Algo::of_learner),
-        );
-        v
+        Algo::styled_names()
+            .into_iter()
+            .map(Algo::borrowed)
+            .collect()
     }
 }
 
@@ -209,6 +227,11 @@ impl Sampler {
     /// Its registry entry.
     pub fn info(&self) -> Option<&'static SamplerInfo> {
         SamplerInfo::by_name(self)
+    }
+
+    /// Its name in the report (`KDE`); a name outside the registry as it is.
+    pub fn display(&self) -> &str {
+        self.info().map_or(self.as_str(), |s| s.display)
     }
 
     /// Whether it samples a learned goal space (KDE, prior): the report names it with the
@@ -281,11 +304,8 @@ impl ConditionKey {
     /// names after known ones, alphabetically.
     pub fn order_key(&self) -> impl Ord + use<> {
         let algo_rank = {
-            let paper = Algo::paper();
-            paper
-                .iter()
-                .position(|a| *a == self.algo)
-                .unwrap_or(paper.len())
+            let paper = Algo::paper_names();
+            rank(paper.into_iter(), &self.algo)
         };
         (
             EnvSpec::order(&self.env),

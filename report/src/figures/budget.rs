@@ -14,8 +14,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::{
-    FONT, FigureFile, Icon, colour, condition_name, env_name, legend_height, legend_strip, marker,
-    marker_points, sampler_name, star_points, write_svg,
+    FONT, FigureFile, Icon, algo_name, colour, condition_name, env_name, legend_height,
+    legend_strip, marker, marker_points, sampler_name, star_points, write_svg,
 };
 use crate::error::ReportError;
 use crate::load::campaign_display;
@@ -63,7 +63,7 @@ pub fn draw_all(
                 let area = root.titled(
                     &format!(
                         "{}: final KL-coverage vs training iterations",
-                        condition_name(algo, "none")
+                        algo_name(algo)
                     ),
                     (FONT, 18),
                 )?;
@@ -84,7 +84,7 @@ pub fn draw_all(
                  (hollow: the network stayed on the plateau), the median over the seeds (n in \
                  the legend and the table; no interval drawn: the table gives the 95% t \
                  intervals), the main campaign and the RGE-EFR / RPE levels",
-                condition_name(algo, "none")
+                algo_name(algo)
             ),
             env: String::new(),
         });
@@ -100,7 +100,7 @@ pub fn series_title(s: &BudgetSeries) -> String {
         env_name(&k.env),
         condition_name(&k.algo, &k.variant)
     );
-    if k.sampler != "none" {
+    if k.sampler != ugl_types::Sampler::NONE {
         t.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
     }
     if k.latents != 0 {
@@ -178,7 +178,7 @@ fn legend(s: &BudgetSeries, main_campaign: &str) -> Vec<(Icon, String)> {
             },
             format!(
                 "{} mean, main campaign (n={})",
-                condition_name(&r.algo, "none"),
+                algo_name(&r.algo),
                 r.summary.n
             ),
         ));
@@ -199,7 +199,11 @@ fn run_marker(trained: Option<bool>) -> (Vec<(i32, i32)>, bool) {
 const MAIN_GREY: RGBColor = RGBColor(0x55, 0x55, 0x55);
 
 fn reference_dash(algo: &str) -> (i32, i32) {
-    if algo == "rpe" { (3, 4) } else { (10, 6) }
+    if algo == ugl_types::Algo::RPE {
+        (3, 4)
+    } else {
+        (10, 6)
+    }
 }
 
 /// x of a seed's dot on the log axis: the budget times a small factor by the seed's rank.

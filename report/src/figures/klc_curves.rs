@@ -35,7 +35,7 @@ const TITLE_H: u32 = 36;
 
 /// Whether a condition belongs in this figure: every goal sampler but the Gaussian prior.
 pub fn in_figure(c: &ConditionSummary) -> bool {
-    c.key.sampler != "gaussian"
+    c.key.sampler != ugl_types::Sampler::GAUSSIAN
 }
 
 /// One panel: a title and the conditions drawn in it.
@@ -223,8 +223,13 @@ fn styles(members: &[&ConditionSummary]) -> Vec<Style> {
         .map(|c| {
             let ui = unknown.iter().position(|a| *a == c.key.algo).unwrap_or(0);
             let slot = algo_slot(&c.key.algo, ui);
-            let corrected = c.key.variant == "corrected";
-            let wanted = usize::from(corrected) + if c.key.sampler == "gaussian" { 2 } else { 0 };
+            let corrected = c.key.variant.is_dashed();
+            let wanted = usize::from(corrected)
+                + if c.key.sampler == ugl_types::Sampler::GAUSSIAN {
+                    2
+                } else {
+                    0
+                };
             let taken = used.entry(c.key.algo.as_str()).or_default();
             let k = (0..)
                 .map(|i| wanted + i)
@@ -241,7 +246,7 @@ fn styles(members: &[&ConditionSummary]) -> Vec<Style> {
 /// the default of the learned spaces and not named; other samplers are.
 fn label(c: &ConditionSummary) -> String {
     let mut s = condition_name(&c.key.algo, &c.key.variant);
-    if !matches!(c.key.sampler.as_str(), "none" | "uniform" | "kde") {
+    if c.key.sampler.is_learned() && c.key.sampler != ugl_types::Sampler::KDE {
         s.push_str(&format!(", {} goals", sampler_name(&c.key.sampler)));
     }
     s.push_str(&format!(", n={}", c.n_label()));

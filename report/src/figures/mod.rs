@@ -35,8 +35,8 @@ use plotters::style::RGBColor;
 use crate::error::ReportError;
 use crate::load::rank;
 pub use crate::names::{
-    algo_name, algos, condition_name, env_name, klc_max, learner_name, panel_order, sampler_name,
-    style_algos, true_latents,
+    algo_name, algos, condition_name, env_name, klc_max, learner_name, panel_order,
+    sampler_marker_slot, sampler_name, style_algos, true_latents,
 };
 
 /// A figure written by the report, with what the markdown needs to show it.
@@ -79,26 +79,14 @@ pub const ALGO_COLOURS: [RGBColor; 13] = [
 /// Colours of the goal samplers where they are what a figure compares: KDE blue, Gaussian
 /// vermillion (Okabe–Ito; 30% and 45% luminance, apart in greyscale too).
 pub fn sampler_colour(sampler: &str) -> RGBColor {
-    match sampler {
-        "kde" => RGBColor(0x00, 0x72, 0xB2),
-        "gaussian" => RGBColor(0xD5, 0x5E, 0x00),
-        _ => RGBColor(0x77, 0x77, 0x77),
-    }
-}
-
-/// Marker slot of a goal sampler where samplers are compared: KDE circle, Gaussian triangle.
-pub fn sampler_marker_slot(sampler: &str) -> usize {
-    match sampler {
-        "kde" => 0,
-        "gaussian" => 2,
-        _ => 3,
-    }
+    let [r, g, b] = crate::names::sampler_rgb(sampler);
+    RGBColor(r, g, b)
 }
 
 /// Line style of a variant where variants are compared: faithful (and `none`) solid, corrected
 /// dashed.
 pub fn variant_dash(variant: &str) -> Option<(i32, i32)> {
-    if variant == "corrected" {
+    if crate::names::variant_dashed(variant) {
         Some((8, 5))
     } else {
         None
@@ -107,7 +95,7 @@ pub fn variant_dash(variant: &str) -> Option<(i32, i32)> {
 
 /// Markers of the corrected variant are hollow, the others filled.
 pub fn variant_filled(variant: &str) -> bool {
-    variant != "corrected"
+    !crate::names::variant_dashed(variant)
 }
 
 /// A dash this long never ends within a panel: a solid line drawn by the dashed-path element.

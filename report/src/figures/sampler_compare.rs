@@ -29,9 +29,14 @@ const STRIP_W: u32 = 130;
 const PANEL_H: u32 = 440;
 const TITLE_H: u32 = 36;
 /// The samplers compared, in legend order.
-pub const SAMPLERS: [&str; 2] = ["kde", "gaussian"];
+pub const SAMPLERS: [ugl_types::Sampler; 2] =
+    [ugl_types::Sampler::KDE, ugl_types::Sampler::GAUSSIAN];
 /// The variants, in legend order (`none` for learners without variants).
-pub const VARIANTS: [&str; 3] = ["none", "faithful", "corrected"];
+pub const VARIANTS: [ugl_types::Variant; 3] = [
+    ugl_types::Variant::NONE,
+    ugl_types::Variant::FAITHFUL,
+    ugl_types::Variant::CORRECTED,
+];
 
 /// One panel: an environment and latent size, with the conditions of the algorithm drawn there.
 #[derive(Debug, Clone)]
@@ -61,12 +66,10 @@ impl SamplerPanel<'_> {
 pub fn panels<'a>(conditions: &'a [ConditionSummary], algo: &str) -> Vec<SamplerPanel<'a>> {
     let mut out: Vec<SamplerPanel<'a>> = Vec::new();
     for c in conditions.iter().filter(|c| c.key.algo == algo) {
-        let Some(&s) = SAMPLERS.iter().find(|s| **s == c.key.sampler) else {
+        if !SAMPLERS.contains(&c.key.sampler) || !VARIANTS.contains(&c.key.variant) {
             continue;
-        };
-        let Some(&v) = VARIANTS.iter().find(|v| **v == c.key.variant) else {
-            continue;
-        };
+        }
+        let (s, v) = (c.key.sampler.as_str(), c.key.variant.as_str());
         match out
             .iter_mut()
             .find(|p| p.env == c.key.env && p.latents == c.key.latents)
@@ -95,7 +98,7 @@ pub fn panels<'a>(conditions: &'a [ConditionSummary], algo: &str) -> Vec<Sampler
 pub fn has_gaussian(conditions: &[ConditionSummary], algo: &str) -> bool {
     conditions
         .iter()
-        .any(|c| c.key.algo == algo && c.key.sampler == "gaussian")
+        .any(|c| c.key.algo == algo && c.key.sampler == ugl_types::Sampler::GAUSSIAN)
 }
 
 /// Draws `fig_dir/<name>` for `algo` if it has Gaussian-goal runs; 2 panels a row.
@@ -180,7 +183,7 @@ fn panel_legend(panel: &SamplerPanel<'_>) -> Vec<(Icon, String)> {
 /// Legend label: `KDE goals, faithful, n=5`.
 fn label(sampler: &str, variant: &str, c: &ConditionSummary) -> String {
     let mut s = format!("{} goals", sampler_name(sampler));
-    if variant != "none" {
+    if *variant != ugl_types::Variant::NONE {
         s.push_str(&format!(", {variant}"));
     }
     s.push_str(&format!(", n={}", c.n_label()));
@@ -293,7 +296,7 @@ fn draw_panel(
 /// faithful variant (or a learner without variants), so the corrected variant gets none.
 fn paper_value(m: &(&str, &str, &ConditionSummary)) -> Option<f64> {
     let (_, variant, c) = m;
-    (*variant != "corrected")
+    (!crate::names::variant_dashed(variant))
         .then(|| c.paper.as_ref().map(|p| p.klc))
         .flatten()
 }

@@ -71,7 +71,7 @@ fn size_label(env: &str, latents: i64) -> String {
 /// Whether a learner's loss is on the plateau's scale: not the RFVAE's, which is annealed (its
 /// cross-entropy and KL weighted by min(1, 0.01 + step/1e4)) and minus the flows' log-determinant.
 fn has_plateau(learner: &str) -> bool {
-    learner != "rfvae"
+    learner != ugl_types::learners::RFVAE.name
 }
 
 /// The legend: one entry per drawn style. The AE has no variant (`none`) and is drawn as the
@@ -91,7 +91,7 @@ fn legend_items(curves: &[LossCurve]) -> Vec<(Icon, String)> {
                 style,
                 size_label(&c.env, c.latents),
                 c.latents,
-                c.variant == "corrected",
+                c.variant == ugl_types::Variant::CORRECTED,
                 vec![&c.variant],
             )),
         }
@@ -102,8 +102,12 @@ fn legend_items(curves: &[LossCurve]) -> Vec<(Icon, String)> {
     groups
         .into_iter()
         .map(|(style, size, _, _, variants)| {
-            let none = variants.contains(&"none");
-            let named: Vec<&str> = variants.iter().copied().filter(|v| *v != "none").collect();
+            let none = variants.iter().any(|v| *v == ugl_types::Variant::NONE);
+            let named: Vec<&str> = variants
+                .iter()
+                .copied()
+                .filter(|v| *v != ugl_types::Variant::NONE)
+                .collect();
             let label = match (named.is_empty(), none) {
                 (true, _) => size,
                 (false, false) => format!("{size}, {}", named.join(", ")),

@@ -18,7 +18,7 @@ pub fn file_name(campaign: &str) -> String {
 
 fn entry_name(e: &Entry) -> String {
     let mut s = condition_name(&e.algo, &e.variant);
-    if !matches!(e.sampler.as_str(), "none" | "uniform") {
+    if ugl_types::Sampler::from(e.sampler.as_str()).is_learned() {
         s.push_str(&format!(", {} goals", sampler_name(&e.sampler)));
     }
     s

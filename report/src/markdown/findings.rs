@@ -212,7 +212,7 @@ fn budget(w: &mut String, inp: &Context<'_>) {
                 .collect()
         };
         let main = &inp.campaigns.main.name;
-        let efr = goal(main, "rge-efr");
+        let efr = goal(main, &ugl_types::Algo::RGE_EFR);
         let mut points: Vec<(i64, Vec<f64>)> = Vec::new();
         for p in s.points.iter().chain(&s.main) {
             for c in &p.campaigns {

@@ -13,7 +13,7 @@ use crate::figures::FigureFile;
 use crate::figures::budget::series_title;
 use crate::figures::sampler_compare::{self, SAMPLERS};
 use crate::load::campaign_display;
-use crate::names::{algo_name, condition_name, env_name, learner_name, sampler_name};
+use crate::names::{algo_name, env_name, learner_name, sampler_name};
 use crate::neural::{self, BudgetPoint, paper_training};
 use crate::stats::{self, Summary};
 
@@ -133,7 +133,7 @@ pub fn training_budgets(w: &mut String, inp: &Context<'_>) {
     );
     let _ = writeln!(w, "|---|---|---:|---|---:|---:|---:|---:|---:|");
     for b in &used {
-        let rfvae = b.learner == "rfvae";
+        let rfvae = b.learner == ugl_types::learners::RFVAE.name;
         let fit = b
             .mean_fit_s
             .map(super::fmt_duration)
@@ -298,27 +298,25 @@ pub fn figure4(w: &mut String, inp: &Context<'_>, sampler_figures: &[FigureFile]
         let fig = sampler_figures
             .iter()
             .find(|f| f.link == format!("figures/{name}"));
-        if algo != "rge-vae" && fig.is_none() {
+        // The paper plotted the first; the others are drawn where their runs exist.
+        let in_paper = algo == crate::names::SAMPLER_FIGURES[0].0;
+        if !in_paper && fig.is_none() {
             continue;
         }
-        if algo != "rge-vae" {
-            let _ = writeln!(
-                w,
-                "### {} (not in the paper)\n",
-                condition_name(algo, "none")
-            );
+        if !in_paper {
+            let _ = writeln!(w, "### {} (not in the paper)\n", algo.display());
         }
         let Some(fig) = fig else {
             let _ = writeln!(
                 w,
                 "No {} run with Gaussian goals in the main campaign {}: no figure.\n",
-                algo_name(algo),
+                algo_name(&algo),
                 campaign(&inp.campaigns.main.name)
             );
             continue;
         };
         let _ = writeln!(w, "![{}]({})\n", fig.caption, fig.link);
-        let panels = sampler_compare::panels(inp.conditions, algo);
+        let panels = sampler_compare::panels(inp.conditions, &algo);
         let _ = writeln!(
             w,
             "| panel | KDE, faithful | KDE, corrected | Gaussian, faithful | Gaussian, corrected | paper (KDE / Gaussian) |"
@@ -337,18 +335,27 @@ pub fn figure4(w: &mut String, inp: &Context<'_>, sampler_figures: &[FigureFile]
                 })
                 .collect();
             // A learner without variants (none) fills the faithful column.
-            let get = |s: &str, v: &str| {
-                p.get(s, v)
-                    .or_else(|| (v == "faithful").then(|| p.get(s, "none")).flatten())
+            let get = |s: ugl_types::Sampler, v: ugl_types::Variant| {
+                p.get(&s, &v).or_else(|| {
+                    (v == ugl_types::Variant::FAITHFUL)
+                        .then(|| p.get(&s, &ugl_types::Variant::NONE))
+                        .flatten()
+                })
             };
             let _ = writeln!(
                 w,
                 "| {} | {} | {} | {} | {} | {} |",
                 p.title(),
-                cell(get("kde", "faithful")),
-                cell(get("kde", "corrected")),
-                cell(get("gaussian", "faithful")),
-                cell(get("gaussian", "corrected")),
+                cell(get(ugl_types::Sampler::KDE, ugl_types::Variant::FAITHFUL)),
+                cell(get(ugl_types::Sampler::KDE, ugl_types::Variant::CORRECTED)),
+                cell(get(
+                    ugl_types::Sampler::GAUSSIAN,
+                    ugl_types::Variant::FAITHFUL
+                )),
+                cell(get(
+                    ugl_types::Sampler::GAUSSIAN,
+                    ugl_types::Variant::CORRECTED
+                )),
                 paper.join(" / ")
             );
         }
@@ -560,7 +567,7 @@ pub fn budget(w: &mut String, inp: &Context<'_>, figures: &[FigureFile]) {
         let efr = s
             .references
             .iter()
-            .find(|r| r.algo == "rge-efr")
+            .find(|r| r.algo == ugl_types::Algo::RGE_EFR)
             .map(|r| r.values.as_slice());
         for p in &s.points {
             let names: Vec<String> = p.campaigns.iter().map(|c| campaign(c)).collect();

@@ -80,7 +80,7 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 fn rows(inp: &Context<'_>) -> Vec<Row> {
     let mut out: Vec<Row> = Vec::new();
     for c in inp.conditions.iter().filter(|c| c.key.latents > 0) {
-        if c.key.sampler != "kde" {
+        if c.key.sampler != ugl_types::Sampler::KDE {
             continue;
         }
         let mut r = Row {

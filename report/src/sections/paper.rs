@@ -144,7 +144,7 @@ impl Section for Figure4 {
         let dir = out.figures_dir();
         let mut figs = Vec::new();
         for (algo, name) in crate::names::SAMPLER_FIGURES {
-            let fig = figures::sampler_compare::draw(ctx.conditions, algo, name, &dir)?;
+            let fig = figures::sampler_compare::draw(ctx.conditions, &algo, name, &dir)?;
             figs.extend(out.figure(fig)?);
         }
         words(|w| neural::figure4(w, ctx, &figs))
@@ -245,7 +245,11 @@ impl Section for Outcomes {
         let in_paper: Vec<String> = ctx
             .conditions
             .iter()
-            .filter(|c| c.key.env == "armball" && c.paper.is_some() && c.key.sampler != "gaussian")
+            .filter(|c| {
+                c.key.env == ugl_types::ARMBALL.name
+                    && c.paper.is_some()
+                    && c.key.sampler != ugl_types::Sampler::GAUSSIAN
+            })
             .map(|c| format!("figures/outcomes_{}.svg", figures::file_safe(&c.key.slug())))
             .collect();
         let (paper, rest): (Vec<_>, Vec<_>) =
