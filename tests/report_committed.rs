@@ -50,3 +50,32 @@ fn committed_report_regenerates_byte_identically() {
         );
     }
 }
+
+/// `ugl compare`'s page, computed without rendering the report, is the committed report's page.
+#[test]
+fn the_compare_page_without_a_render_is_the_reports() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut opts = ugl_report::ReportOptions::new(root.join("data/results"), Default::default());
+    opts.paper_dir = root.join("data/paper");
+    let mut pages = 0;
+    for p in files(&root.join("report/out")) {
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        let Some(campaign) = name
+            .strip_prefix("compare_")
+            .and_then(|n| n.strip_suffix(".md"))
+        else {
+            continue;
+        };
+        let page = ugl_report::compare_page(&opts, campaign)
+            .unwrap()
+            .expect("a page");
+        assert!(
+            page.as_bytes() == std::fs::read(&p).unwrap(),
+            "{name} differs from the page `ugl compare` prints"
+        );
+        pages += 1;
+    }
+    assert!(pages >= 2, "the committed report has {pages} compare pages");
+    let err = ugl_report::compare_page(&opts, "paper").unwrap_err();
+    assert!(err.to_string().contains("not a compare campaign"), "{err}");
+}

@@ -30,4 +30,4 @@ pub mod stats;
 
 pub use error::ReportError;
 pub use options::ReportOptions;
-pub use render::{LEADERBOARD_CONFIDENCE, REPORT_FILE, ReportSummary, render_report};
+pub use render::{LEADERBOARD_CONFIDENCE, REPORT_FILE, ReportSummary, compare_page, render_report};

@@ -33,11 +33,91 @@ pub fn render_report(opts: &ReportOptions) -> Result<ReportSummary, ReportError>
     // The runs are read and measured on every core. Reading a parquet file (polars, built
     // without optimisation in the one dev profile) needs more stack than a rayon worker's
     // default 2 MiB; the stack is reserved, not committed.
+    on_report_pool(|| render_report_on_pool(opts))
+}
+
+/// Runs `f` on the report's threads (see [`render_report`]).
+fn on_report_pool<T>(f: impl FnOnce() -> Result<T, ReportError> + Send) -> Result<T, ReportError>
+where
+    T: Send,
+{
     let pool = rayon::ThreadPoolBuilder::new()
         .stack_size(REPORT_STACK)
         .build()
         .map_err(|e| ReportError::Options(format!("cannot start the report's threads: {e}")))?;
-    pool.install(|| render_report_on_pool(opts))
+    pool.install(f)
+}
+
+/// The page of one `compare` campaign (`compare_<campaign>.md`, what [`render_report`] writes),
+/// computed from the main and `compare` campaigns alone, without rendering the report: what
+/// `ugl compare` prints when its runs are done. None when the campaign has no leaderboard entry;
+/// an error when it is not a `compare` campaign of the store.
+pub fn compare_page(opts: &ReportOptions, campaign: &str) -> Result<Option<String>, ReportError> {
+    if opts.n_boot == 0 {
+        return Err(ReportError::Options("n_boot must be at least 1".into()));
+    }
+    on_report_pool(|| {
+        let roles = [ugl_types::CampaignRole::Compare].into_iter().collect();
+        let camps = campaigns::load_campaigns(&opts.results, &opts.main_campaign, &roles)?;
+        let Some(mine) = camps.compare.iter().find(|c| c.name == campaign) else {
+            return Err(ReportError::Options(format!(
+                "`{campaign}` is not a compare campaign of {}",
+                opts.results.display()
+            )));
+        };
+        let paper = paper::load_paper(&opts.paper_dir)?;
+        let conditions = aggregate::aggregate(&camps.main.store, &paper);
+        let (_, board) = compare_leaderboard(&camps, &conditions, &paper, opts);
+        Ok(crate::markdown::compare::page(
+            campaign,
+            &mine.store,
+            &board,
+            &camps.main.name,
+            opts.bootstrap_seed,
+        ))
+    })
+}
+
+/// New learners (`compare` campaigns): aggregated like the main campaign, ranked with it in the
+/// leaderboard (and drawn with it in the KL-coverage figures).
+fn compare_leaderboard(
+    camps: &campaigns::Campaigns,
+    conditions: &[aggregate::ConditionSummary],
+    paper: &paper::PaperTable,
+    opts: &ReportOptions,
+) -> (
+    Vec<Vec<aggregate::ConditionSummary>>,
+    leaderboard::Leaderboard,
+) {
+    let store = &camps.main.store;
+    let compare_conditions: Vec<Vec<aggregate::ConditionSummary>> = camps
+        .compare
+        .iter()
+        .map(|c| {
+            let mut conds = aggregate::aggregate(&c.store, paper);
+            aggregate::mark_rpe_level_against(&c.store, &mut conds, conditions);
+            conds
+        })
+        .collect();
+    let mut sources = vec![leaderboard::Source {
+        campaign: &camps.main.name,
+        store,
+        conditions,
+    }];
+    for (c, conds) in camps.compare.iter().zip(&compare_conditions) {
+        sources.push(leaderboard::Source {
+            campaign: &c.name,
+            store: &c.store,
+            conditions: conds,
+        });
+    }
+    let board = leaderboard::build(
+        &sources,
+        LEADERBOARD_CONFIDENCE,
+        opts.n_boot,
+        opts.bootstrap_seed,
+    );
+    (compare_conditions, board)
 }
 
 /// Stack of the report's worker threads.
@@ -99,35 +179,7 @@ fn render_report_on_pool(opts: &ReportOptions) -> Result<ReportSummary, ReportEr
         None => claims::ClaimsInput::Missing(&claims_path),
     };
 
-    // New learners (`compare` campaigns): aggregated like the main campaign, ranked with it in
-    // the leaderboard and drawn with it in the KL-coverage figures.
-    let compare_conditions: Vec<Vec<aggregate::ConditionSummary>> = camps
-        .compare
-        .iter()
-        .map(|c| {
-            let mut conds = aggregate::aggregate(&c.store, &paper);
-            aggregate::mark_rpe_level_against(&c.store, &mut conds, &conditions);
-            conds
-        })
-        .collect();
-    let mut sources = vec![leaderboard::Source {
-        campaign: &camps.main.name,
-        store,
-        conditions: &conditions,
-    }];
-    for (c, conds) in camps.compare.iter().zip(&compare_conditions) {
-        sources.push(leaderboard::Source {
-            campaign: &c.name,
-            store: &c.store,
-            conditions: conds,
-        });
-    }
-    let board = leaderboard::build(
-        &sources,
-        LEADERBOARD_CONFIDENCE,
-        opts.n_boot,
-        opts.bootstrap_seed,
-    );
+    let (compare_conditions, board) = compare_leaderboard(&camps, &conditions, &paper, opts);
     let mut curve_conditions = conditions.clone();
     for conds in &compare_conditions {
         curve_conditions.extend(

@@ -76,22 +76,22 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
 }
 
 /// After `ugl compare`: the new learner's one-page summary (what `ugl report` writes as
-/// `compare_<campaign>.md`), from a report rendered into a temporary directory.
+/// `compare_<campaign>.md`), computed by the report from the main and `compare` campaigns
+/// without rendering the report.
 pub(crate) fn print_compare_page(out: &Path, campaign: &str, main_campaign: &str) -> Result<()> {
     let results = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let tmp = std::env::temp_dir().join(format!("ugl-compare-{}", std::process::id()));
-    let mut opts = ugl_report::ReportOptions::new(results.to_path_buf(), tmp.clone());
+    let mut opts = ugl_report::ReportOptions::new(results.to_path_buf(), PathBuf::new());
     opts.main_campaign = main_campaign.to_string();
-    let page = ugl_report::render_report(&opts)
-        .map_err(|e| e.to_string())
-        .and_then(|_| {
-            let p = tmp.join(ugl_report::markdown::compare::file_name(campaign));
-            std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))
-        });
-    let _ = std::fs::remove_dir_all(&tmp);
+    let page = match ugl_report::compare_page(&opts, campaign) {
+        Ok(Some(text)) => Ok(text),
+        Ok(None) => Err(format!(
+            "the campaign `{campaign}` has no leaderboard entry"
+        )),
+        Err(e) => Err(e.to_string()),
+    };
     match page {
         Ok(text) => outln!("{text}")?,
         Err(e) => eprintln!(

@@ -364,7 +364,7 @@ mod tests {
             latents: 10,
             variant: variant.into(),
         };
-        let mut keys = vec![
+        let mut keys = [
             key("rge-mine", "kde", "none"),
             key("rge-vae", "gaussian", "corrected"),
             key("rge-vae", "kde", "corrected"),
