@@ -1586,7 +1586,7 @@ fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
     .unwrap();
     assert_one_line_error(
         &ugl(&["plan", "--config", p(&bad)]),
-        "learners.gaussian-projection: std must be a positive number",
+        "learners.gaussian-projection.std: must be a positive number",
     );
     let results = dir.path().join("results");
     let o = ugl(&[

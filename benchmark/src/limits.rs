@@ -83,58 +83,102 @@ fn gib(bytes: f64) -> String {
     format!("{:.1} GiB", bytes / (1024.0 * 1024.0 * 1024.0))
 }
 
+/// A size refused before anything is allocated: what asks for it, and how much it needs.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LimitError {
+    /// `key = value` needs more memory than this process may use ([`budget`]).
+    #[error("{key} = {value} {}", needs_phrase(*needs, *have, what))]
+    Memory {
+        key: String,
+        value: String,
+        /// Bytes needed (estimated).
+        needs: f64,
+        /// Bytes available.
+        have: f64,
+        /// What sets the budget (`this machine's memory`, ...).
+        what: &'static str,
+    },
+    /// A matrix with more runs than a campaign holds ([`MAX_RUNS`]).
+    #[error(
+        "the run matrix ({dims}) holds up to {total} runs; a campaign holds at most {MAX_RUNS}"
+    )]
+    Runs { dims: String, total: u128 },
+}
+
+impl LimitError {
+    /// The memory error without its `key = value`: `needs about 3.1 GiB of memory, more than ...`.
+    pub fn needs(&self) -> String {
+        match self {
+            LimitError::Memory {
+                needs, have, what, ..
+            } => needs_phrase(*needs, *have, what),
+            other => other.to_string(),
+        }
+    }
+}
+
+fn needs_phrase(needs: f64, have: f64, what: &str) -> String {
+    format!(
+        "needs about {} of memory, more than {what} ({})",
+        gib(needs),
+        gib(have)
+    )
+}
+
 /// Refuse `key = value` if it needs `bytes` (estimated) and that exceeds the memory this
 /// process may use ([`budget`]).
-pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Result<(), String> {
+pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Result<(), LimitError> {
     let (have, what) = budget();
     if !bytes.is_finite() || bytes > have {
-        return Err(format!(
-            "{key} = {value} needs about {} of memory, more than {what} ({})",
-            gib(bytes),
-            gib(have)
-        ));
+        return Err(LimitError::Memory {
+            key: key.to_string(),
+            value: value.to_string(),
+            needs: bytes,
+            have,
+            what,
+        });
     }
     Ok(())
 }
 
 /// `ugl.images` (the UGL data set: `n` images of 70x70 f32, plus a sparse copy).
-pub fn check_images(n: usize) -> Result<(), String> {
+pub fn check_images(n: usize) -> Result<(), LimitError> {
     check_fits("ugl.images", n, n as f64 * PIXELS as f64 * 4.0 * 2.0)
 }
 
 /// `ugl embed --grid N` (`N x N` rendered images of 70x70 f32, held with the `images` training
 /// images while they are encoded; the encoders work on an f64 copy of a set). Computed in
 /// floating point, so that no size overflows.
-pub fn check_grid(grid: usize, images: usize) -> Result<(), String> {
+pub fn check_grid(grid: usize, images: usize) -> Result<(), LimitError> {
     let grid_images = grid as f64 * grid as f64;
     let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * PIXELS as f64;
     check_fits("--grid", grid, bytes)
 }
 
 /// `explore.epochs` (the exploration's per-epoch records).
-pub fn check_epochs(n: usize) -> Result<(), String> {
+pub fn check_epochs(n: usize) -> Result<(), LimitError> {
     check_fits("explore.epochs", n, n as f64 * BYTES_PER_EPOCH)
 }
 
 /// A network's `hidden` sizes: the weights of the 4900-H1-H2 MLP and its mirror, with their
 /// gradients and optimiser state (x5).
-pub fn check_hidden(key: &str, hidden: [usize; 2]) -> Result<(), String> {
+pub fn check_hidden(hidden: [usize; 2]) -> Result<(), LimitError> {
     let [h1, h2] = hidden.map(|h| h as f64);
     let params = 2.0 * (PIXELS as f64 * h1 + h1 * h2) + 200.0 * h2;
-    check_fits(key, format!("{hidden:?}"), params * 4.0 * 5.0)
+    check_fits("hidden", format!("{hidden:?}"), params * 4.0 * 5.0)
 }
 
 /// The number of runs of a matrix (the product of its dimensions, without overflow).
-pub fn check_runs(dims: &[(&str, usize)]) -> Result<(), String> {
+pub fn check_runs(dims: &[(&str, usize)]) -> Result<(), LimitError> {
     let total = dims
         .iter()
         .fold(1u128, |acc, (_, n)| acc.saturating_mul(*n as u128));
     if total > MAX_RUNS {
         let what: Vec<String> = dims.iter().map(|(k, n)| format!("{n} {k}")).collect();
-        return Err(format!(
-            "the run matrix ({}) holds up to {total} runs; a campaign holds at most {MAX_RUNS}",
-            what.join(" x ")
-        ));
+        return Err(LimitError::Runs {
+            dims: what.join(" x "),
+            total,
+        });
     }
     Ok(())
 }
@@ -147,21 +191,23 @@ mod tests {
     fn absurd_sizes_are_refused_and_real_ones_pass() {
         assert!(check_images(10_000).is_ok());
         assert!(check_epochs(5000).is_ok());
-        assert!(check_hidden("learners.vae.hidden", [1200, 1200]).is_ok());
-        let e = check_images(100_000_000_000).unwrap_err();
+        assert!(check_hidden([1200, 1200]).is_ok());
+        let e = check_images(100_000_000_000).unwrap_err().to_string();
         assert!(
             e.starts_with("ugl.images = 100000000000 needs about"),
             "{e}"
         );
         assert!(check_epochs(1 << 63).is_err());
         assert!(check_grid(21, 10_000).is_ok());
-        let e = check_grid(100_000, 300).unwrap_err();
+        let e = check_grid(100_000, 300).unwrap_err().to_string();
         assert!(e.starts_with("--grid = 100000 needs about"), "{e}");
         assert!(check_grid(usize::MAX, 300).is_err());
         assert!(check_epochs(usize::MAX).is_err());
-        assert!(check_hidden("learners.ae.hidden", [100_000_000, 10]).is_err());
+        assert!(check_hidden([100_000_000, 10]).is_err());
         assert!(check_runs(&[("envs", 2), ("algos", 7), ("reps", 5)]).is_ok());
-        let e = check_runs(&[("envs", 2), ("reps", 100_000_000_000)]).unwrap_err();
+        let e = check_runs(&[("envs", 2), ("reps", 100_000_000_000)])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("at most 1000000"), "{e}");
         assert!(check_runs(&[("a", usize::MAX), ("b", usize::MAX), ("c", usize::MAX)]).is_err());
     }

@@ -14,7 +14,7 @@ pub use crate::repr::external::ExternalConfig;
 use crate::repr::external::ExternalParams;
 pub use crate::repr::isomap::IsomapConfig;
 use crate::repr::neural::Variant;
-use crate::repr::registry::{self, Learner, LearnerParams};
+use crate::repr::registry::{self, Learner, LearnerParamError, LearnerParams, ParamError};
 
 /// Errors reading or validating a configuration.
 #[derive(Debug, Error)]
@@ -199,10 +199,15 @@ pub struct LearnersConfig {
 }
 
 impl LearnersConfig {
-    /// The checked parameters of `learner`; the message names the key (`learners.vae: ...`).
-    pub fn params(&self, learner: Learner) -> Result<Box<dyn LearnerParams>, String> {
-        (learner.entry().params)(self.tables.get(learner.name()))
-            .map_err(|m| prefix_key(learner.name(), &m))
+    /// The checked parameters of `learner`; the error names the learner and the key
+    /// (`learners.vae.warmup: ...`).
+    pub fn params(&self, learner: Learner) -> Result<Box<dyn LearnerParams>, LearnerParamError> {
+        (learner.entry().params)(self.tables.get(learner.name())).map_err(|error| {
+            LearnerParamError {
+                learner: learner.name().to_string(),
+                error,
+            }
+        })
     }
 
     /// Set the `[learners.NAME]` table (e.g. an external program given on the command line).
@@ -241,13 +246,14 @@ impl LearnersConfig {
     }
 
     /// Check every table present, and that each names a registered learner.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), LearnerParamError> {
         for name in self.tables.keys() {
-            let l = Learner::by_name(name).ok_or_else(|| {
-                format!(
-                    "learners.{name}: no learner is called '{name}' (registered: {})",
+            let l = Learner::by_name(name).ok_or_else(|| LearnerParamError {
+                learner: name.clone(),
+                error: ParamError::table(format!(
+                    "no learner is called '{name}' (registered: {})",
                     registry::names().join(", ")
-                )
+                )),
             })?;
             self.params(l)?;
         }
@@ -299,9 +305,15 @@ impl CampaignConfig {
             path: path.to_path_buf(),
             message: one_line(&e.to_string()),
         })?;
+        // The learners' tables are checked after parsing, without positions: their errors
+        // carry the key, and the message gains the line that sets it.
+        cfg.learners.validate().map_err(|e| ConfigError::Invalid {
+            path: path.to_path_buf(),
+            message: with_learner_line(text, &e),
+        })?;
         cfg.validate().map_err(|message| ConfigError::Invalid {
             path: path.to_path_buf(),
-            message: with_learner_line(text, message),
+            message,
         })?;
         Ok(cfg)
     }
@@ -379,13 +391,14 @@ impl CampaignConfig {
             ("variants", self.matrix.variants.len()),
             ("reps", self.campaign.reps),
             ("explorations", self.campaign.explorations),
-        ])?;
+        ])
+        .map_err(|e| e.to_string())?;
         if self.matrix.variants.is_empty() {
             return Err(
                 "matrix.variants must list at least one variant (faithful, corrected)".into(),
             );
         }
-        self.learners.validate()?;
+        self.learners.validate().map_err(|e| e.to_string())?;
         self.mge.validate()?;
         // Every size, "true" resolved per environment, before anything is trained.
         for a in self.matrix.algos.iter().filter(|a| a.modules().is_some()) {
@@ -416,7 +429,7 @@ impl CampaignConfig {
         for l in self.matrix.algos.iter().filter_map(|a| a.learner()) {
             self.learners
                 .params(l)
-                .map_err(|m| format!("matrix.algos has {}, but {m}", l.entry().algo))?;
+                .map_err(|e| format!("matrix.algos has {}, but {e}", l.entry().algo))?;
         }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {
@@ -426,7 +439,7 @@ impl CampaignConfig {
             ));
         }
         if learned {
-            crate::limits::check_images(self.ugl.images)?;
+            crate::limits::check_images(self.ugl.images).map_err(|e| e.to_string())?;
         }
         if let Some(LatentSize::N(n)) = self
             .matrix
@@ -457,20 +470,15 @@ fn dup<T: PartialEq + std::fmt::Display>(v: &[T]) -> Option<String> {
         .map(|(_, a)| a.to_string())
 }
 
-/// A message about `learners.NAME.KEY` (the learners' tables are checked after parsing, without
-/// positions) with the line of `text` that sets the key: `... (line 9: `init = 1`)`.
-fn with_learner_line(text: &str, message: String) -> String {
-    let Some((path, _)) = message.split_once(": ") else {
+/// A learner's error with the line of `text` that sets its key: `... (line 9: `init = 1`)`.
+fn with_learner_line(text: &str, e: &LearnerParamError) -> String {
+    let message = e.to_string();
+    let Some(key) = e.error.key.as_deref() else {
         return message;
     };
-    let Some((name, key)) = path
-        .strip_prefix("learners.")
-        .and_then(|p| p.split_once('.'))
-    else {
-        return message;
-    };
+    // The table's own key (`hidden` of `hidden[1]`).
     let key = key.split(['.', '[']).next().unwrap_or(key);
-    match learner_key_line(text, name, key) {
+    match learner_key_line(text, &e.learner, key) {
         Some(at) if !message.contains("(line ") => format!("{message} ({at})"),
         _ => message,
     }
@@ -548,23 +556,6 @@ pub fn resolve_profile(name: &str) -> Result<PathBuf, ConfigError> {
             name: name.into(),
             tried: path,
         })
-    }
-}
-
-/// A `[learners.NAME]` message with its table's path: a message that starts with the key
-/// (`warmup: ...`, as [`ParamGuard::check`](crate::repr::registry::ParamGuard) writes them)
-/// becomes `learners.NAME.warmup: ...`, any other `learners.NAME: ...`.
-fn prefix_key(name: &str, msg: &str) -> String {
-    match msg.split_once(": ") {
-        Some((key, rest))
-            if !key.is_empty()
-                && key.chars().all(|c| {
-                    c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '[' | ']')
-                }) =>
-        {
-            format!("learners.{name}.{key}: {rest}")
-        }
-        _ => format!("learners.{name}: {msg}"),
     }
 }
 

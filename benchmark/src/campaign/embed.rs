@@ -40,7 +40,8 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
             "the grid needs at least 2 x 2 positions, got {grid}"
         )));
     }
-    crate::limits::check_grid(grid, ctx.ugl.images).map_err(ReprError::InvalidInput)?;
+    crate::limits::check_grid(grid, ctx.ugl.images)
+        .map_err(|e| ReprError::InvalidInput(e.to_string()))?;
     let (mut repr, data, ds_seed) = fit_with_data(spec, ctx)?;
     let env = make_env(spec.env, ctx.env);
     let d = env.state_dim();

@@ -99,7 +99,7 @@ pub fn make_learner(
 ) -> Result<Box<dyn RepresentationLearner>, ReprError> {
     Ok(cfg
         .params(learner)
-        .map_err(ReprError::InvalidInput)?
+        .map_err(|e| ReprError::InvalidInput(e.to_string()))?
         .build(variant))
 }
 
@@ -141,7 +141,7 @@ fn fit_or_load(
     let params = ctx
         .learners
         .params(learner)
-        .map_err(ReprError::InvalidInput)?;
+        .map_err(|e| ReprError::InvalidInput(e.to_string()))?;
     let identity = params.identity(spec.variant);
     let fitter = params.build(spec.variant);
     let key = model_key(spec, ctx, &identity);

@@ -161,7 +161,7 @@ pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(),
         if n < 2 {
             return Err(format!("--images must be at least 2, got {n}"));
         }
-        crate::limits::check_images(n).map_err(|m| format!("--images: {m}"))?;
+        crate::limits::check_images(n).map_err(|e| format!("--images: {e}"))?;
         cfg.ugl.images = n;
     }
     Ok(())

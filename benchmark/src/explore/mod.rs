@@ -76,7 +76,7 @@ impl ExploreConfig {
         if self.epochs == 0 {
             return Err("explore.epochs must be at least 1".into());
         }
-        crate::limits::check_epochs(self.epochs)?;
+        crate::limits::check_epochs(self.epochs).map_err(|e| e.to_string())?;
         if self.eval_every == 0 {
             return Err("explore.eval_every must be at least 1".into());
         }

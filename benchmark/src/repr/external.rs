@@ -45,7 +45,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use rand::Rng;
 
 use super::neural_model::Variant;
-use super::params::{LearnerParams, ParamGuard};
+use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::{
     Encoder, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input,
     check_latents, check_no_constant_latent,
@@ -115,9 +115,9 @@ impl ExternalParams {
 
 impl ParamGuard for ExternalConfig {
     type Checked = ExternalParams;
-    fn check(self) -> Result<ExternalParams, String> {
+    fn check(self) -> Result<ExternalParams, ParamError> {
         if self.command.trim().is_empty() || self.name.trim().is_empty() {
-            return Err("name and command must not be empty".into());
+            return Err(ParamError::table("name and command must not be empty"));
         }
         for (key, v) in [
             ("ready_timeout_s", self.ready_timeout_s),
@@ -126,8 +126,9 @@ impl ParamGuard for ExternalConfig {
             if let Some(v) = v
                 && !(v.is_finite() && v > 0.0 && v <= 1e7)
             {
-                return Err(format!(
-                    "{key} must be a positive number of seconds (at most 1e7), got {v}"
+                return Err(ParamError::at(
+                    key,
+                    format!("must be a positive number of seconds (at most 1e7), got {v}"),
                 ));
             }
         }

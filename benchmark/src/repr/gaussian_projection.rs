@@ -12,7 +12,7 @@
 use rand_distr::{Distribution, Normal};
 
 use super::neural_model::Variant;
-use super::params::{LearnerParams, ParamGuard};
+use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::pca::ProjectionEncoder;
 use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input};
 use crate::seed::Stream;
@@ -28,11 +28,14 @@ pub struct GaussianProjectionConfig {
 
 impl ParamGuard for GaussianProjectionConfig {
     type Checked = GaussianProjection;
-    fn check(self) -> Result<GaussianProjection, String> {
+    fn check(self) -> Result<GaussianProjection, ParamError> {
         if let Some(s) = self.std
             && !(s.is_finite() && s > 0.0)
         {
-            return Err(format!("std must be a positive number, got {s}"));
+            return Err(ParamError::at(
+                "std",
+                format!("must be a positive number, got {s}"),
+            ));
         }
         Ok(GaussianProjection { std: self.std })
     }
@@ -128,7 +131,7 @@ mod tests {
         let bad = GaussianProjectionConfig { std: Some(0.0) }
             .check()
             .unwrap_err();
-        assert!(bad.contains("std"), "{bad}");
+        assert_eq!(bad.key.as_deref(), Some("std"), "{bad}");
         let ok = GaussianProjectionConfig { std: Some(0.5) }.check().unwrap();
         assert_eq!(ok.identity(None), serde_json::json!({ "std": 0.5 }));
         assert_eq!(

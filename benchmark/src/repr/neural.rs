@@ -25,7 +25,7 @@ pub use super::neural_encoder::{reconstruct, reconstruction_loss};
 pub use super::neural_model::{
     Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, normals, tensor2,
 };
-use super::params::{LearnerParams, ParamGuard};
+use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::Stream;
 
@@ -80,24 +80,21 @@ impl NeuralSection {
 
 impl ParamGuard for (Model, NeuralSection) {
     type Checked = NeuralParams;
-    fn check(self) -> Result<NeuralParams, String> {
+    fn check(self) -> Result<NeuralParams, ParamError> {
         let (model, section) = self;
         if model.spec().paper_warmup() == 0 && section.warmup.is_some() {
-            return Err("warmup: only the rfvae has a KL warm-up".into());
+            return Err(ParamError::at("warmup", "only the rfvae has a KL warm-up"));
         }
         if model.spec().default_beta().is_none() && section.beta.is_some() {
-            return Err("beta: only the bvae has a KL weight".into());
+            return Err(ParamError::at("beta", "only the bvae has a KL weight"));
         }
         if model.spec().default_beta().is_none() && section.capacity.is_some() {
-            return Err("capacity: only the bvae anneals a KL capacity".into());
+            return Err(ParamError::at(
+                "capacity",
+                "only the bvae anneals a KL capacity",
+            ));
         }
-        section
-            .resolve(model, Variant::Faithful)
-            .validate(model, "")
-            .map_err(|e| match e {
-                ReprError::InvalidInput(m) => m,
-                other => other.to_string(),
-            })?;
+        section.resolve(model, Variant::Faithful).check(model)?;
         Ok(NeuralParams { model, section })
     }
 }

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::ReprError;
 use super::nets::Init;
 use super::neural_model::{NeuralModel, Variant};
+use super::params::ParamError;
 use crate::repr::{ae, bvae, rfvae, vae};
 
 /// The backend neural training runs on (part of the model-cache key, so models trained on
@@ -180,45 +181,56 @@ impl NeuralConfig {
         }
     }
 
-    /// Check every value for `model`; the message names the key.
+    /// Check every value for `model`, as a learner's `who` at fit time.
     pub fn validate(&self, model: Model, who: &str) -> Result<(), ReprError> {
-        let bad = |msg: String| {
-            Err(ReprError::InvalidInput(if who.is_empty() {
-                msg
-            } else {
-                format!("{who}: {msg}")
-            }))
-        };
+        self.check(model)
+            .map_err(|e| ReprError::InvalidInput(format!("{who}: {e}")))
+    }
+
+    /// Check every value for `model`; the error names the key.
+    pub fn check(&self, model: Model) -> Result<(), ParamError> {
         if self.batch == 0 {
-            return bad("batch must be at least 1".into());
+            return Err(ParamError::at("batch", "must be at least 1"));
         }
         if self.hidden.contains(&0) {
-            return bad(format!(
-                "hidden sizes must be at least 1, got {:?}",
-                self.hidden
+            return Err(ParamError::at(
+                "hidden",
+                format!("sizes must be at least 1, got {:?}", self.hidden),
             ));
         }
-        if let Err(m) = crate::limits::check_hidden("hidden", self.hidden) {
-            return bad(m);
+        if let Err(e) = crate::limits::check_hidden(self.hidden) {
+            return Err(ParamError::at(
+                "hidden",
+                format!("{:?} {}", self.hidden, e.needs()),
+            ));
         }
         if !(self.lr.is_finite() && self.lr > 0.0) {
-            return bad(format!("lr must be positive and finite, got {}", self.lr));
+            return Err(ParamError::at(
+                "lr",
+                format!("must be positive and finite, got {}", self.lr),
+            ));
         }
         if self.log_every == 0 {
-            return bad("log_every must be at least 1".into());
+            return Err(ParamError::at("log_every", "must be at least 1"));
         }
         if let Some(b) = self.beta
             && !(b.is_finite() && b > 0.0 && b <= 1e6)
         {
-            return bad(format!("beta must be positive and at most 1e6, got {b}"));
+            return Err(ParamError::at(
+                "beta",
+                format!("must be positive and at most 1e6, got {b}"),
+            ));
         }
         if let Some(c) = self.capacity
             && !(c.is_finite() && (0.0..=1e4).contains(&c))
         {
-            return bad(format!("capacity must be between 0 and 1e4 nats, got {c}"));
+            return Err(ParamError::at(
+                "capacity",
+                format!("must be between 0 and 1e4 nats, got {c}"),
+            ));
         }
         if model.spec().paper_warmup() > 0 && self.warmup == 0 {
-            return bad("warmup must be at least 1".into());
+            return Err(ParamError::at("warmup", "must be at least 1"));
         }
         Ok(())
     }

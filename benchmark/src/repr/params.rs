@@ -7,12 +7,51 @@ use std::fmt::Debug;
 use super::RepresentationLearner;
 use super::neural_model::Variant;
 
+/// A value of a learner's `[learners.NAME]` table that is not valid: its key, as data (None:
+/// the table as a whole), and why. Shown as `KEY: why`.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{}{message}", key.as_deref().map(|k| format!("{k}: ")).unwrap_or_default())]
+pub struct ParamError {
+    /// The key inside the table (`warmup`, `hidden[1]`), without the `learners.NAME.` prefix.
+    pub key: Option<String>,
+    /// Why the value is refused.
+    pub message: String,
+}
+
+impl ParamError {
+    /// The value of `key` is refused.
+    pub fn at(key: impl Into<String>, message: impl Into<String>) -> ParamError {
+        ParamError {
+            key: Some(key.into()),
+            message: message.into(),
+        }
+    }
+
+    /// The table as a whole is refused.
+    pub fn table(message: impl Into<String>) -> ParamError {
+        ParamError {
+            key: None,
+            message: message.into(),
+        }
+    }
+}
+
+/// A learner's table refused: which learner, and the [`ParamError`]. Shown as
+/// `learners.NAME.KEY: why` (or `learners.NAME: why`).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("learners.{learner}{}: {}", error.key.as_deref().map(|k| format!(".{k}")).unwrap_or_default(), error.message)]
+pub struct LearnerParamError {
+    /// The learner's name (the table's).
+    pub learner: String,
+    pub error: ParamError,
+}
+
 /// Unchecked parameters that can be validated (linfa's `ParamGuard`).
 pub trait ParamGuard {
     /// The parameters after validation.
     type Checked;
-    /// Validate every value; the message names the key (without the `learners.NAME.` prefix).
-    fn check(self) -> Result<Self::Checked, String>;
+    /// Validate every value; the error names the key.
+    fn check(self) -> Result<Self::Checked, ParamError>;
 }
 
 /// The checked parameters of one learner: what its runs depend on, and the learner itself.

@@ -12,7 +12,7 @@
 use rand_distr::{Distribution, StandardNormal};
 
 use super::neural_model::Variant;
-use super::params::{LearnerParams, ParamGuard};
+use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::sparse::SparseRows;
 use super::{
     Encoder, ImageSet, Latents, ReprError, RepresentationLearner, check_fit_input, check_latents,
@@ -39,7 +39,7 @@ pub struct PcaConfig<const CENTRE: bool> {}
 
 impl<const CENTRE: bool> ParamGuard for PcaConfig<CENTRE> {
     type Checked = PcaConfig<CENTRE>;
-    fn check(self) -> Result<PcaConfig<CENTRE>, String> {
+    fn check(self) -> Result<PcaConfig<CENTRE>, ParamError> {
         Ok(self)
     }
 }

@@ -19,7 +19,7 @@ use serde::de::DeserializeOwned;
 use super::external::ExternalConfig;
 use super::isomap::IsomapConfig;
 use super::neural::{Model, NeuralConfig, NeuralSection};
-pub use super::params::{LearnerParams, ParamGuard};
+pub use super::params::{LearnerParamError, LearnerParams, ParamError, ParamGuard};
 use super::pca::PcaConfig;
 use ugl_types::learners;
 
@@ -45,7 +45,7 @@ pub struct LearnerEntry {
     /// How it is fitted.
     pub kind: Kind,
     /// Parse and check its `[learners.NAME]` table (None: the campaign file has none).
-    pub params: fn(Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String>,
+    pub params: fn(Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, ParamError>,
 }
 
 impl std::ops::Deref for LearnerEntry {
@@ -191,7 +191,7 @@ pub fn names() -> Vec<&'static str> {
 }
 
 /// Deserialise a table (absent: the defaults) into `U` and check it.
-fn parse<U>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String>
+fn parse<U>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, ParamError>
 where
     U: DeserializeOwned + Default + ParamGuard,
     U::Checked: LearnerParams + 'static,
@@ -224,7 +224,7 @@ impl ModelOf for Rfvae {
     const MODEL: Model = Model::Rfvae;
 }
 
-fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String> {
+fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, ParamError> {
     let section: NeuralSection = match table {
         None => NeuralSection::default(),
         Some(t) => typed(t)?,
@@ -232,33 +232,26 @@ fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerPara
     Ok(Box::new((M::MODEL, section).check()?))
 }
 
-fn external(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, String> {
+fn external(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, ParamError> {
     let Some(t) = table else {
-        return Err("there is no [learners.external] section (name, command)".into());
+        return Err(ParamError::table(
+            "there is no [learners.external] section (name, command)",
+        ));
     };
     let unchecked: ExternalConfig = typed(t)?;
     Ok(Box::new(unchecked.check()?))
 }
 
-/// A `[learners.NAME]` table as `U`. The table was parsed before its learner's type was known,
-/// so serde's message (`invalid type: integer `1`, expected ...`) names no key: the key is the
-/// first one that, alone in a table, fails with the same message, and the message becomes
-/// `KEY: message` (the campaign file's reader adds the table's path and the line).
-fn typed<U: DeserializeOwned>(t: &toml::Value) -> Result<U, String> {
-    t.clone().try_into().map_err(|e| {
-        let message = one_line(&e);
-        let alone = |k: &String, v: &toml::Value| {
-            let one = toml::Table::from_iter([(k.clone(), v.clone())]);
-            toml::Value::Table(one)
-                .try_into::<U>()
-                .is_err_and(|e| one_line(&e) == message)
-        };
-        match t
-            .as_table()
-            .and_then(|t| t.iter().find(|(k, v)| alone(k, v)))
-        {
-            Some((k, _)) => format!("{k}: {message}"),
-            _ => message,
+/// A `[learners.NAME]` table as `U`; the error names the key that does not deserialise (its
+/// path inside the table, as `serde_path_to_error` tracks it).
+fn typed<U: DeserializeOwned>(t: &toml::Value) -> Result<U, ParamError> {
+    serde_path_to_error::deserialize(t.clone()).map_err(|e| {
+        let key = e.path().to_string();
+        let message = one_line(e.inner());
+        if key.is_empty() || key == "." {
+            ParamError::table(message)
+        } else {
+            ParamError::at(key, message)
         }
     })
 }
@@ -329,13 +322,24 @@ mod tests {
     fn unknown_keys_and_bad_values_are_named() {
         let t: toml::Value = toml::from_str("iteration = 5").unwrap();
         let e = (Learner::by_name("vae").unwrap().entry().params)(Some(&t)).unwrap_err();
-        assert!(e.contains("iteration"), "{e}");
-        let t: toml::Value = toml::from_str("n_neighbors = 0").unwrap();
-        let e = (Learner::by_name("isomap").unwrap().entry().params)(Some(&t)).unwrap_err();
-        assert!(e.contains("n_neighbors"), "{e}");
-        let t: toml::Value = toml::from_str("warmup = 5").unwrap();
-        let e = (Learner::by_name("ae").unwrap().entry().params)(Some(&t)).unwrap_err();
-        assert!(e.contains("warmup"), "{e}");
+        assert!(e.to_string().contains("iteration"), "{e}");
+        let key = |learner: &str, toml: &str| {
+            let t: toml::Value = toml::from_str(toml).unwrap();
+            let e = (Learner::by_name(learner).unwrap().entry().params)(Some(&t)).unwrap_err();
+            e.key
+        };
+        // The key is data: from the learner's check, and from serde's path for a value of the
+        // wrong type (no message is parsed).
+        assert_eq!(
+            key("isomap", "n_neighbors = 0").as_deref(),
+            Some("n_neighbors")
+        );
+        assert_eq!(key("ae", "warmup = 5").as_deref(), Some("warmup"));
+        assert_eq!(key("vae", "lr = \"fast\"").as_deref(), Some("lr"));
+        assert_eq!(
+            key("vae", "hidden = [1200, \"x\"]").as_deref(),
+            Some("hidden[1]")
+        );
         let t: toml::Value = toml::from_str("n_iter = 5").unwrap();
         assert!((Learner::by_name("pca").unwrap().entry().params)(Some(&t)).is_err());
     }

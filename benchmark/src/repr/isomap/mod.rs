@@ -78,7 +78,7 @@ use super::{
     check_no_constant_latent,
 };
 use crate::repr::neural_model::Variant;
-use crate::repr::params::{LearnerParams, ParamGuard};
+use crate::repr::params::{LearnerParams, ParamError, ParamGuard};
 use crate::seed::Stream;
 
 mod eigen;
@@ -114,9 +114,9 @@ impl Default for IsomapConfig {
 
 impl ParamGuard for IsomapConfig {
     type Checked = Isomap;
-    fn check(self) -> Result<Isomap, String> {
+    fn check(self) -> Result<Isomap, ParamError> {
         if self.n_neighbors == 0 {
-            return Err("n_neighbors must be at least 1".into());
+            return Err(ParamError::at("n_neighbors", "must be at least 1"));
         }
         Ok(Isomap {
             n_neighbors: self.n_neighbors,
