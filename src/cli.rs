@@ -59,9 +59,7 @@ pub(crate) enum Command {
         env: EnvKind,
         #[arg(long, help = algo_help())]
         algo: Algo,
-        /// Goal sampler of a learned goal space: kde (the paper's default) or gaussian (the
-        /// prior N(0, I); VAE, RFVAE, or an external learner that writes a prior).
-        #[arg(long, default_value = "kde")]
+        #[arg(long, default_value = ugl_types::samplers::KDE.name, help = sampler_help())]
         sampler: SamplerKind,
         /// rge-vae / rge-rfvae: `faithful` (the original code, defects included) or `corrected`.
         #[arg(long)]
@@ -354,6 +352,18 @@ pub(crate) fn algo_help() -> String {
          exploration (docs/armballs.md): mge-efr-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one \
          module), random or lp (learning progress), constants in the profile's [mge]",
         algos.join(", ")
+    )
+}
+
+/// `--sampler`: every sampler of learned goal spaces in the registry, with its description.
+pub(crate) fn sampler_help() -> String {
+    let samplers: Vec<String> = SamplerKind::learned()
+        .into_iter()
+        .map(|s| format!("{}: {}", s.name(), s.info().description))
+        .collect();
+    format!(
+        "Goal sampler of a learned goal space: {}",
+        samplers.join("; ")
     )
 }
 

@@ -122,7 +122,7 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
     let spec = RunSpec::learned(
         a.env,
         Algo::rge(learner),
-        SamplerKind::Kde,
+        SamplerKind::KDE,
         a.latents,
         a.variant.unwrap_or_default(),
         a.seed,

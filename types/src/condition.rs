@@ -313,7 +313,13 @@ impl ConditionKey {
             self.latents,
             algo_rank,
             self.algo.clone(),
-            rank(sampler::SAMPLERS.iter().map(|s| s.name), &self.sampler),
+            rank(
+                SamplerInfo::all()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .into_iter(),
+                &self.sampler,
+            ),
             self.sampler.clone(),
             rank(strategy::VARIANTS.iter().map(|v| v.name), &self.variant),
             self.variant.clone(),

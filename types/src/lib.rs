@@ -57,7 +57,7 @@ pub mod learners {
         AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
     };
 }
-pub use sampler::{SAMPLERS, SamplerInfo};
+pub use sampler::{SAMPLERS, SamplerInfo, SamplerInfoError};
 /// Each goal sampler's entry, by name (`ugl_types::samplers::KDE`).
 pub mod samplers {
     pub use crate::sampler::{GAUSSIAN, KDE, NONE, UNIFORM};

@@ -1,6 +1,9 @@
 //! The goal samplers: how an exploration draws its goals (paper Section 3, "goal sampling").
-//! The science crate pairs each entry with its implementation (`ugl_bench::goals`); the report
-//! reads names, order and style from here.
+//! The science crate pairs each entry with its implementation (`ugl_bench::goals::registry`);
+//! the report reads names, order and style from here. Others are added at run time with
+//! [`SamplerInfo::register`] and come after the built-in ones.
+
+use std::sync::RwLock;
 
 /// One goal sampler.
 #[derive(Debug, PartialEq)]
@@ -17,6 +20,8 @@ pub struct SamplerInfo {
     /// false for the engineered box and for no goals. The report names such a sampler with
     /// every learned condition ("KDE goals").
     pub learned: bool,
+    /// Whether it needs the goal space's prior (a learner whose `Prior` may declare one).
+    pub needs_prior: bool,
     /// Colour (RGB) where samplers are what a figure compares (Okabe–Ito; KDE and Gaussian
     /// differ in greyscale too).
     pub colour: [u8; 3],
@@ -31,6 +36,7 @@ pub static NONE: SamplerInfo = SamplerInfo {
     description: "no goals (random parameter exploration)",
     draws_goals: false,
     learned: false,
+    needs_prior: false,
     colour: [0x77, 0x77, 0x77],
     marker: 3,
 };
@@ -41,6 +47,7 @@ pub static UNIFORM: SamplerInfo = SamplerInfo {
     description: "uniform in the engineered features' box (RGE-EFR)",
     draws_goals: true,
     learned: false,
+    needs_prior: false,
     colour: [0x77, 0x77, 0x77],
     marker: 3,
 };
@@ -51,6 +58,7 @@ pub static KDE: SamplerInfo = SamplerInfo {
     description: "a Gaussian kernel density estimate of the training latents (the paper's default)",
     draws_goals: true,
     learned: true,
+    needs_prior: false,
     colour: [0x00, 0x72, 0xB2],
     marker: 0,
 };
@@ -61,17 +69,59 @@ pub static GAUSSIAN: SamplerInfo = SamplerInfo {
     description: "the isotropic prior N(0, I) of a goal space that has one (VAE, RFVAE, β-VAE)",
     draws_goals: true,
     learned: true,
+    needs_prior: true,
     colour: [0xD5, 0x5E, 0x00],
     marker: 2,
 };
 
-/// Every goal sampler, in the report's order.
+/// The goal samplers of this crate, in the report's order.
 pub static SAMPLERS: [&SamplerInfo; 4] = [&NONE, &UNIFORM, &KDE, &GAUSSIAN];
 
+/// The samplers registered at run time, in registration order.
+static REGISTRY: RwLock<Vec<&'static SamplerInfo>> = RwLock::new(Vec::new());
+
+/// Why a sampler cannot be registered.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SamplerInfoError {
+    /// Its name is taken by another sampler.
+    #[error("goal sampler '{0}' is already registered")]
+    Duplicate(&'static str),
+    /// Its name cannot be written in run ids and file names.
+    #[error("goal sampler '{0}': a name is lower-case letters, digits and '-'")]
+    BadName(&'static str),
+}
+
 impl SamplerInfo {
-    /// Every sampler, in the registry's order.
+    /// Every sampler, in the registry's order: the built-in ones, then the registered ones.
     pub fn all() -> impl Iterator<Item = &'static SamplerInfo> {
-        SAMPLERS.iter().copied()
+        let registered = REGISTRY.read().unwrap_or_else(|e| e.into_inner()).clone();
+        SAMPLERS.iter().copied().chain(registered)
+    }
+
+    /// Add a sampler to the registry (after the built-in ones). Registering the same
+    /// declaration twice is a no-op; another one under a taken name is refused.
+    pub fn register(info: &'static SamplerInfo) -> Result<(), SamplerInfoError> {
+        if info.name.is_empty()
+            || !info
+                .name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+        {
+            return Err(SamplerInfoError::BadName(info.name));
+        }
+        let mut registered = REGISTRY.write().unwrap_or_else(|e| e.into_inner());
+        match SAMPLERS
+            .iter()
+            .chain(registered.iter())
+            .find(|s| s.name == info.name)
+        {
+            Some(s) if std::ptr::eq(*s, info) => Ok(()),
+            Some(_) => Err(SamplerInfoError::Duplicate(info.name)),
+            None => {
+                registered.push(info);
+                Ok(())
+            }
+        }
     }
 
     /// The sampler called `name`.

@@ -119,7 +119,7 @@ fn default_variants() -> Vec<Variant> {
 }
 
 fn default_samplers() -> Vec<SamplerKind> {
-    vec![SamplerKind::Kde]
+    vec![SamplerKind::KDE]
 }
 
 fn default_latents() -> Vec<LatentSize> {
@@ -370,14 +370,10 @@ impl CampaignConfig {
         if self.matrix.samplers.is_empty() {
             return Err("matrix.samplers must name at least one goal sampler".into());
         }
-        if let Some(s) = self
-            .matrix
-            .samplers
-            .iter()
-            .find(|s| !matches!(s, SamplerKind::Kde | SamplerKind::Gaussian))
-        {
+        if let Some(s) = self.matrix.samplers.iter().find(|s| !s.is_learned()) {
             return Err(format!(
-                "matrix.samplers: '{s}' is not a sampler of learned goal spaces (kde, gaussian)"
+                "matrix.samplers: '{s}' is not a sampler of learned goal spaces ({})",
+                SamplerKind::learned_names()
             ));
         }
         if self.matrix.latents.is_empty() {

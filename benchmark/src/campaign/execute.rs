@@ -13,7 +13,7 @@ use crate::explore::{
     Algo, EngineeredGoals, EngineeredSpace, ExplorationLog, ExploreConfig, Explorer, GoalModule,
     GoalSource, GoalSpaceKind, LearnedSpace, Learner, Modules, Rpe, SamplerKind, goal_modules,
 };
-use crate::goals::{GaussianGoals, GoalSampler, KdeGoals};
+use crate::goals::{GoalSampler, TrainingLatents};
 use crate::repr::{GaussianPrior, Latents, ReprError};
 use crate::seed::{Component, run_seed, stream};
 use ugl_types::RunDiscovery;
@@ -132,37 +132,29 @@ impl GoalSource for LearnedGoals<'_> {
     /// of the training encodings; the prior's marginal).
     fn sampler(&self, dims: Option<&[usize]>) -> Result<Box<dyn GoalSampler>, ReprError> {
         let train = self.train;
-        Ok(match self.sampler {
-            SamplerKind::Kde => Box::new(match dims {
-                None => KdeGoals::fit(train)?,
-                Some(dims) => KdeGoals::fit(&Latents {
-                    n: train.n,
-                    latents: dims.len(),
-                    data: (0..train.n)
-                        .flat_map(|i| dims.iter().map(move |&k| train.row(i)[k]))
-                        .collect(),
-                })?,
-            }),
-            SamplerKind::Gaussian => match &self.prior {
-                Some(prior) => Box::new(GaussianGoals::from_prior(&match dims {
-                    None => prior.clone(),
-                    Some(dims) => GaussianPrior {
-                        mean: dims.iter().map(|&k| prior.mean[k]).collect(),
-                        std: dims.iter().map(|&k| prior.std[k]).collect(),
-                    },
-                })),
-                None => {
-                    return Err(ReprError::InvalidInput(format!(
-                        "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
-                        self.algo
-                    )));
-                }
-            },
-            other => {
-                return Err(ReprError::InvalidInput(format!(
-                    "sampler {other} is not for learned goal spaces"
-                )));
-            }
+        let algo = self.algo.to_string();
+        let Some(dims) = dims else {
+            return self.sampler.build(&TrainingLatents {
+                latents: train,
+                prior: self.prior.as_ref(),
+                algo: &algo,
+            });
+        };
+        let module = Latents {
+            n: train.n,
+            latents: dims.len(),
+            data: (0..train.n)
+                .flat_map(|i| dims.iter().map(move |&k| train.row(i)[k]))
+                .collect(),
+        };
+        let prior = self.prior.as_ref().map(|p| GaussianPrior {
+            mean: dims.iter().map(|&k| p.mean[k]).collect(),
+            std: dims.iter().map(|&k| p.std[k]).collect(),
+        });
+        self.sampler.build(&TrainingLatents {
+            latents: &module,
+            prior: prior.as_ref(),
+            algo: &algo,
         })
     }
 }

@@ -31,9 +31,9 @@ impl RunSpec {
     /// A baseline run (RPE or RGE-EFR).
     pub fn baseline(env: EnvKind, algo: Algo, seed: u64) -> Self {
         let sampler = if algo == Algo::RPE {
-            SamplerKind::None
+            SamplerKind::NONE
         } else {
-            SamplerKind::Uniform
+            SamplerKind::UNIFORM
         };
         RunSpec {
             env,
@@ -226,7 +226,7 @@ pub fn plan(cfg: &CampaignConfig) -> Vec<RunSpec> {
             };
             for &variant in variants {
                 for &sampler in &cfg.matrix.samplers {
-                    if sampler == SamplerKind::Gaussian && !learner.may_have_prior() {
+                    if sampler.needs_prior() && !learner.may_have_prior() {
                         continue;
                     }
                     for l in &cfg.matrix.latents {
@@ -337,7 +337,7 @@ mod tests {
         let r = RunSpec::learned(
             EnvKind::ARMBALL,
             Algo::rge(Learner::by_name("pca").unwrap()),
-            SamplerKind::Kde,
+            SamplerKind::KDE,
             10,
             Variant::Corrected,
             2,
@@ -349,7 +349,7 @@ mod tests {
         );
         assert_eq!(r.run_id(), "armball.rge-pca.kde.l10.s2");
         let g = RunSpec {
-            sampler: SamplerKind::Gaussian,
+            sampler: SamplerKind::GAUSSIAN,
             ..r.clone()
         };
         assert_eq!(
@@ -359,7 +359,7 @@ mod tests {
         let v = RunSpec::learned(
             EnvKind::ARMBALL,
             Algo::rge(Learner::by_name("vae").unwrap()),
-            SamplerKind::Gaussian,
+            SamplerKind::GAUSSIAN,
             2,
             Variant::Corrected,
             0,
@@ -383,7 +383,7 @@ mod tests {
             RunSpec::learned(
                 EnvKind::ARMBALL,
                 Algo::rge(Learner::by_name("ae").unwrap()),
-                SamplerKind::Kde,
+                SamplerKind::KDE,
                 2,
                 Variant::Corrected,
                 0

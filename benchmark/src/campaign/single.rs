@@ -64,9 +64,10 @@ impl RunRequest {
         let spec = match self.algo.learner() {
             None => RunSpec::baseline(self.env, self.algo, self.seed),
             Some(_) => {
-                if !matches!(self.sampler, SamplerKind::Kde | SamplerKind::Gaussian) {
+                if !self.sampler.is_learned() {
                     return Err(format!(
-                        "--sampler must be kde or gaussian for {}",
+                        "--sampler must be {} for {}",
+                        SamplerKind::learned_names().replace(", ", " or "),
                         self.algo
                     ));
                 }
@@ -84,9 +85,7 @@ impl RunRequest {
         };
         let spec = spec.with_exploration(self.exploration);
         check_variant(self.algo, self.variant)?;
-        if self.sampler == SamplerKind::Gaussian
-            && !self.algo.learner().is_some_and(|l| l.may_have_prior())
-        {
+        if self.sampler.needs_prior() && !self.algo.learner().is_some_and(|l| l.may_have_prior()) {
             let with_prior: Vec<&str> = Learner::all()
                 .filter(|l| l.may_have_prior())
                 .map(|l| l.entry().algo)
@@ -297,9 +296,9 @@ pub fn compare_campaign(
     cfg.campaign.label = None;
     cfg.matrix.algos = vec![algo];
     if algo.learner().is_some_and(Learner::is_external) && !gaussian {
-        cfg.matrix.samplers.retain(|s| *s != SamplerKind::Gaussian);
+        cfg.matrix.samplers.retain(|s| !s.needs_prior());
         if cfg.matrix.samplers.is_empty() {
-            cfg.matrix.samplers = vec![SamplerKind::Kde];
+            cfg.matrix.samplers = vec![SamplerKind::KDE];
         }
     }
     Ok((cfg, base))
@@ -321,7 +320,7 @@ mod tests {
         RunRequest {
             env: EnvKind::ARMBALL,
             algo: algo.parse().unwrap(),
-            sampler: SamplerKind::Kde,
+            sampler: SamplerKind::KDE,
             variant: None,
             latents: 2,
             images: None,
@@ -355,7 +354,7 @@ mod tests {
         );
         assert!(
             err(RunRequest {
-                sampler: SamplerKind::Gaussian,
+                sampler: SamplerKind::GAUSSIAN,
                 ..request("rge-isomap")
             })
             .contains("prior")
@@ -429,7 +428,7 @@ mod tests {
         assert_eq!(c.matrix.algos, vec!["rge-pca-centred".parse().unwrap()]);
         // An external program: no Gaussian goals unless asked.
         let (c, _) = compare_campaign(cfg(), "mine", Some("python3 m.py"), false).unwrap();
-        assert_eq!(c.matrix.samplers, vec![SamplerKind::Kde]);
+        assert_eq!(c.matrix.samplers, vec![SamplerKind::KDE]);
         assert_eq!(c.learners.external().unwrap().name, "mine");
         let (c, _) = compare_campaign(cfg(), "mine", Some("python3 m.py"), true).unwrap();
         assert_eq!(c.matrix.samplers.len(), 2);

@@ -359,52 +359,8 @@ impl std::str::FromStr for Algo {
     }
 }
 
-/// How goals are drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SamplerKind {
-    /// No goals (RPE).
-    None,
-    /// Uniform in the engineered box (RGE-EFR).
-    Uniform,
-    /// Gaussian KDE of the training latents (the paper's default for RGE-REP).
-    Kde,
-    /// Isotropic standard Gaussian, N(0, I) (the paper's "GP" / `--sampling=normal`).
-    Gaussian,
-}
-
-impl SamplerKind {
-    /// Name in results.
-    pub fn name(self) -> &'static str {
-        match self {
-            SamplerKind::None => "none",
-            SamplerKind::Uniform => "uniform",
-            SamplerKind::Kde => "kde",
-            SamplerKind::Gaussian => "gaussian",
-        }
-    }
-}
-
-impl std::fmt::Display for SamplerKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for SamplerKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "kde" => Ok(SamplerKind::Kde),
-            "gaussian" => Ok(SamplerKind::Gaussian),
-            "uniform" => Ok(SamplerKind::Uniform),
-            "none" => Ok(SamplerKind::None),
-            _ => Err(format!(
-                "unknown goal sampler '{s}' (expected kde or gaussian)"
-            )),
-        }
-    }
-}
+/// How goals are drawn (the goal-sampler registry's handle).
+pub use crate::goals::SamplerKind;
 
 #[cfg(test)]
 mod tests {

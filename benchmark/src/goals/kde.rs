@@ -91,6 +91,13 @@ impl KdeGoals {
     }
 }
 
+/// Its registry entry's builder: the KDE of the training latents.
+pub(crate) fn for_learned(
+    space: &super::TrainingLatents<'_>,
+) -> Result<Box<dyn GoalSampler>, ReprError> {
+    Ok(Box::new(KdeGoals::fit(space.latents)?))
+}
+
 impl GoalSampler for KdeGoals {
     fn dim(&self) -> usize {
         self.data.latents
@@ -105,7 +112,7 @@ impl GoalSampler for KdeGoals {
         }
     }
     fn name(&self) -> &'static str {
-        "kde"
+        ugl_types::samplers::KDE.name
     }
 }
 

@@ -3,10 +3,12 @@
 
 pub mod kde;
 pub mod prior;
+pub mod registry;
 pub mod uniform;
 
 pub use kde::KdeGoals;
 pub use prior::GaussianGoals;
+pub use registry::{SamplerEntry, SamplerKind, TrainingLatents, register};
 pub use uniform::UniformGoals;
 
 use crate::seed::Stream;

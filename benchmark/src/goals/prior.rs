@@ -35,6 +35,19 @@ impl GaussianGoals {
     }
 }
 
+/// Its registry entry's builder: the goal space's prior, which the learner must declare.
+pub(crate) fn for_learned(
+    space: &super::TrainingLatents<'_>,
+) -> Result<Box<dyn GoalSampler>, crate::repr::ReprError> {
+    match space.prior {
+        Some(prior) => Ok(Box::new(GaussianGoals::from_prior(prior))),
+        None => Err(crate::repr::ReprError::InvalidInput(format!(
+            "the gaussian sampler needs a goal-space prior, and {} has none (use kde)",
+            space.algo
+        ))),
+    }
+}
+
 impl GoalSampler for GaussianGoals {
     fn dim(&self) -> usize {
         self.dim
@@ -46,6 +59,6 @@ impl GoalSampler for GaussianGoals {
         }
     }
     fn name(&self) -> &'static str {
-        "gaussian"
+        ugl_types::samplers::GAUSSIAN.name
     }
 }

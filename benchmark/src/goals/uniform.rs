@@ -34,6 +34,6 @@ impl GoalSampler for UniformGoals {
         }
     }
     fn name(&self) -> &'static str {
-        "uniform"
+        ugl_types::samplers::UNIFORM.name
     }
 }
