@@ -250,6 +250,7 @@ mod tests {
             sampler: "kde".into(),
             latents: 10,
             variant: "faithful".into(),
+            tag: None,
         };
         let point = CurvePoint {
             epoch: 100,

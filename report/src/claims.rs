@@ -230,34 +230,18 @@ pub struct TaggedObservations<'a> {
     pub parts: Vec<(Option<String>, &'a [ConditionSummary], &'a Store)>,
 }
 
-impl TaggedObservations<'_> {
-    fn tagged(tag: &Option<String>, key: &ConditionKey) -> ConditionKey {
-        match tag {
-            Some(t) => ConditionKey {
-                algo: format!("{}@{t}", key.algo).into(),
-                ..key.clone()
-            },
-            None => key.clone(),
-        }
-    }
-}
-
 impl Observations for TaggedObservations<'_> {
     fn keys(&self) -> Vec<ConditionKey> {
         self.parts
             .iter()
-            .flat_map(|(tag, conds, _)| conds.iter().map(|c| Self::tagged(tag, &c.key)))
+            .flat_map(|(tag, conds, _)| conds.iter().map(|c| c.key.tagged(tag.as_deref())))
             .collect()
     }
     fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
-        let tag = key.algo.split_once('@').map(|(_, t)| t.to_string());
-        let plain = ConditionKey {
-            algo: untagged(&key.algo).to_string().into(),
-            ..key.clone()
-        };
+        let plain = key.tagged(None);
         self.parts
             .iter()
-            .filter(|(t, _, _)| *t == tag)
+            .filter(|(t, _, _)| *t == key.tag)
             .find_map(|(_, conds, store)| {
                 let c = conds.iter().find(|c| c.key == plain)?;
                 Some(seed_values(store, c, statistic))
@@ -550,7 +534,7 @@ impl Selector {
             set.as_ref().is_none_or(|s| s.iter().any(|x| x == v))
         };
         within(&self.env, &key.env)
-            && within(&self.algo, &key.algo)
+            && within(&self.algo, &key.tagged_algo())
             && within(&self.sampler, &key.sampler)
             && within(&self.variant, &key.variant)
             && match &self.latents {
@@ -564,17 +548,12 @@ impl Selector {
 fn same_on(fields: &[Field], a: &ConditionKey, b: &ConditionKey) -> bool {
     fields.iter().all(|f| match f {
         Field::Env => a.env == b.env,
-        Field::Algo => a.algo == b.algo,
+        Field::Algo => a.algo == b.algo && a.tag == b.tag,
         Field::Sampler => a.sampler == b.sampler,
         Field::Latents => a.latents == b.latents,
         Field::Variant => a.variant == b.variant,
-        Field::Learner => untagged(&a.algo) == untagged(&b.algo),
+        Field::Learner => a.algo == b.algo,
     })
-}
-
-/// An algorithm without its variant campaign's tag (`rge-vae@untrained` → `rge-vae`).
-pub fn untagged(algo: &str) -> &str {
-    algo.split_once('@').map_or(algo, |(a, _)| a)
 }
 
 /// Reads and validates `claims.toml`: any problem is a [`ReportError::Invalid`] naming the file
@@ -1340,6 +1319,7 @@ pub(crate) mod tests {
             sampler: sampler.into(),
             latents,
             variant: variant.into(),
+            tag: None,
         };
         let mut keys = Vec::new();
         for (env, true_dim) in [("armball", 2), ("armarrow", 3)] {
@@ -1471,13 +1451,19 @@ pub(crate) mod tests {
         assert_eq!(Verdict::combine([]), Inconclusive);
     }
 
+    /// A key; `ALGO@TAG` is the condition `ALGO` of the campaign tagged `TAG`.
     fn key(env: &str, algo: &str, sampler: &str, latents: i64, variant: &str) -> ConditionKey {
+        let (algo, tag) = match algo.split_once('@') {
+            Some((a, t)) => (a, Some(t.to_string())),
+            None => (algo, None),
+        };
         ConditionKey {
             env: env.into(),
             algo: algo.into(),
             sampler: sampler.into(),
             latents,
             variant: variant.into(),
+            tag,
         }
     }
 

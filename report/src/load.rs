@@ -414,6 +414,7 @@ pub fn load_run(stem: &Path, campaign: String) -> Result<Run, ReportError> {
         sampler: c.constant_str(curve::SAMPLER)?.into(),
         latents: c.constant_i64(curve::LATENTS)?,
         variant: c.constant_str(curve::VARIANT)?.into(),
+        tag: None,
     };
     let seed = c.constant_i64(curve::SEED)?;
     let epoch = c.i64s(curve::EPOCH)?;
@@ -821,6 +822,7 @@ mod tests {
             sampler: "kde".into(),
             latents: 10,
             variant: variant.into(),
+            tag: None,
         }
     }
 

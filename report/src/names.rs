@@ -94,7 +94,7 @@ pub fn object_word(env: &str) -> &'static str {
 
 /// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.
 pub fn describe_key(k: &ConditionKey) -> String {
-    let mut s = condition_name(&k.algo, &k.variant);
+    let mut s = condition_name(&k.tagged_algo(), &k.variant);
     if k.sampler.is_learned() {
         s.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
     }

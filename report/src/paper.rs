@@ -157,6 +157,7 @@ mod tests {
             sampler: sampler.into(),
             latents,
             variant: "none".into(),
+            tag: None,
         }
     }
 

@@ -1,23 +1,8 @@
 //! The report speaks the vocabulary through `ugl-types`' registries, never by spelling it: outside
 //! test code, no string literal in `report/src` is the name of a learner, an algorithm, a goal
 //! sampler or a variant. (`none`, a sampler and a variant but also an English word, is left out.)
-//!
-//! The follow-up's page (`armballs/`) and its line styles (`figures/lines.rs`) still name its
-//! goal spaces; they are rewritten with the follow-up as its authors ran it.
 
 use std::path::{Path, PathBuf};
-
-/// Files or folders (relative to `report/src`) not yet held to the rule, with why.
-const NOT_YET: &[(&str, &str)] = &[
-    (
-        "armballs/",
-        "the follow-up's page, rewritten with the follow-up (issue 44)",
-    ),
-    (
-        "figures/lines.rs",
-        "the follow-up's line styles, rewritten with it",
-    ),
-];
 
 fn vocabulary() -> Vec<&'static str> {
     let mut v: Vec<&'static str> = Vec::new();
@@ -85,9 +70,6 @@ fn no_report_code_spells_a_learner_sampler_variant_or_algorithm() {
             .unwrap()
             .to_string_lossy()
             .replace('\\', "/");
-        if NOT_YET.iter().any(|(p, _)| rel.starts_with(p)) {
-            continue;
-        }
         let text = std::fs::read_to_string(f).unwrap();
         for (n, line) in production_lines(&text) {
             for lit in literals(line) {

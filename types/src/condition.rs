@@ -12,7 +12,7 @@ use crate::EnvSpec;
 use crate::learner::{self, LearnerInfo};
 use crate::manifest::Manifest;
 use crate::sampler::{self, SamplerInfo};
-use crate::strategy::{self, StrategyInfo, VariantInfo};
+use crate::strategy::{self, MODULAR_PREFIX, ModuleChoiceInfo, StrategyInfo, VariantInfo};
 
 macro_rules! name_type {
     ($(#[$doc:meta])* $name:ident) => {
@@ -158,6 +158,13 @@ impl Algo {
         StrategyInfo::by_algo(self).is_none()
     }
 
+    /// A modular algorithm's goal space (`efr` or a learner's name) and module choice
+    /// (`mge-vae-lp` → (`vae`, LP)); None for the other algorithms.
+    pub fn modular(&self) -> Option<(&str, &'static ModuleChoiceInfo)> {
+        let (space, choice) = self.strip_prefix(MODULAR_PREFIX)?.rsplit_once('-')?;
+        Some((space, ModuleChoiceInfo::by_name(choice)?))
+    }
+
     /// The paper's algorithms, in the report's order: its strategies (RPE, RGE-EFR), then the
     /// registry's learners that the paper evaluated.
     pub fn paper() -> Vec<Algo> {
@@ -277,10 +284,14 @@ pub struct ConditionKey {
     /// Latent dimension of the goal space (0 without latents).
     pub latents: i64,
     pub variant: Variant,
+    /// The tag of the campaign that varies the main one on its repetitions (`untrained` for
+    /// `paper-untrained`'s twins, `still` for the follow-up's still distractor); None for the
+    /// main campaign's conditions.
+    pub tag: Option<String>,
 }
 
 impl ConditionKey {
-    /// The condition of a run, from its manifest.
+    /// The condition of a run, from its manifest (untagged: its campaign tags it).
     pub fn of_manifest(m: &Manifest) -> ConditionKey {
         ConditionKey {
             env: m.env.clone(),
@@ -288,6 +299,24 @@ impl ConditionKey {
             sampler: m.sampler.as_str().into(),
             latents: m.latents as i64,
             variant: m.variant.as_str().into(),
+            tag: None,
+        }
+    }
+
+    /// The same condition in the campaign tagged `tag`.
+    pub fn tagged(&self, tag: Option<&str>) -> ConditionKey {
+        ConditionKey {
+            tag: tag.map(str::to_string),
+            ..self.clone()
+        }
+    }
+
+    /// The algorithm as a claims file selects it: `ALGO`, or `ALGO@TAG` for a tagged campaign's
+    /// condition (`rge-vae@untrained`).
+    pub fn tagged_algo(&self) -> String {
+        match &self.tag {
+            Some(t) => format!("{}@{t}", self.algo),
+            None => self.algo.to_string(),
         }
     }
 
@@ -295,7 +324,11 @@ impl ConditionKey {
     pub fn slug(&self) -> String {
         format!(
             "{}_{}_{}_{}_{}",
-            self.env, self.algo, self.sampler, self.latents, self.variant
+            self.env,
+            self.tagged_algo(),
+            self.sampler,
+            self.latents,
+            self.variant
         )
     }
 
@@ -323,6 +356,7 @@ impl ConditionKey {
             self.sampler.clone(),
             rank(strategy::VARIANTS.iter().map(|v| v.name), &self.variant),
             self.variant.clone(),
+            self.tag.clone(),
         )
     }
 }
@@ -369,6 +403,7 @@ mod tests {
             sampler: sampler.into(),
             latents: 10,
             variant: variant.into(),
+            tag: None,
         };
         let mut keys = [
             key("rge-mine", "kde", "none"),

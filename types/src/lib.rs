@@ -68,6 +68,7 @@ pub use paths::{
     run_paths, verify_files,
 };
 pub use strategy::{
-    CORRECTED, FAITHFUL, NO_VARIANT, RGE_EFR, RGE_EFR_POSITION, RPE, STRATEGIES, StrategyInfo,
-    VARIANTS, VariantInfo,
+    CORRECTED, ENGINEERED_SPACE, FAITHFUL, FLAT, LEARNING_PROGRESS, MODULAR_PREFIX, MODULE_CHOICES,
+    ModuleChoiceInfo, NO_VARIANT, RANDOM_MODULE, RGE_EFR, RGE_EFR_POSITION, RPE, STRATEGIES,
+    StrategyInfo, VARIANTS, VariantInfo,
 };

@@ -105,3 +105,56 @@ impl VariantInfo {
         VariantInfo::all().find(|v| v.name == name)
     }
 }
+
+/// How modular goal exploration (the follow-up paper) chooses the module of a goal: its
+/// algorithms are `mge-<space>-<choice>`, the space `efr` ([`ENGINEERED_SPACE`]) or a learner's.
+#[derive(Debug, PartialEq)]
+pub struct ModuleChoiceInfo {
+    /// Name in algorithm names (`lp`).
+    pub name: &'static str,
+    /// The follow-up's name of the strategy: `RGE` for one module holding every coordinate,
+    /// `MGE` otherwise.
+    pub strategy: &'static str,
+    /// Name in the report (`LP`).
+    pub display: &'static str,
+    /// One line for `--help` and the docs.
+    pub description: &'static str,
+}
+
+/// One module holding every coordinate: the follow-up's RGE.
+pub static FLAT: ModuleChoiceInfo = ModuleChoiceInfo {
+    name: "flat",
+    strategy: "RGE",
+    display: "flat",
+    description: "one module holding every coordinate (the follow-up's RGE)",
+};
+/// A module chosen uniformly.
+pub static RANDOM_MODULE: ModuleChoiceInfo = ModuleChoiceInfo {
+    name: "random",
+    strategy: "MGE",
+    display: "random",
+    description: "a module chosen uniformly",
+};
+/// A module chosen by learning progress.
+pub static LEARNING_PROGRESS: ModuleChoiceInfo = ModuleChoiceInfo {
+    name: "lp",
+    strategy: "MGE",
+    display: "LP",
+    description: "a module chosen by learning progress (epsilon-greedy on the interests)",
+};
+
+/// Every module choice, in the report's order.
+pub static MODULE_CHOICES: [&ModuleChoiceInfo; 3] = [&FLAT, &RANDOM_MODULE, &LEARNING_PROGRESS];
+
+/// The engineered features as a modular goal space's name (`mge-efr-lp`), and its display name.
+pub const ENGINEERED_SPACE: (&str, &str) = ("efr", "EFR");
+
+/// The prefix of the modular algorithms' names (`mge-vae-lp`).
+pub const MODULAR_PREFIX: &str = "mge-";
+
+impl ModuleChoiceInfo {
+    /// The module choice called `name`.
+    pub fn by_name(name: &str) -> Option<&'static ModuleChoiceInfo> {
+        MODULE_CHOICES.iter().copied().find(|c| c.name == name)
+    }
+}

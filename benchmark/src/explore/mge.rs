@@ -56,9 +56,9 @@ impl Modules {
     /// Name in algorithm names (`mge-vae-lp`).
     pub fn name(self) -> &'static str {
         match self {
-            Modules::Flat => "flat",
-            Modules::Random => "random",
-            Modules::Progress => "lp",
+            Modules::Flat => ugl_types::FLAT.name,
+            Modules::Random => ugl_types::RANDOM_MODULE.name,
+            Modules::Progress => ugl_types::LEARNING_PROGRESS.name,
         }
     }
 }

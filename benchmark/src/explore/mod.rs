@@ -266,7 +266,7 @@ impl Algo {
     pub fn name(self) -> Cow<'static, str> {
         let space = match self.space {
             GoalSpaceKind::None => "",
-            GoalSpaceKind::Engineered => "efr",
+            GoalSpaceKind::Engineered => ugl_types::ENGINEERED_SPACE.0,
             GoalSpaceKind::EngineeredPosition => "efr-position",
             GoalSpaceKind::Learned(l) => l.name(),
         };
@@ -275,7 +275,9 @@ impl Algo {
             (Strategy::Rge, GoalSpaceKind::Learned(l)) => l.entry().algo.into(),
             (Strategy::Rge, GoalSpaceKind::EngineeredPosition) => "rge-efr-position".into(),
             (Strategy::Rge, _) => "rge-efr".into(),
-            (Strategy::Mge(m), _) => format!("mge-{space}-{}", m.name()).into(),
+            (Strategy::Mge(m), _) => {
+                format!("{}{space}-{}", ugl_types::MODULAR_PREFIX, m.name()).into()
+            }
         }
     }
 

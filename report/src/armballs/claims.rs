@@ -5,7 +5,7 @@
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use super::labels::{f3, tag};
+use super::labels::f3;
 use super::runs::{FollowupRun, display, role};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
@@ -27,10 +27,9 @@ pub struct FollowupObservations<'a> {
 fn key(r: &FollowupRun) -> ConditionKey {
     ConditionKey {
         env: ENV.into(),
-        algo: r.base.clone().into(),
-        sampler: r.sampler.clone().into(),
-        latents: r.latents,
+        // The follow-up's conditions have no variant.
         variant: String::new().into(),
+        ..r.key.clone()
     }
 }
 
@@ -38,8 +37,8 @@ fn key(r: &FollowupRun) -> ConditionKey {
 fn name(runs: &[FollowupRun], k: &ConditionKey) -> String {
     runs.iter()
         .find(|r| key(r) == *k)
-        .map(|r| display(runs, &r.algo))
-        .unwrap_or_else(|| k.algo.to_string())
+        .map(|r| display(runs, &r.cond))
+        .unwrap_or_else(|| k.tagged_algo())
 }
 
 impl Observations for FollowupObservations<'_> {
@@ -114,7 +113,7 @@ fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
         let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
             continue;
         };
-        if l != learner || !seen.insert((tag(&r.algo).to_string(), r.seed, r.latents)) {
+        if l != learner || !seen.insert((r.cond.tag().to_string(), r.seed, r.key.latents)) {
             continue;
         }
         n += 1;
@@ -230,15 +229,25 @@ mod tests {
     use crate::claims::{evaluate_on, parse_claims};
 
     fn run(algo: &str, seed: i64, ratio: f64) -> FollowupRun {
-        FollowupRun {
-            algo: algo.into(),
-            base: algo.into(),
+        let (name, tag) = match algo.split_once('@') {
+            Some((a, t)) => (a, Some(t.to_string())),
+            None => (algo, None),
+        };
+        let key = ConditionKey {
+            env: ENV.into(),
+            algo: name.into(),
             sampler: if algo == "rpe" { "none" } else { "gaussian" }.into(),
             latents: if algo.contains("efr") || algo == "rpe" {
                 0
             } else {
                 10
             },
+            variant: "none".into(),
+            tag,
+        };
+        FollowupRun {
+            cond: super::super::labels::Condition::of(&key, false),
+            key,
             seed,
             epochs: vec![100],
             ball_coverage: vec![{
@@ -276,8 +285,9 @@ mod tests {
             runs.push(run("mge-efr-lp", s, 0.30 + 0.002 * s as f64));
             runs.push(run("mge-efr-flat@still", s, 0.35 + 0.002 * s as f64));
         }
+        let still = runs.iter().find(|r| r.cond.tag() == "still").unwrap();
         assert_eq!(
-            display(&runs, "mge-efr-flat@still"),
+            display(&runs, &still.cond),
             "RGE-EFR (flat), still distractor"
         );
         let file = committed();
@@ -291,7 +301,7 @@ mod tests {
             get("C6")
                 .comparisons
                 .iter()
-                .all(|c| !c.subject.algo.contains('@'))
+                .all(|c| c.subject.tag.is_none())
         );
         assert!(
             verdict(get("C1")).contains("not run"),
@@ -301,7 +311,7 @@ mod tests {
         assert!(verdict(get("C1")).starts_with("premise not met"));
         // Swap: the flat one wins.
         for r in &mut runs {
-            if r.algo == "mge-efr-flat" {
+            if r.key.algo == "mge-efr-flat" && r.key.tag.is_none() {
                 r.ball_coverage[0] *= 3.0;
             }
         }

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use plotters::style::RGBColor;
 
-use super::labels::{parts, tag};
+use super::labels::Condition;
 use super::runs::{FollowupRun, algos, ball_cells, display, of};
 use super::{COVERAGE_FIGURE, INTEREST_FIGURE};
 use crate::error::ReportError;
@@ -57,8 +57,8 @@ pub(super) fn draw_coverage(
     let requests: Vec<StyleRequest> = conditions
         .iter()
         .map(|a| {
-            let (space, choice) = parts(a);
-            followup_request(space, choice, tag(a))
+            let (space, choice) = a.parts();
+            followup_request(space, choice.map_or("", |c| c.name), a.tag())
         })
         .collect();
     let styles = assign_styles(&requests, 4.0, 2);
@@ -137,9 +137,9 @@ pub(super) fn draw_interest(
     runs: &[FollowupRun],
     fig_dir: &Path,
 ) -> Result<Option<FigureFile>, ReportError> {
-    let modular: Vec<String> = algos(runs)
+    let modular: Vec<Condition> = algos(runs)
         .into_iter()
-        .filter(|a| parts(a).1 == "lp")
+        .filter(|a| a.chooses(&ugl_types::LEARNING_PROGRESS))
         .collect();
     if modular.is_empty() {
         return Ok(None);
@@ -171,7 +171,7 @@ pub(super) fn draw_interest(
                     let label = rs
                         .iter()
                         .find_map(|r| r.modules.get(&m))
-                        .filter(|_| parts(a).0 == "efr")
+                        .filter(|_| a.engineered())
                         .map(|(n, _)| format!("module {m} ({n})"))
                         .unwrap_or_else(|| format!("module {m}"));
                     let mut pts: BTreeMap<i64, Vec<f64>> = BTreeMap::new();

@@ -1,87 +1,118 @@
-//! The follow-up's names for the algorithms, their order, and number formats.
-
+//! The follow-up's conditions, their names and order, and number formats.
 //!
-//! A condition of the page is `ALGO[@TAG][~SAMPLER~LATENTS]`: the algorithm, the tag of the
-//! variant campaign its runs come from (`mge-efr-flat@still`), and, when the campaigns ran one
-//! algorithm with several goal samplers or latent sizes, which one (`mge-vae-lp~kde~4`).
+//! A condition of the page is an algorithm, the tag of the variant campaign its runs come from
+//! (`still`), and, when the campaigns ran one algorithm with several goal samplers or latent
+//! sizes, which one: a [`Condition`], never a string to parse.
+
+use ugl_types::{Algo, ConditionKey, ENGINEERED_SPACE, MODULE_CHOICES, ModuleChoiceInfo, Sampler};
 
 use crate::names::{learner_name, sampler_name};
 
-/// `ALGO[@TAG]` and the `(sampler, latents)` suffix of a condition, if any.
-pub(super) fn split_condition(cond: &str) -> (&str, Option<(&str, &str)>) {
-    match cond.split_once('~') {
-        Some((base, rest)) => (base, rest.split_once('~')),
-        None => (cond, None),
-    }
+/// A condition of the follow-up's page.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Condition {
+    pub algo: Algo,
+    /// The variant campaign's tag (`still`), None for the main campaign's runs.
+    pub tag: Option<String>,
+    /// The goal sampler and latent size, where the campaigns ran this algorithm (and campaign)
+    /// with several: those runs are separate conditions, never pooled.
+    pub split: Option<(Sampler, i64)>,
 }
 
-/// The variant campaign's tag of a condition (`still` in `mge-efr-flat@still`), or "".
-pub(super) fn tag(cond: &str) -> &str {
-    let (base, _) = split_condition(cond);
-    base.split_once('@').map(|t| t.1).unwrap_or("")
-}
+impl Condition {
+    /// The condition of a run's key: pooled over samplers and latent sizes unless `split`.
+    pub fn of(key: &ConditionKey, split: bool) -> Condition {
+        Condition {
+            algo: key.algo.clone(),
+            tag: key.tag.clone(),
+            split: split.then(|| (key.sampler.clone(), key.latents)),
+        }
+    }
 
-/// `mge-<space>-<choice>[@tag][~…]` → (space, choice); `rpe` → ("", "").
-pub(super) fn parts(algo: &str) -> (&str, &str) {
-    let algo = algo.split(['@', '~']).next().unwrap_or(algo);
-    match algo.strip_prefix("mge-").and_then(|r| r.rsplit_once('-')) {
-        Some((space, choice)) => (space, choice),
-        None => ("", ""),
+    /// The variant campaign's tag, or "".
+    pub fn tag(&self) -> &str {
+        self.tag.as_deref().unwrap_or("")
     }
-}
 
-pub(super) fn algo_order(algo: &str) -> (String, usize, String, usize, String) {
-    let tag = tag(algo).to_string();
-    let suffix = split_condition(algo)
-        .1
-        .map(|(s, l)| format!("{s}~{l:0>6}"))
-        .unwrap_or_default();
-    let (space, choice) = parts(algo);
-    let s = match space {
-        "" => 0,
-        "efr" => 1,
-        "vae" => 2,
-        "bvae" => 3,
-        _ => 4,
-    };
-    let c = ["flat", "random", "lp"]
-        .iter()
-        .position(|x| *x == choice)
-        .unwrap_or(3);
-    (tag, s, space.to_string(), c, suffix)
-}
+    /// The modular goal space (`efr`, `vae`) and module choice; ("", None) for RPE.
+    pub fn parts(&self) -> (&str, Option<&'static ModuleChoiceInfo>) {
+        match self.algo.modular() {
+            Some((space, choice)) => (space, Some(choice)),
+            None => ("", None),
+        }
+    }
 
-/// `, KDE goals, 4 latents` for a condition that names its sampler and latent size, else "".
-pub(super) fn suffix_label(cond: &str) -> String {
-    match split_condition(cond).1 {
-        Some((sampler, latents)) => format!(", {} goals, {latents} latents", sampler_name(sampler)),
-        None => String::new(),
+    /// Whether its module choice is `choice`.
+    pub fn chooses(&self, choice: &ModuleChoiceInfo) -> bool {
+        self.parts().1.is_some_and(|c| c == choice)
     }
-}
 
-/// The follow-up's names: `RGE-EFR` (flat), `MGE-β-VAE (LP)`, `MGE-VAE (random)`, `RPE`; a
-/// variant's conditions (`ALGO@TAG`) keep their tag ([`display`] gives its declared label).
-pub fn label(algo: &str) -> String {
-    if let (base, Some(_)) = split_condition(algo) {
-        return format!("{}{}", label(base), suffix_label(algo));
+    /// Whether its goal space is the engineered features.
+    pub fn engineered(&self) -> bool {
+        self.parts().0 == ENGINEERED_SPACE.0
     }
-    if let Some((base, tag)) = algo.split_once('@') {
-        return format!("{}, {tag}", label(base));
+
+    /// The page's order: by campaign tag, goal space (none, the engineered features, the VAE,
+    /// the β-VAE, others), module choice, then sampler and latent size.
+    pub fn order(&self) -> impl Ord + use<> {
+        let (space, choice) = self.parts();
+        let spaces = [
+            "",
+            ENGINEERED_SPACE.0,
+            ugl_types::learners::VAE.name,
+            ugl_types::learners::BVAE.name,
+        ];
+        let s = spaces
+            .iter()
+            .position(|x| *x == space)
+            .unwrap_or(spaces.len());
+        let c = choice
+            .and_then(|c| MODULE_CHOICES.iter().position(|x| *x == c))
+            .unwrap_or(MODULE_CHOICES.len());
+        (
+            self.tag().to_string(),
+            s,
+            space.to_string(),
+            c,
+            self.split.clone(),
+        )
     }
-    if algo == "rpe" {
-        return "RPE".into();
+
+    /// The follow-up's name of the algorithm: `RGE-EFR (flat)`, `MGE-β-VAE (LP)`,
+    /// `MGE-VAE (random)`, `RPE`.
+    pub fn algo_label(&self) -> String {
+        match self.parts() {
+            (space, Some(choice)) => {
+                let space = if space == ENGINEERED_SPACE.0 {
+                    ENGINEERED_SPACE.1.to_string()
+                } else {
+                    learner_name(space)
+                };
+                format!("{}-{space} ({})", choice.strategy, choice.display)
+            }
+            _ => self.algo.display(),
+        }
     }
-    let (space, choice) = parts(algo);
-    let space = if space == "efr" {
-        "EFR".to_string()
-    } else {
-        learner_name(space)
-    };
-    match choice {
-        "flat" => format!("RGE-{space} (flat)"),
-        "random" => format!("MGE-{space} (random)"),
-        "lp" => format!("MGE-{space} (LP)"),
-        _ => algo.to_string(),
+
+    /// `, KDE goals, 4 latents` for a condition that names its sampler and latent size, else "".
+    pub fn suffix_label(&self) -> String {
+        match &self.split {
+            Some((sampler, latents)) => {
+                format!(", {} goals, {latents} latents", sampler_name(sampler))
+            }
+            None => String::new(),
+        }
+    }
+
+    /// Its name with the campaign's tag as the tag (`RGE-EFR (flat), still`); the page names a
+    /// tag by the label its campaign declares ([`super::runs::display`]).
+    pub fn label(&self) -> String {
+        let tag = self
+            .tag
+            .as_ref()
+            .map(|t| format!(", {t}"))
+            .unwrap_or_default();
+        format!("{}{tag}{}", self.algo_label(), self.suffix_label())
     }
 }
 
@@ -105,20 +136,39 @@ pub(super) fn f2(v: f64) -> String {
 mod tests {
     use super::*;
 
+    fn cond(algo: &str, tag: Option<&str>, split: Option<(&str, i64)>) -> Condition {
+        Condition {
+            algo: algo.into(),
+            tag: tag.map(String::from),
+            split: split.map(|(s, l)| (s.into(), l)),
+        }
+    }
+
     #[test]
     fn labels_follow_the_follow_up() {
-        assert_eq!(label("rpe"), "RPE");
-        assert_eq!(label("mge-efr-flat"), "RGE-EFR (flat)");
-        assert_eq!(label("mge-vae-lp"), "MGE-VAE (LP)");
-        assert!(label("mge-bvae-random").starts_with("MGE-"));
-        assert!(algo_order("mge-efr-lp") < algo_order("mge-vae-flat"));
-        assert_eq!(label("mge-efr-flat@still"), "RGE-EFR (flat), still");
+        assert_eq!(cond("rpe", None, None).label(), "RPE");
+        assert_eq!(cond("mge-efr-flat", None, None).label(), "RGE-EFR (flat)");
+        assert_eq!(cond("mge-vae-lp", None, None).label(), "MGE-VAE (LP)");
+        assert!(
+            cond("mge-bvae-random", None, None)
+                .label()
+                .starts_with("MGE-")
+        );
+        assert!(cond("mge-efr-lp", None, None).order() < cond("mge-vae-flat", None, None).order());
         assert_eq!(
-            label("mge-vae-lp~kde~4"),
+            cond("mge-efr-flat", Some("still"), None).label(),
+            "RGE-EFR (flat), still"
+        );
+        assert_eq!(
+            cond("mge-vae-lp", None, Some(("kde", 4))).label(),
             "MGE-VAE (LP), KDE goals, 4 latents"
         );
-        assert_eq!(tag("mge-vae-lp@still~kde~4"), "still");
-        assert_eq!(parts("mge-vae-lp@still~kde~4"), ("vae", "lp"));
-        assert!(algo_order("mge-vae-lp~kde~4") < algo_order("mge-vae-lp~kde~10"));
+        let c = cond("mge-vae-lp", Some("still"), Some(("kde", 4)));
+        assert_eq!((c.tag(), c.parts().0), ("still", "vae"));
+        assert!(c.chooses(&ugl_types::LEARNING_PROGRESS));
+        assert!(
+            cond("mge-vae-lp", None, Some(("kde", 4))).order()
+                < cond("mge-vae-lp", None, Some(("kde", 10))).order()
+        );
     }
 }

@@ -20,7 +20,7 @@ mod runs;
 use std::path::Path;
 
 pub use claims::{FILE as CLAIMS_FILE, FollowupObservations};
-pub use labels::label;
+pub use labels::Condition;
 pub use runs::{FollowupRun, load};
 
 use crate::campaigns::Campaign;
@@ -69,8 +69,9 @@ pub fn render(
     }
     runs::separate_conditions(&mut runs);
     runs.sort_by(|a, b| {
-        labels::algo_order(&a.algo)
-            .cmp(&labels::algo_order(&b.algo))
+        a.cond
+            .order()
+            .cmp(&b.cond.order())
             .then(a.seed.cmp(&b.seed))
     });
     if runs.is_empty() {
@@ -107,11 +108,17 @@ mod tests {
 
     fn run(algo: &str, sampler: &str, latents: i64, seed: i64, ratio: f64) -> FollowupRun {
         let (reachable, all) = runs::ball_cells();
-        FollowupRun {
+        let key = ugl_types::ConditionKey {
+            env: "armballs".into(),
             algo: algo.into(),
-            base: algo.into(),
             sampler: sampler.into(),
             latents,
+            variant: "none".into(),
+            tag: None,
+        };
+        FollowupRun {
+            cond: labels::Condition::of(&key, false),
+            key,
             seed,
             epochs: vec![100],
             ball_coverage: vec![ratio * all / reachable],
@@ -146,10 +153,11 @@ mod tests {
             }
         }
         runs::separate_conditions(&mut rs);
-        rs.sort_by_key(|r| labels::algo_order(&r.algo));
+        rs.sort_by_key(|r| r.cond.order());
         assert_eq!(runs::algos(&rs).len(), 5, "{:?}", runs::algos(&rs));
         assert!(
-            rs.iter().any(|r| r.algo == "rpe"),
+            rs.iter()
+                .any(|r| r.cond.algo == "rpe" && r.cond.split.is_none()),
             "an algorithm run one way keeps its name"
         );
         let campaign = Campaign {

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::labels::{f2, f3, parts, tag};
+use super::labels::{Condition, f2, f3};
 use super::runs::{
     ENCODES, FollowupRun, IGNORES, algos, ball_cells, ball_grid, display, of, ratios, role,
 };
@@ -42,8 +42,8 @@ pub(super) fn write(
             if !learners.contains(&l) {
                 learners.push(l);
             }
-            if !sizes.contains(&r.latents) {
-                sizes.push(r.latents);
+            if !sizes.contains(&r.key.latents) {
+                sizes.push(r.key.latents);
             }
         }
     }
@@ -138,9 +138,11 @@ pub(super) fn write(
     );
 
     // 2. Interest per module.
-    let lp: Vec<String> = algos(runs)
+    let lp: Vec<Condition> = algos(runs)
         .into_iter()
-        .filter(|a| parts(a).1 == "lp" || parts(a).1 == "random")
+        .filter(|a| {
+            a.chooses(&ugl_types::LEARNING_PROGRESS) || a.chooses(&ugl_types::RANDOM_MODULE)
+        })
         .collect();
     if !lp.is_empty() {
         let _ = writeln!(
@@ -187,7 +189,7 @@ pub(super) fn write(
                         objects.push(o);
                     }
                     if let Some((n, _)) = r.modules.get(&m)
-                        && parts(a).0 == "efr"
+                        && a.engineered()
                     {
                         name = n.clone();
                     }
@@ -230,10 +232,10 @@ pub(super) fn write(
             .filter(|r| r.per_latent.is_some())
             .filter(|r| {
                 seen.insert((
-                    tag(&r.algo).to_string(),
+                    r.cond.tag().to_string(),
                     r.learner.clone(),
                     r.seed,
-                    r.latents,
+                    r.key.latents,
                 ))
             })
             .collect()
@@ -267,12 +269,12 @@ pub(super) fn write(
             let _ = writeln!(
                 p,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                match (r.learner.as_deref().map(learner_name), tag(&r.algo)) {
+                match (r.learner.as_deref().map(learner_name), r.cond.tag()) {
                     (Some(l), "") => l,
                     (Some(l), t) => format!("{l}, {t}"),
                     (None, _) => String::new(),
                 } + &if several_sizes {
-                    format!(", {} latents", r.latents)
+                    format!(", {} latents", r.key.latents)
                 } else {
                     String::new()
                 },

@@ -7,16 +7,16 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::labels::{label, split_condition, suffix_label};
+use super::labels::Condition;
 use crate::campaigns::Campaign;
 use crate::error::ReportError;
-use crate::load::{Cols, INTEREST_SUFFIX, read_parquet};
+use crate::load::{Cols, ConditionKey, INTEREST_SUFFIX, read_parquet};
 use crate::stats::mean;
 use ugl_types::columns::{curve, interest};
 
 /// ArmBalls' ball's KL-coverage grid (the registry's).
 pub(super) fn ball_grid() -> ugl_types::KlcGrid {
-    ugl_types::EnvSpec::by_name("armballs")
+    ugl_types::EnvSpec::by_name(ugl_types::ARMBALLS.name)
         .expect("armballs is registered")
         .klc
 }
@@ -38,14 +38,11 @@ pub(super) const IGNORES: f64 = 0.1;
 /// One run of the campaign, as this section reads it.
 #[derive(Debug, Clone)]
 pub struct FollowupRun {
-    /// The page's condition (`labels`): `ALGO[@TAG]`, with `~SAMPLER~LATENTS` when the
-    /// campaigns ran this algorithm with several samplers or latent sizes
-    /// ([`separate_conditions`]).
-    pub algo: String,
-    /// `ALGO[@TAG]`.
-    pub base: String,
-    pub sampler: String,
-    pub latents: i64,
+    /// The run's condition, tagged with its variant campaign's tag.
+    pub key: ConditionKey,
+    /// The page's condition: the key pooled over samplers and latent sizes, unless the
+    /// campaigns ran this algorithm with several ([`separate_conditions`]).
+    pub cond: Condition,
     pub seed: i64,
     pub epochs: Vec<i64>,
     /// The controllable ball: cell coverage (of the 756 reachable cells) and KL-coverage.
@@ -97,8 +94,8 @@ impl FollowupRun {
 }
 
 /// Reads the campaign's runs. The runs of a variant campaign (`[campaign] variant_of`, e.g.
-/// `armballs-still`, a distractor that does not move, tag `still`) get the algorithm
-/// `ALGO@TAG`, and the label the campaign declares.
+/// `armballs-still`, a distractor that does not move, tag `still`) are tagged, and get the
+/// label the campaign declares.
 pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
     let mut out = Vec::new();
     let decl = &campaign.decl;
@@ -157,15 +154,10 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
                 Some((r2("ball")?, r2("distractor")?))
             });
         let (modules, interest) = load_interest(&run.curve_path)?;
-        let base = match tag {
-            Some(t) => format!("{}@{t}", run.key.algo),
-            None => run.key.algo.to_string(),
-        };
+        let key = run.key.tagged(tag);
         out.push(FollowupRun {
-            algo: base.clone(),
-            base,
-            sampler: run.key.sampler.to_string(),
-            latents: run.key.latents,
+            cond: Condition::of(&key, false),
+            key,
             seed: run.seed,
             epochs: order.iter().map(|&i| epochs[i]).collect(),
             ball_coverage: run.curve.iter().map(|p| p.coverage).collect(),
@@ -236,57 +228,57 @@ pub(super) fn load_interest(curve: &Path) -> Result<Interest, ReportError> {
     Ok((modules, points))
 }
 
-/// The name of the condition `algo` among `runs`: [`label`], with a variant campaign's tag
+/// The name of a condition among `runs`: [`Condition::label`], with a variant campaign's tag
 /// replaced by the label its campaign declares (`[campaign] label`: `still distractor`).
-pub(super) fn display(runs: &[FollowupRun], algo: &str) -> String {
-    let (base, _) = split_condition(algo);
-    let name = match base.split_once('@') {
-        Some((b, tag)) => {
-            let declared = runs
-                .iter()
-                .find(|r| r.algo == algo)
-                .and_then(|r| r.variant_label.clone());
-            format!("{}, {}", label(b), declared.as_deref().unwrap_or(tag))
-        }
-        None => label(base),
+pub(super) fn display(runs: &[FollowupRun], cond: &Condition) -> String {
+    let Some(tag) = &cond.tag else {
+        return cond.label();
     };
-    format!("{name}{}", suffix_label(algo))
+    let declared = runs
+        .iter()
+        .find(|r| r.cond == *cond)
+        .and_then(|r| r.variant_label.clone());
+    format!(
+        "{}, {}{}",
+        cond.algo_label(),
+        declared.as_deref().unwrap_or(tag),
+        cond.suffix_label()
+    )
 }
 
 /// Runs of one algorithm (and campaign) with several goal samplers or latent sizes are separate
-/// conditions, never pooled: their condition gets the suffix `~SAMPLER~LATENTS`.
+/// conditions, never pooled: their condition names the sampler and the latent size.
 pub(super) fn separate_conditions(runs: &mut [FollowupRun]) {
-    let mut variants: BTreeMap<String, BTreeSet<(String, i64)>> = BTreeMap::new();
+    let mut variants: BTreeMap<Condition, BTreeSet<(String, i64)>> = BTreeMap::new();
     for r in runs.iter() {
         variants
-            .entry(r.base.clone())
+            .entry(Condition::of(&r.key, false))
             .or_default()
-            .insert((r.sampler.clone(), r.latents));
+            .insert((r.key.sampler.to_string(), r.key.latents));
     }
     for r in runs.iter_mut() {
-        if variants[&r.base].len() > 1 {
-            r.algo = format!("{}~{}~{}", r.base, r.sampler, r.latents);
-        }
+        let split = variants[&Condition::of(&r.key, false)].len() > 1;
+        r.cond = Condition::of(&r.key, split);
     }
 }
 
-/// The algorithms of `runs`, each once, in the order of their first run.
-pub(super) fn algos(runs: &[FollowupRun]) -> Vec<String> {
-    let mut v: Vec<String> = Vec::new();
+/// The conditions of `runs`, each once, in the order of their first run.
+pub(super) fn algos(runs: &[FollowupRun]) -> Vec<Condition> {
+    let mut v: Vec<Condition> = Vec::new();
     for r in runs {
-        if !v.contains(&r.algo) {
-            v.push(r.algo.clone());
+        if !v.contains(&r.cond) {
+            v.push(r.cond.clone());
         }
     }
     v
 }
 
-pub(super) fn of<'a>(runs: &'a [FollowupRun], algo: &str) -> Vec<&'a FollowupRun> {
-    runs.iter().filter(|r| r.algo == algo).collect()
+pub(super) fn of<'a>(runs: &'a [FollowupRun], cond: &Condition) -> Vec<&'a FollowupRun> {
+    runs.iter().filter(|r| r.cond == *cond).collect()
 }
 
-pub(super) fn ratios(runs: &[FollowupRun], algo: &str) -> Vec<f64> {
-    of(runs, algo).iter().map(|r| r.final_ratio()).collect()
+pub(super) fn ratios(runs: &[FollowupRun], cond: &Condition) -> Vec<f64> {
+    of(runs, cond).iter().map(|r| r.final_ratio()).collect()
 }
 
 /// A latent's role from its two R²: `ball`, `distractor`, `both` (entangled) or `none`.

@@ -351,26 +351,29 @@ where
 /// [`super::assign_styles`] resolves what is left (two conditions of one variant campaign with
 /// the same choice, runs split by goal sampler or latent size).
 pub fn followup_request(space: &str, choice: &str, tag: &str) -> StyleRequest {
-    let own = match space {
-        "" => Some(RGBColor(0x00, 0x00, 0x00)),
-        "efr" => Some(RGBColor(0x00, 0x9E, 0x73)),
-        "vae" => Some(RGBColor(0x00, 0x72, 0xB2)),
-        "bvae" => Some(RGBColor(0xD5, 0x5E, 0x00)),
-        _ => None,
-    };
-    let dash = match choice {
-        "lp" => 0,
-        "flat" => 1,
-        "random" => 2,
-        _ => 3,
-    };
-    let marker = match space {
-        "" => 6,
-        "efr" => 1,
-        "vae" => 2,
-        "bvae" => 3,
-        _ => 0,
-    };
+    // (goal space, colour, marker): none (RPE), the engineered features, the VAE, the β-VAE.
+    let spaces = [
+        ("", RGBColor(0x00, 0x00, 0x00), 6),
+        (ugl_types::ENGINEERED_SPACE.0, RGBColor(0x00, 0x9E, 0x73), 1),
+        (ugl_types::learners::VAE.name, RGBColor(0x00, 0x72, 0xB2), 2),
+        (
+            ugl_types::learners::BVAE.name,
+            RGBColor(0xD5, 0x5E, 0x00),
+            3,
+        ),
+    ];
+    let known = spaces.iter().find(|s| s.0 == space);
+    let own = known.map(|s| s.1);
+    let marker = known.map_or(0, |s| s.2);
+    // Module choices: learning progress solid, flat dashed, random dotted, others long-dashed.
+    let dash = [
+        ugl_types::LEARNING_PROGRESS.name,
+        ugl_types::FLAT.name,
+        ugl_types::RANDOM_MODULE.name,
+    ]
+    .iter()
+    .position(|c| *c == choice)
+    .unwrap_or(3);
     let family = if tag.is_empty() {
         format!("space:{space}")
     } else {

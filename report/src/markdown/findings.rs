@@ -101,10 +101,10 @@ fn reference_levels(comparisons: &[Comparison]) -> String {
     let Some(first) = comparisons.first() else {
         return String::new();
     };
-    if comparisons
-        .iter()
-        .any(|c| c.reference.algo != first.reference.algo || c.reference.env != first.reference.env)
-    {
+    if comparisons.iter().any(|c| {
+        c.reference.tagged_algo() != first.reference.tagged_algo()
+            || c.reference.env != first.reference.env
+    }) {
         return String::new();
     }
     let mut seen: Vec<Statistic> = Vec::new();
@@ -121,7 +121,7 @@ fn reference_levels(comparisons: &[Comparison]) -> String {
     }
     format!(
         " ({}: {})",
-        condition_name(&first.reference.algo, &first.reference.variant),
+        condition_name(&first.reference.tagged_algo(), &first.reference.variant),
         parts.join(", ")
     )
 }

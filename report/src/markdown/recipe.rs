@@ -388,6 +388,7 @@ mod tests {
                 sampler: "kde".into(),
                 latents: 10,
                 variant: "faithful".into(),
+                tag: None,
             },
             seed: 0,
             curve: vec![CurvePoint {
