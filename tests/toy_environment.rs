@@ -3,13 +3,16 @@
 //! line (`ugl run`, `ugl campaign`, `ugl report`) in this process, as a program that adds its
 //! own environment would. Nothing outside this file knows it.
 
-use std::path::Path;
+#[path = "common/in_process.rs"]
+mod in_process;
+
 use std::process::ExitCode;
 
+use in_process::{manifest, ok, p, ugl};
 use ugl_bench::env::render::render_ball_into;
 use ugl_bench::env::{EnvConfig, EnvEntry, EnvKind, Environment, PARAMS, Rollout, dmp, register};
 use ugl_bench::seed::Stream;
-use ugl_types::{DISK, EnvSpec, Manifest, ObjectSpec};
+use ugl_types::{DISK, EnvSpec, ObjectSpec};
 
 /// The declaration the report and the command line read.
 static SPEC: EnvSpec = EnvSpec {
@@ -77,22 +80,6 @@ impl Environment for ArmReach {
     fn render_into(&self, state: &[f64], out: &mut [f32]) {
         render_ball_into(state[0], state[1], out);
     }
-}
-
-fn ugl(args: &[&str]) -> ExitCode {
-    ugl::main_with(std::iter::once("ugl").chain(args.iter().copied()))
-}
-
-fn ok(args: &[&str]) {
-    assert_eq!(ugl(args), ExitCode::SUCCESS, "ugl {}", args.join(" "));
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-fn manifest(path: &Path) -> Manifest {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]

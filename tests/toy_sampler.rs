@@ -3,14 +3,17 @@
 //! command line (`ugl run`, `ugl campaign`, `ugl report`) in this process, as a program that
 //! adds its own sampler would. Nothing outside this file knows it.
 
-use std::path::Path;
+#[path = "common/in_process.rs"]
+mod in_process;
+
 use std::process::ExitCode;
 
+use in_process::{manifest, ok, p, ugl};
 use rand::RngExt;
 use ugl_bench::goals::{GoalSampler, SamplerEntry, TrainingLatents, register};
 use ugl_bench::repr::ReprError;
 use ugl_bench::seed::Stream;
-use ugl_types::{Manifest, SamplerInfo};
+use ugl_types::SamplerInfo;
 
 /// The description the report and the command line read.
 static INFO: SamplerInfo = SamplerInfo {
@@ -64,22 +67,6 @@ impl GoalSampler for BoxGoals {
     fn name(&self) -> &'static str {
         INFO.name
     }
-}
-
-fn ugl(args: &[&str]) -> ExitCode {
-    ugl::main_with(std::iter::once("ugl").chain(args.iter().copied()))
-}
-
-fn ok(args: &[&str]) {
-    assert_eq!(ugl(args), ExitCode::SUCCESS, "ugl {}", args.join(" "));
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-fn manifest(path: &Path) -> Manifest {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]
