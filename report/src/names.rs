@@ -92,9 +92,18 @@ pub fn object_word(env: &str) -> &'static str {
     ugl_types::EnvSpec::by_name(env).map_or("object", |e| e.controllable_object())
 }
 
+/// [`condition_name`] of a key, with its campaign's tag: `RGE-VAE (faithful), untrained`.
+pub fn tagged_condition_name(k: &ConditionKey) -> String {
+    let s = condition_name(&k.algo, &k.variant);
+    match &k.tag {
+        Some(t) => format!("{s}, {t}"),
+        None => s,
+    }
+}
+
 /// `RGE-VAE (faithful), KDE goals, 10 latents` etc.; RPE and RGE-EFR are named alone.
 pub fn describe_key(k: &ConditionKey) -> String {
-    let mut s = condition_name(&k.tagged_algo(), &k.variant);
+    let mut s = tagged_condition_name(k);
     if k.sampler.is_learned() {
         s.push_str(&format!(", {} goals", sampler_name(&k.sampler)));
     }

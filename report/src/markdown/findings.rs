@@ -9,7 +9,7 @@ use super::claims::{Validity, validity_of};
 use crate::claims::{ClaimResult, ClaimsInput, Comparison, Finding, Statistic};
 use crate::context::Context;
 use crate::discovery::{Check, Measure};
-use crate::names::{condition_name, env_name};
+use crate::names::env_name;
 use crate::stats;
 
 /// Anchors of the sections the findings link to.
@@ -121,7 +121,7 @@ fn reference_levels(comparisons: &[Comparison]) -> String {
     }
     format!(
         " ({}: {})",
-        condition_name(&first.reference.tagged_algo(), &first.reference.variant),
+        crate::names::tagged_condition_name(&first.reference),
         parts.join(", ")
     )
 }
