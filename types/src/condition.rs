@@ -8,7 +8,7 @@ use std::borrow::{Borrow, Cow};
 use std::fmt;
 use std::ops::Deref;
 
-use crate::EnvSpec;
+use crate::env::EnvSpec;
 use crate::learner::{self, LearnerInfo};
 use crate::manifest::Manifest;
 use crate::sampler::{self, SamplerInfo};

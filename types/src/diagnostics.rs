@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::RecordError;
+use crate::campaign::RecordError;
 
 /// The directory of the sidecars in a campaign's results directory.
 pub const DIAGNOSTICS_DIR: &str = "diagnostics";
@@ -22,7 +22,7 @@ pub struct Diagnostics {
     /// The crate versions and results version of that code.
     pub crate_versions: serde_json::Value,
     /// The latent-quality measure, as a manifest's `latent_quality`.
-    pub latent_quality: serde_json::Value,
+    pub latent_quality: crate::quality::LatentQuality,
 }
 
 impl Diagnostics {
@@ -54,9 +54,6 @@ impl Diagnostics {
 
     /// The measure version it holds (1 when unversioned).
     pub fn measure_version(&self) -> u64 {
-        self.latent_quality
-            .get("version")
-            .and_then(serde_json::Value::as_u64)
-            .unwrap_or(1)
+        u64::from(self.latent_quality.version)
     }
 }

@@ -35,7 +35,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::EnvSpec;
+use crate::env::EnvSpec;
 use crate::klc::{KlCoverage, KlcError};
 
 /// One outcome of an exploration (a row of `<run_id>.outcomes.parquet`): the controllable
@@ -268,10 +268,10 @@ pub struct Discovery {
     /// Those in which the object moved.
     pub n_moved: usize,
     /// KL-coverage of every outcome (the runs' own `klc`, recomputed); +inf is written "inf".
-    #[serde(with = "crate::manifest::inf_as_string")]
+    #[serde(with = "crate::summary::inf_as_string")]
     pub klc: f64,
     /// KL-coverage of the moved outcomes only; None when the object never moved.
-    #[serde(with = "crate::manifest::opt_inf_as_string")]
+    #[serde(with = "crate::summary::opt_inf_as_string")]
     pub moved_klc: Option<f64>,
     /// Fraction of the achievable cells reached.
     pub coverage: f64,
@@ -618,7 +618,11 @@ impl RunDiscovery {
     /// than from it); the error at rest present exactly when an outcome did not move the object,
     /// the moved radius exactly when one did. `env` bounds the distances (its goal space's
     /// diameter); an environment not in this build's registry is bounded by the summary only.
-    pub fn check(&self, env: &str, summary: &crate::Summary) -> Result<(), RecordMismatch> {
+    pub fn check(
+        &self,
+        env: &str,
+        summary: &crate::summary::Summary,
+    ) -> Result<(), RecordMismatch> {
         let bad = |field: &str, why: String| {
             Err(RecordMismatch {
                 field: field.into(),
@@ -766,12 +770,12 @@ mod tests {
         ));
         static ODD: EnvSpec = EnvSpec {
             name: "odd-grid",
-            klc: crate::KlcGrid {
+            klc: crate::env::KlcGrid {
                 dims: 2,
                 bins: 30,
                 achievable_cells: 900,
             },
-            ..crate::ARMBALL
+            ..crate::env::ARMBALL
         };
         assert!(matches!(
             EnvMeasures::new(&ODD),
@@ -796,7 +800,7 @@ mod tests {
         outcomes.extend((1..40).map(|i| outcome(i, 0.9 - 0.04 * i as f64, 0.1, true)));
         let spec = EnvSpec::by_name("armball").unwrap();
         let d = RunDiscovery::measure(spec, &outcomes).unwrap().unwrap();
-        let summary = crate::Summary {
+        let summary = crate::summary::Summary {
             run: "r".into(),
             final_klc: d.at_end.klc,
             n_moved: d.at_end.n_moved,
@@ -814,7 +818,7 @@ mod tests {
         better.check("armball", &summary).unwrap();
         let e = better.check_against(&d).unwrap_err();
         assert_eq!(e.field, "final.goal_error_mean");
-        let field = |f: &dyn Fn(&mut RunDiscovery), s: &crate::Summary| {
+        let field = |f: &dyn Fn(&mut RunDiscovery), s: &crate::summary::Summary| {
             let mut x = d.clone();
             f(&mut x);
             x.check("armball", s).unwrap_err().field
@@ -843,12 +847,12 @@ mod tests {
             field(&|x| x.error_at_rest = None, &summary),
             "error_at_rest"
         );
-        let other = crate::Summary {
+        let other = crate::summary::Summary {
             n_moved: summary.n_moved + 1,
             ..summary.clone()
         };
         assert_eq!(field(&|_| {}, &other), "final.n_moved");
-        let other = crate::Summary {
+        let other = crate::summary::Summary {
             coverage: 0.5,
             ..summary
         };

@@ -35,8 +35,10 @@ pub mod klc;
 mod learner;
 mod manifest;
 mod paths;
+mod quality;
 mod sampler;
 mod strategy;
+mod summary;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use condition::{Algo, AlgoInfo, ConditionKey, Sampler, Variant};
@@ -57,6 +59,7 @@ pub mod learners {
         AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
     };
 }
+pub use quality::{GroupR2, LatentQuality, Neighbourhoods, ObjectR2};
 pub use sampler::{SAMPLERS, SamplerInfo, SamplerInfoError};
 /// Each goal sampler's entry, by name (`ugl_types::samplers::KDE`).
 pub mod samplers {

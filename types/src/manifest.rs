@@ -18,16 +18,7 @@ use crate::campaign::CampaignDecl;
 /// the fitted network differs).
 pub const RESULTS_VERSION: u32 = 4;
 
-/// The final numbers of a run, also printed by `ugl run` as its last line.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    pub run: String,
-    /// Final KL-coverage; JSON has no infinity, so +inf is written as the string "inf".
-    #[serde(with = "inf_as_string")]
-    pub final_klc: f64,
-    pub n_moved: usize,
-    pub coverage: f64,
-}
+pub use crate::summary::Summary;
 
 /// The CPU of a run.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -114,14 +105,14 @@ pub struct Manifest {
     /// Learned goal spaces: held-out R² of a linear and a k-NN map from latents to the true
     /// object state.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub latent_quality: Option<serde_json::Value>,
+    pub latent_quality: Option<crate::quality::LatentQuality>,
     pub summary: Summary,
     /// What the run discovered, measured from its outcomes when it ended (results version 4
-    /// on; [`crate::RunDiscovery`]). A run that records it is complete without its outcomes
+    /// on; [`crate::discovery::RunDiscovery`]). A run that records it is complete without its outcomes
     /// file, which the committed stores keep only for some runs (`data/results/README.md`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub discovery: Option<crate::RunDiscovery>,
-    /// [`crate::RunDiscovery::digest`] of `discovery` as written, so that an edited record is
+    pub discovery: Option<crate::discovery::RunDiscovery>,
+    /// [`crate::discovery::RunDiscovery::digest`] of `discovery` as written, so that an edited record is
     /// detected like a damaged data file ([`crate::verify_files`]). Absent in manifests written
     /// before it was recorded: their records are checked for range and against `summary` only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -177,11 +168,8 @@ impl Manifest {
     /// The (linear, k-NN) R² of a group of targets (`position`, `angle`, `angle_mod_120`) in
     /// the latent quality (measure version 2 and later).
     pub fn group_r2(&self, group: &str) -> Option<(f64, f64)> {
-        let groups = self.latent_quality.as_ref()?.get("groups")?.as_array()?;
-        let g = groups
-            .iter()
-            .find(|g| g.get("group").and_then(|v| v.as_str()) == Some(group))?;
-        Some((g.get("linear_r2")?.as_f64()?, g.get("knn_r2")?.as_f64()?))
+        let g = self.latent_quality.as_ref()?.group(group)?;
+        Some((g.linear_r2, g.knn_r2))
     }
 
     /// `CPU model (SIMD level)`.
@@ -221,48 +209,6 @@ fn none_string() -> String {
     "none".into()
 }
 
-/// An optional f64 that may be +inf, written as `inf_as_string` writes it; None is `null`.
-pub(crate) mod opt_inf_as_string {
-    use serde::{Deserialize, Deserializer, Serializer};
-    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
-        match v {
-            Some(x) => super::inf_as_string::serialize(x, s),
-            None => s.serialize_none(),
-        }
-    }
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-        #[derive(Deserialize)]
-        struct W(#[serde(with = "super::inf_as_string")] f64);
-        Ok(Option::<W>::deserialize(d)?.map(|W(x)| x))
-    }
-}
-
-pub(crate) mod inf_as_string {
-    use serde::{Deserialize, Deserializer, Serializer};
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        if v.is_infinite() && *v > 0.0 {
-            s.serialize_str("inf")
-        } else {
-            s.serialize_f64(*v)
-        }
-    }
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum V {
-            N(f64),
-            S(String),
-        }
-        match V::deserialize(d)? {
-            V::N(x) => Ok(x),
-            V::S(s) if s == "inf" => Ok(f64::INFINITY),
-            V::S(s) => Err(serde::de::Error::custom(format!(
-                "expected a number or \"inf\", got {s:?}"
-            ))),
-        }
-    }
-}
-
 fn is_zero(n: &u32) -> bool {
     *n == 0
 }
@@ -285,7 +231,10 @@ mod tests {
             for f in std::fs::read_dir(&dir).unwrap() {
                 let p = f.unwrap().path();
                 let name = p.file_name().unwrap().to_string_lossy().to_string();
-                if !name.ends_with(".json") || name.starts_with('.') || name == crate::RECORD_FILE {
+                if !name.ends_with(".json")
+                    || name.starts_with('.')
+                    || name == crate::campaign::RECORD_FILE
+                {
                     continue;
                 }
                 let text = std::fs::read_to_string(&p).unwrap();

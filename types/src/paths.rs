@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::Manifest;
+use crate::manifest::Manifest;
 
 /// `<run_id>.parquet`: the exploration curve.
 pub const CURVE_SUFFIX: &str = ".parquet";

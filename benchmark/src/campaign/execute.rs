@@ -289,7 +289,7 @@ pub fn execute(
             .then(|| serde_json::to_value(ctx.learners.external()).expect("serialisable")),
         host: host_name().into(),
         cpu: Some(cpu_info().clone()),
-        latent_quality: latent_quality.map(|q| serde_json::to_value(q).expect("serialisable")),
+        latent_quality,
         summary: summary.clone(),
         discovery,
         // Filled in by `write_run` from the bytes it writes.

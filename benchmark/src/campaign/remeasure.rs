@@ -48,7 +48,7 @@ pub fn measure_version(m: &Manifest, sidecar: Option<&Diagnostics>) -> u64 {
     }
     match &m.latent_quality {
         None => 0,
-        Some(q) => q.get("version").and_then(|v| v.as_u64()).unwrap_or(1),
+        Some(q) => u64::from(q.version),
     }
 }
 
@@ -118,7 +118,6 @@ pub fn refresh_diagnostics(
                         "the latent quality could not be measured (the log says why)".into(),
                     ))
                 })?;
-                let value = serde_json::to_value(quality).expect("serialisable");
                 for manifest in &stale {
                     store::write_diagnostics(
                         out,
@@ -126,7 +125,7 @@ pub fn refresh_diagnostics(
                             run_id: manifest.run_id.clone(),
                             git_revision: git_revision().into(),
                             crate_versions: crate_versions(),
-                            latent_quality: value.clone(),
+                            latent_quality: quality.clone(),
                         },
                     )?;
                 }

@@ -43,7 +43,6 @@
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use serde::{Deserialize, Serialize};
 
 use super::{Latents, ReprError};
 
@@ -55,65 +54,8 @@ pub const KNN_K: usize = 10;
 /// continuity).
 pub const MEASURE_VERSION: u32 = 3;
 
-/// R² of the two regressions, per target and on average.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct LatentQuality {
-    /// [`MEASURE_VERSION`] of this measurement.
-    pub version: u32,
-    /// Target names (`x`, `y`; arrow: `cos_angle`, `sin_angle`, `cos_3angle`, `sin_3angle`).
-    pub targets: Vec<String>,
-    /// Held-out R² of the linear map, per target.
-    pub linear_r2: Vec<f64>,
-    /// Held-out R² of the k-NN regression, per target.
-    pub knn_r2: Vec<f64>,
-    /// Means over the targets.
-    pub linear_r2_mean: f64,
-    pub knn_r2_mean: f64,
-    /// Means per target group ([`TargetGroup`]): linear and k-NN R² of the position, and (arrow)
-    /// of the angle and of the angle modulo 120°.
-    pub groups: Vec<GroupR2>,
-    /// Trustworthiness and continuity per state space (version 3 and later; empty before).
-    #[serde(default)]
-    pub neighbourhoods: Vec<Neighbourhoods>,
-    /// Scenes with several objects (ArmBalls): per object, how much of each latent its
-    /// position explains ([`per_latent_r2`]); empty otherwise.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub per_latent: Vec<ObjectR2>,
-    /// Training and held-out set sizes, and `k`.
-    pub n_train: usize,
-    pub n_heldout: usize,
-    pub k: usize,
-}
-
-/// Disentanglement (follow-up paper): for one object, the held-out R² of a k-NN regression
-/// (`k` = [`KNN_K`]) from the object's (x, y) to each latent, fitted on the training images. A
-/// latent that encodes only the ball scores high for the ball and about 0 for the
-/// distractor; an entangled latent scores in between for both.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ObjectR2 {
-    /// `ball` or `distractor`.
-    pub object: String,
-    /// Per latent, in the encoder's order; None for a constant (collapsed) latent.
-    pub r2: Vec<Option<f64>>,
-}
-
-/// The mean R² of one group of targets.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct GroupR2 {
-    /// `position`, `angle` or `angle_mod_120`.
-    pub group: String,
-    pub linear_r2: f64,
-    pub knn_r2: f64,
-}
-
-/// Neighbourhood preservation between one state space and the latents, on the held-out images.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Neighbourhoods {
-    /// `position` (x, y) or `state` (arrow: x, y, cos a, sin a).
-    pub space: String,
-    pub trustworthiness: f64,
-    pub continuity: f64,
-}
+/// The measure's record, declared in `ugl-types` (a manifest's `latent_quality`).
+pub use ugl_types::{GroupR2, LatentQuality, Neighbourhoods, ObjectR2};
 
 /// The state spaces of the neighbourhood measures: name and target columns.
 const NEIGHBOURHOOD_SPACES: [(&str, &[&str]); 2] = [

@@ -123,36 +123,20 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
         let mut order: Vec<usize> = (0..epochs.len()).collect();
         order.sort_by_key(|&i| epochs[i]);
         let quality = run.manifest.latent_quality.as_ref();
-        let group = |name: &str| {
-            quality
-                .and_then(|q| q.get("groups"))
-                .and_then(Value::as_array)
-                .and_then(|g| {
-                    g.iter()
-                        .find(|x| x.get("group").and_then(Value::as_str) == Some(name))
-                })
-                .and_then(|x| x.get("knn_r2"))
-                .and_then(Value::as_f64)
-        };
-        let per_latent = quality
-            .and_then(|q| q.get("per_latent"))
-            .and_then(Value::as_array)
-            .and_then(|objects| {
-                let r2 = |name: &str| -> Option<Vec<f64>> {
-                    let o = objects
+        let group = |name: &str| quality.and_then(|q| q.group(name)).map(|g| g.knn_r2);
+        let per_latent = quality.and_then(|q| {
+            // A constant latent explains nothing.
+            let r2 = |name: &str| -> Option<Vec<f64>> {
+                Some(
+                    q.object(name)?
+                        .r2
                         .iter()
-                        .find(|o| o.get("object").and_then(Value::as_str) == Some(name))?;
-                    Some(
-                        o.get("r2")?
-                            .as_array()?
-                            .iter()
-                            // A constant latent explains nothing.
-                            .map(|v| v.as_f64().unwrap_or(0.0))
-                            .collect(),
-                    )
-                };
-                Some((r2("ball")?, r2("distractor")?))
-            });
+                        .map(|v| v.unwrap_or(0.0))
+                        .collect(),
+                )
+            };
+            Some((r2("ball")?, r2("distractor")?))
+        });
         let (modules, interest) = load_interest(&run.curve_path)?;
         let key = run.key.tagged(tag);
         out.push(FollowupRun {

@@ -90,19 +90,9 @@ pub fn write(out: &mut Output, camps: &Campaigns) -> Result<Vec<PathBuf>, Report
                 num(evidence
                     .and_then(|e| e.get("loss_fraction"))
                     .and_then(|v| v.as_f64())),
-                num(quality
-                    .and_then(|q| q.get("linear_r2_mean"))
-                    .and_then(|v| v.as_f64())),
-                num(quality
-                    .and_then(|q| q.get("knn_r2_mean"))
-                    .and_then(|v| v.as_f64())),
-                quality
-                    .map(|q| q
-                        .get("version")
-                        .and_then(|v| v.as_u64())
-                        .unwrap_or(1)
-                        .to_string())
-                    .unwrap_or_default(),
+                num(quality.map(|q| q.linear_r2_mean)),
+                num(quality.map(|q| q.knn_r2_mean)),
+                quality.map(|q| q.version.to_string()).unwrap_or_default(),
                 num(r.manifest.group_r2("position").map(|g| g.1)),
                 num(r.manifest.group_r2("angle").map(|g| g.1)),
                 num(r.manifest.group_r2("angle_mod_120").map(|g| g.1)),

@@ -39,18 +39,13 @@ struct Row {
 /// (trustworthiness, continuity) of a manifest's latents against a state space (`position`,
 /// `state`), measure version 3 and later.
 pub fn neighbourhoods(m: &Manifest, space: &str) -> Option<(f64, f64)> {
-    let all = m
+    let n = m
         .latent_quality
         .as_ref()?
-        .get("neighbourhoods")?
-        .as_array()?;
-    let n = all
+        .neighbourhoods
         .iter()
-        .find(|g| g.get("space").and_then(|v| v.as_str()) == Some(space))?;
-    Some((
-        n.get("trustworthiness")?.as_f64()?,
-        n.get("continuity")?.as_f64()?,
-    ))
+        .find(|n| n.space == space)?;
+    Some((n.trustworthiness, n.continuity))
 }
 
 pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
