@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use super::ReprError;
 
 pub use super::model_file::FORMAT_VERSION;
-pub use super::model_file::{f64_bytes, f64s, seal, unseal};
+pub use super::model_file::{ModelFileError, f64_bytes, f64s, seal, unseal};
 pub use super::neural_encoder::{from_bytes, to_bytes};
 
 /// What [`ModelCache::load`] found.
@@ -54,7 +54,7 @@ impl ModelCache {
     pub fn load<T>(
         &self,
         key: &str,
-        decode: impl FnOnce(&[u8]) -> Result<T, String>,
+        decode: impl FnOnce(&[u8]) -> Result<T, ModelFileError>,
     ) -> CacheEntry<T> {
         let path = self.path(key);
         match std::fs::read(&path) {
@@ -130,10 +130,9 @@ mod tests {
             assert_eq!(back.losses, enc.losses);
             assert_eq!(back.encode_seed, enc.encode_seed);
             assert_eq!((back.model, back.variant), (enc.model, enc.variant));
-            assert!(
-                from_bytes("k2", &bytes)
-                    .unwrap_err()
-                    .contains("key mismatch")
+            assert_eq!(
+                from_bytes("k2", &bytes).unwrap_err(),
+                ModelFileError::Key { found: "k1".into() }
             );
             for cut in [0, 5, 40, bytes.len() / 2, bytes.len() - 1] {
                 assert!(from_bytes("k1", &bytes[..cut]).is_err(), "cut at {cut}");

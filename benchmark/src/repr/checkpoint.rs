@@ -237,7 +237,7 @@ fn try_load<'a>(
     if blake3::hash(&optim_bytes).to_hex().as_str() != state.optim_blake3 {
         return Err(format!("{} does not match its hash", optim_path.display()));
     }
-    let enc = neural_encoder::from_bytes(&c.key, &net_bytes)?;
+    let enc = neural_encoder::from_bytes(&c.key, &net_bytes).map_err(|e| e.to_string())?;
     let word_pos: u128 = state
         .rng_word_pos
         .parse()

@@ -33,6 +33,7 @@ use gemm::Parallelism;
 use rayon::prelude::*;
 
 use super::ReprError;
+use super::model_file::ModelFileError;
 use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
 use super::neural_config::{Model, NeuralConfig};
 use super::neural_model::{LatentInput, Optimiser, tensor2};
@@ -407,18 +408,19 @@ impl HostOptimizer {
     }
 
     /// Read back a state written by [`HostOptimizer::to_bytes`] for `model` and `net`'s shapes.
-    pub fn from_bytes(model: Model, net: &HostNet, bytes: &[u8]) -> Result<Self, String> {
+    pub fn from_bytes(model: Model, net: &HostNet, bytes: &[u8]) -> Result<Self, ModelFileError> {
+        let bad = |why: &str| ModelFileError::Content(why.to_string());
         let mut fresh = HostOptimizer::new(model, net);
         let mut at = 0usize;
-        let mut take = |n: usize| -> Result<&[u8], String> {
+        let mut take = |n: usize| -> Result<&[u8], ModelFileError> {
             let s = bytes
                 .get(at..at + n)
-                .ok_or_else(|| "optimiser state truncated".to_string())?;
+                .ok_or_else(|| bad("optimiser state truncated"))?;
             at += n;
             Ok(s)
         };
         if take(8)? != OPT_MAGIC {
-            return Err("not an optimiser state".into());
+            return Err(bad("not an optimiser state"));
         }
         let kind = take(1)?[0];
         let time = u64::from_le_bytes(take(8)?.try_into().expect("8 bytes")) as usize;
@@ -428,19 +430,19 @@ impl HostOptimizer {
                 m.iter_mut().chain(v.iter_mut()).collect()
             }
             HostOptimizer::Adagrad { acc, .. } if kind == 1 => acc.iter_mut().collect(),
-            _ => return Err("optimiser state of another model".into()),
+            _ => return Err(bad("optimiser state of another model")),
         };
         for b in bufs {
             let n = u64::from_le_bytes(take(8)?.try_into().expect("8 bytes")) as usize;
             if n != b.len() {
-                return Err("optimiser state of another network shape".into());
+                return Err(bad("optimiser state of another network shape"));
             }
             for (v, c) in b.iter_mut().zip(take(4 * n)?.chunks_exact(4)) {
                 *v = f32::from_le_bytes(c.try_into().expect("4 bytes"));
             }
         }
         if at != bytes.len() {
-            return Err("trailing bytes after the optimiser state".into());
+            return Err(bad("trailing bytes after the optimiser state"));
         }
         Ok(fresh)
     }

@@ -250,12 +250,15 @@ pub trait RepresentationLearner: Send + Sync {
     /// An encoder from the bytes [`Encoder::save`] wrote under `key`; `Err` says why the bytes
     /// cannot be trusted (the harness fits again and overwrites them). A loaded encoder must
     /// encode bit-identically to the one that was saved.
-    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+    fn load(
+        &self,
+        key: &str,
+        bytes: &[u8],
+    ) -> Result<Box<dyn Encoder>, model_file::ModelFileError> {
         let _ = (key, bytes);
-        Err(format!(
-            "{} encoders are not kept in the model cache",
-            self.name()
-        ))
+        Err(model_file::ModelFileError::NotKept {
+            learner: self.name().to_string(),
+        })
     }
 }
 

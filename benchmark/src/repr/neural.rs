@@ -20,6 +20,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use super::model_file::ModelFileError;
 pub use super::nets::Init;
 pub use super::neural_encoder::{reconstruct, reconstruction_loss};
 pub use super::neural_model::{
@@ -273,16 +274,16 @@ impl super::RepresentationLearner for NeuralLearner {
         true
     }
 
-    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, ModelFileError> {
         let enc = super::cache::from_bytes(key, bytes)?;
         if (enc.model, enc.variant) != (self.model, self.config.variant) {
-            return Err(format!(
+            return Err(ModelFileError::Content(format!(
                 "the file holds a {} ({}), not a {} ({})",
                 enc.model.name(),
                 enc.variant,
                 self.model.name(),
                 self.config.variant
-            ));
+            )));
         }
         Ok(Box::new(enc))
     }

@@ -5,7 +5,7 @@ use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::model_file::{seal, unseal};
+use super::model_file::{ModelFileError, seal, unseal};
 use super::nets::{HostLayer, HostNet, Scratch};
 use super::neural_config::Model;
 use super::neural_model::Variant;
@@ -246,11 +246,12 @@ pub fn to_bytes(key: &str, enc: &NeuralEncoder) -> Vec<u8> {
 }
 
 /// Parse and check a neural encoder's bytes; `Err` says why they cannot be trusted.
-pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
+pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, ModelFileError> {
     let (header, payload) = unseal(bytes)?;
-    let h: Header = serde_json::from_slice(header).map_err(|e| format!("bad header: {e}"))?;
+    let h: Header =
+        serde_json::from_slice(header).map_err(|e| ModelFileError::Header(e.to_string()))?;
     if h.key != key {
-        return Err(format!("key mismatch (file holds {})", h.key));
+        return Err(ModelFileError::Key { found: h.key });
     }
     let [h1, h2] = h.hidden;
     let p: usize = h.model.head_blocks(h.latents).iter().sum();
@@ -263,15 +264,17 @@ pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
         (h1, h.dim),
     ];
     if h.layers != expect {
-        return Err("layer shapes do not match the model".into());
+        return Err(ModelFileError::Content(
+            "layer shapes do not match the model".into(),
+        ));
     }
     let values: usize = expect.iter().map(|(i, o)| i * o + o).sum();
     if payload.len() != 4 * values {
-        return Err(format!(
+        return Err(ModelFileError::Content(format!(
             "weights have {} bytes, the shapes need {}",
             payload.len(),
             4 * values
-        ));
+        )));
     }
     let mut floats = payload
         .chunks_exact(4)
@@ -294,7 +297,8 @@ pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<NeuralEncoder, String> {
         dec2: layer(expect[4]),
         dec_out: layer(expect[5]),
     };
-    let seed = unhex(&h.encode_seed).ok_or("bad encoder seed")?;
+    let seed =
+        unhex(&h.encode_seed).ok_or_else(|| ModelFileError::Header("bad encoder seed".into()))?;
     Ok(NeuralEncoder::new(h.model, h.variant, net, h.losses, seed))
 }
 

@@ -11,6 +11,7 @@
 
 use rand_distr::{Distribution, StandardNormal};
 
+use super::model_file::ModelFileError;
 use super::neural_model::Variant;
 use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::sparse::SparseRows;
@@ -106,24 +107,27 @@ struct ProjectionHeader {
 
 impl ProjectionEncoder {
     /// The encoder from the bytes of [`Encoder::save`]; `Err` says why they cannot be trusted.
-    pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<ProjectionEncoder, String> {
+    pub fn from_bytes(key: &str, bytes: &[u8]) -> Result<ProjectionEncoder, ModelFileError> {
         let (header, payload) = super::cache::unseal(bytes)?;
         let h: ProjectionHeader =
-            serde_json::from_slice(header).map_err(|e| format!("bad header: {e}"))?;
+            serde_json::from_slice(header).map_err(|e| ModelFileError::Header(e.to_string()))?;
         if h.key != key {
-            return Err(format!("key mismatch (file holds {})", h.key));
+            return Err(ModelFileError::Key { found: h.key });
         }
         if h.encoder != "projection" {
-            return Err(format!("a {} encoder, not a projection", h.encoder));
+            return Err(ModelFileError::Content(format!(
+                "a {} encoder, not a projection",
+                h.encoder
+            )));
         }
         let values = super::cache::f64s(payload)?;
         let (nc, ns) = (h.dim * h.latents, h.singular_values);
         if values.len() != nc + ns + h.latents {
-            return Err(format!(
+            return Err(ModelFileError::Content(format!(
                 "{} values, the shapes need {}",
                 values.len(),
                 nc + ns + h.latents
-            ));
+            )));
         }
         Ok(ProjectionEncoder {
             components: values[..nc].to_vec(),
@@ -207,7 +211,7 @@ impl RepresentationLearner for TruncatedSvd {
         true
     }
 
-    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, String> {
+    fn load(&self, key: &str, bytes: &[u8]) -> Result<Box<dyn Encoder>, ModelFileError> {
         Ok(Box::new(ProjectionEncoder::from_bytes(key, bytes)?))
     }
 

@@ -266,7 +266,8 @@ impl<'a> Trainer<'a> {
             }
             Engine::Host => {
                 let bytes = std::fs::read(state.optimizer).map_err(|e| fail(e.to_string()))?;
-                let opt = HostOptimizer::from_bytes(model, state.net, &bytes).map_err(fail)?;
+                let opt = HostOptimizer::from_bytes(model, state.net, &bytes)
+                    .map_err(|e| fail(e.to_string()))?;
                 EngineState::Host(Box::new(HostTrainer::new(state.net.clone(), opt)))
             }
         };
