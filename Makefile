@@ -21,7 +21,7 @@ help:
 	@echo "make lint                cargo fmt --check and cargo clippy -D warnings (CI runs it first)"
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
 	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC, Isomap)"
-	@echo "make verify              rerun the smoke campaign; compare result checksums with data/checksums/smoke.sha256"
+	@echo "make verify              rerun the smoke campaign on every kernel path; compare bytes with data/checksums/smoke.sha256"
 
 lint: check-toolchain
 	$(CARGO) fmt --all -- --check
@@ -60,7 +60,8 @@ campaign: check-toolchain
 bench: check-toolchain
 	$(CARGO) bench -p ugl-bench --profile dev  # rollout, render, nn_query, klc, isomap
 
-# Reproducibility check: the smoke campaign's result files must hash to the committed checksums
+# Reproducibility check: on every kernel path the CPU has (UGL_SIMD), the smoke campaign's result
+# files must hash to the committed checksums
 # (`tests/verify_smoke.rs`, also part of `make test`, so CI builds the binary once). A change that
 # alters results shows up here, and in review as a change of data/checksums/smoke.sha256
 # (`make verify-update`).

@@ -61,6 +61,12 @@ where
             return ExitCode::from(2);
         }
     };
+    // A bad `UGL_SIMD` (no such kernel path, or one this CPU cannot run) stops every command
+    // before it computes anything.
+    if let Err(e) = ugl_bench::kernels::check_active_path() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<output::StdoutError>().is_some() => {

@@ -6,6 +6,8 @@
 //! the campaign machinery that writes the results store.
 
 pub mod campaign;
+/// The deterministic float kernels and their paths (`UGL_SIMD`).
+pub use ugl_kernels as kernels;
 pub mod env;
 pub mod explore;
 pub mod fsio;

@@ -465,7 +465,7 @@ impl RunDiscovery {
         let radii: Vec<f64> = outcomes
             .iter()
             .filter(|o| o.moved)
-            .map(|o| o.x.hypot(o.y))
+            .map(|o| libm::hypot(o.x, o.y))
             .collect();
         let moved_radius_mean =
             (!radii.is_empty()).then(|| radii.iter().sum::<f64>() / radii.len() as f64);

@@ -45,7 +45,7 @@ pub struct KlcGrid {
 impl KlcGrid {
     /// The largest possible KL-coverage, `ln(achievable cells)`.
     pub fn max_klc(&self) -> f64 {
-        (self.achievable_cells as f64).ln()
+        libm::log(self.achievable_cells as f64)
     }
 }
 

@@ -138,7 +138,7 @@ impl KlCoverage {
 
     /// The largest possible KLC: every outcome in one cell, ln(N_achievable).
     pub fn max_klc(&self) -> f64 {
-        (self.n_achievable as f64).ln()
+        libm::log(self.n_achievable as f64)
     }
 
     /// Bin of one coordinate, numpy histogramdd semantics; None outside [-1, 1].
@@ -261,7 +261,7 @@ impl CoverageHistogram<'_> {
         let mut s = 0.0;
         for c in cells {
             let p = self.counts[c] as f64 / n;
-            s += p * (p / q).ln();
+            s += p * libm::log(p / q);
         }
         Ok(s)
     }

@@ -16,7 +16,11 @@ use crate::campaign::CampaignDecl;
 /// 4: the corrected RFVAE puts its prior N(0, I) on `z_K`, the space its outcomes are encoded
 /// in, so that its Gaussian goals are drawn where the outcomes live (its KDE runs change too:
 /// the fitted network differs).
-pub const RESULTS_VERSION: u32 = 4;
+/// 5: the same bits on every CPU: the host engine's and Isomap's products are one FMA chain per
+/// output (`ugl-kernels`, no gemm/faer), the dense symmetric eigen-solver and the latent-quality
+/// solve are plain arithmetic, transcendental functions come from `libm`, and burn's `flex`
+/// backend runs without its run-time SIMD dispatch.
+pub const RESULTS_VERSION: u32 = 5;
 
 pub use crate::summary::Summary;
 
@@ -25,8 +29,12 @@ pub use crate::summary::Summary;
 pub struct CpuInfo {
     /// `model name` of /proc/cpuinfo (`unknown` where there is none).
     pub model: String,
-    /// The SIMD level the float kernels can dispatch to.
+    /// The SIMD level of the CPU (`x86-64-v3`, `x86-64-v4`, ...).
     pub simd: String,
+    /// The path the float kernels ran on (`scalar`, `avx2`, `avx512`; `UGL_SIMD` forces one).
+    /// Every path gives the same bits (results version 5 on); absent before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kernels: Option<String>,
 }
 
 /// Everything about a run that is not its data. Fields added after results version 1 have
@@ -172,11 +180,12 @@ impl Manifest {
         Some((g.linear_r2, g.knn_r2))
     }
 
-    /// `CPU model (SIMD level)`.
+    /// `CPU model (SIMD level)`, and `, kernels PATH` where the manifest records the path.
     pub fn cpu_label(&self) -> Option<String> {
-        self.cpu
-            .as_ref()
-            .map(|c| format!("{} ({})", c.model, c.simd))
+        self.cpu.as_ref().map(|c| match &c.kernels {
+            Some(path) => format!("{} ({}, kernels {path})", c.model, c.simd),
+            None => format!("{} ({})", c.model, c.simd),
+        })
     }
 
     /// The command of an external learner (`external.command`).

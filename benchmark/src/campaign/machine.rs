@@ -1,9 +1,9 @@
 //! The machine a run executed on, as recorded in its manifest: host, CPU model and SIMD level.
 //!
-//! The SIMD level matters for reproducibility: the float kernels of burn's `flex` backend
-//! (`gemm`, `macerator`) and of `faer` (`pulp`) choose their instructions at run time from the
-//! CPU's features, and a different instruction set may sum in a different order. Results are
-//! therefore guaranteed bit-for-bit only within one SIMD level (README "Reproducibility").
+//! From results version 5 the SIMD level does not change a run's bits: the float kernels
+//! ([`ugl_kernels`]) compute the same bits on every path, and the path they ran on is recorded
+//! beside the level (`kernels`). The level still says which paths a machine could run, and
+//! the optional burn engine's products (`gemm`) still depend on it.
 
 use std::sync::OnceLock;
 
@@ -15,6 +15,7 @@ pub fn cpu_info() -> &'static CpuInfo {
     CPU.get_or_init(|| CpuInfo {
         model: cpu_model(),
         simd: simd_level().to_string(),
+        kernels: Some(ugl_kernels::active_path().name().to_string()),
     })
 }
 

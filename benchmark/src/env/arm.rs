@@ -57,7 +57,7 @@ impl ArmConfig {
             cum += q[k].clamp(-1.0, 1.0);
             let a = self.angle_shift + cum;
             angle_std = a;
-            let (s, c) = (std::f64::consts::PI * a).sin_cos();
+            let (s, c) = libm::sincos(std::f64::consts::PI * a);
             x += c * self.lengths[k];
             y += s * self.lengths[k];
         }

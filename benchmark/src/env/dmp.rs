@@ -81,15 +81,19 @@ impl DmpConfig {
     pub fn centres(&self) -> [f64; BASIS] {
         // np.linspace(0.4, 0.8, 3): start + i * step, step = 0.4 / 2; the last is exactly 0.8.
         let step = (0.8 - 0.4) / 2.0;
-        [-(0.4f64).ln(), -(1.0 * step + 0.4f64).ln(), -(0.8f64).ln()]
+        [
+            -libm::log(0.4),
+            -libm::log(1.0 * step + 0.4),
+            -libm::log(0.8),
+        ]
     }
 
     /// Basis widths h_b.
     pub fn widths(&self) -> [f64; BASIS] {
         let c = self.centres();
         match self.widths {
-            DmpWidths::Explauto130 => c.map(|c| 3f64.powf(1.5) / c),
-            DmpWidths::ExplautoHead => c.map(|c| 8.0 * 3f64.powi(2) / c.powf(1.5)),
+            DmpWidths::Explauto130 => c.map(|c| libm::pow(3.0, 1.5) / c),
+            DmpWidths::ExplautoHead => c.map(|c| 8.0 * 3f64.powi(2) / libm::pow(c, 1.5)),
         }
     }
 
@@ -104,7 +108,7 @@ impl DmpConfig {
         for _ in 0..self.timesteps {
             // cs.step: x += (-ax * x * error_coupling) * tau * dt, before the state is used.
             x += (-self.ax * x) * dt;
-            let psi: [f64; BASIS] = std::array::from_fn(|b| (-h[b] * (x - c[b]).powi(2)).exp());
+            let psi: [f64; BASIS] = std::array::from_fn(|b| libm::exp(-h[b] * (x - c[b]).powi(2)));
             xs.push(x);
             sums.push(psi[0] + psi[1] + psi[2]);
             psis.push(psi);

@@ -196,8 +196,8 @@ pub fn arrow_vertices(x: f64, y: f64, angle: f64) -> Option<[(i32, i32); 4]> {
     let r2 = r + 2.0 * PI / 3.0;
     let r4 = r + 4.0 * PI / 3.0;
     let pt = |a: f64| {
-        let fx = a.cos() * ARROW_RADIUS + px;
-        let fy = a.sin() * ARROW_RADIUS + py;
+        let fx = libm::cos(a) * ARROW_RADIUS + px;
+        let fy = libm::sin(a) * ARROW_RADIUS + py;
         (fx.trunc() as i32, fy.trunc() as i32)
     };
     Some([pt(r), pt(r2), (px as i32, py as i32), pt(r4)])

@@ -4,10 +4,9 @@
 //! factor^2 x data covariance. Sampling = a training latent chosen uniformly + the kernel's
 //! Gaussian noise (`gaussian_kde.resample`).
 
-use faer::linalg::solvers::SelfAdjointEigen;
-use faer::{MatRef, Side};
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
+use ugl_kernels::SymmetricEigen;
 
 use super::GoalSampler;
 use crate::repr::{Latents, ReprError};
@@ -62,24 +61,21 @@ impl KdeGoals {
                 }
             }
         }
-        let factor = (n as f64).powf(-1.0 / (d as f64 + 4.0));
+        let factor = libm::pow(n as f64, -1.0 / (d as f64 + 4.0));
         let covariance: Vec<f64> = cov
             .iter()
             .map(|c| c / (n as f64 - 1.0) * factor * factor)
             .collect();
-        // The symmetric eigen-decomposition (faer) of the covariance: S = V sqrt(max(L, 0)).
-        let eig =
-            SelfAdjointEigen::new(MatRef::from_row_major_slice(&covariance, d, d), Side::Lower)
-                .map_err(|e| {
-                    ReprError::Numerical(format!("KDE: eigen-decomposition failed: {e:?}"))
-                })?;
-        let (vals, vecs) = (eig.S().column_vector(), eig.U());
+        // The symmetric eigen-decomposition of the covariance (deterministic, plain arithmetic):
+        // S = V sqrt(max(L, 0)).
+        let eig = SymmetricEigen::new(&covariance, d)
+            .map_err(|e| ReprError::Numerical(format!("KDE: eigen-decomposition failed: {e}")))?;
         let mut sqrt = vec![0.0; d * d];
         for c in 0..d {
-            let s = vals[c].max(0.0).sqrt();
+            let s = eig.values[c].max(0.0).sqrt();
             for r in 0..d {
                 // Column c of the eigenvectors scaled by sqrt(lambda).
-                sqrt[r * d + c] = vecs[(r, c)] * s;
+                sqrt[r * d + c] = eig.vector(r, c) * s;
             }
         }
         Ok(KdeGoals {

@@ -32,7 +32,7 @@ pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>) -> Latent {
 /// Encoding from the head outputs: the sigmoid latent.
 pub fn encoding(head: &[f32], d: usize, out: &mut [f64]) {
     for (o, &h) in out.iter_mut().zip(&head[..d]) {
-        *o = 1.0 / (1.0 + (-f64::from(h)).exp());
+        *o = 1.0 / (1.0 + libm::exp(-f64::from(h)));
     }
 }
 

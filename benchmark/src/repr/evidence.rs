@@ -40,10 +40,10 @@ pub fn mean_image_loss(images: &ImageSet) -> f64 {
             let m = s / n;
             let mut h = 0.0;
             if m > 0.0 {
-                h -= m * m.ln();
+                h -= m * libm::log(m);
             }
             if m < 1.0 {
-                h -= (1.0 - m) * (1.0 - m).ln();
+                h -= (1.0 - m) * libm::log(1.0 - m);
             }
             h
         })
@@ -106,10 +106,10 @@ mod tests {
             for (p, &x) in images.row(i).iter().enumerate() {
                 let (x, m) = (x as f64, mean[p]);
                 if x > 0.0 {
-                    total -= x * m.ln();
+                    total -= x * libm::log(m);
                 }
                 if x < 1.0 {
-                    total -= (1.0 - x) * (1.0 - m).ln();
+                    total -= (1.0 - x) * libm::log(1.0 - m);
                 }
             }
         }

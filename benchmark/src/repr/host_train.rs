@@ -1,6 +1,6 @@
 //! The host training engine (`engine = "host"`, the default): one training iteration of the
-//! paper's dense networks written on the `gemm` crate (the kernel burn's `flex` backend and
-//! `faer` call), with the structure of the data exploited. Measured against PyTorch: `docs/neural.md`,
+//! paper's dense networks written on the project's deterministic matrix products
+//! ([`ugl_kernels::matmul`]), with the structure of the data exploited. Measured against PyTorch: `docs/neural.md`,
 //! "Speed, side by side with PyTorch".
 //!
 //! What differs from the burn engine ([`super::neural::Engine::Burn`]), and why it is faster:
@@ -9,7 +9,7 @@
 //!   of lit pixels (exactly: the skipped terms are products with 0). No input gradient is
 //!   computed (the images are not trained).
 //! - **No copies, no graph for the big layers.** The six dense layers run forward and backward
-//!   as `gemm` calls on row-major buffers, with transposes expressed as strides; the workspace
+//!   as matrix products on row-major buffers, with transposes expressed as strides; the workspace
 //!   is allocated once. The gradient of the pixel loss is fused with the loss
 //!   (`sigmoid(l) - x`, one pass).
 //! - **The optimiser runs in place** on the host weights (the same TF update rules,
@@ -21,16 +21,17 @@
 //! through the surrogate `sum(z * dz) + extra`, whose gradient with respect to the heads is the
 //! true one.
 //!
-//! Determinism: every sum runs in a fixed order that does not depend on the thread count
-//! (`gemm` splits its output, never its inner dimension; the sparse products and the bias sums
-//! run over pixels / batch rows in order), so the weights after `n` iterations are a function
-//! of the stream alone (tested with 1 and 2 threads). They differ from the burn engine's in the
+//! Determinism: every sum runs in a fixed order that depends neither on the thread count nor on
+//! the CPU (the products are one FMA chain per output, identical on the scalar, AVX2 and
+//! AVX-512 paths; the sparse products and the bias sums run over pixels / batch rows in order,
+//! unfused), so the weights after `n` iterations are a function of the stream alone (tested
+//! with 1 and 2 threads). They differ from the burn engine's in the
 //! last bits (other summation orders); a test checks that both engines compute the same loss and
 //! the same update to float precision.
 
 use burn::tensor::Device;
-use gemm::Parallelism;
 use rayon::prelude::*;
+use ugl_kernels::MatRef;
 
 use super::ReprError;
 use super::model_file::ModelFileError;
@@ -39,81 +40,13 @@ use super::neural_config::{Model, NeuralConfig};
 use super::neural_model::{LatentInput, Optimiser, tensor2};
 use crate::seed::Stream;
 
-/// A `rows x cols` matrix view on a slice, with strides (a transpose is a view with swapped
-/// strides).
-#[derive(Clone, Copy)]
-struct View<'a> {
-    data: &'a [f32],
-    rows: usize,
-    cols: usize,
-    rs: isize,
-    cs: isize,
-}
+type View<'a> = MatRef<'a, f32>;
 
-impl<'a> View<'a> {
-    /// A row-major `rows x cols` matrix.
-    fn of(data: &'a [f32], rows: usize, cols: usize) -> View<'a> {
-        assert!(data.len() >= rows * cols, "view out of bounds");
-        View {
-            data,
-            rows,
-            cols,
-            rs: cols as isize,
-            cs: 1,
-        }
-    }
-
-    /// The transpose.
-    fn t(self) -> View<'a> {
-        View {
-            data: self.data,
-            rows: self.cols,
-            cols: self.rows,
-            rs: self.cs,
-            cs: self.rs,
-        }
-    }
-}
-
-/// `gemm`'s parallelism for the current rayon pool.
-fn parallelism() -> Parallelism {
-    match rayon::current_num_threads() {
-        0 | 1 => Parallelism::None,
-        n => Parallelism::Rayon(n),
-    }
-}
-
-/// `out = a b` (or `out += a b` with `accumulate`), `out` row-major `a.rows x b.cols`.
+/// `out = a b` (or `out += a b` with `accumulate`), `out` row-major `a.rows x b.cols`: one fused
+/// multiply-add chain per output in a fixed order, the same bits on every CPU path
+/// ([`ugl_kernels::matmul`]).
 fn matmul(out: &mut [f32], a: View<'_>, b: View<'_>, accumulate: bool) {
-    assert_eq!(a.cols, b.rows, "inner dimensions");
-    let (m, n, k) = (a.rows, b.cols, a.cols);
-    assert_eq!(out.len(), m * n, "output shape");
-    // SAFETY: the views were checked to lie inside their slices (`View::of`, a transpose keeps
-    // the extent), `out` is exactly m x n row-major and does not alias the inputs (it is a
-    // `&mut`).
-    unsafe {
-        gemm::gemm(
-            m,
-            n,
-            k,
-            out.as_mut_ptr(),
-            1,
-            n as isize,
-            accumulate,
-            a.data.as_ptr(),
-            a.cs,
-            a.rs,
-            b.data.as_ptr(),
-            b.cs,
-            b.rs,
-            1.0,
-            1.0,
-            false,
-            false,
-            false,
-            parallelism(),
-        );
-    }
+    ugl_kernels::matmul(out, a, b, accumulate);
 }
 
 /// `out[r, :] = bias` for every row.
@@ -128,8 +61,8 @@ fn dense_forward(layer: &HostLayer, x: &[f32], rows: usize, out: &mut [f32]) {
     fill_bias(out, &layer.b);
     matmul(
         out,
-        View::of(x, rows, layer.inp),
-        View::of(&layer.w, layer.inp, layer.out),
+        View::row_major(x, rows, layer.inp),
+        View::row_major(&layer.w, layer.inp, layer.out),
         true,
     );
 }
@@ -170,16 +103,16 @@ fn dense_backward(
 ) {
     matmul(
         dw,
-        View::of(x, rows, layer.inp).t(),
-        View::of(dy, rows, layer.out),
+        View::row_major(x, rows, layer.inp).t(),
+        View::row_major(dy, rows, layer.out),
         false,
     );
     col_sums(dy, layer.out, db);
     if let Some(dx) = dx {
         matmul(
             dx,
-            View::of(dy, rows, layer.out),
-            View::of(&layer.w, layer.inp, layer.out).t(),
+            View::row_major(dy, rows, layer.out),
+            View::row_major(&layer.w, layer.inp, layer.out).t(),
             false,
         );
     }
@@ -333,13 +266,13 @@ fn bce_and_grad(logits: &[f32], x: &[f32], dim: usize, scale: f32, grad: &mut [f
         .map(|((l, t), g)| {
             let mut sum = 0.0f64;
             for ((&l, &t), g) in l.iter().zip(t).zip(g.iter_mut()) {
-                let e = (-l.abs()).exp();
+                let e = libm::expf(-l.abs());
                 let sig = if l >= 0.0 {
                     1.0 / (1.0 + e)
                 } else {
                     e / (1.0 + e)
                 };
-                sum += f64::from(l.max(0.0) - t * l + e.ln_1p());
+                sum += f64::from(l.max(0.0) - t * l + libm::log1pf(e));
                 *g = scale * (sig - t);
             }
             sum
@@ -820,21 +753,31 @@ mod tests {
         let b = rand_mat(k, n, 2);
         let want = naive(&a, &b, m, k, n);
         let mut out = vec![0.0; m * n];
-        matmul(&mut out, View::of(&a, m, k), View::of(&b, k, n), false);
+        matmul(
+            &mut out,
+            View::row_major(&a, m, k),
+            View::row_major(&b, k, n),
+            false,
+        );
         close(&out, &want);
         // Through transposed storage.
         let at = transpose(&a, m, k);
         let bt = transpose(&b, k, n);
         matmul(
             &mut out,
-            View::of(&at, k, m).t(),
-            View::of(&bt, n, k).t(),
+            View::row_major(&at, k, m).t(),
+            View::row_major(&bt, n, k).t(),
             false,
         );
         close(&out, &want);
         // Accumulate.
         let mut acc = vec![1.0; m * n];
-        matmul(&mut acc, View::of(&a, m, k), View::of(&b, k, n), true);
+        matmul(
+            &mut acc,
+            View::row_major(&a, m, k),
+            View::row_major(&b, k, n),
+            true,
+        );
         close(&acc, &want.iter().map(|v| v + 1.0).collect::<Vec<_>>());
     }
 

@@ -437,7 +437,7 @@ pub fn bce_with_logits_sum(logits: Tensor<2>, targets: Tensor<2>) -> Tensor<2> {
 
 /// Analytic `KL(N(mu, exp(logvar)) || N(0, I))` per sample: `[B, 1]`.
 pub fn kl_std_normal(mu: Tensor<2>, logvar: Tensor<2>) -> Tensor<2> {
-    let inner = logvar.clone().add_scalar(1.0) - mu.square() - logvar.exp();
+    let inner = logvar.clone().add_scalar(1.0) - mu.square() - logvar.exp(); // burn tensor op
     inner.sum_dim(1).mul_scalar(-0.5)
 }
 

@@ -424,7 +424,7 @@ mod evidence_tests {
             for (p, b) in net.dec_out.b.iter_mut().enumerate() {
                 let m = (0..n).map(|i| images.row(i)[p] as f64).sum::<f64>() / n as f64;
                 let m = m.clamp(1e-7, 1.0 - 1e-7);
-                *b = (m / (1.0 - m)).ln() as f32;
+                *b = libm::log(m / (1.0 - m)) as f32;
             }
             let mean = reconstruction_loss(model, &net, &images, n);
             assert!(

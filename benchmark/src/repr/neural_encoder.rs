@@ -335,7 +335,7 @@ pub fn reconstruction_loss(model: Model, net: &HostNet, images: &ImageSet, max: 
                 .zip(x)
                 .map(|(&l, &t)| {
                     let l = f64::from(l);
-                    l.max(0.0) + (-l.abs()).exp().ln_1p() - f64::from(t) * l
+                    l.max(0.0) + libm::log1p(libm::exp(-l.abs())) - f64::from(t) * l
                 })
                 .sum::<f64>()
         })
@@ -359,6 +359,6 @@ fn noise_free_logits(model: Model, net: &HostNet, x: &[f32], scratch: &mut Scrat
 pub fn reconstruct(model: Model, net: &HostNet, x: &[f32]) -> Vec<f32> {
     noise_free_logits(model, net, x, &mut Scratch::default())
         .into_iter()
-        .map(|l| 1.0 / (1.0 + (-l).exp()))
+        .map(|l| 1.0 / (1.0 + libm::expf(-l)))
         .collect()
 }

@@ -10,6 +10,7 @@
 //!   `ugl run --algo rge-pca-centred`); it remains the reference of a cross-check test.
 
 use rand_distr::{Distribution, StandardNormal};
+use ugl_kernels::SymmetricEigen;
 
 use super::model_file::ModelFileError;
 use super::neural_model::Variant;
@@ -275,7 +276,12 @@ impl RepresentationLearner for TruncatedSvd {
                 }
             }
         }
-        let (vals, vecs) = jacobi_eigen(&c, k);
+        // Eigenpairs of the small k x k problem, decreasing (plain arithmetic: the same bits on
+        // every CPU).
+        let eig = SymmetricEigen::new(&c, k)
+            .map_err(|e| ReprError::Numerical(format!("PCA: eigen-decomposition failed: {e}")))?;
+        let vals: Vec<(f64, usize)> = (0..k).rev().map(|j| (eig.values[j], j)).collect();
+        let vecs = eig.vectors;
         let mut components = vec![0.0; p * latents];
         let mut singular_values = Vec::with_capacity(latents);
         for (t, &(lambda, col)) in vals.iter().take(latents).enumerate() {
@@ -342,58 +348,6 @@ fn orthonormalize(a: &mut [f64], m: usize, k: usize) {
             }
         }
     }
-}
-
-/// Eigen-decomposition of a small symmetric matrix by cyclic Jacobi rotations. Returns
-/// (eigenvalue, column index) sorted by decreasing eigenvalue, and the eigenvector matrix
-/// (row-major, eigenvectors in columns).
-pub fn jacobi_eigen(a: &[f64], k: usize) -> (Vec<(f64, usize)>, Vec<f64>) {
-    let mut m = a.to_vec();
-    let mut v = vec![0.0; k * k];
-    for i in 0..k {
-        v[i * k + i] = 1.0;
-    }
-    for _sweep in 0..100 {
-        let off: f64 = (0..k)
-            .flat_map(|i| (0..k).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| m[i * k + j].powi(2))
-            .sum();
-        let total: f64 = m.iter().map(|x| x * x).sum();
-        if off <= 1e-30 * total.max(1e-300) {
-            break;
-        }
-        for p in 0..k {
-            for q in p + 1..k {
-                let apq = m[p * k + q];
-                if apq == 0.0 {
-                    continue;
-                }
-                let theta = (m[q * k + q] - m[p * k + p]) / (2.0 * apq);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for r in 0..k {
-                    let (mrp, mrq) = (m[r * k + p], m[r * k + q]);
-                    m[r * k + p] = c * mrp - s * mrq;
-                    m[r * k + q] = s * mrp + c * mrq;
-                }
-                for r in 0..k {
-                    let (mpr, mqr) = (m[p * k + r], m[q * k + r]);
-                    m[p * k + r] = c * mpr - s * mqr;
-                    m[q * k + r] = s * mpr + c * mqr;
-                }
-                for r in 0..k {
-                    let (vrp, vrq) = (v[r * k + p], v[r * k + q]);
-                    v[r * k + p] = c * vrp - s * vrq;
-                    v[r * k + q] = s * vrp + c * vrq;
-                }
-            }
-        }
-    }
-    let mut vals: Vec<(f64, usize)> = (0..k).map(|i| (m[i * k + i], i)).collect();
-    vals.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    (vals, v)
 }
 
 #[cfg(test)]
@@ -480,19 +434,6 @@ mod tests {
                 "component {t}: norms {n1} {n2}"
             );
         }
-    }
-
-    #[test]
-    fn jacobi_recovers_eigenpairs() {
-        let a = [4.0, 1.0, 0.0, 1.0, 3.0, 0.5, 0.0, 0.5, 1.0];
-        let (vals, v) = jacobi_eigen(&a, 3);
-        for &(l, c) in &vals {
-            for r in 0..3 {
-                let av: f64 = (0..3).map(|j| a[r * 3 + j] * v[j * 3 + c]).sum();
-                assert!((av - l * v[r * 3 + c]).abs() < 1e-12);
-            }
-        }
-        assert!(vals[0].0 >= vals[1].0 && vals[1].0 >= vals[2].0);
     }
 
     #[test]

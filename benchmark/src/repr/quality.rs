@@ -41,8 +41,7 @@
 //! Ranks break ties by index (a collapsed encoder gets chance-level values, about 0.5). Spaces:
 //! `position` (x, y) and, for the arrow, `state` (x, y, cos a, sin a).
 
-use faer::linalg::solvers::Solve;
-use faer::{Mat, Side};
+use ugl_kernels::{MatRef, cholesky_solve};
 
 use super::{Latents, ReprError};
 
@@ -80,7 +79,12 @@ pub fn targets(states: &[f64], state_dim: usize) -> (Vec<f64>, Vec<String>) {
         out.extend_from_slice(&s[..2]);
         if state_dim == 3 {
             let a = s[2] * std::f64::consts::PI;
-            out.extend([a.cos(), a.sin(), (3.0 * a).cos(), (3.0 * a).sin()]);
+            out.extend([
+                libm::cos(a),
+                libm::sin(a),
+                libm::cos(3.0 * a),
+                libm::sin(3.0 * a),
+            ]);
         }
         if state_dim == 4 {
             out.extend_from_slice(&s[2..4]);
@@ -306,32 +310,42 @@ fn linear_predictions(
 ) -> Result<Vec<f64>, ReprError> {
     let d = train.latents;
     let (mean, sd) = standardiser(train);
-    let design = |z: &Latents| {
-        Mat::<f64>::from_fn(z.n, d + 1, |i, j| {
-            if j == d {
-                1.0
-            } else {
-                (z.row(i)[j] - mean[j]) / sd[j]
-            }
-        })
+    let p = d + 1;
+    // The standardised design matrix with an intercept column, row-major n x (d + 1).
+    let design = |z: &Latents| -> Vec<f64> {
+        let mut x = Vec::with_capacity(z.n * p);
+        for i in 0..z.n {
+            let r = z.row(i);
+            x.extend((0..d).map(|j| (r[j] - mean[j]) / sd[j]));
+            x.push(1.0);
+        }
+        x
     };
     let x = design(train);
-    let yt = Mat::<f64>::from_fn(train.n, t, |i, j| y[i * t + j]);
-    let mut gram = x.transpose() * &x;
-    let trace: f64 = (0..=d).map(|j| gram[(j, j)]).sum();
-    for j in 0..=d {
-        gram[(j, j)] += 1e-9 * trace;
+    let xm = MatRef::row_major(&x, train.n, p);
+    // Ridge-stabilised normal equations (X^T X + 1e-9 tr I) beta = X^T y, by Cholesky.
+    let mut gram = vec![0.0; p * p];
+    ugl_kernels::matmul(&mut gram, xm.t(), xm, false);
+    let trace: f64 = (0..p).map(|j| gram[j * p + j]).sum();
+    for j in 0..p {
+        gram[j * p + j] += 1e-9 * trace;
     }
-    let rhs = x.transpose() * &yt;
-    let llt = gram
-        .llt(Side::Lower)
-        .map_err(|e| ReprError::Numerical(format!("latent quality: {e:?}")))?;
-    let beta = llt.solve(&rhs);
-    let pred = design(heldout) * &beta;
-    Ok((0..heldout.n)
-        .flat_map(|i| (0..t).map(move |j| (i, j)))
-        .map(|(i, j)| pred[(i, j)])
-        .collect())
+    let mut beta = vec![0.0; p * t];
+    ugl_kernels::matmul(&mut beta, xm.t(), MatRef::row_major(y, train.n, t), false);
+    cholesky_solve(&gram, p, &mut beta, t).ok_or_else(|| {
+        ReprError::Numerical(
+            "latent quality: the normal equations are not positive definite".into(),
+        )
+    })?;
+    let xh = design(heldout);
+    let mut pred = vec![0.0; heldout.n * t];
+    ugl_kernels::matmul(
+        &mut pred,
+        MatRef::row_major(&xh, heldout.n, p),
+        MatRef::row_major(&beta, p, t),
+        false,
+    );
+    Ok(pred)
 }
 
 fn knn_predictions(train: &Latents, y: &[f64], heldout: &Latents, t: usize) -> Vec<f64> {

@@ -146,7 +146,7 @@ fn code(
     let logvar = heads.clone().narrow(1, d, d);
     let p = FlowParams::from_heads(&heads, d);
     let e = eps(input.variant, input.batch, d, rng, input.device);
-    let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
+    let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp()); // burn tensor op
     let (zk, logdet) = flows(z0.clone(), &p, d, input.variant);
     let ann = annealing(input.step, input.warmup);
     let kl = kl_std_normal(mu, logvar);
@@ -189,7 +189,11 @@ pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> La
 
 /// Softplus in f64 (`ln(1 + e^x)`, linear above 20 like burn's).
 fn softplus_f64(x: f64) -> f64 {
-    if x > 20.0 { x } else { x.exp().ln_1p() }
+    if x > 20.0 {
+        x
+    } else {
+        libm::log1p(libm::exp(x))
+    }
 }
 
 /// One radial flow on the host (f64): updates `z` in place and returns the corrected
@@ -209,7 +213,7 @@ pub fn flow_step_host(z: &mut [f64], c: &[f64], a_raw: f64, b_raw: f64) -> f64 {
     for (zi, ci) in z.iter_mut().zip(c) {
         *zi += bh * (*zi - ci);
     }
-    ((1.0 + bh).powi(d as i32 - 1) * (1.0 + bh - beta * r / ((a + r) * (a + r)))).ln()
+    libm::log((1.0 + bh).powi(d as i32 - 1) * (1.0 + bh - beta * r / ((a + r) * (a + r))))
 }
 
 /// All flows of one image on the host, from the head outputs; `z` holds `z0` on entry.
@@ -230,7 +234,7 @@ pub fn flows_host(head: &[f32], d: usize, z: &mut [f64]) {
 pub fn z0_sample(head: &[f32], d: usize, rng: &mut Stream, out: &mut [f64]) {
     for j in 0..d {
         let e: f64 = StandardNormal.sample(rng);
-        out[j] = f64::from(head[j]) + e * (0.5 * f64::from(head[d + j])).exp();
+        out[j] = f64::from(head[j]) + e * libm::exp(0.5 * f64::from(head[d + j]));
     }
 }
 

@@ -46,7 +46,7 @@ pub fn code(
     let mu = heads.clone().narrow(1, 0, d);
     let logvar = heads.narrow(1, d, d);
     let e = eps(variant, input.batch, d, rng, input.device);
-    let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp());
+    let z = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp()); // burn tensor op
     (z, mu, logvar)
 }
 

@@ -1133,11 +1133,12 @@ pub fn reproduce(w: &mut String, inp: &Context<'_>) {
     let _ = writeln!(w, "```\n");
     let _ = writeln!(
         w,
-        "Every random draw comes from a seeded stream derived from the run's identity, so the same \
-         campaign on the same thread count and the same SIMD level gives byte-identical result \
-         files (the committed `paper` store mixes AVX2 and AVX-512 runs, so no one machine \
-         regenerates all of it byte for byte; `make verify` checks \
-         this for the `smoke` profile against committed checksums); the leaderboard's bootstrap is \
+        "Every random draw comes from a seeded stream derived from the run's identity. From \
+         results version 5 a run's result files are byte-identical on every machine, kernel path \
+         and thread count (`make verify` reruns the `smoke` profile on every kernel path the CPU \
+         has against one committed checksum file); runs of earlier versions are identical only on \
+         the same SIMD level (the version-4 `paper` store mixes AVX2 and AVX-512 runs, so no one \
+         machine regenerates all of it byte for byte). The leaderboard's bootstrap is \
          seeded too and the other intervals draw nothing, so rendering the same results gives the \
          same bytes. A campaign reruns the runs written at another results version than the \
          code's (version {} here; *What was run* gives each campaign's): to reproduce older runs \

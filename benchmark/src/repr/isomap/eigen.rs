@@ -101,17 +101,10 @@ pub(super) fn rayleigh_ritz(
     keep: usize,
     d: usize,
 ) -> Result<Ritz, ReprError> {
-    let qm = MatRef::from_column_major_slice(q, n, m);
-    let aqm = MatRef::from_column_major_slice(aq, n, m);
+    let qm = MatRef::col_major(q, n, m);
+    let aqm = MatRef::col_major(aq, n, m);
     let mut t = vec![0.0f64; m * m];
-    matmul(
-        MatMut::from_column_major_slice_mut(&mut t, m, m),
-        Accum::Replace,
-        qm.transpose(),
-        aqm,
-        1.0,
-        Par::Seq,
-    );
+    matmul_cm(&mut t, qm.t(), aqm, false);
     for i in 0..m {
         for j in 0..i {
             let s = 0.5 * (t[i + j * m] + t[j + i * m]);
@@ -119,12 +112,10 @@ pub(super) fn rayleigh_ritz(
             t[j + i * m] = s;
         }
     }
-    let eig = SelfAdjointEigen::new(MatRef::from_column_major_slice(&t, m, m), Side::Lower)
-        .map_err(|e| {
-            ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e:?}"))
-        })?;
-    let all: Vec<f64> = eig.S().column_vector().iter().copied().collect();
-    let u = eig.U();
+    let eig = SymmetricEigen::new(&t, m).map_err(|e| {
+        ReprError::Numerical(format!("isomap: Rayleigh-Ritz eigen-solver failed: {e}"))
+    })?;
+    let all = &eig.values;
     // Top `keep` Ritz vectors, decreasing eigenvalue.
     let mut s = vec![0.0f64; m * keep];
     let mut theta = vec![0.0f64; keep];
@@ -132,28 +123,14 @@ pub(super) fn rayleigh_ritz(
         let src = m - 1 - c;
         theta[c] = all[src];
         for r in 0..m {
-            s[r + c * m] = u[(r, src)];
+            s[r + c * m] = eig.vector(r, src);
         }
     }
-    let smat = MatRef::from_column_major_slice(&s, m, keep);
+    let smat = MatRef::col_major(&s, m, keep);
     let mut y = vec![0.0f64; n * keep];
     let mut ay = vec![0.0f64; n * keep];
-    matmul(
-        MatMut::from_column_major_slice_mut(&mut y, n, keep),
-        Accum::Replace,
-        qm,
-        smat,
-        1.0,
-        Par::Seq,
-    );
-    matmul(
-        MatMut::from_column_major_slice_mut(&mut ay, n, keep),
-        Accum::Replace,
-        aqm,
-        smat,
-        1.0,
-        Par::Seq,
-    );
+    matmul_cm(&mut y, qm, smat, false);
+    matmul_cm(&mut ay, aqm, smat, false);
     let norm_est = all.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
     let converged = keep >= d
         && (m == n
@@ -177,17 +154,16 @@ pub(super) fn dense_top_eigenpairs(
     n: usize,
     d: usize,
 ) -> Result<(Vec<f64>, Vec<f64>), ReprError> {
-    let eig = SelfAdjointEigen::new(MatRef::from_column_major_slice(a, n, n), Side::Lower)
-        .map_err(|e| ReprError::Numerical(format!("isomap: eigen-solver failed: {e:?}")))?;
-    let s = eig.S().column_vector();
-    let u = eig.U();
-    let mut vals = Vec::with_capacity(d);
+    // `a` is symmetric, so its column-major slice is also the row-major one.
+    let eig = SymmetricEigen::new(&a[..n * n], n)
+        .map_err(|e| ReprError::Numerical(format!("isomap: eigen-solver failed: {e}")))?;
+    let (s, mut vals) = (&eig.values, Vec::with_capacity(d));
     let mut vecs = vec![0.0; n * d];
     for c in 0..d {
         let src = n - 1 - c;
         vals.push(s[src]);
         for r in 0..n {
-            vecs[r + c * n] = u[(r, src)];
+            vecs[r + c * n] = eig.vector(r, src);
         }
     }
     Ok((vals, vecs))
@@ -209,25 +185,13 @@ pub(super) fn orthonormalise_into(
     let orig: Vec<f64> = (0..xcols).map(|c| norm(&x[c * n..(c + 1) * n])).collect();
     if m > 0 {
         let (qb, _) = q.split_at(n * m);
-        let qm = MatRef::from_column_major_slice(qb, n, m);
+        let qm = MatRef::col_major(qb, n, m);
         let mut coef = vec![0.0f64; m * xcols];
         for _ in 0..2 {
-            matmul(
-                MatMut::from_column_major_slice_mut(&mut coef, m, xcols),
-                Accum::Replace,
-                qm.transpose(),
-                MatRef::from_column_major_slice(x, n, xcols),
-                1.0,
-                Par::Seq,
-            );
-            matmul(
-                MatMut::from_column_major_slice_mut(x, n, xcols),
-                Accum::Add,
-                qm,
-                MatRef::from_column_major_slice(&coef, m, xcols),
-                -1.0,
-                Par::Seq,
-            );
+            matmul_cm(&mut coef, qm.t(), MatRef::col_major(x, n, xcols), false);
+            // x -= Q coef, as x + Q (-coef) (negation is exact).
+            coef.iter_mut().for_each(|c| *c = -*c);
+            matmul_cm(x, qm, MatRef::col_major(&coef, m, xcols), true);
         }
     }
     let mut kept = 0;
@@ -271,23 +235,15 @@ pub(super) fn norm(a: &[f64]) -> f64 {
 /// `y = A x` for the symmetric n x n `a` and x with `cols` columns (column-major), in
 /// fixed-size row blocks (`A[rows, :] = A[:, rows]^T` by symmetry), each a sequential product.
 pub(super) fn sym_mul(a: &[f64], n: usize, x: &[f64], cols: usize, y: &mut [f64]) {
-    let amat = MatRef::from_column_major_slice(a, n, n);
-    let xmat = MatRef::from_column_major_slice(x, n, cols);
+    let xmat = MatRef::col_major(x, n, cols);
     let blocks: Vec<Vec<f64>> = (0..n.div_ceil(MUL_ROWS))
         .into_par_iter()
         .map(|bi| {
             let r0 = bi * MUL_ROWS;
             let rn = MUL_ROWS.min(n - r0);
             let mut out = vec![0.0f64; rn * cols];
-            let ablk = amat.subcols(r0, rn);
-            matmul(
-                MatMut::from_column_major_slice_mut(&mut out, rn, cols),
-                Accum::Replace,
-                ablk.transpose(),
-                xmat,
-                1.0,
-                Par::Seq,
-            );
+            let ablk = MatRef::col_major(&a[r0 * n..(r0 + rn) * n], n, rn);
+            matmul_cm(&mut out, ablk.t(), xmat, false);
             out
         })
         .collect();

@@ -270,7 +270,7 @@ pub(super) fn select_k(c: &mut Vec<(f64, u32)>, k: usize) {
 pub(super) const DENSE_TRAIN_CHUNK: usize = 512;
 pub(super) const DENSE_QUERY_BLOCK: usize = 64;
 
-/// Dense kNN by blocked Gram products (faer, f64): for each of the `m` queries, its k nearest
+/// Dense kNN by blocked Gram products (f64, [`ugl_kernels::matmul`]): for each of the `m` queries, its k nearest
 /// of the `n` training rows, sorted by (squared distance, index); `exclude_self` drops training
 /// row i from query i's candidates (queries = training set). Memory: one f64 training chunk
 /// (dim x 512) and per-thread blocks, never an n x n matrix.
@@ -301,7 +301,7 @@ pub(super) fn dense_knn(
                     *d = s as f64;
                 }
             });
-        let tmat = MatRef::from_column_major_slice(&tbuf[..dim * tn], dim, tn);
+        let tmat = MatRef::col_major(&tbuf[..dim * tn], dim, tn);
         best.par_chunks_mut(DENSE_QUERY_BLOCK * k)
             .enumerate()
             .for_each_init(
@@ -320,9 +320,8 @@ pub(super) fn dense_knn(
                     {
                         *d = s as f64;
                     }
-                    let qmat = MatRef::from_column_major_slice(&qbuf[..dim * qn], dim, qn);
-                    let gram = MatMut::from_column_major_slice_mut(&mut gbuf[..qn * tn], qn, tn);
-                    matmul(gram, Accum::Replace, qmat.transpose(), tmat, 1.0, Par::Seq);
+                    let qmat = MatRef::col_major(&qbuf[..dim * qn], dim, qn);
+                    matmul_cm(&mut gbuf[..qn * tn], qmat.t(), tmat, false);
                     for a in 0..qn {
                         let qi = q0 + a;
                         let top = &mut slots[a * k..(a + 1) * k];

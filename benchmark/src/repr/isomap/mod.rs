@@ -12,7 +12,7 @@
 //!    distance, and identical images at distance 0); distances that are equal mathematically but
 //!    rounded differently are ordered by their computed values, deterministically.
 //!    The rendered images are sparse (a ball lights 97 of 4900 pixels), so the dot products go
-//!    through an inverted index pixel -> images, with a dense fallback (blocked faer products,
+//!    through an inverted index pixel -> images, with a dense fallback (blocked deterministic products,
 //!    chosen when the sparse work `sum_p c_p^2` is not 80x below `n^2 dim`). Both paths give
 //!    identical neighbour lists whenever the arithmetic is exact (tested).
 //! 2. **Geodesic distances** = `shortest_path(kng, method='D', directed=False)`: the graph is
@@ -59,16 +59,20 @@
 //! 500 ball images within 2e-8 once sklearn's kNN ties are broken by index as here (with
 //! sklearn's own tie order the graphs differ and the embeddings by ~5%).
 //!
-//! Determinism: every parallel loop writes disjoint outputs computed sequentially, and every
-//! matrix product is split into fixed-size blocks run with `Par::Seq`, so a fit is a pure
-//! function of (images, latents, n_neighbors, stream) on a given CPU, independent of the
-//! number of threads.
+//! Determinism: every parallel loop writes disjoint outputs computed sequentially, every matrix
+//! product is one FMA chain per output ([`ugl_kernels::matmul`]) and the dense eigen-solver is
+//! plain arithmetic ([`ugl_kernels::SymmetricEigen`]), so a fit is a pure function of (images,
+//! latents, n_neighbors, stream), independent of the number of threads and of the CPU.
 
 use std::cmp::Ordering;
 
-use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::SelfAdjointEigen;
-use faer::{Accum, MatMut, MatRef, Par, Side};
+use ugl_kernels::{MatRef, SymmetricEigen};
+
+/// `out = a b` (or `out += a b`) with `out` column-major `a.rows() x b.cols()`: the row-major
+/// `out^T = b^T a^T`.
+fn matmul_cm(out: &mut [f64], a: MatRef<'_, f64>, b: MatRef<'_, f64>, accumulate: bool) {
+    ugl_kernels::matmul(out, b.t(), a.t(), accumulate);
+}
 use rand::RngExt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

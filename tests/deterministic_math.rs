@@ -1,0 +1,73 @@
+//! Code that reaches a result file computes transcendental functions with the `libm` crate, not
+//! the platform's libm (whose variants are chosen by CPU feature): outside test modules, no
+//! `.exp()`, `.ln()`, `.sin()`, ... method call on a float in `benchmark/src`, `types/src` or
+//! `kernels/src`. The only exceptions are burn tensor operations (the networks' latent middle,
+//! README "Reproducibility"), each marked `// burn tensor op` on its line.
+
+use std::path::Path;
+
+const METHODS: [&str; 11] = [
+    ".exp(",
+    ".ln(",
+    ".ln_1p(",
+    ".exp_m1(",
+    ".sin(",
+    ".cos(",
+    ".sin_cos(",
+    ".tanh(",
+    ".powf(",
+    ".atan2(",
+    ".hypot(",
+];
+
+/// The offending lines of one source file (`path:line: text`), test modules left out.
+fn offending(path: &Path, text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if line.trim_start().starts_with("#[cfg(test)]") {
+            break;
+        }
+        let code = line.split("//").next().unwrap_or("");
+        if line.contains("// burn tensor op") || line.trim_start().starts_with("//") {
+            continue;
+        }
+        if METHODS.iter().any(|m| code.contains(m)) {
+            out.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
+        }
+    }
+    out
+}
+
+fn walk(dir: &Path, out: &mut Vec<String>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            walk(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.extend(offending(&p, &std::fs::read_to_string(&p).unwrap()));
+        }
+    }
+}
+
+#[test]
+fn result_code_uses_libm_for_transcendental_functions() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut found = Vec::new();
+    for dir in ["benchmark/src", "types/src", "kernels/src"] {
+        walk(&root.join(dir), &mut found);
+    }
+    assert!(
+        found.is_empty(),
+        "platform transcendental functions in result code (use libm::...): {found:#?}"
+    );
+}
+
+#[test]
+fn the_check_finds_a_platform_call() {
+    let planted = "fn f(x: f64) -> f64 {\n    x.exp() + libm::log(x)\n}\n";
+    assert_eq!(offending(Path::new("x.rs"), planted).len(), 1);
+    let tensor = "let z = e.mul(v.exp()); // burn tensor op\n";
+    assert!(offending(Path::new("x.rs"), tensor).is_empty());
+    let in_tests = "#[cfg(test)]\nmod tests { fn g() { 2f64.ln(); } }\n";
+    assert!(offending(Path::new("x.rs"), in_tests).is_empty());
+}
