@@ -319,7 +319,8 @@ fn pack_b<T: Element>(
 }
 
 /// Rows `ic..ic + mc` and columns `pc..pc + kc` of `a`, as panels of `mr` rows: panel `q` holds
-/// `kc` columns of `mr` values from `q * mr * kc`, zero-padded.
+/// `kc` columns of `mr` values from `q * mr * kc`, zero-padded. That is [`pack_b`] of the
+/// transpose.
 fn pack_a<T: Element>(
     dst: &mut [T],
     a: MatRef<'_, T>,
@@ -329,22 +330,7 @@ fn pack_a<T: Element>(
     kc: usize,
     mr: usize,
 ) {
-    for (q, i0) in (0..mc).step_by(mr).enumerate() {
-        let h = mr.min(mc - i0);
-        let panel = &mut dst[q * mr * kc..(q + 1) * mr * kc];
-        for p in 0..kc {
-            let col = &mut panel[p * mr..(p + 1) * mr];
-            let base = (ic + i0) * a.rs + (pc + p) * a.cs;
-            if a.rs == 1 {
-                col[..h].copy_from_slice(&a.data[base..base + h]);
-            } else {
-                for (i, v) in col[..h].iter_mut().enumerate() {
-                    *v = a.data[base + i * a.rs];
-                }
-            }
-            col[h..].fill(T::ZERO);
-        }
-    }
+    pack_b(dst, a.t(), pc, kc, ic, mc, mr);
 }
 
 /// The portable micro-kernel (`mul_add`), `MR x NR`.
