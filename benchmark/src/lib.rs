@@ -17,3 +17,4 @@ pub mod metrics;
 pub mod npy;
 pub mod repr;
 pub mod seed;
+mod ziggurat_tables;

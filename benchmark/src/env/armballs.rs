@@ -11,7 +11,7 @@
 //! so an episode's distractor path depends only on the run's identity and the episode's place in
 //! the run, never on the explorer's other draws.
 
-use rand_distr::{Distribution, StandardNormal};
+use crate::seed::standard_normal;
 
 use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
 use crate::seed::Stream;
@@ -46,7 +46,7 @@ impl ArmBalls {
         let mut p = [self.initial[2], self.initial[3]];
         for _ in 0..self.body.table.x.len() {
             for v in &mut p {
-                let n: f64 = StandardNormal.sample(rng);
+                let n = standard_normal(rng);
                 *v = (*v + n * self.noise).clamp(-DISTRACTOR_BOUND, DISTRACTOR_BOUND);
             }
         }

@@ -2,7 +2,6 @@
 //! parameters plus independent Gaussian noise, clipped to [-1,1].
 
 use rand::RngExt;
-use rand_distr::StandardNormal;
 
 use crate::env::PARAMS;
 use crate::seed::Stream;
@@ -15,7 +14,7 @@ pub fn random_params(rng: &mut Stream) -> [f64; PARAMS] {
 /// `theta + N(0, sigma^2)` per dimension, clipped to [-1, 1].
 pub fn perturb(theta: &[f64; PARAMS], sigma: f64, rng: &mut Stream) -> [f64; PARAMS] {
     std::array::from_fn(|k| {
-        let n: f64 = rng.sample(StandardNormal);
+        let n = crate::seed::standard_normal(rng);
         (theta[k] + sigma * n).clamp(-1.0, 1.0)
     })
 }

@@ -4,8 +4,8 @@
 //! factor^2 x data covariance. Sampling = a training latent chosen uniformly + the kernel's
 //! Gaussian noise (`gaussian_kde.resample`).
 
+use crate::seed::standard_normal;
 use rand::RngExt;
-use rand_distr::{Distribution, StandardNormal};
 use ugl_kernels::SymmetricEigen;
 
 use super::GoalSampler;
@@ -101,7 +101,7 @@ impl GoalSampler for KdeGoals {
     fn sample(&mut self, rng: &mut Stream, out: &mut [f64]) {
         let d = self.data.latents;
         let i = rng.random_range(0..self.data.n);
-        let eps: Vec<f64> = (0..d).map(|_| StandardNormal.sample(rng)).collect();
+        let eps: Vec<f64> = (0..d).map(|_| standard_normal(rng)).collect();
         let base = self.data.row(i);
         for r in 0..d {
             out[r] = base[r] + (0..d).map(|c| self.sqrt[r * d + c] * eps[c]).sum::<f64>();
@@ -122,8 +122,8 @@ mod tests {
         let n = 500;
         let mut data = Vec::new();
         for _ in 0..n {
-            let a: f64 = StandardNormal.sample(&mut rng);
-            let b: f64 = StandardNormal.sample(&mut rng);
+            let a = standard_normal(&mut rng);
+            let b = standard_normal(&mut rng);
             data.extend_from_slice(&[2.0 * a + 1.0, 0.5 * a + 0.3 * b - 2.0]);
         }
         Latents {

@@ -1,7 +1,7 @@
 //! Goals from an isotropic standard Gaussian, N(0, I): the paper's Gaussian-prior ("GP") goal
 //! sampling for VAE-type latent spaces (docs/original-code.md section 3, `--sampling=normal`).
 
-use rand_distr::{Distribution, StandardNormal};
+use crate::seed::standard_normal;
 
 use super::GoalSampler;
 use crate::seed::Stream;
@@ -54,7 +54,7 @@ impl GoalSampler for GaussianGoals {
     }
     fn sample(&mut self, rng: &mut Stream, out: &mut [f64]) {
         for ((v, m), s) in out.iter_mut().zip(&self.mean).zip(&self.std) {
-            let z: f64 = StandardNormal.sample(rng);
+            let z = standard_normal(rng);
             *v = m + s * z;
         }
     }

@@ -9,7 +9,7 @@
 //! so a learned goal space that does not beat it has learned nothing the exploration can use
 //! (untrained networks rank with it: the report's controls).
 
-use rand_distr::{Distribution, Normal};
+use crate::seed::standard_normal;
 
 use super::neural_model::Variant;
 use super::params::{LearnerParams, ParamError, ParamGuard};
@@ -76,10 +76,14 @@ impl RepresentationLearner for GaussianProjection {
     ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         check_fit_input(images, latents)?;
         let std = self.std.unwrap_or(1.0 / (latents as f64).sqrt());
-        let normal = Normal::new(0.0, std).map_err(|e| ReprError::InvalidInput(e.to_string()))?;
+        if !(std.is_finite() && std >= 0.0) {
+            return Err(ReprError::InvalidInput(format!(
+                "gaussian projection: std must be finite and non-negative, got {std}"
+            )));
+        }
         // Row-major dim x latents, drawn row by row: the same stream gives the same W.
         let components: Vec<f64> = (0..images.dim * latents)
-            .map(|_| normal.sample(rng))
+            .map(|_| std * standard_normal(rng))
             .collect();
         let mut encoder = ProjectionEncoder {
             components,
@@ -109,6 +113,7 @@ mod tests {
         let learner = GaussianProjection::default();
         let (mut enc, z) = learner.fit(&set, 3, &mut stream_named(1, "t")).unwrap();
         // W again from the same stream: z = x W exactly, on the training set and per image.
+        use rand_distr::{Distribution, Normal};
         let normal = Normal::new(0.0, 1.0 / 3f64.sqrt()).unwrap();
         let mut rng = stream_named(1, "t");
         let w: Vec<f64> = (0..8 * 3).map(|_| normal.sample(&mut rng)).collect();

@@ -18,13 +18,13 @@
 //! column blocks of one `[H2, P]` layer; each block is drawn separately, in that order, as the
 //! original's separate variables are.
 
+use crate::seed::standard_normal;
 use burn::module::{Module, Param, ParamId};
 use burn::nn::Linear;
 use burn::optim::{Optimizer, RecordState, StateSink, StateSource};
 use burn::tensor::activation::{log_sigmoid, relu};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::RngExt;
-use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -142,7 +142,7 @@ pub fn truncated_normal(rng: &mut Stream, n: usize, std: f64) -> Vec<f32> {
     (0..n)
         .map(|_| {
             loop {
-                let v: f64 = StandardNormal.sample(rng);
+                let v = standard_normal(rng);
                 if v.abs() <= 2.0 {
                     break (v * std) as f32;
                 }

@@ -4,8 +4,8 @@
 //! encoder, cache keys) and reaches a model only through [`super::neural::Model::spec`]; the
 //! model files depend on this module and on `nets.rs`, never on `neural.rs`.
 
+use crate::seed::standard_normal;
 use burn::tensor::{Device, Tensor, TensorData};
-use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use super::nets::DenseNet;
@@ -135,10 +135,7 @@ pub struct Latent {
 
 /// `n` standard normals from `rng`.
 pub fn normals(rng: &mut Stream, n: usize) -> Vec<f32> {
-    (0..n)
-        .map(|_| StandardNormal.sample(rng))
-        .map(|v: f64| v as f32)
-        .collect()
+    (0..n).map(|_| standard_normal(rng) as f32).collect()
 }
 
 /// Helper for the model files: a `[rows, cols]` tensor from host values.

@@ -9,7 +9,7 @@
 //!   PCA was the first choice, but it took 426 s and 1.4 GB for 10,000 images (measured with
 //!   `ugl run --algo rge-pca-centred`); it remains the reference of a cross-check test.
 
-use rand_distr::{Distribution, StandardNormal};
+use crate::seed::standard_normal;
 use ugl_kernels::SymmetricEigen;
 
 use super::model_file::ModelFileError;
@@ -256,7 +256,7 @@ impl RepresentationLearner for TruncatedSvd {
             }
             out
         };
-        let omega: Vec<f64> = (0..p * k).map(|_| StandardNormal.sample(rng)).collect();
+        let omega: Vec<f64> = (0..p * k).map(|_| standard_normal(rng)).collect();
         let mut y = mul(&omega);
         orthonormalize(&mut y, n, k);
         for _ in 0..self.n_iter {
@@ -406,7 +406,7 @@ mod tests {
         let mut rng = stream_named(4, "t");
         let data: Vec<f32> = (0..80 * 30)
             .map(|i| {
-                let v: f64 = StandardNormal.sample(&mut rng);
+                let v = standard_normal(&mut rng);
                 (v * (1.0 + (i % 30) as f64 / 5.0)).max(0.0) as f32
             })
             .collect();
@@ -449,7 +449,7 @@ mod tests {
             .collect();
         let mut data = Vec::new();
         for _ in 0..60 {
-            let w: Vec<f64> = (0..3).map(|_| StandardNormal.sample(&mut rng)).collect();
+            let w: Vec<f64> = (0..3).map(|_| standard_normal(&mut rng)).collect();
             for j in 0..50 {
                 data.push((0..3).map(|k| w[k] * pats[k][j] as f64).sum::<f64>() as f32);
             }

@@ -38,9 +38,9 @@
 //!   not on `z0` as in the original, whose Gaussian goals are drawn from a prior of another
 //!   space than the encodings. (Results version 4.)
 
+use crate::seed::standard_normal;
 use burn::tensor::activation::softplus;
 use burn::tensor::{Device, Tensor};
-use rand_distr::{Distribution, StandardNormal};
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
 use super::neural_model::{
@@ -233,7 +233,7 @@ pub fn flows_host(head: &[f32], d: usize, z: &mut [f64]) {
 /// `z0 = mu + eps sigma` with a fresh `eps` (`d` normals from `rng`).
 pub fn z0_sample(head: &[f32], d: usize, rng: &mut Stream, out: &mut [f64]) {
     for j in 0..d {
-        let e: f64 = StandardNormal.sample(rng);
+        let e = standard_normal(rng);
         out[j] = f64::from(head[j]) + e * libm::exp(0.5 * f64::from(head[d + j]));
     }
 }
