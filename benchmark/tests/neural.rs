@@ -1067,3 +1067,115 @@ fn zero_iterations_keep_the_initial_weights_and_are_flagged_untrained() {
         });
     }
 }
+
+/// The plateau rule: a network stopped on the mean-image plateau trains on, in chunks, until it
+/// leaves it (or the cap); one that left it stops where it was told; the extension is recorded
+/// in the loss curve and the training record, and a training killed in an extension resumes
+/// from its checkpoint to the same bits.
+#[test]
+fn the_plateau_rule_trains_on_until_the_network_leaves_the_plateau() {
+    use ugl_bench::repr::evidence::{EVIDENCE_IMAGES, UNTRAINED_FRACTION, mean_image_loss};
+    use ugl_bench::repr::neural::{
+        CheckpointSpec, Init, PlateauRule, reconstruction_loss, train, train_with_checkpoints,
+    };
+    let set = images(EnvKind::ARMBALL, 200);
+    let model = Model::Vae;
+    let head = set.head(EVIDENCE_IMAGES);
+    let plateau = mean_image_loss(&head);
+    let fraction = |enc: &ugl_bench::repr::neural::NeuralEncoder| {
+        reconstruction_loss(model, &enc.net, &head, head.n) / plateau
+    };
+    let stream = || stream_named(4, "plateau-learner");
+    // 3 iterations leave a small VAE on the plateau (He init, so that it can leave it soon).
+    let short = NeuralConfig {
+        init: Init::He,
+        hidden: [128, 64],
+        ..tiny(model, Variant::Corrected, 3)
+    };
+    let stuck = train(model, &short, &set, 2, &mut stream(), None).unwrap();
+    assert!(
+        fraction(&stuck) >= UNTRAINED_FRACTION,
+        "{}",
+        fraction(&stuck)
+    );
+    let rule = PlateauRule {
+        chunk: 40,
+        cap: 1200,
+    };
+    let cfg = NeuralConfig {
+        plateau: Some(rule),
+        log_every: 10,
+        ..short
+    };
+    let trained = train(model, &cfg, &set, 2, &mut stream(), None).unwrap();
+    let done = trained.losses.last().unwrap().0 + 1;
+    assert!(
+        fraction(&trained) < UNTRAINED_FRACTION,
+        "{}",
+        fraction(&trained)
+    );
+    assert!(
+        done > 3 && done <= 1200 && (done - 3).is_multiple_of(40),
+        "{done}"
+    );
+    // It stopped at the first boundary off the plateau: one chunk fewer stays on it.
+    let fewer = NeuralConfig {
+        iterations: done - 40,
+        plateau: None,
+        ..cfg
+    };
+    let before = train(model, &fewer, &set, 2, &mut stream(), None).unwrap();
+    assert!(fraction(&before) >= UNTRAINED_FRACTION);
+    assert_eq!(before.net, {
+        // The same first `done - 40` iterations: the rule changes nothing before it acts.
+        let capped = NeuralConfig {
+            plateau: Some(PlateauRule {
+                chunk: 40,
+                cap: done - 40,
+            }),
+            ..cfg
+        };
+        train(model, &capped, &set, 2, &mut stream(), None)
+            .unwrap()
+            .net
+    });
+    // A network that left the plateau within its iterations is not trained on.
+    let long = NeuralConfig {
+        iterations: done,
+        ..cfg
+    };
+    let at_once = train(model, &long, &set, 2, &mut stream(), None).unwrap();
+    assert_eq!(at_once.losses.last().unwrap().0 + 1, done);
+    assert_eq!(at_once.net, trained.net);
+
+    // Killed inside an extension, resumed from the checkpoint: the same bits.
+    let dir = tempfile::tempdir().unwrap();
+    let spec = CheckpointSpec {
+        dir: dir.path().to_path_buf(),
+        key: "plateau".into(),
+        every: 10,
+    };
+    let kill_at = done - 5;
+    let killer: ugl_bench::repr::neural::ProgressFn = Arc::new(move |p| {
+        if p.iteration == kill_at {
+            panic!("killed");
+        }
+    });
+    let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        train_with_checkpoints(
+            model,
+            &cfg,
+            &set,
+            2,
+            &mut stream(),
+            Some(&killer),
+            Some(&spec),
+        )
+    }));
+    assert!(killed.is_err());
+    let resumed =
+        train_with_checkpoints(model, &cfg, &set, 2, &mut stream(), None, Some(&spec)).unwrap();
+    assert_eq!(resumed.net, trained.net);
+    assert_eq!(resumed.losses, trained.losses);
+    assert_eq!(resumed.encode_seed, trained.encode_seed);
+}

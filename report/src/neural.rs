@@ -84,6 +84,11 @@ pub struct Training {
     pub key: Option<String>,
     /// (iteration, loss), as recorded, sorted by iteration.
     pub losses: Vec<(i64, f64)>,
+    /// The iterations trained (`train.iterations`, results version 5 on): more than
+    /// `iterations` where the plateau rule trained on.
+    pub iterations_used: Option<i64>,
+    /// The plateau rule (`train.config.plateau`): iterations per extension and the cap.
+    pub plateau: Option<(i64, i64)>,
 }
 
 /// The `train` object of a manifest, if the run trained a neural representation.
@@ -124,6 +129,11 @@ pub fn training(m: &Manifest) -> Option<Training> {
         cache: t.get("cache").and_then(Value::as_str).map(str::to_string),
         key: t.get("key").and_then(Value::as_str).map(str::to_string),
         losses,
+        iterations_used: t.get("iterations").and_then(Value::as_i64),
+        plateau: cfg
+            .and_then(|c| c.get("plateau"))
+            .and_then(Value::as_object)
+            .and_then(|p| Some((p.get("chunk")?.as_i64()?, p.get("cap")?.as_i64()?))),
     })
 }
 
@@ -161,6 +171,11 @@ pub struct BudgetUsed {
     pub trainings: usize,
     /// Mean `fit_s` (data set + training) over distinct trainings, seconds.
     pub mean_fit_s: Option<f64>,
+    /// Runs per plateau rule, `chunk N, cap M` (none without the rule).
+    pub plateau_rules: BTreeMap<String, usize>,
+    /// The distinct trainings the plateau rule trained on past their iterations: training key
+    /// -> (configured, used) iterations.
+    pub extended: BTreeMap<String, (i64, i64)>,
 }
 
 /// The learners' budgets actually used by `store`'s runs, in the paper's learner order.
@@ -198,6 +213,16 @@ pub fn budgets_used(store: &Store) -> Vec<BudgetUsed> {
             Some(t.init.clone().unwrap_or_else(|| "paper".into())),
         );
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
+        if let Some((chunk, cap)) = t.plateau {
+            *b.plateau_rules
+                .entry(format!("chunk {chunk}, cap {cap}"))
+                .or_default() += 1;
+        }
+        if let (Some(configured), Some(used)) = (t.iterations, t.iterations_used)
+            && used > configured
+        {
+            b.extended.insert(key.clone(), (configured, used));
+        }
         keys.entry(l).or_default().insert(key, r.manifest.fit_s);
     }
     for (l, ks) in keys {

@@ -80,6 +80,9 @@ pub struct TrainInfo {
     pub config: serde_json::Value,
     /// The recorded loss curve, `(iteration, mini-batch loss)`.
     pub losses: Vec<(usize, f64)>,
+    /// The iterations trained: `config.iterations`, or more where the plateau rule
+    /// (`config.plateau`) trained on.
+    pub iterations: usize,
     /// `hit` (loaded from the model cache), `miss` (trained and stored), `rebuilt` (a cache
     /// file was invalid: trained again and overwritten) or `off` (no cache).
     pub cache: &'static str,
@@ -190,6 +193,7 @@ fn fit_or_load(
     let info = encoder.training_record(images).map(|r| TrainInfo {
         config: identity,
         losses: r.losses,
+        iterations: r.iterations,
         cache: status,
         key,
         evidence: r.evidence,

@@ -224,7 +224,7 @@ fn try_load<'a>(
     rng: &mut Stream,
 ) -> Result<(Trainer<'a>, Vec<(usize, f64)>), String> {
     let text = std::fs::read(dir.join("state.json")).map_err(|e| e.to_string())?;
-    let state = verify(&text, cfg.iterations, images.n)?;
+    let state = verify(&text, cfg.max_iterations(), images.n)?;
     if state.key != c.key || state.rng_seed != hex(&rng.get_seed()) {
         return Err("written for another training".into());
     }

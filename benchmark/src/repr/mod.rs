@@ -181,6 +181,8 @@ pub trait Encoder: Send {
 pub struct TrainingRecord {
     /// The recorded loss curve, `(iteration, mini-batch loss)`.
     pub losses: Vec<(usize, f64)>,
+    /// The iterations trained (more than configured where the plateau rule trained on).
+    pub iterations: usize,
     /// The reconstruction loss against the plateau, and whether the network left it.
     pub evidence: TrainingEvidence,
 }

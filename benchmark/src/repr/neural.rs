@@ -31,7 +31,9 @@ use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::Stream;
 
 pub use super::checkpoint::CheckpointSpec;
-pub use super::neural_config::{BACKEND, Engine, Model, NeuralConfig, training_device};
+pub use super::neural_config::{
+    BACKEND, Engine, Model, NeuralConfig, PlateauRule, training_device,
+};
 pub use super::neural_encoder::NeuralEncoder;
 pub use super::trainer::{ProgressFn, ResumeState, TrainProgress, Trainer, draw_batch, init_net};
 
@@ -57,6 +59,8 @@ pub struct NeuralSection {
     /// β-VAE: capacity annealing, the KL target's final value in nats (only valid in
     /// `[learners.bvae]`).
     pub capacity: Option<f64>,
+    /// The plateau rule: `{ chunk = N, cap = M }` ([`PlateauRule`]).
+    pub plateau: Option<PlateauRule>,
 }
 
 impl NeuralSection {
@@ -75,6 +79,7 @@ impl NeuralSection {
             engine: self.engine.unwrap_or(p.engine),
             beta: p.beta.map(|b| self.beta.unwrap_or(b)),
             capacity: p.beta.and(self.capacity),
+            plateau: self.plateau,
         }
     }
 }
@@ -328,25 +333,51 @@ pub fn train_with_checkpoints(
             (Trainer::new(model, cfg, images, latents, rng)?, Vec::new())
         }
     };
-    for step in trainer.step..cfg.iterations {
-        let value = trainer.step(rng)?;
-        if step % cfg.log_every == 0 || step + 1 == cfg.iterations {
-            losses.push((step, value));
+    // Where the training may stop: `iterations`, and with the plateau rule every `chunk` more
+    // up to the cap. A resumed training passed every boundary before its step (each found the
+    // network on the plateau: the check is a function of the weights), and a checkpoint is
+    // never written at a boundary, so its target is the first boundary after it.
+    let boundaries: Vec<usize> = match cfg.plateau {
+        Some(rule) => rule.boundaries(cfg.iterations).collect(),
+        None => vec![cfg.iterations],
+    };
+    let mut at = boundaries
+        .iter()
+        .position(|&b| b > trainer.step)
+        .unwrap_or(boundaries.len() - 1);
+    let evidence = images.head(super::evidence::EVIDENCE_IMAGES);
+    let plateau_loss = super::evidence::mean_image_loss(&evidence);
+    loop {
+        let target = boundaries[at];
+        for step in trainer.step..target {
+            let value = trainer.step(rng)?;
+            if step % cfg.log_every == 0 || step + 1 == target {
+                losses.push((step, value));
+            }
+            if let Some(c) = ckpt
+                && c.every > 0
+                && (step + 1) % c.every == 0
+                && step + 1 < target
+            {
+                super::checkpoint::save(c, &trainer, rng, &losses)?;
+            }
+            if let Some(p) = progress {
+                p(TrainProgress {
+                    iteration: step + 1,
+                    total: target,
+                    loss: value,
+                });
+            }
         }
-        if let Some(c) = ckpt
-            && c.every > 0
-            && (step + 1) % c.every == 0
-            && step + 1 < cfg.iterations
-        {
-            super::checkpoint::save(c, &trainer, rng, &losses)?;
+        if at + 1 >= boundaries.len() {
+            break;
         }
-        if let Some(p) = progress {
-            p(TrainProgress {
-                iteration: step + 1,
-                total: cfg.iterations,
-                loss: value,
-            });
+        let net = trainer.host_net()?;
+        let rec = super::neural_encoder::reconstruction_loss(model, &net, &evidence, evidence.n);
+        if rec / plateau_loss < super::evidence::UNTRAINED_FRACTION {
+            break;
         }
+        at += 1;
     }
     let trained = trainer.host_net()?;
     if let Some(c) = ckpt {

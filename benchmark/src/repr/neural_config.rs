@@ -155,9 +155,46 @@ pub struct NeuralConfig {
     /// training. Absent: the plain β-VAE (and every other model).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capacity: Option<f64>,
+    /// The plateau rule ([`PlateauRule`]): train on past `iterations`, in fixed chunks, while the
+    /// network is still on the mean-image plateau. Absent: train exactly `iterations` (and the
+    /// configurations and hashes of profiles without it are what they were).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plateau: Option<PlateauRule>,
+}
+
+/// Train on while on the plateau: after `iterations`, and after every further `chunk`
+/// iterations, the reconstruction loss of the first [`super::evidence::EVIDENCE_IMAGES`]
+/// training images is compared with their mean-image loss; while it is not below
+/// [`super::evidence::UNTRAINED_FRACTION`] of it and fewer than `cap` iterations have run, the
+/// training goes on for `chunk` more (the same stream, optimiser and schedule: the RFVAE's
+/// warm-up and the β-VAE's capacity have saturated by then). The check draws nothing, so a run
+/// is still a function of its identity; a resumed training finds its place from the iteration
+/// count alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlateauRule {
+    /// Iterations per extension.
+    pub chunk: usize,
+    /// Most iterations in all, `iterations` included.
+    pub cap: usize,
+}
+
+impl PlateauRule {
+    /// Where the training may stop: `iterations`, then every `chunk` more, up to `cap`.
+    pub fn boundaries(&self, iterations: usize) -> impl Iterator<Item = usize> + '_ {
+        (0..)
+            .map(move |k| iterations + k * self.chunk)
+            .take_while(move |&b| b <= self.cap.max(iterations))
+    }
 }
 
 impl NeuralConfig {
+    /// The most iterations this training can run: `iterations`, or the plateau rule's cap.
+    pub fn max_iterations(&self) -> usize {
+        self.plateau
+            .map_or(self.iterations, |r| r.cap.max(self.iterations))
+    }
+
     /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
     pub fn capacity_at(&self, step: usize) -> Option<f64> {
         self.capacity
@@ -178,6 +215,7 @@ impl NeuralConfig {
             capacity: None,
             init: Init::Paper,
             engine: Engine::Host,
+            plateau: None,
         }
     }
 
@@ -212,6 +250,26 @@ impl NeuralConfig {
         }
         if self.log_every == 0 {
             return Err(ParamError::at("log_every", "must be at least 1"));
+        }
+        if let Some(rule) = self.plateau {
+            if rule.chunk == 0 {
+                return Err(ParamError::at("plateau.chunk", "must be at least 1"));
+            }
+            if rule.cap < self.iterations {
+                return Err(ParamError::at(
+                    "plateau.cap",
+                    format!(
+                        "must be at least the iterations ({}), got {}",
+                        self.iterations, rule.cap
+                    ),
+                ));
+            }
+            if self.iterations == 0 {
+                return Err(ParamError::at(
+                    "plateau",
+                    "an untrained twin (iterations = 0) has no plateau rule",
+                ));
+            }
         }
         if let Some(b) = self.beta
             && !(b.is_finite() && b > 0.0 && b <= 1e6)

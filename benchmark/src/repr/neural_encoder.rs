@@ -142,6 +142,8 @@ impl Encoder for NeuralEncoder {
         let rec = reconstruction_loss(self.model, &self.net, &head, head.n);
         Some(super::TrainingRecord {
             losses: self.losses.clone(),
+            // The last iteration is always logged.
+            iterations: self.losses.last().map_or(0, |&(step, _)| step + 1),
             evidence: super::evidence::TrainingEvidence::new(
                 super::evidence::mean_image_loss(&head),
                 rec,

@@ -163,6 +163,25 @@ pub fn training_budgets(w: &mut String, inp: &Context<'_>) {
                 plural(b.unrecorded)
             );
         }
+        if !b.plateau_rules.is_empty() {
+            let used: Vec<i64> = b.extended.values().map(|&(_, u)| u).collect();
+            let _ = writeln!(
+                w,
+                "| | plateau rule ({}): {} of {} trainings trained on past their iterations{} | | | | | | | |",
+                b.plateau_rules
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join("; "),
+                b.extended.len(),
+                b.trainings,
+                match (used.iter().min(), used.iter().max()) {
+                    (Some(lo), Some(hi)) if lo == hi => format!(", to {lo}"),
+                    (Some(lo), Some(hi)) => format!(", to {lo}-{hi}"),
+                    _ => String::new(),
+                }
+            );
+        }
         if let Some(p) = paper_training(&b.learner) {
             let _ = writeln!(
                 w,
