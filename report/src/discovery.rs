@@ -517,7 +517,9 @@ mod tests {
 
     /// The KL-coverage and cell coverage computed again from the kept outcomes equal what the
     /// runs recorded, at every evaluation epoch and in the manifest's summary, on runs of every
-    /// environment.
+    /// environment: bit for bit for runs of the code's results version; for older runs, whose
+    /// `ln` came from the platform's libm (now `libm`'s, which may round the last bit apart),
+    /// to a few ulp.
     #[test]
     fn the_klc_on_all_outcomes_equals_the_runs_own() {
         let stems = [
@@ -538,12 +540,32 @@ mod tests {
             let env = EnvMeasures::by_name(&run.key.env).unwrap();
             let fin = measure_run(&run).unwrap().unwrap();
             let summary = &run.manifest.summary;
-            assert_eq!(fin.klc, summary.final_klc, "{stem}");
+            let current =
+                run.manifest.results_version() == Some(u64::from(ugl_types::RESULTS_VERSION));
+            let same_klc = |a: f64, b: f64| {
+                if current || !(a.is_finite() && b.is_finite()) {
+                    a == b
+                } else {
+                    (a - b).abs() <= 4.0 * f64::EPSILON * b.abs().max(1.0)
+                }
+            };
+            assert!(
+                same_klc(fin.klc, summary.final_klc),
+                "{stem}: {} vs {}",
+                fin.klc,
+                summary.final_klc
+            );
             assert_eq!(fin.coverage, summary.coverage, "{stem}");
             assert_eq!(fin.n_moved, summary.n_moved, "{stem}");
             for p in &run.curve {
                 let d = env.measure(&run.outcomes, Some(p.epoch)).unwrap().unwrap();
-                assert_eq!(d.klc, p.klc, "{stem} epoch {}", p.epoch);
+                assert!(
+                    same_klc(d.klc, p.klc),
+                    "{stem} epoch {}: {} vs {}",
+                    p.epoch,
+                    d.klc,
+                    p.klc
+                );
                 assert_eq!(d.coverage, p.coverage, "{stem} epoch {}", p.epoch);
                 assert_eq!(
                     d.n_outcomes as i64, p.n_outcomes,
