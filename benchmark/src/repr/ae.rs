@@ -8,8 +8,8 @@
 //! `Corrected` train and encode identically (same stream, same weights, same latents).
 
 use burn::tensor::Tensor;
-use burn::tensor::activation::sigmoid;
 
+use super::host_ops::sigmoid;
 use super::nets::{DenseNet, bce_with_logits_sum};
 use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput};
 use crate::seed::Stream;

@@ -14,6 +14,7 @@ pub mod dataset;
 pub mod evidence;
 pub mod external;
 pub mod gaussian_projection;
+pub mod host_ops;
 pub mod host_train;
 pub mod isomap;
 pub mod model_file;

@@ -22,13 +22,14 @@ use crate::seed::standard_normal;
 use burn::module::{Module, Param, ParamId};
 use burn::nn::Linear;
 use burn::optim::{Optimizer, RecordState, StateSink, StateSource};
-use burn::tensor::activation::{log_sigmoid, relu};
+use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::RngExt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::ReprError;
+use super::host_ops::{exp, log_sigmoid};
 use crate::seed::Stream;
 
 /// Standard deviation of the initial weights (all of the original's dense layers).
@@ -437,7 +438,7 @@ pub fn bce_with_logits_sum(logits: Tensor<2>, targets: Tensor<2>) -> Tensor<2> {
 
 /// Analytic `KL(N(mu, exp(logvar)) || N(0, I))` per sample: `[B, 1]`.
 pub fn kl_std_normal(mu: Tensor<2>, logvar: Tensor<2>) -> Tensor<2> {
-    let inner = logvar.clone().add_scalar(1.0) - mu.square() - logvar.exp(); // burn tensor op
+    let inner = logvar.clone().add_scalar(1.0) - mu.square() - exp(logvar);
     inner.sum_dim(1).mul_scalar(-0.5)
 }
 

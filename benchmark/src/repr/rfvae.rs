@@ -39,9 +39,9 @@
 //!   space than the encodings. (Results version 4.)
 
 use crate::seed::standard_normal;
-use burn::tensor::activation::softplus;
 use burn::tensor::{Device, Tensor};
 
+use super::host_ops::{exp, log, powf, softplus};
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
 use super::neural_model::{
     Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, tensor2,
@@ -99,7 +99,7 @@ pub fn flow_step(
 ) -> (Tensor<2>, Tensor<2>) {
     let c = p.c.clone().narrow(1, k * d, d);
     let a = p.a.clone().narrow(1, k, 1).abs();
-    let beta = softplus(p.b.clone().narrow(1, k, 1), 1.0) - a.clone();
+    let beta = softplus(p.b.clone().narrow(1, k, 1)) - a.clone();
     let diff = z.clone() - c;
     let r = diff.clone().square().sum_dim(1).sqrt();
     let a_plus_r = a + r.clone();
@@ -114,8 +114,8 @@ pub fn flow_step(
         Variant::Faithful => (bh.transpose(), q.transpose()),
     };
     let one_bh = bh.add_scalar(1.0);
-    let t = one_bh.clone().powf_scalar((d - 1) as f64) * (one_bh - beta * q);
-    let logdet = t.clamp(LOGDET_CLIP.0, LOGDET_CLIP.1).log();
+    let t = powf(one_bh.clone(), (d - 1) as f32) * (one_bh - beta * q);
+    let logdet = log(t.clamp(LOGDET_CLIP.0, LOGDET_CLIP.1));
     (z_next, logdet)
 }
 
@@ -146,7 +146,7 @@ fn code(
     let logvar = heads.clone().narrow(1, d, d);
     let p = FlowParams::from_heads(&heads, d);
     let e = eps(input.variant, input.batch, d, rng, input.device);
-    let z0 = mu.clone() + e.mul(logvar.clone().mul_scalar(0.5).exp()); // burn tensor op
+    let z0 = mu.clone() + e.mul(exp(logvar.clone().mul_scalar(0.5)));
     let (zk, logdet) = flows(z0.clone(), &p, d, input.variant);
     let ann = annealing(input.step, input.warmup);
     let kl = kl_std_normal(mu, logvar);
