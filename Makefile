@@ -11,7 +11,7 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test test-cargo test-slurm lint campaign bench verify verify-update check-toolchain check-shared-build
+.PHONY: help report test test-cargo test-slurm lint campaign bench verify verify-update verify-store check-toolchain check-shared-build
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
@@ -22,6 +22,7 @@ help:
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
 	@echo "make bench               criterion benchmarks (rollout, render, NN query, KLC, Isomap)"
 	@echo "make verify              rerun the smoke campaign on every kernel path; compare bytes with data/checksums/smoke.sha256"
+	@echo "make verify-store        rerun a stratified sample of the committed runs (ugl verify) and compare bytes"
 
 lint: check-toolchain
 	$(CARGO) fmt --all -- --check
@@ -43,7 +44,7 @@ report: check-toolchain
 	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT) --main $(MAIN)
 	@echo "report: $(REPORT_OUT)/REPORT.md"
 
-test: test-cargo test-slurm
+test: test-cargo test-slurm verify-store
 
 test-cargo: check-toolchain
 	$(CARGO) test --workspace
@@ -53,6 +54,15 @@ test-cargo: check-toolchain
 # them); without them it fails and says so.
 test-slurm: check-toolchain
 	bash tests/slurm/real_cluster.sh
+
+# The committed results themselves, not only the smoke campaign: `ugl verify` checks every run's
+# files against its manifest, then reruns VERIFY_SAMPLE runs (stratified over the conditions, a
+# trained network among them) from the campaign's profile and compares their bytes. The stores
+# of the current results version (the version-5 rerun fills data/results-pending/ first).
+VERIFY_STORES ?= data/results-pending/paper
+VERIFY_SAMPLE ?= 3
+verify-store: check-toolchain
+	@for d in $(VERIFY_STORES); do $(UGL) verify --results $$d --sample $(VERIFY_SAMPLE) || exit 1; done
 
 campaign: check-toolchain
 	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))

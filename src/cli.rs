@@ -171,6 +171,22 @@ pub(crate) enum Command {
         #[arg(long)]
         require_complete: bool,
     },
+    /// Check a store against the code: every run's files against its manifest's digests, then
+    /// rerun a sample of its runs (stratified over the conditions, at least one trained
+    /// network) from the campaign's profile into a scratch directory, fitting afresh, and
+    /// compare their bytes with the committed ones. Exits with an error on any difference.
+    Verify {
+        /// A campaign's results directory (holding its campaign.toml).
+        #[arg(long)]
+        results: PathBuf,
+        /// The campaign's profile (default: data/campaigns/<the record's name>.toml); its
+        /// configuration hash must be the record's.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// How many runs to rerun.
+        #[arg(long, default_value_t = 4)]
+        sample: usize,
+    },
     /// Merge run files from several results directories (e.g. one per machine) into one store.
     Merge {
         /// Destination results directory.

@@ -185,6 +185,11 @@ fn dispatch(cmd: Command) -> Result<()> {
             require_complete,
         } => status(&config, out, shards, require_complete),
         Command::Merge { into, sources } => merge(&into, &sources),
+        Command::Verify {
+            results,
+            config,
+            sample,
+        } => commands::verify::verify(&results, config.as_deref(), sample),
         Command::Learners => learners(),
         Command::Compare(a) => compare(a),
         Command::Embed(a) => embed(a),

@@ -4,3 +4,4 @@ pub(crate) mod campaign;
 pub(crate) mod compare;
 pub(crate) mod environment;
 pub(crate) mod single;
+pub(crate) mod verify;

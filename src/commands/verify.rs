@@ -1,0 +1,219 @@
+//! `ugl verify`: rerun a sample of a store's runs from their campaign profile and compare bytes.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+
+use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
+use ugl_bench::campaign::plan::{RunSpec, plan};
+use ugl_bench::campaign::store::read_manifest;
+use ugl_bench::campaign::{Harness, RunContext};
+use ugl_types::{CampaignRecord, Manifest, RESULTS_VERSION, verify_files};
+
+use crate::output::outln;
+
+/// One committed run chosen for a rerun.
+struct Pick {
+    spec: RunSpec,
+    manifest: Manifest,
+}
+
+/// The iterations a run's network trained (0: not a trained network).
+fn trained_iterations(m: &Manifest) -> u64 {
+    m.train
+        .as_ref()
+        .and_then(|t| t.get("iterations"))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0)
+}
+
+/// The condition of a run: its id with the repetition and replicate set to 0.
+fn condition(spec: &RunSpec) -> String {
+    RunSpec {
+        seed: 0,
+        exploration: 0,
+        ..spec.clone()
+    }
+    .run_id()
+}
+
+/// `n` runs stratified over the conditions: conditions evenly spaced in their sorted order, one
+/// run each (the repetition and replicate from a hash of the condition, so the same runs every
+/// time); if none of them is a trained network and `n >= 2`, the last is replaced by the
+/// trained network with the fewest iterations (the cheapest to retrain).
+fn sample(runs: Vec<Pick>, n: usize) -> Vec<Pick> {
+    let mut by_condition: BTreeMap<String, Vec<Pick>> = BTreeMap::new();
+    for p in runs {
+        by_condition.entry(condition(&p.spec)).or_default().push(p);
+    }
+    let mut groups: Vec<Vec<Pick>> = by_condition.into_values().collect();
+    let n = n.min(groups.len());
+    let mut chosen: Vec<usize> = (0..n).map(|i| i * groups.len() / n).collect();
+    let trained = |g: &Vec<Pick>| g.iter().map(|p| trained_iterations(&p.manifest)).min();
+    if n >= 2 && !chosen.iter().any(|&i| trained(&groups[i]).unwrap_or(0) > 0) {
+        let cheapest = (0..groups.len())
+            .filter_map(|i| trained(&groups[i]).filter(|&it| it > 0).map(|it| (it, i)))
+            .min();
+        if let Some((_, i)) = cheapest {
+            chosen[n - 1] = i;
+        }
+    }
+    chosen.sort_unstable();
+    chosen.dedup();
+    chosen
+        .into_iter()
+        .rev()
+        .map(|i| {
+            let mut g = groups.swap_remove(i);
+            g.sort_by_key(|p| (p.spec.seed, p.spec.exploration));
+            let hash = blake3::hash(condition(&g[0].spec).as_bytes());
+            let k = u64::from_le_bytes(hash.as_bytes()[..8].try_into().expect("8 bytes"));
+            g.swap_remove((k % g.len() as u64) as usize)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .collect()
+}
+
+/// The differences between a committed run and its rerun (empty: the same bytes).
+fn differences(committed: &Manifest, rerun: &Manifest) -> Vec<String> {
+    let mut out = Vec::new();
+    if committed.config_hash != rerun.config_hash {
+        out.push("the configuration hash differs (the profile or the code changed)".into());
+    }
+    let files = |m: &Manifest| {
+        m.files
+            .iter()
+            .flatten()
+            .map(|f| (f.name.clone(), f.blake3.clone()))
+            .collect::<BTreeMap<_, _>>()
+    };
+    let (a, b) = (files(committed), files(rerun));
+    for (name, hash) in &a {
+        match b.get(name) {
+            Some(h) if h == hash => {}
+            Some(h) => out.push(format!("{name}: BLAKE3 {hash} committed, {h} rerun")),
+            None => out.push(format!("{name}: not written by the rerun")),
+        }
+    }
+    for name in b.keys().filter(|n| !a.contains_key(*n)) {
+        out.push(format!(
+            "{name}: written by the rerun, not in the committed manifest"
+        ));
+    }
+    if committed.discovery_blake3 != rerun.discovery_blake3 {
+        out.push("the discovery record differs".into());
+    }
+    if serde_json::to_value(&committed.summary).ok() != serde_json::to_value(&rerun.summary).ok() {
+        out.push("the summary differs".into());
+    }
+    out
+}
+
+pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result<()> {
+    if n == 0 {
+        bail!("--sample must be at least 1");
+    }
+    let record = CampaignRecord::read(results)
+        .with_context(|| format!("--results {}", results.display()))?
+        .with_context(|| {
+            format!(
+                "--results {}: no campaign.toml (not a campaign's results directory)",
+                results.display()
+            )
+        })?;
+    let path: PathBuf = match profile {
+        Some(p) => p.to_path_buf(),
+        None => resolve_profile(&record.name)?,
+    };
+    let cfg = CampaignConfig::load(&path)?;
+    let hash = cfg.configuration_hash();
+    if record.configuration.as_deref() != Some(hash.as_str()) {
+        bail!(
+            "{}: its configuration hash is not the one {} was run with; pass the campaign's \
+             profile with --config",
+            path.display(),
+            results.display()
+        );
+    }
+    // Every committed run's files against its manifest, and the runs of this results version.
+    let mut runs = Vec::new();
+    let mut older = 0;
+    for spec in plan(&cfg) {
+        let file = results.join(format!("{}.json", spec.run_id()));
+        if !file.is_file() {
+            continue;
+        }
+        let manifest = read_manifest(&file)?;
+        verify_files(results, &manifest)
+            .with_context(|| format!("{}: the committed files", spec.run_id()))?;
+        if manifest.results_version() == Some(u64::from(RESULTS_VERSION)) {
+            runs.push(Pick { spec, manifest });
+        } else {
+            older += 1;
+        }
+    }
+    let checked = runs.len() + older;
+    if runs.is_empty() {
+        bail!(
+            "{}: none of its {checked} runs is of this code's results version ({RESULTS_VERSION}): \
+             they cannot be reproduced by it",
+            results.display()
+        );
+    }
+    outln!(
+        "{}: {checked} runs match their recorded digests ({older} of an older results version); \
+         rerunning {} of the {} of version {RESULTS_VERSION}",
+        results.display(),
+        n.min(runs.len()),
+        runs.len()
+    )?;
+    let picks = sample(runs, n);
+    let scratch = std::env::temp_dir().join(format!("ugl-verify-{}", std::process::id()));
+    let profile_name = path.display().to_string();
+    let ctx = RunContext::new(
+        &cfg,
+        rayon::current_num_threads(),
+        Harness {
+            profile: &profile_name,
+            ..Harness::default()
+        },
+    );
+    let mut failed = 0;
+    for p in &picks {
+        let dir = scratch.join(p.spec.run_id());
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
+        let t0 = Instant::now();
+        ugl_bench::campaign::execute(&p.spec, &ctx, &dir, None)?;
+        let rerun = read_manifest(&dir.join(format!("{}.json", p.spec.run_id())))?;
+        let diff = differences(&p.manifest, &rerun);
+        let files = rerun.files.as_ref().map_or(0, Vec::len);
+        if diff.is_empty() {
+            outln!(
+                "same bytes  {}  ({files} files, {:.0} s)",
+                p.spec.run_id(),
+                t0.elapsed().as_secs_f64()
+            )?;
+        } else {
+            failed += 1;
+            outln!("DIFFERENT   {}", p.spec.run_id())?;
+            for d in diff {
+                outln!("    {d}")?;
+            }
+        }
+        // Best effort: a scratch copy left behind is harmless.
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    let _ = std::fs::remove_dir_all(&scratch);
+    if failed > 0 {
+        bail!(
+            "{failed} of {} rerun runs differ from the committed ones",
+            picks.len()
+        );
+    }
+    Ok(())
+}
