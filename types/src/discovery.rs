@@ -37,6 +37,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::env::EnvSpec;
 use crate::klc::{KlCoverage, KlcError};
+use crate::nn::NnIndex;
 
 /// One outcome of an exploration (a row of `<run_id>.outcomes.parquet`): the controllable
 /// object's state at the end of an episode.
@@ -180,78 +181,6 @@ impl GoalGrid {
     }
 }
 
-/// A static k-d tree over points of `dims` coordinates (median splits, cycling axes), for the
-/// nearest-neighbour distance of each goal.
-struct KdTree<'p> {
-    dims: usize,
-    points: &'p [f64],
-    /// Point indices in tree order: the node of `lo..hi` is its middle.
-    order: Vec<usize>,
-}
-
-impl<'p> KdTree<'p> {
-    fn new(points: &'p [f64], dims: usize) -> Self {
-        let mut order: Vec<usize> = (0..points.len() / dims).collect();
-        Self::build(points, dims, &mut order, 0);
-        KdTree {
-            dims,
-            points,
-            order,
-        }
-    }
-
-    fn build(points: &[f64], dims: usize, idx: &mut [usize], depth: usize) {
-        if idx.len() <= 1 {
-            return;
-        }
-        let axis = depth % dims;
-        let mid = idx.len() / 2;
-        idx.select_nth_unstable_by(mid, |&a, &b| {
-            points[a * dims + axis].total_cmp(&points[b * dims + axis])
-        });
-        let (left, right) = idx.split_at_mut(mid);
-        Self::build(points, dims, left, depth + 1);
-        Self::build(points, dims, &mut right[1..], depth + 1);
-    }
-
-    fn point(&self, i: usize) -> &[f64] {
-        &self.points[i * self.dims..(i + 1) * self.dims]
-    }
-
-    /// Distance from `q` to the nearest point; None for an empty tree.
-    fn nearest(&self, q: &[f64]) -> Option<f64> {
-        if self.order.is_empty() {
-            return None;
-        }
-        let mut best = f64::INFINITY;
-        self.search(q, 0, self.order.len(), 0, &mut best);
-        Some(best.sqrt())
-    }
-
-    fn search(&self, q: &[f64], lo: usize, hi: usize, depth: usize, best: &mut f64) {
-        if lo >= hi {
-            return;
-        }
-        let mid = lo + (hi - lo) / 2;
-        let p = self.point(self.order[mid]);
-        let d2: f64 = p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum();
-        if d2 < *best {
-            *best = d2;
-        }
-        let axis = depth % self.dims;
-        let diff = q[axis] - p[axis];
-        let (near, far) = if diff < 0.0 {
-            ((lo, mid), (mid + 1, hi))
-        } else {
-            ((mid + 1, hi), (lo, mid))
-        };
-        self.search(q, near.0, near.1, depth + 1, best);
-        if diff * diff < *best {
-            self.search(q, far.0, far.1, depth + 1, best);
-        }
-    }
-}
-
 /// The measures of one environment: its grid, its goals and which outcome fields it measures.
 #[derive(Debug, Clone)]
 pub struct EnvMeasures {
@@ -388,8 +317,16 @@ impl EnvMeasures {
             Err(KlcError::Empty) => return Ok(None),
             Err(e) => return Err(klc_error(e)),
         };
-        let tree = KdTree::new(&points, d);
-        let mut errors: Vec<f64> = self.goals.goals().filter_map(|g| tree.nearest(g)).collect();
+        // No NaN reaches the tree: KL-coverage refused it above.
+        let mut tree = NnIndex::new(d);
+        for p in points.chunks_exact(d) {
+            tree.insert(p);
+        }
+        let mut errors: Vec<f64> = self
+            .goals
+            .goals()
+            .filter_map(|g| tree.nearest(g).map(|(_, d2)| d2.sqrt()))
+            .collect();
         errors.sort_by(f64::total_cmp);
         Ok(Some(Discovery {
             n_outcomes: all.total() as usize,
@@ -919,7 +856,10 @@ mod tests {
         for dims in [2, 3] {
             for n in [1, 2, 5, 300] {
                 let pts: Vec<f64> = (0..n * dims).map(|_| uniform(-1.0, 1.0)).collect();
-                let tree = KdTree::new(&pts, dims);
+                let mut tree = NnIndex::new(dims);
+                for p in pts.chunks_exact(dims) {
+                    tree.insert(p);
+                }
                 for _ in 0..200 {
                     let q: Vec<f64> = (0..dims).map(|_| uniform(-1.2, 1.2)).collect();
                     let brute = pts
@@ -932,11 +872,11 @@ mod tests {
                         })
                         .fold(f64::INFINITY, f64::min)
                         .sqrt();
-                    assert_eq!(tree.nearest(&q), Some(brute));
+                    assert_eq!(tree.nearest(&q).map(|(_, d2)| d2.sqrt()), Some(brute));
                 }
             }
         }
-        assert_eq!(KdTree::new(&[], 2).nearest(&[0.0, 0.0]), None);
+        assert_eq!(NnIndex::new(2).nearest(&[0.0, 0.0]), None);
     }
 
     #[test]

@@ -34,6 +34,7 @@ mod goal_space;
 pub mod klc;
 mod learner;
 mod manifest;
+pub mod nn;
 mod paths;
 mod quality;
 mod sampler;

@@ -13,7 +13,8 @@ pub mod imgep;
 pub mod interest;
 pub mod meta_policy;
 pub mod mge;
-pub mod nn;
+/// The k-d tree (in `ugl-types`, shared with the discovery measures).
+pub use ugl_types::nn;
 pub mod rpe;
 
 use std::borrow::Cow;
