@@ -13,6 +13,20 @@ fn ugl(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `ugl verify` of `out` with the profile `cfg`: (success, stdout and stderr).
+fn verify(out: &str, cfg: &str, sample: &str) -> (bool, String) {
+    let o = ugl(&[
+        "verify",
+        "--results",
+        out,
+        "--config",
+        cfg,
+        "--sample",
+        sample,
+    ]);
+    (o.status.success(), text(&o))
+}
+
 fn write_file(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
@@ -64,17 +78,8 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
 
     // Six conditions (RGE-EFR, PCA-2, PCA-3, VAE-2, VAE-3, RPE); two evenly spaced ones are
     // RGE-EFR and PCA-3, so the second is replaced by the cheapest trained network.
-    let o = ugl(&[
-        "verify",
-        "--results",
-        out_s,
-        "--config",
-        cfg,
-        "--sample",
-        "2",
-    ]);
-    let t = text(&o);
-    assert!(o.status.success(), "{t}");
+    let (ok, t) = verify(out_s, cfg, "2");
+    assert!(ok, "{t}");
     assert!(t.contains("12 runs match their recorded digests"), "{t}");
     let same: Vec<&str> = t.lines().filter(|l| l.starts_with("same bytes")).collect();
     assert_eq!(same.len(), 2, "{t}");
@@ -82,17 +87,8 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
     assert!(same[1].contains("armball.rge-vae."), "{t}");
 
     // Every condition once; then one run's curve swapped for another's, digests forged.
-    let o = ugl(&[
-        "verify",
-        "--results",
-        out_s,
-        "--config",
-        cfg,
-        "--sample",
-        "100",
-    ]);
-    let t = text(&o);
-    assert!(o.status.success(), "{t}");
+    let (ok, t) = verify(out_s, cfg, "100");
+    assert!(ok, "{t}");
     let reran: Vec<String> = t
         .lines()
         .filter_map(|l| l.strip_prefix("same bytes  "))
@@ -109,17 +105,8 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
         "armball.rge-pca.kde.l2.s0"
     };
     forge(&out, victim, other);
-    let o = ugl(&[
-        "verify",
-        "--results",
-        out_s,
-        "--config",
-        cfg,
-        "--sample",
-        "100",
-    ]);
-    let t = text(&o);
-    assert!(!o.status.success(), "{t}");
+    let (ok, t) = verify(out_s, cfg, "100");
+    assert!(!ok, "{t}");
     assert!(t.contains(&format!("DIFFERENT   {victim}")), "{t}");
     assert!(t.contains(&format!("{victim}.parquet: BLAKE3")), "{t}");
     assert!(t.contains("1 of 6 rerun runs differ"), "{t}");
@@ -127,21 +114,13 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
     // A damaged file is caught before anything is rerun; a profile of another configuration
     // is refused.
     std::fs::write(out.join(format!("{victim}.parquet")), b"damaged").unwrap();
-    let o = ugl(&["verify", "--results", out_s, "--config", cfg]);
-    assert!(!o.status.success());
-    assert!(text(&o).contains("the committed files"), "{}", text(&o));
+    let (ok, t) = verify(out_s, cfg, "4");
+    assert!(!ok && t.contains("the committed files"), "{t}");
     let other_cfg = write_file(
         dir.path(),
         "other.toml",
         "[campaign]\nname = \"tiny\"\nreps = 3\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n",
     );
-    let o = ugl(&[
-        "verify",
-        "--results",
-        out_s,
-        "--config",
-        other_cfg.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    assert!(text(&o).contains("configuration hash"), "{}", text(&o));
+    let (ok, t) = verify(out_s, other_cfg.to_str().unwrap(), "4");
+    assert!(!ok && t.contains("configuration hash"), "{t}");
 }

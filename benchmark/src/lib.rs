@@ -12,6 +12,7 @@ pub mod env;
 pub mod explore;
 pub mod fsio;
 pub mod goals;
+pub mod invalid;
 pub mod limits;
 pub mod metrics;
 pub mod npy;

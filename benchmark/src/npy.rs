@@ -57,7 +57,8 @@ pub fn write_npy_f32_file(path: &Path, rows: usize, cols: usize, data: &[f32]) -
 }
 
 /// A read error: the message (prefixed with what was read), and whether the stream ended.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
 pub struct NpyError {
     pub message: String,
     /// The stream ended (the program probably exited).
@@ -84,19 +85,21 @@ fn io_err(what: &str, e: io::Error) -> NpyError {
     }
 }
 
-pub fn read_npy_file(path: &Path, rows: Option<usize>, cols: usize) -> Result<Vec<f64>, String> {
+/// Read the npy file `path`: one array of shape (rows, cols) (rows checked when given), and
+/// nothing after it.
+pub fn read_npy_file(path: &Path, rows: Option<usize>, cols: usize) -> Result<Vec<f64>, NpyError> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let file =
-        File::open(path).map_err(|e| format!("cannot open {name} ({}): {e}", path.display()))?;
+    let file = File::open(path)
+        .map_err(|e| npy_err(&format!("cannot open {name} ({})", path.display()), e))?;
     let mut r = BufReader::new(file);
     let mut out = Vec::new();
-    read_npy(&mut r, &mut Vec::new(), &mut out, rows, cols, &name).map_err(|e| e.message)?;
+    read_npy(&mut r, &mut Vec::new(), &mut out, rows, cols, &name)?;
     let mut probe = [0u8; 1];
-    if r.read(&mut probe).map_err(|e| format!("{name}: {e}"))? != 0 {
-        return Err(format!("{name}: trailing bytes after the array"));
+    if r.read(&mut probe).map_err(|e| npy_err(&name, e))? != 0 {
+        return Err(npy_err(&name, "trailing bytes after the array"));
     }
     Ok(out)
 }

@@ -1,6 +1,7 @@
 //! Campaign configuration (TOML; `data/campaigns/NAME.toml`). Every budget lives here, never in
 //! code; the defaults of the `explore` and `env` sections are the paper's values.
 
+use crate::invalid::InvalidValue;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -311,9 +312,9 @@ impl CampaignConfig {
             path: path.to_path_buf(),
             message: with_learner_line(text, &e),
         })?;
-        cfg.validate().map_err(|message| ConfigError::Invalid {
+        cfg.validate().map_err(|e| ConfigError::Invalid {
             path: path.to_path_buf(),
-            message,
+            message: e.message,
         })?;
         Ok(cfg)
     }
@@ -328,7 +329,7 @@ impl CampaignConfig {
     }
 
     /// Check every value; the message names the key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidValue> {
         if self.campaign.name.is_empty()
             || !self
                 .campaign
@@ -336,26 +337,41 @@ impl CampaignConfig {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         {
-            return Err(format!(
-                "campaign.name must be non-empty and use only letters, digits, '-' and '_', got '{}'",
-                self.campaign.name
+            return Err(InvalidValue::new(
+                "campaign.name",
+                format!(
+                    "campaign.name must be non-empty and use only letters, digits, '-' and '_', got '{}'",
+                    self.campaign.name
+                ),
             ));
         }
         if self.campaign.reps == 0 {
-            return Err("campaign.reps must be at least 1".into());
+            return Err(InvalidValue::new(
+                "campaign.reps",
+                "campaign.reps must be at least 1",
+            ));
         }
         if self.campaign.explorations == 0 || self.campaign.explorations > u32::MAX as usize {
-            return Err(format!(
-                "campaign.explorations must be between 1 and {}, got {}",
-                u32::MAX,
-                self.campaign.explorations
+            return Err(InvalidValue::new(
+                "campaign.explorations",
+                format!(
+                    "campaign.explorations must be between 1 and {}, got {}",
+                    u32::MAX,
+                    self.campaign.explorations
+                ),
             ));
         }
         if self.matrix.envs.is_empty() {
-            return Err("matrix.envs must name at least one environment".into());
+            return Err(InvalidValue::new(
+                "matrix.envs",
+                "matrix.envs must name at least one environment",
+            ));
         }
         if self.matrix.algos.is_empty() {
-            return Err("matrix.algos must name at least one algorithm".into());
+            return Err(InvalidValue::new(
+                "matrix.algos",
+                "matrix.algos must name at least one algorithm",
+            ));
         }
         for (k, list) in [
             ("matrix.envs", dup(&self.matrix.envs)),
@@ -364,20 +380,29 @@ impl CampaignConfig {
             ("matrix.variants", dup(&self.matrix.variants)),
         ] {
             if let Some(d) = list {
-                return Err(format!("{k} lists '{d}' twice"));
+                return Err(InvalidValue::new(k, format!("{k} lists '{d}' twice")));
             }
         }
         if self.matrix.samplers.is_empty() {
-            return Err("matrix.samplers must name at least one goal sampler".into());
+            return Err(InvalidValue::new(
+                "matrix.samplers",
+                "matrix.samplers must name at least one goal sampler",
+            ));
         }
         if let Some(s) = self.matrix.samplers.iter().find(|s| !s.is_learned()) {
-            return Err(format!(
-                "matrix.samplers: '{s}' is not a sampler of learned goal spaces ({})",
-                SamplerKind::learned_names()
+            return Err(InvalidValue::new(
+                "matrix.samplers",
+                format!(
+                    "matrix.samplers: '{s}' is not a sampler of learned goal spaces ({})",
+                    SamplerKind::learned_names()
+                ),
             ));
         }
         if self.matrix.latents.is_empty() {
-            return Err("matrix.latents must list at least one latent size".into());
+            return Err(InvalidValue::new(
+                "matrix.latents",
+                "matrix.latents must list at least one latent size",
+            ));
         }
         crate::limits::check_runs(&[
             ("envs", self.matrix.envs.len()),
@@ -388,13 +413,16 @@ impl CampaignConfig {
             ("reps", self.campaign.reps),
             ("explorations", self.campaign.explorations),
         ])
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| InvalidValue::new("campaign.reps", e.to_string()))?;
         if self.matrix.variants.is_empty() {
-            return Err(
-                "matrix.variants must list at least one variant (faithful, corrected)".into(),
-            );
+            return Err(InvalidValue::new(
+                "matrix.variants",
+                "matrix.variants must list at least one variant (faithful, corrected)",
+            ));
         }
-        self.learners.validate().map_err(|e| e.to_string())?;
+        self.learners
+            .validate()
+            .map_err(|e| InvalidValue::new("learners", e.to_string()))?;
         self.mge.validate()?;
         // Every size, "true" resolved per environment, before anything is trained.
         for a in self.matrix.algos.iter().filter(|a| a.modules().is_some()) {
@@ -415,27 +443,34 @@ impl CampaignConfig {
                         format!("\"true\" ({} latents in {env})", l.size(env))
                     }
                 };
-                return Err(format!(
-                    "matrix.algos has {a}, whose modules take mge.module_size = {} latents, \
+                return Err(InvalidValue::new(
+                    "matrix.algos",
+                    format!(
+                        "matrix.algos has {a}, whose modules take mge.module_size = {} latents, \
                      but matrix.latents has {has}",
-                    self.mge.module_size
+                        self.mge.module_size
+                    ),
                 ));
             }
         }
         for l in self.matrix.algos.iter().filter_map(|a| a.learner()) {
-            self.learners
-                .params(l)
-                .map_err(|e| format!("matrix.algos has {}, but {e}", l.entry().algo))?;
+            self.learners.params(l).map_err(|e| {
+                InvalidValue::new(
+                    "matrix.algos",
+                    format!("matrix.algos has {}, but {e}", l.entry().algo),
+                )
+            })?;
         }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {
-            return Err(format!(
-                "ugl.images must be at least 2, got {}",
-                self.ugl.images
+            return Err(InvalidValue::new(
+                "ugl.images",
+                format!("ugl.images must be at least 2, got {}", self.ugl.images),
             ));
         }
         if learned {
-            crate::limits::check_images(self.ugl.images).map_err(|e| e.to_string())?;
+            crate::limits::check_images(self.ugl.images)
+                .map_err(|e| InvalidValue::new("ugl.images", e.to_string()))?;
         }
         if let Some(LatentSize::N(n)) = self
             .matrix
@@ -443,9 +478,12 @@ impl CampaignConfig {
             .iter()
             .find(|l| matches!(l, LatentSize::N(n) if *n >= self.ugl.images))
         {
-            return Err(format!(
-                "matrix.latents: {n} must be below ugl.images ({})",
-                self.ugl.images
+            return Err(InvalidValue::new(
+                "matrix.latents",
+                format!(
+                    "matrix.latents: {n} must be below ugl.images ({})",
+                    self.ugl.images
+                ),
             ));
         }
         self.explore.validate()?;

@@ -1,5 +1,6 @@
 //! The errors of a run or a campaign.
 
+use crate::explore::ExploreError;
 use thiserror::Error;
 
 use super::store::StoreError;
@@ -14,6 +15,8 @@ pub enum RunError {
     Pool(String),
     #[error("run {run}: {source}")]
     Repr { run: String, source: ReprError },
+    #[error("run {run}: {source}")]
+    Explore { run: String, source: ExploreError },
     /// A run whose representation was not fitted because the same fit failed before: in its
     /// group (the runs sharing the representation), or, for an external learner, in another
     /// seed of the same cell (a failing program is started once, not once per run).

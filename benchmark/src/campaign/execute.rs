@@ -44,7 +44,10 @@ pub fn explore(
         run: spec.run_id(),
         source,
     };
-    let explore_err = |m: String| run_err(ReprError::InvalidInput(m));
+    let explore_err = |source| RunError::Explore {
+        run: spec.run_id(),
+        source,
+    };
     let strategy = spec.algo.strategy();
     match spec.algo.space() {
         GoalSpaceKind::None => Ok(Explored {
@@ -125,7 +128,7 @@ impl GoalSource for LearnedGoals<'_> {
             &latent_spread(self.train),
             module_size,
         )
-        .map_err(ReprError::InvalidInput)
+        .map_err(|e| ReprError::InvalidInput(e.to_string()))
     }
 
     /// Over every latent (`dims` None) or over one module's latents (the KDE of those latents

@@ -1,5 +1,6 @@
 //! The run matrix: which runs a campaign consists of, and their identities.
 
+use crate::invalid::InvalidValue;
 use serde::Serialize;
 
 use super::config::CampaignConfig;
@@ -309,9 +310,13 @@ pub fn shard(runs: &[RunSpec], images: usize, index: usize, count: usize) -> Vec
 }
 
 /// Parse `i/n` (0 <= i < n).
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let err =
-        || format!("--shard must be i/n with 0 <= i < n (0-based, e.g. 0/4 .. 3/4), got '{s}'");
+pub fn parse_shard(s: &str) -> Result<(usize, usize), InvalidValue> {
+    let err = || {
+        InvalidValue::new(
+            "--shard",
+            format!("--shard must be i/n with 0 <= i < n (0-based, e.g. 0/4 .. 3/4), got '{s}'"),
+        )
+    };
     let (i, n) = s.split_once('/').ok_or_else(err)?;
     let (i, n): (usize, usize) = (
         i.trim().parse().map_err(|_| err())?,

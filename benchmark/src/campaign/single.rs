@@ -3,6 +3,7 @@
 //! command line only parses arguments, shows progress and prints. Every error is one line that
 //! names the flag.
 
+use crate::invalid::InvalidValue;
 use std::path::Path;
 
 use super::config::{CampaignConfig, ExternalConfig};
@@ -35,29 +36,36 @@ pub struct RunRequest {
 impl RunRequest {
     /// Check the request against the profile `cfg` (read from `profile`), apply its
     /// overrides to `cfg`, and return the run.
-    pub fn resolve(&self, cfg: &mut CampaignConfig, profile: &Path) -> Result<RunSpec, String> {
+    pub fn resolve(
+        &self,
+        cfg: &mut CampaignConfig,
+        profile: &Path,
+    ) -> Result<RunSpec, InvalidValue> {
         check_seed(self.seed)?;
         if let Some(e) = self.epochs {
             cfg.explore.epochs = e;
             cfg.explore
                 .validate()
-                .map_err(|m| format!("--epochs: {m}"))?;
+                .map_err(|m| InvalidValue::new("--epochs", format!("--epochs: {m}")))?;
         }
         let goal_directed = self.algo.strategy() != crate::explore::Strategy::Rpe;
         cfg.explore
             .check_goal_epochs(goal_directed)
             .map_err(|m| match self.epochs {
-                Some(e) => format!("--epochs {e}: {m}"),
+                Some(e) => InvalidValue::new("--epochs", format!("--epochs {e}: {m}")),
                 None => m,
             })?;
         if self.algo.space() == crate::explore::GoalSpaceKind::EngineeredPosition
             && !self.env.spec().has_orientation()
         {
-            return Err(format!(
-                "--algo {}: the outcome of {} is the objects' positions already, so its \
+            return Err(InvalidValue::new(
+                "--algo",
+                format!(
+                    "--algo {}: the outcome of {} is the objects' positions already, so its \
                  position-only goal space is rge-efr's (use --algo rge-efr)",
-                self.algo,
-                self.env.name()
+                    self.algo,
+                    self.env.name()
+                ),
             ));
         }
         set_images(cfg, self.images)?;
@@ -65,10 +73,13 @@ impl RunRequest {
             None => RunSpec::baseline(self.env, self.algo, self.seed),
             Some(_) => {
                 if !self.sampler.is_learned() {
-                    return Err(format!(
-                        "--sampler must be {} for {}",
-                        SamplerKind::learned_names().replace(", ", " or "),
-                        self.algo
+                    return Err(InvalidValue::new(
+                        "--sampler",
+                        format!(
+                            "--sampler must be {} for {}",
+                            SamplerKind::learned_names().replace(", ", " or "),
+                            self.algo
+                        ),
                     ));
                 }
                 check_latents(self.latents, cfg.ugl.images)?;
@@ -90,18 +101,24 @@ impl RunRequest {
                 .filter(|l| l.may_have_prior())
                 .map(|l| l.entry().algo)
                 .collect();
-            return Err(format!(
-                "--sampler gaussian needs a goal-space prior: {}, not {} (use kde)",
-                with_prior.join(", "),
-                self.algo
+            return Err(InvalidValue::new(
+                "--sampler",
+                format!(
+                    "--sampler gaussian needs a goal-space prior: {}, not {} (use kde)",
+                    with_prior.join(", "),
+                    self.algo
+                ),
             ));
         }
         let external = self.algo.learner().is_some_and(Learner::is_external);
         if !external && (self.command.is_some() || self.name.is_some()) {
-            return Err(format!(
-                "--command and --name apply to the external learner's algorithms only \
+            return Err(InvalidValue::new(
+                "--command",
+                format!(
+                    "--command and --name apply to the external learner's algorithms only \
                  (rge-external, mge-external-*), not {}",
-                self.algo
+                    self.algo
+                ),
             ));
         }
         if external {
@@ -111,10 +128,13 @@ impl RunRequest {
     }
 
     /// `--command` / `--name` of an external run, over the profile's `[learners.external]`.
-    fn set_external(&self, cfg: &mut CampaignConfig, profile: &Path) -> Result<(), String> {
+    fn set_external(&self, cfg: &mut CampaignConfig, profile: &Path) -> Result<(), InvalidValue> {
         if let Some(cmd) = &self.command {
             if cmd.trim().is_empty() {
-                return Err("--command must not be empty".into());
+                return Err(InvalidValue::new(
+                    "--command",
+                    "--command must not be empty",
+                ));
             }
             let configured = cfg.learners.external();
             let name = self
@@ -133,45 +153,59 @@ impl RunRequest {
             cfg.learners.set_external(&e);
         }
         if cfg.learners.external().is_none() {
-            return Err(format!(
-                "--algo {} needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
-                self.algo,
-                profile.display()
+            return Err(InvalidValue::new(
+                "--algo",
+                format!(
+                    "--algo {} needs --command (a program speaking the external-learner protocol) or a [learners.external] section (name, command) in the profile {}",
+                    self.algo,
+                    profile.display()
+                ),
             ));
         }
-        cfg.validate().map_err(|m| format!("--name/--command: {m}"))
+        cfg.validate()
+            .map_err(|m| InvalidValue::new("--name", format!("--name/--command: {m}")))
     }
 }
 
 /// The results store keeps repetition indices as signed 64-bit integers (parquet `seed`).
-pub fn check_seed(seed: u64) -> Result<(), String> {
+pub fn check_seed(seed: u64) -> Result<(), InvalidValue> {
     if seed > i64::MAX as u64 {
-        return Err(format!(
-            "--seed must be below 2^63 = {} (the results store keeps it as a signed 64-bit integer), got {seed}",
-            i64::MAX as u64 + 1
+        return Err(InvalidValue::new(
+            "--seed",
+            format!(
+                "--seed must be below 2^63 = {} (the results store keeps it as a signed 64-bit integer), got {seed}",
+                i64::MAX as u64 + 1
+            ),
         ));
     }
     Ok(())
 }
 
 /// `--images`: override the profile's number of UGL training images.
-pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(), String> {
+pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(), InvalidValue> {
     if let Some(n) = images {
         if n < 2 {
-            return Err(format!("--images must be at least 2, got {n}"));
+            return Err(InvalidValue::new(
+                "--images",
+                format!("--images must be at least 2, got {n}"),
+            ));
         }
-        crate::limits::check_images(n).map_err(|e| format!("--images: {e}"))?;
+        crate::limits::check_images(n)
+            .map_err(|e| InvalidValue::new("--images", format!("--images: {e}")))?;
         cfg.ugl.images = n;
     }
     Ok(())
 }
 
 /// `--latents` of a learned goal space fitted on `images` images.
-pub fn check_latents(latents: usize, images: usize) -> Result<(), String> {
+pub fn check_latents(latents: usize, images: usize) -> Result<(), InvalidValue> {
     if latents == 0 || latents >= images {
-        return Err(format!(
-            "--latents must be between 1 and the number of images - 1 ({}), got {latents}",
-            images - 1
+        return Err(InvalidValue::new(
+            "--latents",
+            format!(
+                "--latents must be between 1 and the number of images - 1 ({}), got {latents}",
+                images - 1
+            ),
         ));
     }
     Ok(())
@@ -179,15 +213,18 @@ pub fn check_latents(latents: usize, images: usize) -> Result<(), String> {
 
 /// `--latents` of a modular exploration of a learned goal space: its modules take
 /// `module_size` latents each (`[mge] module_size`), checked before anything is trained.
-pub fn check_modules(algo: Algo, latents: usize, module_size: usize) -> Result<(), String> {
+pub fn check_modules(algo: Algo, latents: usize, module_size: usize) -> Result<(), InvalidValue> {
     let modular = algo.learner().is_some()
         && algo
             .modules()
             .is_some_and(|m| m != crate::explore::Modules::Flat);
     if modular && module_size > 0 && !latents.is_multiple_of(module_size) {
-        return Err(format!(
-            "--latents {latents}: {algo} splits its latents into modules of \
+        return Err(InvalidValue::new(
+            "--latents",
+            format!(
+                "--latents {latents}: {algo} splits its latents into modules of \
              mge.module_size = {module_size}, and {latents} is not a multiple of {module_size}"
+            ),
         ));
     }
     Ok(())
@@ -195,7 +232,7 @@ pub fn check_modules(algo: Algo, latents: usize, module_size: usize) -> Result<(
 
 /// `--variant` applies to the algorithms whose learner has variants only (the registry says
 /// which).
-pub fn check_variant(algo: Algo, variant: Option<Variant>) -> Result<(), String> {
+pub fn check_variant(algo: Algo, variant: Option<Variant>) -> Result<(), InvalidValue> {
     variant_applies(
         algo.learner(),
         variant,
@@ -205,7 +242,10 @@ pub fn check_variant(algo: Algo, variant: Option<Variant>) -> Result<(), String>
 }
 
 /// [`check_variant`] for a command that names learners (`ugl embed --learner`).
-pub fn check_learner_variant(learner: Learner, variant: Option<Variant>) -> Result<(), String> {
+pub fn check_learner_variant(
+    learner: Learner,
+    variant: Option<Variant>,
+) -> Result<(), InvalidValue> {
     variant_applies(Some(learner), variant, Learner::name, learner.name())
 }
 
@@ -214,15 +254,18 @@ fn variant_applies(
     variant: Option<Variant>,
     name: fn(Learner) -> &'static str,
     given: &str,
-) -> Result<(), String> {
+) -> Result<(), InvalidValue> {
     if variant.is_some() && !learner.is_some_and(|l| l.has_variants()) {
         let with_variants: Vec<&str> = Learner::all()
             .filter(|l| l.has_variants())
             .map(name)
             .collect();
-        return Err(format!(
-            "--variant applies to {} only (the others have one behaviour), not {given}",
-            with_variants.join(" and ")
+        return Err(InvalidValue::new(
+            "--variant",
+            format!(
+                "--variant applies to {} only (the others have one behaviour), not {given}",
+                with_variants.join(" and ")
+            ),
         ));
     }
     Ok(())
@@ -234,16 +277,22 @@ pub fn resolve_learner(
     name: &str,
     command: Option<&str>,
     cfg: &mut CampaignConfig,
-) -> Result<Learner, String> {
+) -> Result<Learner, InvalidValue> {
     let registered: Vec<Learner> = Learner::all().filter(|l| !l.is_external()).collect();
     match (registered.iter().find(|l| l.name() == name), command) {
         (Some(l), None) => Ok(*l),
-        (Some(_), Some(_)) => Err(format!(
-            "--learner {name} is a registered learner: drop --command, or give the external program another name"
+        (Some(_), Some(_)) => Err(InvalidValue::new(
+            "--learner",
+            format!(
+                "--learner {name} is a registered learner: drop --command, or give the external program another name"
+            ),
         )),
         (None, Some(cmd)) => {
             if cmd.trim().is_empty() {
-                return Err("--command must not be empty".into());
+                return Err(InvalidValue::new(
+                    "--command",
+                    "--command must not be empty",
+                ));
             }
             // The profile's timeouts still apply to the program given here.
             let configured = cfg.learners.external();
@@ -255,13 +304,16 @@ pub fn resolve_learner(
             });
             Learner::all()
                 .find(|l| l.is_external())
-                .ok_or_else(|| "this build has no external learner".to_string())
+                .ok_or_else(|| InvalidValue::new("--command", "this build has no external learner"))
         }
         (None, None) => {
             let names: Vec<&str> = registered.iter().map(|l| l.name()).collect();
-            Err(format!(
-                "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
-                names.join(", ")
+            Err(InvalidValue::new(
+                "--learner",
+                format!(
+                    "--learner {name} is not a registered learner ({}); for a program speaking the external-learner protocol add --command",
+                    names.join(", ")
+                ),
             ))
         }
     }
@@ -276,15 +328,18 @@ pub fn compare_campaign(
     learner: &str,
     command: Option<&str>,
     gaussian: bool,
-) -> Result<(CampaignConfig, String), String> {
+) -> Result<(CampaignConfig, String), InvalidValue> {
     let name = learner.trim().to_string();
     if name.is_empty()
         || !name
             .chars()
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
     {
-        return Err(format!(
-            "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
+        return Err(InvalidValue::new(
+            "--learner",
+            format!(
+                "--learner must be a short name of lowercase letters, digits, '-' and '_', got '{name}'"
+            ),
         ));
     }
     let algo = Algo::rge(resolve_learner(&name, command, &mut cfg)?);
@@ -344,7 +399,12 @@ mod tests {
         .unwrap();
         assert_eq!(spec.run_id(), "armball.rge-pca.kde.l2.s0");
         assert_eq!((c.ugl.images, c.explore.epochs), (300, 150));
-        let err = |r: RunRequest| r.resolve(&mut cfg(), Path::new("base.toml")).unwrap_err();
+        let err = |r: RunRequest| {
+            let e = r.resolve(&mut cfg(), Path::new("base.toml")).unwrap_err();
+            // The key is data, and the message names it.
+            assert!(e.message.contains(&e.key), "{e:?}");
+            e.message
+        };
         assert!(
             err(RunRequest {
                 variant: Some(Variant::Corrected),
@@ -436,11 +496,13 @@ mod tests {
         assert!(
             compare_campaign(cfg(), "nosuch", None, false)
                 .unwrap_err()
+                .message
                 .contains("not a registered learner")
         );
         assert!(
             compare_campaign(cfg(), "pca", Some("true"), false)
                 .unwrap_err()
+                .message
                 .contains("registered learner")
         );
     }

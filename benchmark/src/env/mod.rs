@@ -12,6 +12,7 @@ pub mod armballs;
 pub mod dmp;
 pub mod render;
 
+use crate::invalid::InvalidValue;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::RwLock;
@@ -378,33 +379,45 @@ impl EnvConfig {
     /// starts in the scene, the arm's reach fits in it, and the motor primitive's movement is
     /// finite for every motor command (checked on the extreme commands, where a linear
     /// movement is largest).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidValue> {
         let within = |key: &str, v: f64, lo: f64, hi: f64| {
             if v.is_finite() && (lo..=hi).contains(&v) {
                 Ok(())
             } else {
-                Err(format!(
-                    "{key} must be a finite number in [{lo}, {hi}], got {}",
-                    num(v)
+                Err(InvalidValue::new(
+                    key,
+                    format!(
+                        "{key} must be a finite number in [{lo}, {hi}], got {}",
+                        num(v)
+                    ),
                 ))
             }
         };
         let a = &self.arm;
         if let Some(l) = a.lengths.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
-            return Err(format!("env.arm.lengths must be finite and >= 0, got {l}"));
+            return Err(InvalidValue::new(
+                "env.arm.lengths",
+                format!("env.arm.lengths must be finite and >= 0, got {l}"),
+            ));
         }
         let reach: f64 = a.lengths.iter().sum();
         if !(reach > 0.0 && reach <= 1.0 + 1e-9) {
-            return Err(format!(
-                "env.arm.lengths must add up to a reach in (0, 1] (the scene), got {reach}"
+            return Err(InvalidValue::new(
+                "env.arm.lengths",
+                format!(
+                    "env.arm.lengths must add up to a reach in (0, 1] (the scene), got {reach}"
+                ),
             ));
         }
         within("env.arm.angle_shift", a.angle_shift, -2.0, 2.0)?;
         let d = &self.dmp;
         if !(1..=MAX_TIMESTEPS).contains(&d.timesteps) {
-            return Err(format!(
-                "env.dmp.timesteps must be between 1 and {MAX_TIMESTEPS}, got {}",
-                d.timesteps
+            return Err(InvalidValue::new(
+                "env.dmp.timesteps",
+                format!(
+                    "env.dmp.timesteps must be between 1 and {MAX_TIMESTEPS}, got {}",
+                    d.timesteps
+                ),
             ));
         }
         for (k, v, lo, hi) in [
@@ -420,9 +433,9 @@ impl EnvConfig {
                 } else {
                     format!("[{lo}")
                 };
-                return Err(format!(
-                    "{k} must be a finite number in {lo}, {hi}], got {}",
-                    num(v)
+                return Err(InvalidValue::new(
+                    k,
+                    format!("{k} must be a finite number in {lo}, {hi}], got {}", num(v)),
                 ));
             }
         }
@@ -436,10 +449,13 @@ impl EnvConfig {
                 .iter()
                 .any(|q| q.iter().any(|v| !v.is_finite()))
             {
-                return Err(format!(
-                    "env.dmp: the movement is not finite with these constants (timesteps = {}, \
+                return Err(InvalidValue::new(
+                    "env.dmp",
+                    format!(
+                        "env.dmp: the movement is not finite with these constants (timesteps = {}, \
                      run_time = {}, ay = {}, ax = {}, max_params = {})",
-                    d.timesteps, d.run_time, d.ay, d.ax, d.max_params
+                        d.timesteps, d.run_time, d.ay, d.ax, d.max_params
+                    ),
                 ));
             }
         }
@@ -641,7 +657,8 @@ mod tests {
             let mut e = EnvConfig::default();
             change(&mut e);
             let m = e.validate().unwrap_err();
-            assert!(m.starts_with(key), "{m} should start with {key}");
+            assert_eq!(m.key, key, "{m}");
+            assert!(m.message.starts_with(key), "{m} should start with {key}");
         }
     }
 

@@ -29,7 +29,7 @@ impl EngineeredGoals {
 impl GoalSource for EngineeredGoals {
     fn modules(&self, choice: Modules, module_size: usize) -> Result<Vec<GoalModule>, ReprError> {
         goal_modules(choice, self.dim, Some(&self.objects), &[], module_size)
-            .map_err(ReprError::InvalidInput)
+            .map_err(|e| ReprError::InvalidInput(e.to_string()))
     }
     fn sampler(&self, dims: Option<&[usize]>) -> Result<Box<dyn GoalSampler>, ReprError> {
         Ok(Box::new(UniformGoals::unit(

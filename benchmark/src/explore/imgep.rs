@@ -11,7 +11,7 @@
 use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
-use super::{ExploreConfig, Explorer};
+use super::{ExploreConfig, ExploreError, Explorer};
 use crate::env::render::PIXELS;
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;
@@ -172,7 +172,7 @@ impl Explorer for Rge<'_> {
         env: &dyn Environment,
         cfg: &ExploreConfig,
         run_seed: u64,
-    ) -> Result<ExplorationLog, String> {
+    ) -> Result<ExplorationLog, ExploreError> {
         Ok(run_rge(
             env,
             self.space,

@@ -18,6 +18,7 @@
 
 use rand::RngExt;
 
+use super::ExploreError;
 use crate::seed::Stream;
 
 /// The interest before any episode (the original's initial value).
@@ -42,14 +43,12 @@ pub struct ModuleInterest {
 impl ModuleInterest {
     /// A module of `dim` goal dimensions whose progress is averaged with rate `1 / window`
     /// (the original: 1000). `Err` for `dim = 0` or a window below 1 or not finite.
-    pub fn new(dim: usize, window: f64) -> Result<Self, String> {
+    pub fn new(dim: usize, window: f64) -> Result<Self, ExploreError> {
         if dim == 0 {
-            return Err("a goal module needs at least one dimension".into());
+            return Err(ExploreError::EmptyModule);
         }
         if !(window.is_finite() && window >= 1.0) {
-            return Err(format!(
-                "the interest window must be at least 1, got {window}"
-            ));
+            return Err(ExploreError::InterestWindow(window));
         }
         Ok(ModuleInterest {
             dim,
@@ -68,17 +67,16 @@ impl ModuleInterest {
     /// Record one episode with `goal` and its outcome `reached` (the module's dimensions) and
     /// return its progress. `Err` if a length is not the module's dimension or a value is not
     /// finite (a silent NaN would poison the interest for good).
-    pub fn update(&mut self, goal: &[f64], reached: &[f64]) -> Result<f64, String> {
+    pub fn update(&mut self, goal: &[f64], reached: &[f64]) -> Result<f64, ExploreError> {
         if goal.len() != self.dim || reached.len() != self.dim {
-            return Err(format!(
-                "goal and outcome must have {} values, got {} and {}",
-                self.dim,
-                goal.len(),
-                reached.len()
-            ));
+            return Err(ExploreError::GoalLength {
+                dim: self.dim,
+                goal: goal.len(),
+                reached: reached.len(),
+            });
         }
         if goal.iter().chain(reached).any(|v| !v.is_finite()) {
-            return Err("goal or outcome has a non-finite value".into());
+            return Err(ExploreError::NonFinite);
         }
         let c = Self::competence(goal, reached);
         let p = match self.nearest_goal(goal) {
@@ -131,17 +129,15 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
 /// proportion to `interests` (explauto's `prop_choice`; the same draws in the same order: a
 /// uniform number only when some interest is positive, then the index). `Err` for no module, a
 /// negative or non-finite interest, or `eps` outside [0, 1].
-pub fn choose_module(interests: &[f64], eps: f64, rng: &mut Stream) -> Result<usize, String> {
+pub fn choose_module(interests: &[f64], eps: f64, rng: &mut Stream) -> Result<usize, ExploreError> {
     if interests.is_empty() {
-        return Err("no module to choose from".into());
+        return Err(ExploreError::NoModule);
     }
     if let Some(v) = interests.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-        return Err(format!(
-            "interests must be finite and non-negative, got {v}"
-        ));
+        return Err(ExploreError::Interest(*v));
     }
     if !(0.0..=1.0).contains(&eps) {
-        return Err(format!("eps must be in [0, 1], got {eps}"));
+        return Err(ExploreError::Eps(eps));
     }
     let total: f64 = interests.iter().sum();
     if total == 0.0 || rng.random::<f64>() < eps {

@@ -22,6 +22,7 @@
 //! for every module. Unlike this project's ICLR RGE (`imgep.rs`) there is no random episode
 //! after the bootstrap (the follow-up's loop has none).
 
+use crate::invalid::InvalidValue;
 use std::fmt;
 use std::str::FromStr;
 
@@ -32,7 +33,7 @@ use super::imgep::{History, OutcomeSpace};
 use super::interest::{ModuleInterest, choose_module};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
-use super::{ExploreConfig, Explorer};
+use super::{ExploreConfig, ExploreError, Explorer};
 use crate::env::{Environment, PARAMS};
 use crate::goals::GoalSampler;
 use crate::seed::{Component, stream};
@@ -108,18 +109,27 @@ impl Default for MgeConfig {
 
 impl MgeConfig {
     /// Check the values; the error names the offending key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidValue> {
         if self.module_size == 0 {
-            return Err("mge.module_size must be at least 1".into());
+            return Err(InvalidValue::new(
+                "mge.module_size",
+                "mge.module_size must be at least 1",
+            ));
         }
         if !(self.interest_window.is_finite() && self.interest_window >= 1.0) {
-            return Err(format!(
-                "mge.interest_window must be at least 1, got {}",
-                self.interest_window
+            return Err(InvalidValue::new(
+                "mge.interest_window",
+                format!(
+                    "mge.interest_window must be at least 1, got {}",
+                    self.interest_window
+                ),
             ));
         }
         if !(0.0..=1.0).contains(&self.eps) {
-            return Err(format!("mge.eps must be in [0, 1], got {}", self.eps));
+            return Err(InvalidValue::new(
+                "mge.eps",
+                format!("mge.eps must be in [0, 1], got {}", self.eps),
+            ));
         }
         Ok(())
     }
@@ -147,7 +157,7 @@ pub fn goal_modules(
     objects: Option<&[(&str, std::ops::Range<usize>)]>,
     spread: &[f64],
     module_size: usize,
-) -> Result<Vec<GoalModule>, String> {
+) -> Result<Vec<GoalModule>, ExploreError> {
     if modules == Modules::Flat {
         return Ok(vec![GoalModule {
             name: "all".into(),
@@ -164,9 +174,7 @@ pub fn goal_modules(
             .collect());
     }
     if module_size == 0 || !dim.is_multiple_of(module_size) || spread.len() != dim {
-        return Err(format!(
-            "{dim} latents cannot be split into modules of {module_size} (mge.module_size)"
-        ));
+        return Err(ExploreError::ModuleSplit { dim, module_size });
     }
     let mut order: Vec<usize> = (0..dim).collect();
     order.sort_by(|&a, &b| spread[b].total_cmp(&spread[a]).then(a.cmp(&b)));
@@ -227,23 +235,21 @@ pub fn run_mge(
     cfg: &ExploreConfig,
     mge: &MgeConfig,
     run_seed: u64,
-) -> Result<ExplorationLog, String> {
+) -> Result<ExplorationLog, ExploreError> {
     if modules.is_empty() || modules.len() != samplers.len() {
-        return Err(format!(
-            "{} modules and {} goal samplers",
-            modules.len(),
-            samplers.len()
-        ));
+        return Err(ExploreError::ModuleCount {
+            modules: modules.len(),
+            samplers: samplers.len(),
+        });
     }
     for (m, s) in modules.iter().zip(samplers.iter()) {
         if s.dim() != m.dims.len() || m.dims.iter().any(|&k| k >= space.dim()) {
-            return Err(format!(
-                "module {} ({:?}) does not fit its sampler (dim {}) or the goal space (dim {})",
-                m.name,
-                m.dims,
-                s.dim(),
-                space.dim()
-            ));
+            return Err(ExploreError::ModuleFit {
+                name: m.name.clone(),
+                dims: m.dims.clone(),
+                sampler: s.dim(),
+                space: space.dim(),
+            });
         }
     }
     let metrics = Metrics::for_env(env);
@@ -359,7 +365,7 @@ impl Explorer for Mge<'_> {
         env: &dyn Environment,
         cfg: &ExploreConfig,
         run_seed: u64,
-    ) -> Result<ExplorationLog, String> {
+    ) -> Result<ExplorationLog, ExploreError> {
         run_mge(
             env,
             self.space,

@@ -17,6 +17,7 @@ pub mod mge;
 pub use ugl_types::nn;
 pub mod rpe;
 
+use crate::invalid::InvalidValue;
 use std::borrow::Cow;
 
 use serde::{Deserialize, Serialize};
@@ -31,6 +32,53 @@ pub use imgep::{EngineeredSpace, LearnedSpace, OutcomeSpace, Rge, run_rge};
 pub use mge::{GoalModule, Mge, MgeConfig, Modules, goal_modules, run_mge};
 pub use rpe::{Rpe, run_rpe};
 
+/// What refuses an algorithm or stops an exploration (modular exploration's modules and
+/// interests; the other loops cannot fail).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExploreError {
+    #[error("random parameter exploration has no goal space")]
+    RpeInGoalSpace,
+    #[error("goal exploration needs a goal space")]
+    NoGoalSpace,
+    #[error(
+        "modular exploration with engineered features already has one module per object; the \
+         position-only space is for random goal exploration"
+    )]
+    ModularPositionOnly,
+    #[error("{dim} latents cannot be split into modules of {module_size} (mge.module_size)")]
+    ModuleSplit { dim: usize, module_size: usize },
+    #[error("{modules} modules and {samplers} goal samplers")]
+    ModuleCount { modules: usize, samplers: usize },
+    #[error(
+        "module {name} ({dims:?}) does not fit its sampler (dim {sampler}) or the goal space \
+         (dim {space})"
+    )]
+    ModuleFit {
+        name: String,
+        dims: Vec<usize>,
+        sampler: usize,
+        space: usize,
+    },
+    #[error("a goal module needs at least one dimension")]
+    EmptyModule,
+    #[error("the interest window must be at least 1, got {0}")]
+    InterestWindow(f64),
+    #[error("goal and outcome must have {dim} values, got {goal} and {reached}")]
+    GoalLength {
+        dim: usize,
+        goal: usize,
+        reached: usize,
+    },
+    #[error("goal or outcome has a non-finite value")]
+    NonFinite,
+    #[error("no module to choose from")]
+    NoModule,
+    #[error("interests must be finite and non-negative, got {0}")]
+    Interest(f64),
+    #[error("eps must be in [0, 1], got {0}")]
+    Eps(f64),
+}
+
 /// An exploration loop (RPE, RGE or MGE), built for one run ([`Strategy::explorer`]).
 pub trait Explorer {
     /// Explore `env` for `cfg.epochs` iterations, drawing from the streams of `run_seed`.
@@ -39,7 +87,7 @@ pub trait Explorer {
         env: &dyn Environment,
         cfg: &ExploreConfig,
         run_seed: u64,
-    ) -> Result<ExplorationLog, String>;
+    ) -> Result<ExplorationLog, ExploreError>;
 }
 
 /// Constants of the exploration loop; the defaults are the paper's code's.
@@ -73,24 +121,37 @@ impl Default for ExploreConfig {
 
 impl ExploreConfig {
     /// Check the values; the error names the offending key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidValue> {
         if self.epochs == 0 {
-            return Err("explore.epochs must be at least 1".into());
+            return Err(InvalidValue::new(
+                "explore.epochs",
+                "explore.epochs must be at least 1",
+            ));
         }
-        crate::limits::check_epochs(self.epochs).map_err(|e| e.to_string())?;
+        crate::limits::check_epochs(self.epochs)
+            .map_err(|e| InvalidValue::new("explore.epochs", e.to_string()))?;
         if self.eval_every == 0 {
-            return Err("explore.eval_every must be at least 1".into());
+            return Err(InvalidValue::new(
+                "explore.eval_every",
+                "explore.eval_every must be at least 1",
+            ));
         }
         if !(0.0..=1.0).contains(&self.random_ratio) {
-            return Err(format!(
-                "explore.random_ratio must be in [0, 1], got {}",
-                self.random_ratio
+            return Err(InvalidValue::new(
+                "explore.random_ratio",
+                format!(
+                    "explore.random_ratio must be in [0, 1], got {}",
+                    self.random_ratio
+                ),
             ));
         }
         if !(self.noise_sigma.is_finite() && self.noise_sigma >= 0.0) {
-            return Err(format!(
-                "explore.noise_sigma must be finite and >= 0, got {}",
-                self.noise_sigma
+            return Err(InvalidValue::new(
+                "explore.noise_sigma",
+                format!(
+                    "explore.noise_sigma must be finite and >= 0, got {}",
+                    self.noise_sigma
+                ),
             ));
         }
         Ok(())
@@ -98,13 +159,16 @@ impl ExploreConfig {
 
     /// For goal exploration (`goal_directed`): at least one epoch after the bootstrap, else
     /// every epoch is random and the run is RPE under another label.
-    pub fn check_goal_epochs(&self, goal_directed: bool) -> Result<(), String> {
+    pub fn check_goal_epochs(&self, goal_directed: bool) -> Result<(), InvalidValue> {
         if goal_directed && self.bootstrap_epochs >= self.epochs {
-            return Err(format!(
-                "explore.bootstrap_epochs = {} leaves none of the {} epochs to goal exploration \
+            return Err(InvalidValue::new(
+                "explore.bootstrap_epochs",
+                format!(
+                    "explore.bootstrap_epochs = {} leaves none of the {} epochs to goal exploration \
                  (every epoch would be random: an RPE run under a goal-exploration label); \
                  give more epochs than bootstrap_epochs",
-                self.bootstrap_epochs, self.epochs
+                    self.bootstrap_epochs, self.epochs
+                ),
             ));
         }
         Ok(())
@@ -218,16 +282,14 @@ impl Algo {
     };
 
     /// `strategy` in `space`; `Err` for RPE in a goal space or goal exploration without one.
-    pub fn new(strategy: Strategy, space: GoalSpaceKind) -> Result<Algo, String> {
+    pub fn new(strategy: Strategy, space: GoalSpaceKind) -> Result<Algo, ExploreError> {
         match (strategy, space) {
             (Strategy::Rpe, GoalSpaceKind::None) => Ok(Algo::RPE),
-            (Strategy::Rpe, _) => Err("random parameter exploration has no goal space".into()),
-            (_, GoalSpaceKind::None) => Err("goal exploration needs a goal space".into()),
-            (Strategy::Mge(_), GoalSpaceKind::EngineeredPosition) => Err(
-                "modular exploration with engineered features already has one module per \
-                 object; the position-only space is for random goal exploration"
-                    .into(),
-            ),
+            (Strategy::Rpe, _) => Err(ExploreError::RpeInGoalSpace),
+            (_, GoalSpaceKind::None) => Err(ExploreError::NoGoalSpace),
+            (Strategy::Mge(_), GoalSpaceKind::EngineeredPosition) => {
+                Err(ExploreError::ModularPositionOnly)
+            }
             _ => Ok(Algo { strategy, space }),
         }
     }

@@ -3,7 +3,7 @@
 
 use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::random_params;
-use super::{ExploreConfig, Explorer};
+use super::{ExploreConfig, ExploreError, Explorer};
 use crate::env::Environment;
 use crate::seed::{Component, stream};
 
@@ -31,7 +31,7 @@ impl Explorer for Rpe {
         env: &dyn Environment,
         cfg: &ExploreConfig,
         run_seed: u64,
-    ) -> Result<ExplorationLog, String> {
+    ) -> Result<ExplorationLog, ExploreError> {
         Ok(run_rpe(env, cfg, run_seed))
     }
 }

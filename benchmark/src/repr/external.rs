@@ -290,8 +290,14 @@ impl ExternalLearner {
             return Err(e);
         }
         let prior = if prior_path.exists() {
-            match read_npy_file(&prior_path, Some(2), latents).and_then(|p| prior_from(&p, latents))
-            {
+            match read_npy_file(&prior_path, Some(2), latents)
+                .map_err(|e| e.to_string())
+                .and_then(|p| {
+                    prior_from(&p, latents).ok_or_else(|| {
+                        "prior.npy: values must be finite and the std row (row 1) positive"
+                            .to_string()
+                    })
+                }) {
                 Ok(p) => Some(p),
                 Err(e) => return Err(session.fail(format!("after READY: {e}"), false)),
             }
@@ -313,12 +319,14 @@ impl ExternalLearner {
     }
 }
 
-fn prior_from(p: &[f64], latents: usize) -> Result<GaussianPrior, String> {
+/// The prior of `prior.npy` (row 0 the mean, row 1 the std); None if a value is not finite or
+/// a std not positive.
+fn prior_from(p: &[f64], latents: usize) -> Option<GaussianPrior> {
     let (mean, std) = p.split_at(latents);
     if p.iter().any(|v| !v.is_finite()) || std.iter().any(|&s| s <= 0.0) {
-        return Err("prior.npy: values must be finite and the std row (row 1) positive".into());
+        return None;
     }
-    Ok(GaussianPrior {
+    Some(GaussianPrior {
         mean: mean.to_vec(),
         std: std.to_vec(),
     })
@@ -598,7 +606,7 @@ struct Session {
     answer_timeout: Duration,
     child: Child,
     to_writer: Option<Sender<Vec<u8>>>,
-    from_writer: Receiver<Result<Vec<u8>, String>>,
+    from_writer: Receiver<Result<Vec<u8>, std::io::Error>>,
     to_reader: Option<Sender<ReadRequest>>,
     from_reader: Receiver<FromReader>,
     stderr: Arc<Mutex<StderrTail>>,
@@ -964,7 +972,11 @@ fn kill_group(pgid: u32) {
     let _ = pgid;
 }
 
-fn writer_loop(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>, tx: Sender<Result<Vec<u8>, String>>) {
+fn writer_loop(
+    mut stdin: ChildStdin,
+    rx: Receiver<Vec<u8>>,
+    tx: Sender<Result<Vec<u8>, std::io::Error>>,
+) {
     while let Ok(buf) = rx.recv() {
         match stdin.write_all(&buf).and_then(|()| stdin.flush()) {
             Ok(()) => {
@@ -973,7 +985,7 @@ fn writer_loop(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>, tx: Sender<Result<V
                 }
             }
             Err(e) => {
-                let _ = tx.send(Err(e.to_string()));
+                let _ = tx.send(Err(e));
                 return;
             }
         }
