@@ -46,8 +46,8 @@ pub struct KernelSet<T> {
 
 /// Bytes of a packed B micro-panel (`kc x NR`): half a 32 KiB L1 data cache.
 const B_PANEL_BYTES: usize = 16 << 10;
-/// Row block (a multiple of every path's `MR`).
-const MC: usize = 96;
+/// Row block (a multiple of every path's `MR`: 4, 6, 12); 120 holds a batch of 100 rows.
+const MC: usize = 120;
 /// Column block (a multiple of every path's `NR`).
 const NC: usize = 2048;
 /// Below this many multiply-adds a product runs on one thread.
@@ -303,6 +303,22 @@ fn pack_b<T: Element>(
     for (q, j0) in (0..nc).step_by(nr).enumerate() {
         let w = nr.min(nc - j0);
         let panel = &mut dst[q * nr * kc..(q + 1) * nr * kc];
+        if b.rs == 1 && b.cs != 1 {
+            // A transposed row-major matrix: each panel column is a contiguous run of the
+            // source; read it in order and scatter into the (L1-resident) panel.
+            for j in 0..w {
+                let base = pc + (jc + j0 + j) * b.cs;
+                for (p, &v) in b.data[base..base + kc].iter().enumerate() {
+                    panel[p * nr + j] = v;
+                }
+            }
+            if w < nr {
+                for p in 0..kc {
+                    panel[p * nr + w..(p + 1) * nr].fill(T::ZERO);
+                }
+            }
+            continue;
+        }
         for p in 0..kc {
             let row = &mut panel[p * nr..(p + 1) * nr];
             let base = (pc + p) * b.rs + (jc + j0) * b.cs;

@@ -21,14 +21,15 @@ fn in_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
         .install(f)
 }
 
-/// Shapes chosen to cross the blocking edges: the inner block (256), the row block (96) and
+/// Shapes chosen to cross the blocking edges: the inner block (256), the row block (120) and
 /// every micro-tile's edges, and a product big enough to split across threads.
-const SHAPES: [(usize, usize, usize); 9] = [
+const SHAPES: [(usize, usize, usize); 10] = [
     (1, 1, 1),
     (3, 5, 7),
     (6, 16, 256),
     (7, 33, 257),
     (97, 65, 600),
+    (121, 20, 300),
     (100, 50, 1200),
     (200, 300, 40),
     (13, 1, 513),
