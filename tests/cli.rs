@@ -13,6 +13,37 @@ fn ugl(args: &[&str]) -> Output {
         .expect("ugl runs")
 }
 
+/// The words of `line`, each `{}` replaced by the next of `values` (one argument each).
+fn argv<'a>(line: &'a str, values: &[&'a str]) -> Vec<&'a str> {
+    let mut values = values.iter();
+    let args: Vec<&str> = line
+        .split_whitespace()
+        .map(|w| {
+            if w == "{}" {
+                values.next().expect("a value per {}")
+            } else {
+                w
+            }
+        })
+        .collect();
+    assert!(values.next().is_none(), "more values than {{}} in {line:?}");
+    args
+}
+
+/// `ugl campaign --config CFG --out OUT --quiet` and `extra`.
+fn campaign(cfg: &str, out: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["campaign", "--config", cfg, "--out", out, "--quiet"];
+    args.extend_from_slice(extra);
+    ugl(&args)
+}
+
+/// Write `to` as a copy of `from` with `what` replaced by `with`.
+fn replaced(from: &Path, to: &Path, what: &str, with: &str) {
+    let text = std::fs::read_to_string(from).unwrap();
+    assert!(text.contains(what), "{} has no {what:?}", from.display());
+    std::fs::write(to, text.replace(what, with)).unwrap();
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -121,59 +152,37 @@ fn klc_contract() {
 fn render_contract() {
     let dir = tempfile::tempdir().unwrap();
     let npy = dir.path().join("ball.npy");
-    let o = ugl(&[
-        "render",
-        "--env",
-        "armball",
-        "--state",
-        "0.2,-0.4",
-        "--out",
-        p(&npy),
-    ]);
+    let o = ugl(&argv(
+        "render --env armball --state 0.2,-0.4 --out {}",
+        &[p(&npy)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&npy).unwrap();
     assert_eq!(&bytes[..6], b"\x93NUMPY");
     assert!(bytes.len() >= 4900 * 4 + 64);
     let png = dir.path().join("arrow.png");
-    let o = ugl(&[
-        "render",
-        "--env",
-        "armarrow",
-        "--state",
-        "-0.3,0.1,0.5",
-        "--out",
-        p(&png),
-    ]);
+    let o = ugl(&argv(
+        "render --env armarrow --state -0.3,0.1,0.5 --out {}",
+        &[p(&png)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
     assert_one_line_error(
-        &ugl(&[
-            "render",
-            "--env",
-            "armball",
-            "--state",
-            "0.2",
-            "--out",
-            p(&npy),
-        ]),
+        &ugl(&argv(
+            "render --env armball --state 0.2 --out {}",
+            &[p(&npy)],
+        )),
         "2 comma-separated",
     );
     assert_one_line_error(
-        &ugl(&[
-            "render",
-            "--env",
-            "armball",
-            "--state",
-            "1.2,0",
-            "--out",
-            p(&npy),
-        ]),
+        &ugl(&argv(
+            "render --env armball --state 1.2,0 --out {}",
+            &[p(&npy)],
+        )),
         "outside",
     );
     assert_one_line_error(
-        &ugl(&[
-            "render", "--env", "armball", "--state", "0,0", "--out", "x.jpg",
-        ]),
+        &ugl(&argv("render --env armball --state 0,0 --out x.jpg", &[])),
         ".npy or .png",
     );
 }
@@ -183,19 +192,10 @@ fn run_contract_and_determinism() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     let args = |out: &Path, seed: &str| {
-        ugl(&[
-            "run",
-            "--env",
-            "armarrow",
-            "--algo",
-            "rge-efr",
-            "--seed",
-            seed,
-            "--epochs",
-            "400",
-            "--out",
-            p(out),
-        ])
+        ugl(&argv(
+            "run --env armarrow --algo rge-efr --seed {} --epochs 400 --out {}",
+            &[seed, p(out)],
+        ))
     };
     let o = args(&a, "1");
     assert!(o.status.success(), "{}", stderr(&o));
@@ -242,19 +242,10 @@ fn a_run_records_its_discovery_and_its_outcomes_file_may_be_left_out() {
         ("armball", "rpe", "armball.rpe.s1"),
     ] {
         let out = dir.path().join(env);
-        let o = ugl(&[
-            "run",
-            "--env",
-            env,
-            "--algo",
-            algo,
-            "--seed",
-            "1",
-            "--epochs",
-            "300",
-            "--out",
-            p(&out),
-        ]);
+        let o = ugl(&argv(
+            "run --env {} --algo {} --seed 1 --epochs 300 --out {}",
+            &[env, algo, p(&out)],
+        ));
         assert!(o.status.success(), "{}", stderr(&o));
         let stem = out.join(id);
         let run = ugl_report::load::load_run(&stem, String::new()).unwrap();
@@ -322,16 +313,10 @@ fn a_forged_discovery_record_is_detected() {
     );
     let store = dir.path().join("res");
     let out = store.join("tiny");
-    let campaign = ugl(&[
-        "campaign",
-        "--config",
-        p(&cfg),
-        "--out",
-        p(&out),
-        "--jobs",
-        "1",
-        "--quiet",
-    ]);
+    let campaign = ugl(&argv(
+        "campaign --config {} --out {} --jobs 1 --quiet",
+        &[p(&cfg), p(&out)],
+    ));
     assert!(campaign.status.success(), "{}", stderr(&campaign));
     let id = "armball.rge-efr.s0";
     let json_path = out.join(format!("{id}.json"));
@@ -341,25 +326,16 @@ fn a_forged_discovery_record_is_detected() {
         std::fs::read(&outcomes).unwrap(),
     );
     let status = || {
-        ugl(&[
-            "status",
-            "--config",
-            p(&cfg),
-            "--out",
-            p(&out),
-            "--require-complete",
-        ])
+        ugl(&argv(
+            "status --config {} --out {} --require-complete",
+            &[p(&cfg), p(&out)],
+        ))
     };
     let report = || {
-        ugl(&[
-            "report",
-            "--results",
-            p(&store),
-            "--main",
-            "tiny",
-            "--out",
-            p(&dir.path().join("report")),
-        ])
+        ugl(&argv(
+            "report --results {} --main tiny --out {}",
+            &[p(&store), p(&dir.path().join("report"))],
+        ))
     };
     assert!(status().status.success(), "{}", stderr(&status()));
     assert!(report().status.success(), "{}", stderr(&report()));
@@ -496,15 +472,10 @@ fn the_audit_refusals_are_one_line() {
     );
     assert_one_line_error(&ugl(&["plan", "--config", p(&short)]), "bootstrap_epochs");
     assert_one_line_error(
-        &ugl(&[
-            "status",
-            "--config",
-            "data/campaigns/baselines.toml",
-            "--out",
-            p(&out),
-            "--shards",
-            "18446744073709551615",
-        ]),
+        &ugl(&argv(
+            "status --config data/campaigns/baselines.toml --out {} --shards 18446744073709551615",
+            &[p(&out)],
+        )),
         "--shards 18446744073709551615: must be between 1 and",
     );
     let many = file(
@@ -552,48 +523,26 @@ fn ugl_run_keeps_a_store_to_one_configuration() {
          algos = [\"rpe\"]\n[explore]\nepochs = 200\neval_every = 100\n",
     );
     let store = dir.path().join("tiny");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&cfg),
-        "--out",
-        p(&store),
-        "--jobs",
-        "1",
-        "--quiet",
-    ]);
+    let o = ugl(&argv(
+        "campaign --config {} --out {} --jobs 1 --quiet",
+        &[p(&cfg), p(&store)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let manifest = store.join("armball.rpe.s0.json");
     let before = std::fs::read(&manifest).unwrap();
     let run = |out: &Path, epochs: &str| {
-        ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rpe",
-            "--profile",
-            p(&cfg),
-            "--epochs",
-            epochs,
-            "--out",
-            p(out),
-        ])
+        ugl(&argv(
+            "run --env armball --algo rpe --profile {} --epochs {} --out {}",
+            &[p(&cfg), epochs, p(out)],
+        ))
     };
     assert_one_line_error(&run(&store, "201"), "another configuration");
     assert_eq!(std::fs::read(&manifest).unwrap(), before, "the run is kept");
     // Another campaign's profile.
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rpe",
-        "--profile",
-        "smoke",
-        "--out",
-        p(&store),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rpe --profile smoke --out {}",
+        &[p(&store)],
+    ));
     assert_one_line_error(&o, "holds campaign `tiny`");
     // A directory of single runs: the same run again is fine, another configuration is not.
     let single = dir.path().join("single");
@@ -728,53 +677,39 @@ fn run_errors() {
     std::fs::write(&file, "").unwrap();
     let out = p(dir.path());
     assert_one_line_error(
-        &ugl(&[
-            "run", "--env", "armball", "--algo", "rge-nope", "--out", out,
-        ]),
+        &ugl(&argv("run --env armball --algo rge-nope --out {}", &[out])),
         "rge-nope",
     );
     assert_one_line_error(
-        &ugl(&[
-            "run", "--env", "armball", "--algo", "rpe", "--epochs", "0", "--out", out,
-        ]),
+        &ugl(&argv(
+            "run --env armball --algo rpe --epochs 0 --out {}",
+            &[out],
+        )),
         "epochs",
     );
     assert_one_line_error(
-        &ugl(&[
-            "run", "--env", "armball", "--algo", "rpe", "--epochs", "-3", "--out", out,
-        ]),
+        &ugl(&argv(
+            "run --env armball --algo rpe --epochs -3 --out {}",
+            &[out],
+        )),
         "-3",
     );
     assert_one_line_error(
-        &ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rpe",
-            "--profile",
-            "nosuch",
-            "--out",
-            out,
-        ]),
+        &ugl(&argv(
+            "run --env armball --algo rpe --profile nosuch --out {}",
+            &[out],
+        )),
         "nosuch",
     );
     assert_one_line_error(
-        &ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rpe",
-            "--out",
-            p(&file),
-        ]),
+        &ugl(&argv("run --env armball --algo rpe --out {}", &[p(&file)])),
         "not a directory",
     );
     assert_one_line_error(
-        &ugl(&[
-            "run", "--env", "armball", "--algo", "rpe", "--bogus", "--out", out,
-        ]),
+        &ugl(&argv(
+            "run --env armball --algo rpe --bogus --out {}",
+            &[out],
+        )),
         "--bogus",
     );
     assert_one_line_error(&ugl(&["frobnicate"]), "frobnicate");
@@ -799,16 +734,7 @@ fn campaign_plan_and_resume() {
         ]
     );
     let out = dir.path().join("res");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&cfg),
-        "--out",
-        p(&out),
-        "--quiet",
-        "--jobs",
-        "2",
-    ]);
+    let o = campaign(p(&cfg), p(&out), &["--jobs", "2"]);
     assert!(o.status.success(), "{}", stderr(&o));
     // Three files for each of the four runs, the campaign's record and the store's lock file.
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 14);
@@ -819,19 +745,10 @@ fn campaign_plan_and_resume() {
     let single = dir.path().join("single");
     let prof = p(&cfg);
     assert!(
-        ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rge-efr",
-            "--seed",
-            "1",
-            "--profile",
-            prof,
-            "--out",
-            p(&single)
-        ])
+        ugl(&argv(
+            "run --env armball --algo rge-efr --seed 1 --profile {} --out {}",
+            &[prof, p(&single)]
+        ))
         .status
         .success()
     );
@@ -840,7 +757,7 @@ fn campaign_plan_and_resume() {
         std::fs::read(single.join("armball.rge-efr.s1.outcomes.parquet")).unwrap()
     );
     // A rerun skips everything.
-    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    let o = campaign(p(&cfg), p(&out), &[]);
     assert!(stderr(&o).contains("0 runs executed"), "{}", stderr(&o));
     std::fs::write(&cfg, "[campaign]\nname = \"tiny\"\nreps = 0\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rpe\"]\n").unwrap();
     assert_one_line_error(&ugl(&["campaign", "--config", p(&cfg)]), "campaign.reps");
@@ -866,19 +783,10 @@ fn run_with_an_external_learner() {
          [learners.external]\nname = \"random-projection\"\ncommand = \"python3 scripts/external_learners/random_projection.py\"\n",
     );
     let out = dir.path().join("res");
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-external",
-        "--latents",
-        "3",
-        "--profile",
-        p(&cfg),
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-external --latents 3 --profile {} --out {}",
+        &[p(&cfg), p(&out)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
     assert_eq!(s["run"], "armball.rge-external.kde.l3.s0");
@@ -923,25 +831,10 @@ fn run_with_an_external_learner() {
         p(&out),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-pca",
-        "--latents",
-        "3",
-        "--seed",
-        "1",
-        "--epochs",
-        "150",
-        "--images",
-        "200",
-        "--profile",
-        "smoke",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-pca --latents 3 --seed 1 --epochs 150 --images 200 --profile smoke --out {}",
+        &[p(&out)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let ext = manifest(&out.join("armball.rge-external.kde.l3.s1.json"));
     let pca = manifest(&out.join("armball.rge-pca.kde.l3.s1.json"));
@@ -957,28 +850,16 @@ fn run_with_an_external_learner() {
     assert_ne!(ext["identity"], pca["identity"]);
 
     // Without the [learners.external] section or --command: a one-line error.
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-external",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-external --out {}",
+        &[p(&out)],
+    ));
     assert_one_line_error(&o, "--command");
     // --command is for rge-external only; an empty one is refused.
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-pca",
-        "--command",
-        "x",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-pca --command x --out {}",
+        &[p(&out)],
+    ));
     assert_one_line_error(&o, "apply to the external learner's algorithms only");
     let o = ugl(&[
         "run",
@@ -1004,34 +885,16 @@ fn shards_merge_into_the_whole_campaign() {
          samplers = [\"kde\", \"gaussian\"]\nlatents = [3]\n[ugl]\nimages = 100\n[explore]\nepochs = 120\neval_every = 40\n",
     );
     let whole = dir.path().join("whole");
-    assert!(
-        ugl(&[
-            "campaign",
-            "--config",
-            p(&cfg),
-            "--out",
-            p(&whole),
-            "--quiet"
-        ])
-        .status
-        .success()
-    );
+    assert!(campaign(p(&cfg), p(&whole), &[]).status.success());
     // Three machines, three shards, three stores; merged into one.
     let mut parts = Vec::new();
     for i in 0..3 {
         let d = dir.path().join(format!("part{i}"));
-        let o = ugl(&[
-            "campaign",
-            "--config",
+        let o = campaign(
             p(&cfg),
-            "--out",
             p(&d),
-            "--quiet",
-            "--jobs",
-            "1",
-            "--shard",
-            &format!("{i}/3"),
-        ]);
+            &["--jobs", "1", "--shard", &format!("{i}/3")],
+        );
         assert!(o.status.success(), "{}", stderr(&o));
         parts.push(d);
     }
@@ -1060,15 +923,10 @@ fn shards_merge_into_the_whole_campaign() {
     std::fs::write(&source, b"corrupt").unwrap();
     assert_one_line_error(&ugl(&args), "is incomplete or damaged");
     assert_one_line_error(
-        &ugl(&[
-            "campaign",
-            "--config",
-            p(&cfg),
-            "--out",
-            p(&whole),
-            "--shard",
-            "3/3",
-        ]),
+        &ugl(&argv(
+            "campaign --config {} --out {} --shard 3/3",
+            &[p(&cfg), p(&whole)],
+        )),
         "--shard",
     );
 }
@@ -1095,7 +953,7 @@ fn status_counts_complete_missing_and_damaged_runs() {
     let text = stdout(&o);
     assert!(text.contains("4 runs: 0 complete, 4 missing"), "{text}");
     assert_one_line_error(&status(&["--require-complete"]), "is not complete");
-    let o = ugl(&["campaign", "--config", p(&cfg), "--out", p(&out), "--quiet"]);
+    let o = campaign(p(&cfg), p(&out), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = status(&["--shards", "2", "--require-complete"]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -1122,16 +980,10 @@ fn slurm_scripts() {
     let scripts = dir.path().join("slurm");
     // `--allow-dirty` (passed on to the tasks): the default results directory is in this
     // checkout's data/, which a developer's tree may have changed.
-    let o = ugl(&[
-        "slurm",
-        "--config",
-        "data/campaigns/baselines.toml",
-        "--shards",
-        "4",
-        "--scripts",
-        p(&scripts),
-        "--allow-dirty",
-    ]);
+    let o = ugl(&argv(
+        "slurm --config data/campaigns/baselines.toml --shards 4 --scripts {} --allow-dirty",
+        &[p(&scripts)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let array = std::fs::read_to_string(scripts.join("array.sh")).unwrap();
     assert!(array.contains("#SBATCH --array=0-3"), "{array}");
@@ -1159,15 +1011,10 @@ fn slurm_scripts() {
         assert!(st.success(), "{f} is valid bash");
     }
     assert_one_line_error(
-        &ugl(&[
-            "slurm",
-            "--config",
-            "data/campaigns/baselines.toml",
-            "--shards",
-            "0",
-            "--scripts",
-            p(&scripts),
-        ]),
+        &ugl(&argv(
+            "slurm --config data/campaigns/baselines.toml --shards 0 --scripts {}",
+            &[p(&scripts)],
+        )),
         "--shards",
     );
 }
@@ -1277,25 +1124,10 @@ fn neural_runs_share_the_model_cache_and_rebuild_a_corrupted_one() {
     let profile = neural_profile(dir.path());
     let cache = dir.path().join("cache");
     let run = |out: &Path, sampler: &str, variant: &str| {
-        ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rge-rfvae",
-            "--variant",
-            variant,
-            "--sampler",
-            sampler,
-            "--latents",
-            "2",
-            "--profile",
-            p(&profile),
-            "--cache",
-            p(&cache),
-            "--out",
-            p(out),
-        ])
+        ugl(&argv(
+            "run --env armball --algo rge-rfvae --variant {} --sampler {} --latents 2 --profile {} --cache {} --out {}",
+            &[variant, sampler, p(&profile), p(&cache), p(out)],
+        ))
     };
     let (a, b, c) = (
         dir.path().join("a"),
@@ -1377,25 +1209,10 @@ fn pca_runs_share_the_model_cache_too() {
     let cache = dir.path().join("cache");
     let id = "armball.rge-pca.kde.l3.s0";
     let run = |out: &Path| {
-        let o = ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rge-pca",
-            "--latents",
-            "3",
-            "--images",
-            "300",
-            "--epochs",
-            "200",
-            "--profile",
-            "smoke",
-            "--cache",
-            p(&cache),
-            "--out",
-            p(out),
-        ]);
+        let o = ugl(&argv(
+            "run --env armball --algo rge-pca --latents 3 --images 300 --epochs 200 --profile smoke --cache {} --out {}",
+            &[p(&cache), p(out)],
+        ));
         assert!(o.status.success(), "{}", stderr(&o));
         std::fs::read(out.join(format!("{id}.parquet"))).unwrap()
     };
@@ -1471,16 +1288,10 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
          [ugl]\nimages = 200\n[explore]\nepochs = 200\n",
     );
     let out = dir.path().join("cmp");
-    let o = ugl(&[
-        "compare",
-        "--learner",
-        "pca-centred",
-        "--config",
-        p(&base),
-        "--out",
-        p(&out),
-        "--quiet",
-    ]);
+    let o = ugl(&argv(
+        "compare --learner pca-centred --config {} --out {} --quiet",
+        &[p(&base), p(&out)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     // No main campaign `base` in the results directory yet: no ranking page, said so.
     assert!(stderr(&o).contains("no summary page"), "{}", stderr(&o));
@@ -1504,19 +1315,10 @@ fn compare_runs_a_new_learner_on_the_campaign_cells_and_seeds() {
     // The same run as `ugl run` with the base campaign's seed.
     let single = dir.path().join("single");
     assert!(
-        ugl(&[
-            "run",
-            "--env",
-            "armball",
-            "--algo",
-            "rge-pca-centred",
-            "--latents",
-            "2",
-            "--profile",
-            p(&base),
-            "--out",
-            p(&single),
-        ])
+        ugl(&argv(
+            "run --env armball --algo rge-pca-centred --latents 2 --profile {} --out {}",
+            &[p(&base), p(&single)]
+        ))
         .status
         .success()
     );
@@ -1559,55 +1361,27 @@ fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
         stdout(&o)
     );
     let single = dir.path().join("single");
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-gaussian-projection",
-        "--latents",
-        "2",
-        "--profile",
-        p(&base),
-        "--out",
-        p(&single),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-gaussian-projection --latents 2 --profile {} --out {}",
+        &[p(&base), p(&single)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let m = manifest(&single.join("armball.rge-gaussian-projection.kde.l2.s0.json"));
     assert_eq!(m["learner"], "gaussian-projection");
     // Its [learners.NAME] table is checked: a bad value is a one-line error naming the key.
     let bad = dir.path().join("bad.toml");
-    std::fs::write(
-        &bad,
-        std::fs::read_to_string(&base)
-            .unwrap()
-            .replace("std = 0.5", "std = -1.0"),
-    )
-    .unwrap();
+    replaced(&base, &bad, "std = 0.5", "std = -1.0");
     assert_one_line_error(
         &ugl(&["plan", "--config", p(&bad)]),
         "learners.gaussian-projection.std: must be a positive number",
     );
     let results = dir.path().join("results");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&base),
-        "--out",
-        p(&results.join("base")),
-        "--quiet",
-    ]);
+    let o = campaign(p(&base), p(&results.join("base")), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = ugl(&[
-        "compare",
-        "--learner",
-        "gaussian-projection",
-        "--config",
-        p(&base),
-        "--out",
-        p(&results.join("compare-gaussian-projection")),
-        "--quiet",
-    ]);
+    let o = ugl(&argv(
+        "compare --learner gaussian-projection --config {} --out {} --quiet",
+        &[p(&base), p(&results.join("compare-gaussian-projection"))],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     // The same run as `ugl run`, and a ranking page against the base campaign.
     assert_eq!(
@@ -1626,15 +1400,10 @@ fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
     );
     assert!(page.contains("rank "), "{page}");
     let report = dir.path().join("report");
-    let o = ugl(&[
-        "report",
-        "--results",
-        p(&results),
-        "--out",
-        p(&report),
-        "--main",
-        "base",
-    ]);
+    let o = ugl(&argv(
+        "report --results {} --out {} --main base",
+        &[p(&results), p(&report)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
     let row = md
@@ -1648,23 +1417,10 @@ fn a_learner_added_in_one_file_runs_is_compared_and_ranked() {
 fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("emb").join("pca.npy");
-    let o = ugl(&[
-        "embed",
-        "--env",
-        "armarrow",
-        "--learner",
-        "pca",
-        "--latents",
-        "3",
-        "--grid",
-        "4",
-        "--images",
-        "300",
-        "--profile",
-        "smoke",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "embed --env armarrow --learner pca --latents 3 --grid 4 --images 300 --profile smoke --out {}",
+        &[p(&out)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
     assert_eq!(s["representation"], "armarrow.rge-pca.l3.s0");
@@ -1687,23 +1443,7 @@ fn embed_writes_the_latents_of_the_training_set_and_a_grid() {
     // The training latents are the ones a run of the same cell fits: same bytes twice.
     let first = std::fs::read(&out).unwrap();
     assert!(
-        ugl(&[
-            "embed",
-            "--env",
-            "armarrow",
-            "--learner",
-            "pca",
-            "--latents",
-            "3",
-            "--grid",
-            "4",
-            "--images",
-            "300",
-            "--profile",
-            "smoke",
-            "--out",
-            p(&out),
-        ])
+        ugl(&argv("embed --env armarrow --learner pca --latents 3 --grid 4 --images 300 --profile smoke --out {}", &[p(&out)]))
         .status
         .success()
     );
@@ -1834,15 +1574,10 @@ fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
 fn bad_arguments_touch_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("never-created");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        "data/campaigns/baselines.toml",
-        "--jobs",
-        "0",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "campaign --config data/campaigns/baselines.toml --jobs 0 --out {}",
+        &[p(&out)],
+    ));
     assert_one_line_error(&o, "--jobs must be at least 1");
     assert!(!out.exists(), "--out was created before --jobs was checked");
     for cmd in [
@@ -1876,21 +1611,10 @@ fn bad_arguments_touch_nothing() {
         assert!(!out.exists());
     }
     // The largest seed the store holds still runs.
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rpe",
-        "--seed",
-        "9223372036854775807",
-        "--epochs",
-        "50",
-        "--profile",
-        "baselines",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rpe --seed 9223372036854775807 --epochs 50 --profile baselines --out {}",
+        &[p(&out)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -1946,25 +1670,13 @@ fn errors_are_one_line_each_cause_once_and_huge_sizes_are_refused() {
 fn report_paper_and_top_level_arguments() {
     let dir = tempfile::tempdir().unwrap();
     let store = dir.path().join("store");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        "data/campaigns/baselines.toml",
-        "--out",
-        p(&store),
-        "--quiet",
-    ]);
+    let o = campaign("data/campaigns/baselines.toml", p(&store), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let report = dir.path().join("report");
-    let o = ugl(&[
-        "report",
-        "--results",
-        p(&store),
-        "--paper",
-        "/nonexistent/paper",
-        "--out",
-        p(&report),
-    ]);
+    let o = ugl(&argv(
+        "report --results {} --paper /nonexistent/paper --out {}",
+        &[p(&store), p(&report)],
+    ));
     assert_one_line_error(&o, "--paper /nonexistent/paper: not a directory");
     let o = ugl(&["report", "--results", p(&store), "--out", p(&report)]);
     assert_one_line_error(&o, "(top level)");
@@ -2251,16 +1963,10 @@ fn a_failing_external_fit_is_started_once_per_cell() {
         ),
     )
     .unwrap();
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&cfg),
-        "--out",
-        p(&dir.path().join("res")),
-        "--jobs",
-        "1",
-        "--quiet",
-    ]);
+    let o = ugl(&argv(
+        "campaign --config {} --out {} --jobs 1 --quiet",
+        &[p(&cfg), p(&dir.path().join("res"))],
+    ));
     assert_one_line_error(&o, "armball.rge-external");
     assert!(
         !stderr(&o).contains("not run:"),
@@ -2295,15 +2001,10 @@ fn a_truncated_run_file_is_detected_and_recomputed() {
     let original = std::fs::read(&victim).unwrap();
     std::fs::write(&victim, &original[..original.len() / 2]).unwrap();
 
-    let report = ugl(&[
-        "report",
-        "--results",
-        p(&store),
-        "--main",
-        ".",
-        "--out",
-        p(&dir.path().join("report")),
-    ]);
+    let report = ugl(&argv(
+        "report --results {} --main . --out {}",
+        &[p(&store), p(&dir.path().join("report"))],
+    ));
     assert_one_line_error(&report, "armball.rpe.s0.parquet");
     assert!(
         stderr(&report).contains("truncated or damaged"),
@@ -2397,19 +2098,10 @@ fn a_killed_harness_leaves_no_learner_behind_and_the_ready_timeout_is_configurab
          [learners.external]\nname = \"slow\"\ncommand = \"sleep 1000\"\nready_timeout_s = 1.5\n",
     );
     let t0 = std::time::Instant::now();
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "rge-external",
-        "--latents",
-        "2",
-        "--profile",
-        p(&cfg),
-        "--out",
-        p(&dir.path().join("out2")),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo rge-external --latents 2 --profile {} --out {}",
+        &[p(&cfg), p(&dir.path().join("out2"))],
+    ));
     assert_one_line_error(&o, "no READY line within the ready timeout (1.5s)");
     assert!(t0.elapsed().as_secs() < 30);
 }
@@ -2429,26 +2121,13 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     );
     // Modules of 2 latents need an even latent count: a one-line error naming the keys.
     let odd = dir.path().join("odd.toml");
-    std::fs::write(
-        &odd,
-        std::fs::read_to_string(&cfg)
-            .unwrap()
-            .replace("latents = [4]", "latents = [3]"),
-    )
-    .unwrap();
+    replaced(&cfg, &odd, "latents = [4]", "latents = [3]");
     assert_one_line_error(
         &ugl(&["plan", "--config", p(&odd)]),
         "mge.module_size = 2 latents, but matrix.latents has 3",
     );
     let results = dir.path().join("results");
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&cfg),
-        "--out",
-        p(&results.join("armballs")),
-        "--quiet",
-    ]);
+    let o = campaign(p(&cfg), p(&results.join("armballs")), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let ab = results.join("armballs");
     // Modular runs write their interest; the others do not.
@@ -2477,37 +2156,17 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
     assert_eq!(per[0]["r2"].as_array().unwrap().len(), 4);
     // `ugl run` gives the same bytes as the campaign.
     let single = dir.path().join("single");
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armballs",
-        "--algo",
-        "mge-efr-lp",
-        "--seed",
-        "2",
-        "--profile",
-        p(&cfg),
-        "--out",
-        p(&single),
-    ]);
+    let o = ugl(&argv(
+        "run --env armballs --algo mge-efr-lp --seed 2 --profile {} --out {}",
+        &[p(&cfg), p(&single)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     // And in a learned space, where the campaign shared one fitted PCA between runs and
     // `ugl run` fits its own.
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armballs",
-        "--algo",
-        "mge-pca-lp",
-        "--latents",
-        "4",
-        "--seed",
-        "1",
-        "--profile",
-        p(&cfg),
-        "--out",
-        p(&single),
-    ]);
+    let o = ugl(&argv(
+        "run --env armballs --algo mge-pca-lp --latents 4 --seed 1 --profile {} --out {}",
+        &[p(&cfg), p(&single)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     for f in [
         "armballs.mge-efr-lp.s2.parquet",
@@ -2530,25 +2189,13 @@ fn armballs_campaign_records_interest_and_the_report_gives_the_follow_up_section
          algos = [\"rpe\", \"rge-efr\"]\nsamplers = [\"kde\"]\nlatents = [\"true\"]\n\
          [explore]\nepochs = 150\n",
     );
-    let o = ugl(&[
-        "campaign",
-        "--config",
-        p(&main),
-        "--out",
-        p(&results.join("base")),
-        "--quiet",
-    ]);
+    let o = campaign(p(&main), p(&results.join("base")), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let report = dir.path().join("report");
-    let o = ugl(&[
-        "report",
-        "--results",
-        p(&results),
-        "--out",
-        p(&report),
-        "--main",
-        "base",
-    ]);
+    let o = ugl(&argv(
+        "report --results {} --out {} --main base",
+        &[p(&results), p(&report)],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let md = std::fs::read_to_string(report.join("REPORT.md")).unwrap();
     assert!(
@@ -2631,23 +2278,10 @@ fn embed_grid_is_checked_against_memory_before_fitting() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("emb").join("pca.npy");
     let embed = |grid: &str| {
-        ugl(&[
-            "embed",
-            "--env",
-            "armball",
-            "--learner",
-            "pca",
-            "--latents",
-            "2",
-            "--images",
-            "300",
-            "--profile",
-            "smoke",
-            "--grid",
-            grid,
-            "--out",
-            p(&out),
-        ])
+        ugl(&argv(
+            "embed --env armball --learner pca --latents 2 --images 300 --profile smoke --grid {} --out {}",
+            &[grid, p(&out)],
+        ))
     };
     assert_one_line_error(&embed("100000"), "--grid = 100000 needs about");
     let mem_gib = std::fs::read_to_string("/proc/meminfo")
@@ -2674,19 +2308,10 @@ fn embed_grid_is_checked_against_memory_before_fitting() {
 fn modular_latent_sizes_are_checked_before_training() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armarrow",
-        "--algo",
-        "mge-vae-lp",
-        "--latents",
-        "3",
-        "--profile",
-        "smoke",
-        "--out",
-        p(&out),
-    ]);
+    let o = ugl(&argv(
+        "run --env armarrow --algo mge-vae-lp --latents 3 --profile smoke --out {}",
+        &[p(&out)],
+    ));
     assert_one_line_error(
         &o,
         "--latents 3: mge-vae-lp splits its latents into modules of mge.module_size = 2",
@@ -2699,27 +2324,15 @@ fn modular_latent_sizes_are_checked_before_training() {
 #[test]
 fn messages_name_the_algorithm_the_flag_and_the_key_given() {
     let dir = tempfile::tempdir().unwrap();
-    let o = ugl(&[
-        "run",
-        "--env",
-        "armball",
-        "--algo",
-        "mge-external-lp",
-        "--latents",
-        "2",
-        "--out",
-        p(&dir.path().join("run")),
-    ]);
+    let o = ugl(&argv(
+        "run --env armball --algo mge-external-lp --latents 2 --out {}",
+        &[p(&dir.path().join("run"))],
+    ));
     assert_one_line_error(&o, "--algo mge-external-lp needs --command");
-    let o = ugl(&[
-        "report",
-        "--results",
-        "data/results",
-        "--main",
-        "nosuch",
-        "--out",
-        p(&dir.path().join("report")),
-    ]);
+    let o = ugl(&argv(
+        "report --results data/results --main nosuch --out {}",
+        &[p(&dir.path().join("report"))],
+    ));
     assert_one_line_error(&o, "choose one with --main NAME");
     assert!(!stderr(&o).contains("ReportOptions"), "{}", stderr(&o));
     let cfg = common::write_file(
@@ -2745,19 +2358,10 @@ fn the_position_only_efr_is_paired_with_efr_and_drops_only_the_angle() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("runs");
     let run = |env: &str, algo: &str| {
-        ugl(&[
-            "run",
-            "--env",
-            env,
-            "--algo",
-            algo,
-            "--epochs",
-            "300",
-            "--profile",
-            "smoke",
-            "--out",
-            p(&out),
-        ])
+        ugl(&argv(
+            "run --env {} --algo {} --epochs 300 --profile smoke --out {}",
+            &[env, algo, p(&out)],
+        ))
     };
     for algo in ["rge-efr", "rge-efr-position"] {
         let o = run("armarrow", algo);
