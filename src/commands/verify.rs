@@ -64,17 +64,13 @@ fn sample(runs: Vec<Pick>, n: usize) -> Vec<Pick> {
     chosen.dedup();
     chosen
         .into_iter()
-        .rev()
         .map(|i| {
-            let mut g = groups.swap_remove(i);
+            let mut g = std::mem::take(&mut groups[i]);
             g.sort_by_key(|p| (p.spec.seed, p.spec.exploration));
             let hash = blake3::hash(condition(&g[0].spec).as_bytes());
             let k = u64::from_le_bytes(hash.as_bytes()[..8].try_into().expect("8 bytes"));
             g.swap_remove((k % g.len() as u64) as usize)
         })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .rev()
         .collect()
 }
 

@@ -1,15 +1,13 @@
 //! The transcendental functions of the networks' latent middle (exp, log, powf, softplus,
-//! sigmoid) and of the burn engine's pixel loss (log-sigmoid) on burn tensors, computed by the `libm` crate: burn's own ops call the platform's
-//! libm, whose variants are chosen by CPU feature, so a run's bytes would depend on the machine
-//! (README "Reproducibility").
+//! sigmoid) and of the burn engine's pixel loss (log-sigmoid) on burn tensors, computed by the
+//! `libm` crate: burn's own ops call the platform's libm, whose variants are chosen by CPU
+//! feature, so a run's bytes would depend on the machine (README "Reproducibility").
 
 use burn::tensor::{Tensor, TensorData};
 
-/// `f` applied elementwise by host code (the `libm` crate), as a tensor whose value is exactly
-/// `f(x)` and whose gradient is `df(x, f(x))`: the transcendental functions of the networks'
-/// latent middle (exp, log, powf, softplus, sigmoid). burn's own ops call the platform's libm,
-/// whose variants are chosen by CPU feature. Built as `y + (x - detach(x)) * g` with `y` and
-/// `g` constants: `x - detach(x)` is exactly zero forward and the identity backward.
+/// `f` applied elementwise on the host, as a tensor whose value is exactly `f(x)` and whose
+/// gradient is `df(x, f(x))`. Built as `y + (x - detach(x)) * g` with `y` and `g` constants:
+/// `x - detach(x)` is exactly zero forward and the identity backward.
 pub fn host_map(x: Tensor<2>, f: impl Fn(f32) -> f32, df: impl Fn(f32, f32) -> f32) -> Tensor<2> {
     let [rows, cols] = x.dims();
     let device = x.device();
