@@ -1,6 +1,6 @@
 //! The campaign engine: bad configurations, worker-count independence, resume after kill -9.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};

@@ -1,6 +1,6 @@
 //! Integration tests of the `ugl` command line: the contract other tools depend on.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Output};

@@ -10,7 +10,7 @@
 //!    `kill -9` between the two runs of a cell leaves), resumed: the representation comes from
 //!    the model cache, and the deleted runs run again after nothing else.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -113,3 +113,137 @@ fn klc_matches_numpy_scipy() {
         }
     }
 }
+
+/// The follow-up's ArmBalls (`ugl_bench::env::cdge`) against its authors' code
+/// (`scripts/followup_fixtures.py`: `latentgoalexplo` at the commit the fixture names).
+mod followup {
+    use super::{floats, load};
+    use serde_json::Value;
+    use ugl_bench::env::cdge::{self, CdgeArmBalls, PARAMS, Scene, VALUES};
+
+    fn theta(v: &Value) -> [f64; PARAMS] {
+        floats(v).try_into().expect("49 parameters")
+    }
+
+    fn pair(v: &Value) -> [f64; 2] {
+        floats(v).try_into().expect("two numbers")
+    }
+
+    /// Standard base64 (the fixture's 8-bit pictures).
+    fn base64(text: &str) -> Vec<u8> {
+        let value = |c: u8| match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("not base64: {c}"),
+        };
+        let digits: Vec<u8> = text.bytes().filter(|c| *c != b'=').map(value).collect();
+        digits
+            .chunks(4)
+            .flat_map(|c| {
+                let n = c.len();
+                let w = c.iter().fold(0u32, |w, d| w << 6 | *d as u32) << (6 * (4 - n));
+                let bytes = [(w >> 16) as u8, (w >> 8) as u8, w as u8];
+                bytes.into_iter().take(n - 1)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_radial_basis_table_is_theirs_to_1e15() {
+        let fx = load("cdge_armballs.json");
+        let ours = cdge::RbfTable::new(cdge::STEPS, cdge::SDEV);
+        let theirs = fx["basis"].as_array().unwrap();
+        assert_eq!(theirs.len(), ours.basis.len());
+        for (t, row) in theirs.iter().enumerate() {
+            for (k, v) in floats(row).iter().enumerate() {
+                let d = (v - ours.basis[t][k]).abs();
+                assert!(d <= 1e-15, "basis[{t}][{k}]: {v} vs {}", ours.basis[t][k]);
+            }
+        }
+    }
+
+    #[test]
+    fn rollouts_match_their_code_to_1e12() {
+        let fx = load("cdge_armballs.json");
+        let env = CdgeArmBalls::new(Scene::default());
+        let cases = fx["rollouts"].as_array().unwrap();
+        assert!(cases.len() >= 140);
+        let (mut caught, mut worst) = (0, 0.0f64);
+        for (i, c) in cases.iter().enumerate() {
+            let draws: Vec<f64> = c["distractor_draws"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(floats)
+                .collect();
+            assert_eq!(draws.len(), 2 * cdge::STEPS);
+            let mut next = draws.iter();
+            let e = env.rollout_with(&theta(&c["theta"]), || *next.next().unwrap());
+            assert!(next.next().is_none(), "case {i}: every draw is used");
+            assert_eq!(
+                e.caught,
+                c["caught"].as_bool().unwrap(),
+                "case {i} ({})",
+                c["kind"]
+            );
+            caught += e.caught as usize;
+            for (ours, key) in [
+                (&e.ball[..], "ball"),
+                (&e.distractor[..], "distractor"),
+                (&e.hand[..], "hand"),
+                (&e.pose[..], "arm_pose"),
+            ] {
+                for (a, b) in ours.iter().zip(floats(&c[key])) {
+                    worst = worst.max((a - b).abs());
+                    assert!((a - b).abs() <= 1e-12, "case {i} {key}: {a} vs {b}");
+                }
+            }
+        }
+        assert!(caught >= 40, "the fixture must exercise catches: {caught}");
+        assert!(worst > 0.0 || caught > 0);
+    }
+
+    /// Their pictures are cairo's; ours re-trace cairo's outline and coverage: the same pixels
+    /// lit, and at most 2 levels of 255 apart.
+    #[test]
+    fn pictures_match_their_renderer_pixel_close() {
+        let fx = load("cdge_armballs.json");
+        let rollouts = fx["rollouts"].as_array().unwrap();
+        let images = fx["images"].as_array().unwrap();
+        assert!(images.len() >= 20);
+        let (mut worst, mut sum, mut n) = (0u8, 0u64, 0u64);
+        for (i, im) in images.iter().enumerate() {
+            let theirs = base64(im["rgb"].as_str().unwrap());
+            assert_eq!(theirs.len(), VALUES);
+            let (ball, distractor, ball_r) = match im["source"].as_str().unwrap() {
+                "observer" => {
+                    let r = &rollouts[im["rollout"].as_u64().unwrap() as usize];
+                    (pair(&r["ball"]), pair(&r["distractor"]), cdge::BALL_RADIUS)
+                }
+                // The observation phase draws the ball with its physical size.
+                _ => {
+                    let s = floats(&im["state"]);
+                    ([s[11], s[12]], [s[9], s[10]], 0.1)
+                }
+            };
+            let mut ours = vec![0u8; VALUES];
+            cdge::render_rgb(ball, distractor, ball_r, cdge::DISTRACTOR_RADIUS, &mut ours);
+            for (p, (a, b)) in ours.iter().zip(&theirs).enumerate() {
+                let d = a.abs_diff(*b);
+                assert!(
+                    (*a == 0) == (*b == 0) && d <= 2,
+                    "picture {i}, value {p}: ours {a}, theirs {b}"
+                );
+                worst = worst.max(d);
+                sum += d as u64;
+                n += 1;
+            }
+        }
+        let mean = sum as f64 / n as f64;
+        eprintln!("pictures: largest difference {worst} / 255, mean {mean:.4}");
+        assert!(mean < 0.01, "mean difference {mean} / 255");
+    }
+}

@@ -9,6 +9,7 @@ pub mod arm;
 pub mod armarrow;
 pub mod armball;
 pub mod armballs;
+pub mod cdge;
 pub mod dmp;
 pub mod render;
 
