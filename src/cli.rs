@@ -26,11 +26,12 @@ pub(crate) enum Command {
     Rollout {
         #[arg(long, help = env_help())]
         env: EnvKind,
-        /// JSON file: an array of arrays of 21 numbers (motor parameters; clipped to [-1,1]).
+        /// JSON file: an array of arrays of motor parameters, clipped to [-1,1] (21 per episode;
+        /// armballs-corl: 49).
         #[arg(long)]
         params: PathBuf,
-        /// armballs: the distractor's random walk draws from this seed's `distractor` stream,
-        /// episode after episode (the other environments draw nothing).
+        /// armballs, armballs-corl: the distractor's random walk draws from this seed's
+        /// `distractor` stream, episode after episode (the other environments draw nothing).
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
@@ -42,13 +43,15 @@ pub(crate) enum Command {
         #[arg(long)]
         outcomes: PathBuf,
     },
-    /// Render an object state as the 70x70 image the learners see.
+    /// Render an object state as the picture the learners see (70x70 gray; armballs-corl:
+    /// 64x64 RGB).
     Render {
         #[arg(long, help = env_help())]
         env: EnvKind,
         #[arg(long, allow_hyphen_values = true, help = state_help())]
         state: String,
-        /// Output file: `.npy` (float32 70x70 indexed [x][y]) or `.png` (for people).
+        /// Output file: `.npy` (float32 70x70 indexed [x][y]; armballs-corl: 64x64x3, rows
+        /// first) or `.png` (for people).
         #[arg(long)]
         out: PathBuf,
     },

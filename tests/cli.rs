@@ -120,6 +120,77 @@ fn rollout_contract() {
     );
 }
 
+/// The follow-up's own ArmBalls (`armballs-corl`): 49 parameters an episode, 64x64 RGB pictures,
+/// and the whole pipeline (an explorer in an engineered space, a learner on its pictures) runs on
+/// it, to the same bytes twice.
+#[test]
+fn the_followups_own_armballs_takes_49_parameters_draws_rgb_and_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("params.json");
+    std::fs::write(
+        &f,
+        serde_json::to_string(&[vec![0.0; 49], vec![0.2; 49]]).unwrap(),
+    )
+    .unwrap();
+    let o = ugl(&[
+        "rollout",
+        "--env",
+        "armballs-corl",
+        "--params",
+        p(&f),
+        "--seed",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    // At rest the arm points along +x (no angle shift in the authors' arm).
+    let hand: Vec<f64> = serde_json::from_value(v[0]["hand"].clone()).unwrap();
+    assert_eq!(hand, [1.0, 0.0]);
+    let object: Vec<f64> = serde_json::from_value(v[0]["object"].clone()).unwrap();
+    assert_eq!(object[..2], [0.6, 0.6]);
+    assert!(object[2..].iter().all(|d| d.abs() <= 0.95) && object[2..] != [0.7, -0.45]);
+    std::fs::write(&f, serde_json::to_string(&[vec![0.0; 21]]).unwrap()).unwrap();
+    assert_one_line_error(
+        &ugl(&["rollout", "--env", "armballs-corl", "--params", p(&f)]),
+        "armballs-corl takes 49",
+    );
+    let npy = dir.path().join("a.npy");
+    let o = ugl(&[
+        "render",
+        "--env",
+        "armballs-corl",
+        "--state",
+        "0.6,0.6,-0.5,0.3",
+        "--out",
+        p(&npy),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&npy).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..128]);
+    assert!(header.contains("'shape': (64, 64, 3)"), "{header}");
+    let run = |out: &Path, algo: &str| {
+        let o = ugl(&argv(
+            "run --env armballs-corl --algo {} --latents 4 --images 200 --epochs 150 --out {} --no-cache",
+            &[algo, p(out)],
+        ));
+        assert!(o.status.success(), "{algo}: {}", stderr(&o));
+        let summary: serde_json::Value =
+            serde_json::from_str(stdout(&o).lines().last().unwrap()).unwrap();
+        assert!(
+            summary["n_moved"].as_u64().unwrap() > 0,
+            "{algo}: {summary}"
+        );
+    };
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for algo in ["rge-efr", "rge-pca"] {
+        run(&a, algo);
+        run(&b, algo);
+    }
+    let (ra, rb) = (common::parquet_files(&a), common::parquet_files(&b));
+    assert_eq!(ra.len(), 4);
+    assert!(ra == rb, "the same runs, the same bytes");
+}
+
 #[test]
 fn klc_contract() {
     let dir = tempfile::tempdir().unwrap();

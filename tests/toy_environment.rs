@@ -12,7 +12,7 @@ use in_process::{manifest, ok, p, ugl};
 use ugl_bench::env::render::render_ball_into;
 use ugl_bench::env::{EnvConfig, EnvEntry, EnvKind, Environment, PARAMS, Rollout, dmp, register};
 use ugl_bench::seed::Stream;
-use ugl_types::{DISK, EnvSpec, ObjectSpec};
+use ugl_types::{DISK, EnvSpec, GRAY70, ObjectSpec};
 
 /// The declaration the report and the command line read.
 static SPEC: EnvSpec = EnvSpec {
@@ -30,6 +30,8 @@ static SPEC: EnvSpec = EnvSpec {
     true_latents: 2,
     outcome_columns: &["x", "y"],
     klc: DISK,
+    params: PARAMS,
+    image: GRAY70,
 };
 
 /// Its registry entry.
@@ -63,8 +65,8 @@ impl Environment for ArmReach {
         &self.rest
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut Stream) -> Rollout {
-        let theta = theta.map(|v| v.clamp(-1.0, 1.0));
+    fn rollout(&self, theta: &[f64], _noise: &mut Stream) -> Rollout {
+        let theta: [f64; PARAMS] = std::array::from_fn(|k| theta[k].clamp(-1.0, 1.0));
         let path = dmp::trajectory(&self.cfg.dmp, &theta);
         let hand = path
             .last()

@@ -2,8 +2,6 @@
 //! machine's memory, or whose run matrix is absurdly large, is refused with one line naming the
 //! key, instead of an allocation failure (an abort with a backtrace) or minutes of silence.
 
-use crate::env::render::PIXELS;
-
 /// At most this many runs in one campaign (the `paper` matrix has 240).
 pub const MAX_RUNS: u128 = 1_000_000;
 
@@ -141,17 +139,28 @@ pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Resul
     Ok(())
 }
 
-/// `ugl.images` (the UGL data set: `n` images of 70x70 f32, plus a sparse copy).
-pub fn check_images(n: usize) -> Result<(), LimitError> {
-    check_fits("ugl.images", n, n as f64 * PIXELS as f64 * 4.0 * 2.0)
+/// Values of the largest picture of the registry's environments (70 x 70 = 4900 gray values
+/// for the paper's, 64 x 64 x 3 = 12,288 for the follow-up's own ArmBalls): the limits below
+/// hold for every environment.
+fn largest_image() -> f64 {
+    ugl_types::environments()
+        .iter()
+        .map(|e| e.image.len())
+        .max()
+        .unwrap_or(0) as f64
 }
 
-/// `ugl embed --grid N` (`N x N` rendered images of 70x70 f32, held with the `images` training
+/// `ugl.images` (the UGL data set: `n` images of f32, plus a sparse copy).
+pub fn check_images(n: usize) -> Result<(), LimitError> {
+    check_fits("ugl.images", n, n as f64 * largest_image() * 4.0 * 2.0)
+}
+
+/// `ugl embed --grid N` (`N x N` rendered images of f32, held with the `images` training
 /// images while they are encoded; the encoders work on an f64 copy of a set). Computed in
 /// floating point, so that no size overflows.
 pub fn check_grid(grid: usize, images: usize) -> Result<(), LimitError> {
     let grid_images = grid as f64 * grid as f64;
-    let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * PIXELS as f64;
+    let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * largest_image();
     check_fits("--grid", grid, bytes)
 }
 
@@ -160,11 +169,11 @@ pub fn check_epochs(n: usize) -> Result<(), LimitError> {
     check_fits("explore.epochs", n, n as f64 * BYTES_PER_EPOCH)
 }
 
-/// A network's `hidden` sizes: the weights of the 4900-H1-H2 MLP and its mirror, with their
+/// A network's `hidden` sizes: the weights of the picture-H1-H2 MLP and its mirror, with their
 /// gradients and optimiser state (x5).
 pub fn check_hidden(hidden: [usize; 2]) -> Result<(), LimitError> {
     let [h1, h2] = hidden.map(|h| h as f64);
-    let params = 2.0 * (PIXELS as f64 * h1 + h1 * h2) + 200.0 * h2;
+    let params = 2.0 * (largest_image() * h1 + h1 * h2) + 200.0 * h2;
     check_fits("hidden", format!("{hidden:?}"), params * 4.0 * 5.0)
 }
 

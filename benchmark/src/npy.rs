@@ -25,8 +25,17 @@ pub fn push_npy_f32(buf: &mut Vec<u8>, rows: usize, cols: usize, data: &[f32]) {
 }
 
 pub fn push_npy_header(buf: &mut Vec<u8>, descr: &str, rows: usize, cols: usize) {
-    let mut header =
-        format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    push_npy_header_shape(buf, descr, &[rows, cols]);
+}
+
+/// The header of an array of any shape (C order).
+pub fn push_npy_header_shape(buf: &mut Vec<u8>, descr: &str, shape: &[usize]) {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape = match dims.len() {
+        1 => format!("({},)", dims[0]),
+        _ => format!("({})", dims.join(", ")),
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
     // Total length (10-byte preamble + header + '\n') a multiple of 64, as numpy writes it.
     let unpadded = 10 + header.len() + 1;
     header.extend(std::iter::repeat_n(
@@ -41,9 +50,15 @@ pub fn push_npy_header(buf: &mut Vec<u8>, descr: &str, rows: usize, cols: usize)
 }
 
 pub fn write_npy_f32_file(path: &Path, rows: usize, cols: usize, data: &[f32]) -> io::Result<()> {
+    write_npy_f32_shape_file(path, &[rows, cols], data)
+}
+
+/// Write a float32 array of any shape (C order) as .npy.
+pub fn write_npy_f32_shape_file(path: &Path, shape: &[usize], data: &[f32]) -> io::Result<()> {
+    debug_assert_eq!(data.len(), shape.iter().product::<usize>());
     let mut w = BufWriter::with_capacity(1 << 20, File::create(path)?);
     let mut header = Vec::new();
-    push_npy_header(&mut header, "<f4", rows, cols);
+    push_npy_header_shape(&mut header, "<f4", shape);
     w.write_all(&header)?;
     let mut chunk = Vec::with_capacity(64 * 1024);
     for block in data.chunks(16 * 1024) {

@@ -49,6 +49,39 @@ impl KlcGrid {
     }
 }
 
+/// The picture an environment renders: what a goal-space learner sees of an outcome.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageShape {
+    /// Pixels per row.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Values per pixel (1: gray, 3: RGB).
+    pub channels: usize,
+}
+
+impl ImageShape {
+    /// Values of one picture.
+    pub const fn len(&self) -> usize {
+        self.width * self.height * self.channels
+    }
+
+    /// Whether a picture holds no value.
+    pub const fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The paper's pictures: 70 x 70 gray, stored x-major (pixel (x, y) at x * 70 + y).
+pub const GRAY70: ImageShape = ImageShape {
+    width: 70,
+    height: 70,
+    channels: 1,
+};
+
+/// The paper's motor parameters: a DMP of 3 weights per joint of the 7-joint arm.
+pub const DMP_PARAMS: usize = 21;
+
 /// One environment of the registry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EnvSpec {
@@ -70,6 +103,10 @@ pub struct EnvSpec {
     pub outcome_columns: &'static [&'static str],
     /// The KL-coverage grid of the controllable object.
     pub klc: KlcGrid,
+    /// Motor parameters of an episode, each in [-1, 1].
+    pub params: usize,
+    /// The picture of an outcome.
+    pub image: ImageShape,
 }
 
 /// The 30 x 30 grid over the arm's disk: 756 achievable cells.
@@ -95,6 +132,8 @@ pub static ARMBALL: EnvSpec = EnvSpec {
     true_latents: 2,
     outcome_columns: &["x", "y"],
     klc: DISK,
+    params: DMP_PARAMS,
+    image: GRAY70,
 };
 
 /// ArmArrow (paper Section 4.1).
@@ -117,6 +156,8 @@ pub static ARMARROW: EnvSpec = EnvSpec {
         bins: 30,
         achievable_cells: 756 * 30,
     },
+    params: DMP_PARAMS,
+    image: GRAY70,
 };
 
 /// ArmBalls (the follow-up paper): the ball and a distractor the arm cannot move.
@@ -143,11 +184,32 @@ pub static ARMBALLS: EnvSpec = EnvSpec {
     true_latents: 4,
     outcome_columns: &["x", "y", "distractor_x", "distractor_y"],
     klc: DISK,
+    params: DMP_PARAMS,
+    image: GRAY70,
+};
+
+/// The follow-up's pictures: 64 x 64 RGB, row-major, channels last.
+pub const RGB64: ImageShape = ImageShape {
+    width: 64,
+    height: 64,
+    channels: 3,
+};
+
+/// The follow-up's ArmBalls as its authors' code has it: a radial-basis controller of 49
+/// parameters and 64 x 64 RGB pictures (the science crate's `env::cdge`).
+pub static ARMBALLS_CORL: EnvSpec = EnvSpec {
+    name: "armballs-corl",
+    display: "ArmBalls (CoRL 2018)",
+    description: "the follow-up's own ArmBalls: 49 radial-basis parameters, 64x64 RGB pictures",
+    in_paper: false,
+    params: 49,
+    image: RGB64,
+    ..ARMBALLS
 };
 
 /// The environments of this crate, in the report's order (the paper's first). Others are
 /// added at run time with [`EnvSpec::register`] and come after them.
-pub static BUILT_IN: [&EnvSpec; 3] = [&ARMBALL, &ARMARROW, &ARMBALLS];
+pub static BUILT_IN: [&EnvSpec; 4] = [&ARMBALL, &ARMARROW, &ARMBALLS, &ARMBALLS_CORL];
 
 /// The registry: the built-in environments, then the registered ones in registration order.
 static REGISTRY: RwLock<Vec<&'static EnvSpec>> = RwLock::new(Vec::new());
@@ -360,6 +422,8 @@ mod tests {
         true_latents: 2,
         outcome_columns: &["x", "y"],
         klc: DISK,
+        params: DMP_PARAMS,
+        image: GRAY70,
     };
 
     #[test]

@@ -49,8 +49,8 @@ pub use discovery::{
     RecordMismatch, RunDiscovery, median, quantile_sorted,
 };
 pub use env::{
-    ARMARROW, ARMBALL, ARMBALLS, BUILT_IN, DISK, EnvSpec, EnvSpecError, KlcGrid, ObjectSpec,
-    environments,
+    ARMARROW, ARMBALL, ARMBALLS, ARMBALLS_CORL, BUILT_IN, DISK, DMP_PARAMS, EnvSpec, EnvSpecError,
+    GRAY70, ImageShape, KlcGrid, ObjectSpec, RGB64, environments,
 };
 pub use goal_space::{GOAL_SPACE_DIR, GoalSpaceSample};
 pub use learner::{LEARNERS, LearnerInfo, PaperTraining, Prior};

@@ -12,7 +12,6 @@ use std::path::Path;
 use super::context::RunContext;
 use super::fit::fit_with_data;
 use super::plan::RunSpec;
-use crate::env::render::PIXELS;
 use crate::env::{Environment, make_env};
 use crate::repr::quality::LatentQuality;
 use crate::repr::{ImageSet, Latents, ReprError};
@@ -64,8 +63,9 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
 pub fn grid_images(env: &dyn Environment, grid: usize) -> Result<(Vec<f64>, ImageSet), ReprError> {
     let d = env.state_dim();
     let mut states = Vec::with_capacity(grid * grid * d);
-    let mut pixels = vec![0f32; grid * grid * PIXELS];
-    for (k, img) in pixels.chunks_exact_mut(PIXELS).enumerate() {
+    let values = env.image_len();
+    let mut pixels = vec![0f32; grid * grid * values];
+    for (k, img) in pixels.chunks_exact_mut(values).enumerate() {
         let (i, j) = (k / grid, k % grid);
         let at = |t: usize| -1.0 + 2.0 * t as f64 / (grid - 1) as f64;
         let mut s = vec![at(i), at(j)];
@@ -73,7 +73,7 @@ pub fn grid_images(env: &dyn Environment, grid: usize) -> Result<(Vec<f64>, Imag
         env.render_into(&s, img);
         states.extend_from_slice(&s);
     }
-    Ok((states, ImageSet::new(grid * grid, PIXELS, pixels)?))
+    Ok((states, ImageSet::new(grid * grid, values, pixels)?))
 }
 
 /// Write a float64 `rows x cols` array as .npy (C order): [`crate::npy::write_npy_f64_file`].

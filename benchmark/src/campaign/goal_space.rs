@@ -88,7 +88,8 @@ pub fn write(
             None => break,
         }
     }
-    let reconstructions = if recon.is_empty() {
+    // The reconstruction figure draws 70x70 gray pictures; other pictures have none yet.
+    let reconstructions = if recon.is_empty() || env.kind().spec().image != ugl_types::GRAY70 {
         None
     } else {
         let name = format!("{label}.reconstructions.png");

@@ -3,7 +3,7 @@
 //! [-1, 1). The engineered outcome is (x, y, angle). The angle is a linear coordinate everywhere
 //! (no wrap-around in distances or bins), as in the original code.
 
-use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
+use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
 
 /// The ArmArrow environment.
 #[derive(Clone, Debug)]
@@ -38,7 +38,8 @@ impl Environment for ArmArrow {
         &self.initial
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut crate::seed::Stream) -> Rollout {
+    fn rollout(&self, theta: &[f64], _noise: &mut crate::seed::Stream) -> Rollout {
+        let theta = super::dmp_params(theta);
         let (caught, pose) = self.body.run(theta, [self.initial[0], self.initial[1]]);
         let s = if caught {
             [pose.hand[0], pose.hand[1], wrap_angle(pose.last_link)]

@@ -1,7 +1,7 @@
 //! ArmBall (paper Section 4.1): the arm can catch a ball of radius 0.1 at (0.6, 0.6) and move it.
 //! The engineered outcome is the ball's final (x, y).
 
-use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
+use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
 
 /// The ArmBall environment.
 #[derive(Clone, Debug)]
@@ -29,7 +29,8 @@ impl Environment for ArmBall {
         &self.initial
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS], _noise: &mut crate::seed::Stream) -> Rollout {
+    fn rollout(&self, theta: &[f64], _noise: &mut crate::seed::Stream) -> Rollout {
+        let theta = super::dmp_params(theta);
         let (caught, pose) = self.body.run(theta, self.initial);
         let ball = if caught { pose.hand } else { self.initial };
         Rollout {

@@ -13,7 +13,7 @@
 
 use crate::seed::standard_normal;
 
-use super::{Body, EnvConfig, EnvKind, Environment, PARAMS, Rollout};
+use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
 use crate::seed::Stream;
 
 /// The distractor's walk is clipped to this box (CDGE `np.clip(…, -.95, 0.95)`).
@@ -63,7 +63,8 @@ impl Environment for ArmBalls {
         &self.initial
     }
 
-    fn rollout(&self, theta: &[f64; PARAMS], noise: &mut Stream) -> Rollout {
+    fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout {
+        let theta = super::dmp_params(theta);
         let (caught, pose) = self.body.run(theta, [self.initial[0], self.initial[1]]);
         let ball = if caught {
             pose.hand
@@ -87,6 +88,7 @@ impl Environment for ArmBalls {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::env::PARAMS;
     use crate::seed::{Component, stream};
 
     fn env(noise: f64) -> ArmBalls {
@@ -130,7 +132,7 @@ mod tests {
         let mut rng = stream(4, Component::Params);
         let mut caught = 0;
         for _ in 0..3000 {
-            let theta = crate::explore::meta_policy::random_params(&mut rng);
+            let theta = crate::explore::meta_policy::random_params(&mut rng, PARAMS);
             let mut noise = stream(1, Component::Distractor);
             let r = e.rollout(&theta, &mut noise);
             let b = ball.rollout(&theta, &mut noise);

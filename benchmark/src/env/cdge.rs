@@ -16,6 +16,7 @@
 //! from the first step on), and the distractor's walk (reset every episode to (0.7, -0.45), a
 //! step of `N(0, noise^2)` per coordinate and time step, clipped to +-0.95) are the same as ours.
 
+use super::{EnvConfig, EnvKind, Environment, Rollout};
 use crate::seed::{Stream, standard_normal};
 
 /// Joints of the arm.
@@ -137,7 +138,9 @@ fn numpy_sum(a: &[f64]) -> f64 {
     res
 }
 
-/// The constants of an episode (CDGE's defaults for the plotted runs).
+/// The constants of an episode (CDGE's defaults for the plotted runs). In a campaign they come
+/// from the `[env]` table's `object_size`, `ball_initial`, `distractor_initial` and
+/// `distractor_noise` (whose defaults are these); its arm and DMP constants do not apply.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// Catch radius (CDGE `--object_size`; the plotted runs: 0.1).
@@ -148,6 +151,18 @@ pub struct Scene {
     pub distractor_initial: [f64; 2],
     /// The distractor's step standard deviation (CDGE `--distract_noise`).
     pub distractor_noise: f64,
+}
+
+impl Scene {
+    /// The scene of an `[env]` table.
+    pub fn of(cfg: &EnvConfig) -> Scene {
+        Scene {
+            object_size: cfg.object_size,
+            ball_initial: cfg.ball_initial,
+            distractor_initial: cfg.distractor_initial,
+            distractor_noise: cfg.distractor_noise,
+        }
+    }
 }
 
 impl Default for Scene {
@@ -182,14 +197,19 @@ pub struct CdgeArmBalls {
     /// The episode's constants.
     pub scene: Scene,
     table: RbfTable,
+    /// Ball, then distractor, at the start of every episode.
+    initial: [f64; 4],
 }
 
 impl CdgeArmBalls {
     /// The environment with the plotted runs' scene, 50 steps and basis functions of 10 steps.
     pub fn new(scene: Scene) -> Self {
+        let [bx, by] = scene.ball_initial;
+        let [dx, dy] = scene.distractor_initial;
         CdgeArmBalls {
             scene,
             table: RbfTable::new(STEPS, SDEV),
+            initial: [bx, by, dx, dy],
         }
     }
 
@@ -200,7 +220,7 @@ impl CdgeArmBalls {
 
     /// One episode, the distractor's steps drawn from the run's stream (two standard normal
     /// draws per step, x then y).
-    pub fn rollout(&self, theta: &[f64; PARAMS], noise: &mut Stream) -> Episode {
+    pub fn episode(&self, theta: &[f64; PARAMS], noise: &mut Stream) -> Episode {
         self.rollout_with(theta, || standard_normal(noise))
     }
 
@@ -235,6 +255,53 @@ impl CdgeArmBalls {
             pose,
             caught,
         }
+    }
+}
+
+impl Environment for CdgeArmBalls {
+    fn kind(&self) -> EnvKind {
+        EnvKind::ARMBALLS_CORL
+    }
+
+    fn initial_state(&self) -> &[f64] {
+        &self.initial
+    }
+
+    /// The outcome: ball (x, y), then distractor (x, y), at the last step.
+    fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout {
+        let theta: &[f64; PARAMS] = theta.try_into().unwrap_or_else(|_| {
+            panic!(
+                "{} motor parameters given to {}, which takes {PARAMS}",
+                theta.len(),
+                self.kind()
+            )
+        });
+        let e = self.episode(theta, noise);
+        Rollout {
+            state: [
+                e.ball[0].clamp(-1.0, 1.0),
+                e.ball[1].clamp(-1.0, 1.0),
+                e.distractor[0],
+                e.distractor[1],
+            ],
+            dim: 4,
+            caught: e.caught,
+            hand: e.hand,
+        }
+    }
+
+    /// The observer's picture of an outcome (ball drawn with radius 0.17, distractor 0.15),
+    /// min-max normalised.
+    fn render_into(&self, state: &[f64], out: &mut [f32]) {
+        let mut raw = vec![0u8; VALUES];
+        render_rgb(
+            [state[0], state[1]],
+            [state[2], state[3]],
+            BALL_RADIUS,
+            DISTRACTOR_RADIUS,
+            &mut raw,
+        );
+        normalise(&raw, out);
     }
 }
 
@@ -469,6 +536,64 @@ pub fn normalise(raw: &[u8], out: &mut [f32]) {
     for (o, v) in out.iter_mut().zip(raw) {
         *o = if hi > 0.0 { (*v as f32 - lo) / hi } else { 0.0 };
     }
+}
+
+/// Write a picture ([`VALUES`] values in [0, 1]) as .npy: float32, shape (64, 64, 3), rows
+/// first, as CDGE's frames are.
+pub fn write_npy(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
+    check_picture(values, path)?;
+    crate::npy::write_npy_f32_shape_file(path, &[SIDE, SIDE, CHANNELS], values).map_err(|source| {
+        super::render::RenderError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Write a picture as an RGB PNG a person can look at: 4x nearest-neighbour upscaling, rows
+/// flipped so that larger y is higher, as in the world (CDGE's frames put y downwards).
+pub fn write_png(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
+    use super::render::RenderError;
+    use std::io::Write;
+    check_picture(values, path)?;
+    const SCALE: usize = 4;
+    let side = SIDE * SCALE;
+    let mut data = Vec::with_capacity(side * side * CHANNELS);
+    for row in 0..side {
+        let y = SIDE - 1 - row / SCALE;
+        for col in 0..side {
+            let px = &values[(y * SIDE + col / SCALE) * CHANNELS..][..CHANNELS];
+            data.extend(px.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+    }
+    let io_err = |source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let png_err = |source| RenderError::Png {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut buf = std::io::BufWriter::new(std::fs::File::create(path).map_err(io_err)?);
+    {
+        let mut encoder = png::Encoder::new(&mut buf, side as u32, side as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(png_err)?;
+        writer.write_image_data(&data).map_err(png_err)?;
+        writer.finish().map_err(png_err)?;
+    }
+    buf.flush().map_err(io_err)
+}
+
+fn check_picture(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
+    if values.len() != VALUES {
+        return Err(super::render::RenderError::BadLength {
+            path: path.to_path_buf(),
+            len: values.len(),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -44,7 +44,7 @@ pub struct EnvEntry {
 }
 
 /// This crate's environments, in the report's order (the registry's built-in declarations).
-pub static BUILT_IN: [EnvEntry; 3] = [
+pub static BUILT_IN: [EnvEntry; 4] = [
     EnvEntry {
         spec: &ugl_types::ARMBALL,
         build: |cfg| Box::new(ArmBall::new(cfg)),
@@ -56,6 +56,10 @@ pub static BUILT_IN: [EnvEntry; 3] = [
     EnvEntry {
         spec: &ugl_types::ARMBALLS,
         build: |cfg| Box::new(ArmBalls::new(cfg)),
+    },
+    EnvEntry {
+        spec: &ugl_types::ARMBALLS_CORL,
+        build: |cfg| Box::new(cdge::CdgeArmBalls::new(cdge::Scene::of(cfg))),
     },
 ];
 
@@ -138,8 +142,10 @@ impl EnvKind {
     pub const ARMBALL: EnvKind = EnvKind(&BUILT_IN[0]);
     /// ArmArrow (paper Section 4.1).
     pub const ARMARROW: EnvKind = EnvKind(&BUILT_IN[1]);
-    /// ArmBalls (the follow-up paper).
+    /// ArmBalls (the follow-up paper), our DMP variant.
     pub const ARMBALLS: EnvKind = EnvKind(&BUILT_IN[2]);
+    /// ArmBalls as the follow-up's code has it ([`cdge`]).
+    pub const ARMBALLS_CORL: EnvKind = EnvKind(&BUILT_IN[3]);
 
     /// The handle of an entry; [`register`] it to make it known by name.
     pub const fn of(entry: &'static EnvEntry) -> EnvKind {
@@ -514,9 +520,10 @@ impl Rollout {
 pub trait Environment: Send + Sync {
     /// Which environment this is.
     fn kind(&self) -> EnvKind;
-    /// Number of motor parameters (21).
+    /// Number of motor parameters (the declaration's: 21 DMP weights in the paper's
+    /// environments).
     fn param_dim(&self) -> usize {
-        PARAMS
+        self.kind().spec().params
     }
     /// Dimension of the engineered outcome.
     fn state_dim(&self) -> usize {
@@ -524,13 +531,30 @@ pub trait Environment: Send + Sync {
     }
     /// The object's initial state.
     fn initial_state(&self) -> &[f64];
-    /// Run one episode with motor parameters `theta` (each clipped to [-1,1]). `noise` is the
-    /// run's environment stream ([`crate::seed::Component::Distractor`]), consumed episode
-    /// after episode by the environments that move on their own (ArmBalls' distractor);
-    /// ArmBall and ArmArrow draw nothing from it.
-    fn rollout(&self, theta: &[f64; PARAMS], noise: &mut Stream) -> Rollout;
-    /// Render an object state (engineered coordinates) into a 70x70 x-major buffer.
+    /// Run one episode with motor parameters `theta` ([`Environment::param_dim`] of them, each
+    /// clipped to [-1,1]; another length is a caller's bug and panics). `noise` is the run's
+    /// environment stream ([`crate::seed::Component::Distractor`]), consumed episode after
+    /// episode by the environments that move on their own (ArmBalls' distractor); ArmBall and
+    /// ArmArrow draw nothing from it.
+    fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout;
+    /// Values of one picture (the declaration's: 70 x 70 gray, 4900, in the paper's).
+    fn image_len(&self) -> usize {
+        self.kind().spec().image.len()
+    }
+    /// Render an object state (engineered coordinates) into a picture of
+    /// [`Environment::image_len`] values (70x70 gray, x-major, in the paper's environments).
     fn render_into(&self, state: &[f64], out: &mut [f32]);
+}
+
+/// The 21 DMP parameters of an episode of the paper's environments (a caller passing another
+/// number has a bug: [`Environment::rollout`]).
+pub(crate) fn dmp_params(theta: &[f64]) -> &[f64; PARAMS] {
+    theta.try_into().unwrap_or_else(|_| {
+        panic!(
+            "{} motor parameters given to a DMP environment, which takes {PARAMS}",
+            theta.len()
+        )
+    })
 }
 
 /// Build an environment.

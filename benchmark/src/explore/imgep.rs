@@ -12,8 +12,7 @@ use super::history::{ExplorationLog, Metrics, Recorder};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use super::{ExploreConfig, ExploreError, Explorer};
-use crate::env::render::PIXELS;
-use crate::env::{Environment, PARAMS};
+use crate::env::Environment;
 use crate::goals::GoalSampler;
 use crate::repr::{Encoder, ReprError};
 use crate::seed::{Component, stream};
@@ -76,7 +75,7 @@ impl<'a> LearnedSpace<'a> {
         LearnedSpace {
             env,
             encoder,
-            image: vec![0.0; PIXELS],
+            image: vec![0.0; env.image_len()],
             encode_s: 0.0,
             error: None,
         }
@@ -137,7 +136,7 @@ pub fn run_rge(
     let mut goal = vec![0.0; space.dim()];
 
     // Warm-up episode.
-    let theta = random_params(&mut params_rng);
+    let theta = random_params(&mut params_rng, env.param_dim());
     h.store(env, space, &mut rec, theta, 0, true);
     rec.end_epoch(0);
 
@@ -148,11 +147,11 @@ pub fn run_rge(
             || i < cfg.bootstrap_epochs
             || choice_rng.random::<f64>() < cfg.random_ratio;
         let theta = if random {
-            random_params(&mut params_rng)
+            random_params(&mut params_rng, env.param_dim())
         } else {
             sampler.sample(&mut goal_rng, &mut goal);
             let (j, _) = h.index.nearest(&goal).expect("history is not empty");
-            perturb(&h.thetas[j], cfg.noise_sigma, &mut noise_rng)
+            perturb(h.theta(j), cfg.noise_sigma, &mut noise_rng)
         };
         h.store(env, space, &mut rec, theta, epoch, random);
         rec.end_epoch(epoch);
@@ -187,7 +186,10 @@ impl Explorer for Rge<'_> {
 /// (also the base of modular exploration's memory, `mge.rs`).
 pub(crate) struct History {
     pub index: NnIndex,
-    pub thetas: Vec<[f64; PARAMS]>,
+    /// The motor parameters of every episode, one after the other ([`History::theta`]).
+    thetas: Vec<f64>,
+    /// Motor parameters per episode.
+    param_dim: usize,
     /// The encoding of the last stored outcome.
     pub z: Vec<f64>,
     /// The controllable object's initial state ([`crate::env::EnvKind::metric_dims`]).
@@ -204,12 +206,18 @@ impl History {
     pub fn new(env: &dyn Environment, dim: usize, capacity: usize, run_seed: u64) -> Self {
         History {
             index: NnIndex::new(dim),
-            thetas: Vec::with_capacity(capacity),
+            thetas: Vec::with_capacity(capacity * env.param_dim()),
+            param_dim: env.param_dim(),
             z: vec![0.0; dim],
             initial: env.initial_state()[env.kind().metric_dims()].to_vec(),
             ever_moved: false,
             env_rng: stream(run_seed, Component::Distractor),
         }
+    }
+
+    /// The motor parameters of episode `j`.
+    pub fn theta(&self, j: usize) -> &[f64] {
+        &self.thetas[j * self.param_dim..(j + 1) * self.param_dim]
     }
 
     /// Run `theta`, encode and store its outcome (its encoding is then in `z`).
@@ -218,7 +226,7 @@ impl History {
         env: &dyn Environment,
         space: &mut dyn OutcomeSpace,
         rec: &mut Recorder,
-        theta: [f64; PARAMS],
+        theta: Vec<f64>,
         epoch: usize,
         random: bool,
     ) {
@@ -230,7 +238,7 @@ impl History {
             .all(|(a, b)| a != b);
         space.encode(s, &mut self.z);
         self.index.insert(&self.z);
-        self.thetas.push(theta);
+        self.thetas.extend_from_slice(&theta);
         rec.push(epoch, &r, random);
     }
 }

@@ -3,25 +3,28 @@
 
 use rand::RngExt;
 
-use crate::env::PARAMS;
 use crate::seed::Stream;
 
-/// Uniform random motor parameters in [-1, 1) (explauto `rand_bounds`).
-pub fn random_params(rng: &mut Stream) -> [f64; PARAMS] {
-    std::array::from_fn(|_| rng.random_range(-1.0..1.0))
+/// `n` uniform random motor parameters in [-1, 1) (explauto `rand_bounds`), drawn in order.
+pub fn random_params(rng: &mut Stream, n: usize) -> Vec<f64> {
+    (0..n).map(|_| rng.random_range(-1.0..1.0)).collect()
 }
 
 /// `theta + N(0, sigma^2)` per dimension, clipped to [-1, 1].
-pub fn perturb(theta: &[f64; PARAMS], sigma: f64, rng: &mut Stream) -> [f64; PARAMS] {
-    std::array::from_fn(|k| {
-        let n = crate::seed::standard_normal(rng);
-        (theta[k] + sigma * n).clamp(-1.0, 1.0)
-    })
+pub fn perturb(theta: &[f64], sigma: f64, rng: &mut Stream) -> Vec<f64> {
+    theta
+        .iter()
+        .map(|t| {
+            let n = crate::seed::standard_normal(rng);
+            (t + sigma * n).clamp(-1.0, 1.0)
+        })
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::env::PARAMS;
     use crate::seed::{Component, stream};
 
     #[test]
@@ -29,7 +32,7 @@ mod tests {
         let mut rng = stream(1, Component::Params);
         let mut sum = 0.0;
         for _ in 0..1000 {
-            let t = random_params(&mut rng);
+            let t = random_params(&mut rng, PARAMS);
             assert!(t.iter().all(|v| (-1.0..1.0).contains(v)));
             sum += t.iter().sum::<f64>();
         }

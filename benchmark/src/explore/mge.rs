@@ -34,7 +34,7 @@ use super::interest::{ModuleInterest, choose_module};
 use super::meta_policy::{perturb, random_params};
 use super::nn::NnIndex;
 use super::{ExploreConfig, ExploreError, Explorer};
-use crate::env::{Environment, PARAMS};
+use crate::env::Environment;
 use crate::goals::GoalSampler;
 use crate::seed::{Component, stream};
 
@@ -208,7 +208,7 @@ impl Memory {
         space: &mut dyn OutcomeSpace,
         modules: &[GoalModule],
         rec: &mut Recorder,
-        theta: [f64; PARAMS],
+        theta: Vec<f64>,
         epoch: usize,
         random: bool,
     ) -> &[f64] {
@@ -294,7 +294,7 @@ pub fn run_mge(
         };
 
     // Warm-up episode.
-    let theta = random_params(&mut params_rng);
+    let theta = random_params(&mut params_rng, env.param_dim());
     mem.store(env, space, modules, &mut rec, theta, 0, true);
     rec.end_epoch(0);
 
@@ -306,7 +306,7 @@ pub fn run_mge(
             || epoch < cfg.bootstrap_epochs;
         if bootstrapping {
             epoch += 1;
-            let theta = random_params(&mut params_rng);
+            let theta = random_params(&mut params_rng, env.param_dim());
             mem.store(env, space, modules, &mut rec, theta, epoch, true);
             record_interest(&mut rec, epoch, &interests, &chosen);
             rec.end_epoch(epoch);
@@ -334,9 +334,9 @@ pub fn run_mge(
                 .expect("the memory is not empty");
             let exploit = k == mge.n_explore;
             let theta = if exploit {
-                mem.history.thetas[j]
+                mem.history.theta(j).to_vec()
             } else {
-                perturb(&mem.history.thetas[j], cfg.noise_sigma, &mut noise_rng)
+                perturb(mem.history.theta(j), cfg.noise_sigma, &mut noise_rng)
             };
             let z = mem.store(env, space, modules, &mut rec, theta, epoch, false);
             if exploit {

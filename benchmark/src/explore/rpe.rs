@@ -14,7 +14,7 @@ pub fn run_rpe(env: &dyn Environment, cfg: &ExploreConfig, run_seed: u64) -> Exp
     let mut params = stream(run_seed, Component::Params);
     let mut env_rng = stream(run_seed, Component::Distractor);
     for epoch in 1..=cfg.epochs {
-        let theta = random_params(&mut params);
+        let theta = random_params(&mut params, env.param_dim());
         let r = env.rollout(&theta, &mut env_rng);
         rec.push(epoch, &r, true);
         rec.end_epoch(epoch);

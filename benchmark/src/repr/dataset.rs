@@ -6,7 +6,6 @@
 use rand::RngExt;
 
 use super::{ImageSet, ReprError};
-use crate::env::render::PIXELS;
 use crate::env::{EnvKind, Environment};
 use crate::seed::Stream;
 
@@ -32,8 +31,9 @@ pub fn generate(
     }
     let d = env.state_dim();
     let mut states = Vec::with_capacity(n * d);
-    let mut data = vec![0f32; n * PIXELS];
-    for (i, img) in data.chunks_exact_mut(PIXELS).enumerate() {
+    let values = env.image_len();
+    let mut data = vec![0f32; n * values];
+    for (i, img) in data.chunks_exact_mut(values).enumerate() {
         let s: Vec<f64> = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
         env.render_into(&s, img);
         states.extend_from_slice(&s);
@@ -41,7 +41,7 @@ pub fn generate(
     }
     Ok(UglDataset {
         states,
-        images: ImageSet::new(n, PIXELS, data)?,
+        images: ImageSet::new(n, values, data)?,
     })
 }
 
