@@ -247,3 +247,58 @@ mod followup {
         assert!(mean < 0.01, "mean difference {mean} / 255");
     }
 }
+
+/// Random motor parameters explore the ball of `armballs-corl` as far as in the authors' own
+/// runs: the fraction of the 900 cells of a 30 x 30 grid over [-1, 1]² holding a final ball
+/// position after 9666 rollouts (their last point; `data/followup/`). Our DMP variant,
+/// `armballs`, reaches about half of it (0.078): the test tells the two environments apart.
+#[test]
+fn random_exploration_reaches_the_authors_exploration_ratio() {
+    use ugl_bench::env::{EnvConfig, EnvKind, make_env};
+    use ugl_bench::explore::meta_policy::random_params;
+    use ugl_bench::seed::{Component, stream};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/followup/authors_exploration30_curves.csv"
+    );
+    let text = std::fs::read_to_string(path).expect("the authors' curves are committed");
+    let row: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("RPE,9666.0,"))
+        .expect("the authors' last RPE point")
+        .split(',')
+        .collect();
+    let (n_theirs, theirs, sd) = (
+        row[2].parse::<f64>().unwrap(),
+        row[3].parse::<f64>().unwrap(),
+        row[4].parse::<f64>().unwrap(),
+    );
+    let ratio = |kind: EnvKind, seed: u64| {
+        let env = make_env(kind, &EnvConfig::default());
+        let (mut params, mut noise) = (
+            stream(seed, Component::Params),
+            stream(seed, Component::Distractor),
+        );
+        let mut cells = std::collections::HashSet::new();
+        for _ in 0..9666 {
+            let r = env.rollout(&random_params(&mut params, env.param_dim()), &mut noise);
+            let cell = |v: f64| (((v + 1.0) / 2.0 * 30.0).floor() as i64).clamp(0, 29);
+            cells.insert((cell(r.state[0]), cell(r.state[1])));
+        }
+        cells.len() as f64 / 900.0
+    };
+    let seeds = 5;
+    let ours: f64 = (0..seeds)
+        .map(|s| ratio(EnvKind::ARMBALLS_CORL, s))
+        .sum::<f64>()
+        / seeds as f64;
+    // Three standard errors of the difference of the two means (their spread for both).
+    let se = (sd * sd / n_theirs + sd * sd / seeds as f64).sqrt();
+    eprintln!("RPE exploration ratio: ours {ours:.4} ({seeds} runs), theirs {theirs:.4} ± {sd:.4}");
+    assert!(
+        (ours - theirs).abs() < 3.0 * se,
+        "ours {ours}, theirs {theirs}"
+    );
+    let dmp = ratio(EnvKind::ARMBALLS, 0);
+    assert!(dmp < theirs / 1.5, "our DMP variant: {dmp}");
+}
