@@ -1,0 +1,426 @@
+//! 2-D convolutions and their transposes on the deterministic products ([`crate::matmul`]).
+//!
+//! Images are `f32`, batch-major and channel-major (`NCHW`): value `(n, c, y, x)` at
+//! `((n * C + c) * H + y) * W + x`. A convolution is lowered to a product with the `im2col`
+//! matrix, whose rows are ordered `(c, ky, kx)` and whose columns are the output pixels: every
+//! output is then one FMA chain over `(c, ky, kx)` in that order, starting from its bias, and
+//! the bits depend only on the inputs, whatever the SIMD path and the thread count (the products'
+//! contract). The weight gradient is one chain per weight over `(n, output pixel)`, in that
+//! order. The input gradient scatters the columns back (`col2im`) in a fixed order, with plain
+//! additions.
+//!
+//! The transposed convolution (the decoders' `ConvTranspose2d`) is the adjoint of a convolution:
+//! its forward pass is a convolution's input gradient, its input gradient a convolution's forward
+//! pass, and its weight gradient a convolution's weight gradient with the roles of input and
+//! output gradient exchanged. The weights keep PyTorch's layouts: `[out, in, k, k]` for a
+//! convolution, `[in, out, k, k]` for a transposed one.
+
+use crate::matmul::{MatRef, matmul_on};
+use crate::path::{SimdPath, active_path};
+
+/// The shape of a convolution: `channels_in` images of `height x width`, a square kernel,
+/// a stride and a zero padding on every side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Conv2d {
+    /// Input channels.
+    pub channels_in: usize,
+    /// Output channels.
+    pub channels_out: usize,
+    /// Kernel side.
+    pub kernel: usize,
+    /// Stride.
+    pub stride: usize,
+    /// Zero padding on each side.
+    pub padding: usize,
+    /// Input rows.
+    pub height: usize,
+    /// Input columns.
+    pub width: usize,
+}
+
+impl Conv2d {
+    /// Output rows: `(height + 2 padding - kernel) / stride + 1`.
+    pub fn out_height(&self) -> usize {
+        (self.height + 2 * self.padding - self.kernel) / self.stride + 1
+    }
+
+    /// Output columns.
+    pub fn out_width(&self) -> usize {
+        (self.width + 2 * self.padding - self.kernel) / self.stride + 1
+    }
+
+    /// Values of one input image (all channels).
+    pub fn in_len(&self) -> usize {
+        self.channels_in * self.height * self.width
+    }
+
+    /// Values of one output image.
+    pub fn out_len(&self) -> usize {
+        self.channels_out * self.out_height() * self.out_width()
+    }
+
+    /// Values of the weight, `[out, in, k, k]`.
+    pub fn weight_len(&self) -> usize {
+        self.channels_out * self.patch()
+    }
+
+    /// Rows of the `im2col` matrix: `in * k * k`.
+    fn patch(&self) -> usize {
+        self.channels_in * self.kernel * self.kernel
+    }
+
+    fn pixels_out(&self) -> usize {
+        self.out_height() * self.out_width()
+    }
+
+    fn check(&self) {
+        assert!(
+            self.kernel >= 1 && self.stride >= 1,
+            "conv2d: kernel and stride must be at least 1: {self:?}"
+        );
+        assert!(
+            self.height + 2 * self.padding >= self.kernel
+                && self.width + 2 * self.padding >= self.kernel,
+            "conv2d: the kernel is larger than the padded image: {self:?}"
+        );
+    }
+
+    /// The `im2col` matrix of one image into `cols` (`patch x pixels_out`, row-major, starting at
+    /// column `col0` of a matrix `stride_cols` wide).
+    fn im2col(&self, x: &[f32], cols: &mut [f32], col0: usize, stride_cols: usize) {
+        let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
+        let (oh, ow) = (self.out_height(), self.out_width());
+        for c in 0..self.channels_in {
+            let plane = &x[c * self.height * self.width..][..self.height * self.width];
+            for ky in 0..k {
+                for kx in 0..k {
+                    let row = (c * k + ky) * k + kx;
+                    let dst = &mut cols[row * stride_cols + col0..][..oh * ow];
+                    for oy in 0..oh {
+                        let y = (oy * s + ky) as isize - p;
+                        let line = &mut dst[oy * ow..][..ow];
+                        if y < 0 || y >= self.height as isize {
+                            line.fill(0.0);
+                            continue;
+                        }
+                        let src = &plane[y as usize * self.width..][..self.width];
+                        for (ox, v) in line.iter_mut().enumerate() {
+                            let xx = (ox * s + kx) as isize - p;
+                            *v = if xx < 0 || xx >= self.width as isize {
+                                0.0
+                            } else {
+                                src[xx as usize]
+                            };
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Add the `im2col`-shaped `cols` (`patch x pixels_out`) back into one image's gradient,
+    /// in the order `(c, ky, kx, oy, ox)`.
+    fn col2im_add(&self, cols: &[f32], dx: &mut [f32]) {
+        let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
+        let (oh, ow) = (self.out_height(), self.out_width());
+        for c in 0..self.channels_in {
+            let plane = &mut dx[c * self.height * self.width..][..self.height * self.width];
+            for ky in 0..k {
+                for kx in 0..k {
+                    let row = (c * k + ky) * k + kx;
+                    let src = &cols[row * oh * ow..][..oh * ow];
+                    for oy in 0..oh {
+                        let y = (oy * s + ky) as isize - p;
+                        if y < 0 || y >= self.height as isize {
+                            continue;
+                        }
+                        let line = &mut plane[y as usize * self.width..][..self.width];
+                        for ox in 0..ow {
+                            let xx = (ox * s + kx) as isize - p;
+                            if xx >= 0 && xx < self.width as isize {
+                                line[xx as usize] += src[oy * ow + ox];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// `y = conv(x, w) + b` for a batch of `n` images; `y` is overwritten. Runs on the
+    /// process's path ([`active_path`]).
+    ///
+    /// # Panics
+    /// If a slice has the wrong length.
+    pub fn forward(&self, n: usize, x: &[f32], w: &[f32], b: Option<&[f32]>, y: &mut [f32]) {
+        self.forward_on(active_path(), n, x, w, b, y)
+    }
+
+    /// [`Self::forward`] on a given path (the tests compare the paths with it).
+    pub fn forward_on(
+        &self,
+        path: SimdPath,
+        n: usize,
+        x: &[f32],
+        w: &[f32],
+        b: Option<&[f32]>,
+        y: &mut [f32],
+    ) {
+        self.check();
+        assert_eq!(x.len(), n * self.in_len(), "conv2d: input length");
+        assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
+        assert_eq!(y.len(), n * self.out_len(), "conv2d: output length");
+        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
+        let mut cols = vec![0.0f32; patch * pix];
+        let wm = MatRef::row_major(w, co, patch);
+        for i in 0..n {
+            self.im2col(&x[i * self.in_len()..][..self.in_len()], &mut cols, 0, pix);
+            let out = &mut y[i * self.out_len()..][..self.out_len()];
+            match b {
+                Some(b) => {
+                    assert_eq!(b.len(), co, "conv2d: bias length");
+                    for (o, bias) in b.iter().enumerate() {
+                        out[o * pix..][..pix].fill(*bias);
+                    }
+                }
+                None => out.fill(0.0),
+            }
+            matmul_on(path, out, wm, MatRef::row_major(&cols, patch, pix), true);
+        }
+    }
+
+    /// The input gradient `dx` (overwritten) of a batch, from the output gradient `dy`.
+    pub fn backward_input(&self, n: usize, dy: &[f32], w: &[f32], dx: &mut [f32]) {
+        self.backward_input_on(active_path(), n, dy, w, dx)
+    }
+
+    /// [`Self::backward_input`] on a given path.
+    pub fn backward_input_on(
+        &self,
+        path: SimdPath,
+        n: usize,
+        dy: &[f32],
+        w: &[f32],
+        dx: &mut [f32],
+    ) {
+        self.check();
+        assert_eq!(
+            dy.len(),
+            n * self.out_len(),
+            "conv2d: output-gradient length"
+        );
+        assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
+        assert_eq!(dx.len(), n * self.in_len(), "conv2d: input-gradient length");
+        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
+        let mut cols = vec![0.0f32; patch * pix];
+        let wt = MatRef::row_major(w, co, patch).t();
+        dx.fill(0.0);
+        for i in 0..n {
+            let g = MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix);
+            matmul_on(path, &mut cols, wt, g, false);
+            self.col2im_add(&cols, &mut dx[i * self.in_len()..][..self.in_len()]);
+        }
+    }
+
+    /// The weight gradient `dw` (`[out, in, k, k]`) and the bias gradient `db` of a batch
+    /// (both overwritten).
+    pub fn backward_weight(
+        &self,
+        n: usize,
+        x: &[f32],
+        dy: &[f32],
+        dw: &mut [f32],
+        db: Option<&mut [f32]>,
+    ) {
+        self.backward_weight_on(active_path(), n, x, dy, dw, db)
+    }
+
+    /// [`Self::backward_weight`] on a given path.
+    pub fn backward_weight_on(
+        &self,
+        path: SimdPath,
+        n: usize,
+        x: &[f32],
+        dy: &[f32],
+        dw: &mut [f32],
+        db: Option<&mut [f32]>,
+    ) {
+        self.check();
+        assert_eq!(x.len(), n * self.in_len(), "conv2d: input length");
+        assert_eq!(
+            dy.len(),
+            n * self.out_len(),
+            "conv2d: output-gradient length"
+        );
+        assert_eq!(
+            dw.len(),
+            self.weight_len(),
+            "conv2d: weight-gradient length"
+        );
+        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
+        let wide = n * pix;
+        // Every image's columns side by side, and the output gradient as [out, n * pixels]:
+        // each weight's gradient is one chain over (image, pixel).
+        let mut cols = vec![0.0f32; patch * wide];
+        let mut g = vec![0.0f32; co * wide];
+        for i in 0..n {
+            self.im2col(
+                &x[i * self.in_len()..][..self.in_len()],
+                &mut cols,
+                i * pix,
+                wide,
+            );
+            for o in 0..co {
+                g[o * wide + i * pix..][..pix]
+                    .copy_from_slice(&dy[i * self.out_len() + o * pix..][..pix]);
+            }
+        }
+        matmul_on(
+            path,
+            dw,
+            MatRef::row_major(&g, co, wide),
+            MatRef::row_major(&cols, patch, wide).t(),
+            false,
+        );
+        if let Some(db) = db {
+            assert_eq!(db.len(), co, "conv2d: bias-gradient length");
+            for (o, d) in db.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for v in &g[o * wide..][..wide] {
+                    s += v;
+                }
+                *d = s;
+            }
+        }
+    }
+}
+
+/// A transposed convolution (`ConvTranspose2d`): the adjoint of the convolution [`Self::adjoint`]
+/// from its output back to its input. Its input is `channels_in x height x width`; its weight is
+/// `[in, out, k, k]` (PyTorch's layout); its output side is
+/// `(side - 1) stride - 2 padding + kernel`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ConvTranspose2d {
+    /// Input channels.
+    pub channels_in: usize,
+    /// Output channels.
+    pub channels_out: usize,
+    /// Kernel side.
+    pub kernel: usize,
+    /// Stride.
+    pub stride: usize,
+    /// Padding (removed from each side of the full output).
+    pub padding: usize,
+    /// Input rows.
+    pub height: usize,
+    /// Input columns.
+    pub width: usize,
+}
+
+impl ConvTranspose2d {
+    /// Output rows.
+    pub fn out_height(&self) -> usize {
+        ((self.height - 1) * self.stride + self.kernel)
+            .checked_sub(2 * self.padding)
+            .expect("conv-transpose: padding larger than the output")
+    }
+
+    /// Output columns.
+    pub fn out_width(&self) -> usize {
+        ((self.width - 1) * self.stride + self.kernel)
+            .checked_sub(2 * self.padding)
+            .expect("conv-transpose: padding larger than the output")
+    }
+
+    /// Values of one input image.
+    pub fn in_len(&self) -> usize {
+        self.channels_in * self.height * self.width
+    }
+
+    /// Values of one output image.
+    pub fn out_len(&self) -> usize {
+        self.channels_out * self.out_height() * self.out_width()
+    }
+
+    /// Values of the weight, `[in, out, k, k]`.
+    pub fn weight_len(&self) -> usize {
+        self.channels_in * self.channels_out * self.kernel * self.kernel
+    }
+
+    /// The convolution whose adjoint this is: from this output's shape to this input's, with the
+    /// same weight read as `[out, in, k, k]` of that convolution.
+    pub fn adjoint(&self) -> Conv2d {
+        let c = Conv2d {
+            channels_in: self.channels_out,
+            channels_out: self.channels_in,
+            kernel: self.kernel,
+            stride: self.stride,
+            padding: self.padding,
+            height: self.out_height(),
+            width: self.out_width(),
+        };
+        assert_eq!(
+            (c.out_height(), c.out_width()),
+            (self.height, self.width),
+            "conv-transpose: no convolution maps {}x{} back to {}x{}",
+            c.height,
+            c.width,
+            self.height,
+            self.width
+        );
+        c
+    }
+
+    /// `y = conv_transpose(x, w) + b`; `y` is overwritten.
+    pub fn forward(&self, n: usize, x: &[f32], w: &[f32], b: Option<&[f32]>, y: &mut [f32]) {
+        let conv = self.adjoint();
+        conv.backward_input(n, x, w, y);
+        if let Some(b) = b {
+            assert_eq!(b.len(), self.channels_out, "conv-transpose: bias length");
+            let pix = self.out_height() * self.out_width();
+            for img in y.chunks_exact_mut(self.out_len()) {
+                for (o, bias) in b.iter().enumerate() {
+                    for v in &mut img[o * pix..][..pix] {
+                        *v += bias;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The input gradient `dx` (overwritten) from the output gradient `dy`.
+    pub fn backward_input(&self, n: usize, dy: &[f32], w: &[f32], dx: &mut [f32]) {
+        self.adjoint().forward(n, dy, w, None, dx);
+    }
+
+    /// The weight gradient (`[in, out, k, k]`) and bias gradient (both overwritten).
+    pub fn backward_weight(
+        &self,
+        n: usize,
+        x: &[f32],
+        dy: &[f32],
+        dw: &mut [f32],
+        db: Option<&mut [f32]>,
+    ) {
+        // For y = conv^T(x): dL/dw = the convolution's weight gradient with its input dy and
+        // its output gradient x.
+        self.adjoint().backward_weight(n, dy, x, dw, None);
+        if let Some(db) = db {
+            assert_eq!(
+                db.len(),
+                self.channels_out,
+                "conv-transpose: bias-gradient length"
+            );
+            let pix = self.out_height() * self.out_width();
+            for (o, d) in db.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for img in dy.chunks_exact(self.out_len()) {
+                    for v in &img[o * pix..][..pix] {
+                        s += v;
+                    }
+                }
+                *d = s;
+            }
+        }
+    }
+}
