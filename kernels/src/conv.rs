@@ -17,6 +17,7 @@
 
 use crate::matmul::{MatRef, matmul_on};
 use crate::path::{SimdPath, active_path};
+use rayon::prelude::*;
 
 /// The shape of a convolution: `channels_in` images of `height x width`, a square kernel,
 /// a stride and a zero padding on every side.
@@ -85,50 +86,48 @@ impl Conv2d {
         );
     }
 
-    /// The `im2col` matrix of one image into `cols` (`patch x pixels_out`, row-major, starting at
-    /// column `col0` of a matrix `stride_cols` wide).
-    fn im2col(&self, x: &[f32], cols: &mut [f32], col0: usize, stride_cols: usize) {
+    /// Row `r = (c, ky, kx)` of the `im2col` matrix of a batch, `[patch, n * pixels]`: the
+    /// input value under kernel position `r` for every output pixel of every image, image after
+    /// image (0 in the padding).
+    fn im2col_row(&self, n: usize, x: &[f32], r: usize, row: &mut [f32]) {
         let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
         let (oh, ow) = (self.out_height(), self.out_width());
-        for c in 0..self.channels_in {
-            let plane = &x[c * self.height * self.width..][..self.height * self.width];
-            for ky in 0..k {
-                for kx in 0..k {
-                    let row = (c * k + ky) * k + kx;
-                    let dst = &mut cols[row * stride_cols + col0..][..oh * ow];
-                    for oy in 0..oh {
-                        let y = (oy * s + ky) as isize - p;
-                        let line = &mut dst[oy * ow..][..ow];
-                        if y < 0 || y >= self.height as isize {
-                            line.fill(0.0);
-                            continue;
-                        }
-                        let src = &plane[y as usize * self.width..][..self.width];
-                        for (ox, v) in line.iter_mut().enumerate() {
-                            let xx = (ox * s + kx) as isize - p;
-                            *v = if xx < 0 || xx >= self.width as isize {
-                                0.0
-                            } else {
-                                src[xx as usize]
-                            };
-                        }
-                    }
+        let (c, ky, kx) = (r / (k * k), r / k % k, r % k);
+        for i in 0..n {
+            let plane =
+                &x[i * self.in_len() + c * self.height * self.width..][..self.height * self.width];
+            let dst = &mut row[i * oh * ow..][..oh * ow];
+            for oy in 0..oh {
+                let y = (oy * s + ky) as isize - p;
+                let line = &mut dst[oy * ow..][..ow];
+                if y < 0 || y >= self.height as isize {
+                    line.fill(0.0);
+                    continue;
+                }
+                let src = &plane[y as usize * self.width..][..self.width];
+                for (ox, v) in line.iter_mut().enumerate() {
+                    let xx = (ox * s + kx) as isize - p;
+                    *v = if xx < 0 || xx >= self.width as isize {
+                        0.0
+                    } else {
+                        src[xx as usize]
+                    };
                 }
             }
         }
     }
 
-    /// Add the `im2col`-shaped `cols` (`patch x pixels_out`) back into one image's gradient,
-    /// in the order `(c, ky, kx, oy, ox)`.
-    fn col2im_add(&self, cols: &[f32], dx: &mut [f32]) {
+    /// Add columns `i * pixels ..` of an `im2col`-shaped gradient (`[patch, n * pixels]`) back
+    /// into image `i`'s gradient, in the order `(c, ky, kx, oy, ox)`.
+    fn col2im_add(&self, cols: &[f32], wide: usize, i: usize, dx: &mut [f32]) {
         let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
         let (oh, ow) = (self.out_height(), self.out_width());
         for c in 0..self.channels_in {
             let plane = &mut dx[c * self.height * self.width..][..self.height * self.width];
             for ky in 0..k {
                 for kx in 0..k {
-                    let row = (c * k + ky) * k + kx;
-                    let src = &cols[row * oh * ow..][..oh * ow];
+                    let r = (c * k + ky) * k + kx;
+                    let src = &cols[r * wide + i * oh * ow..][..oh * ow];
                     for oy in 0..oh {
                         let y = (oy * s + ky) as isize - p;
                         if y < 0 || y >= self.height as isize {
@@ -170,23 +169,34 @@ impl Conv2d {
         assert_eq!(x.len(), n * self.in_len(), "conv2d: input length");
         assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
         assert_eq!(y.len(), n * self.out_len(), "conv2d: output length");
-        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
-        let mut cols = vec![0.0f32; patch * pix];
-        let wm = MatRef::row_major(w, co, patch);
-        for i in 0..n {
-            self.im2col(&x[i * self.in_len()..][..self.in_len()], &mut cols, 0, pix);
-            let out = &mut y[i * self.out_len()..][..self.out_len()];
-            match b {
-                Some(b) => {
-                    assert_eq!(b.len(), co, "conv2d: bias length");
-                    for (o, bias) in b.iter().enumerate() {
-                        out[o * pix..][..pix].fill(*bias);
-                    }
-                }
-                None => out.fill(0.0),
-            }
-            matmul_on(path, out, wm, MatRef::row_major(&cols, patch, pix), true);
+        if n == 0 {
+            return;
         }
+        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
+        if let Some(b) = b {
+            assert_eq!(b.len(), co, "conv2d: bias length");
+        }
+        // Image by image, in parallel: every output a chain over (c, ky, kx) from its bias.
+        let wm = MatRef::row_major(w, co, patch);
+        y.par_chunks_mut(self.out_len())
+            .zip(x.par_chunks(self.in_len()))
+            .for_each_init(
+                || vec![0.0f32; patch * pix],
+                |cols, (out, img)| {
+                    for (r, row) in cols.chunks_exact_mut(pix).enumerate() {
+                        self.im2col_row(1, img, r, row);
+                    }
+                    match b {
+                        Some(b) => {
+                            for (row, bias) in out.chunks_exact_mut(pix).zip(b) {
+                                row.fill(*bias);
+                            }
+                        }
+                        None => out.fill(0.0),
+                    }
+                    matmul_on(path, out, wm, MatRef::row_major(cols, patch, pix), true);
+                },
+            );
     }
 
     /// The input gradient `dx` (overwritten) of a batch, from the output gradient `dy`.
@@ -211,15 +221,22 @@ impl Conv2d {
         );
         assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
         assert_eq!(dx.len(), n * self.in_len(), "conv2d: input-gradient length");
-        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
-        let mut cols = vec![0.0f32; patch * pix];
-        let wt = MatRef::row_major(w, co, patch).t();
         dx.fill(0.0);
-        for i in 0..n {
-            let g = MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix);
-            matmul_on(path, &mut cols, wt, g, false);
-            self.col2im_add(&cols, &mut dx[i * self.in_len()..][..self.in_len()]);
+        if n == 0 {
+            return;
         }
+        let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
+        // Image by image, in parallel: every value a chain over the output channels.
+        let wt = MatRef::row_major(w, co, patch).t();
+        dx.par_chunks_mut(self.in_len())
+            .zip(dy.par_chunks(self.out_len()))
+            .for_each_init(
+                || vec![0.0f32; patch * pix],
+                |cols, (d, g)| {
+                    matmul_on(path, cols, wt, MatRef::row_major(g, co, pix), false);
+                    self.col2im_add(cols, pix, 0, d);
+                },
+            );
     }
 
     /// The weight gradient `dw` (`[out, in, k, k]`) and the bias gradient `db` of a batch
@@ -258,36 +275,41 @@ impl Conv2d {
             "conv2d: weight-gradient length"
         );
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
-        let wide = n * pix;
-        // Every image's columns side by side, and the output gradient as [out, n * pixels]:
-        // each weight's gradient is one chain over (image, pixel).
-        let mut cols = vec![0.0f32; patch * wide];
-        let mut g = vec![0.0f32; co * wide];
+        let block = patch * pix;
+        let mut cols = vec![0.0f32; n * block];
+        cols.par_chunks_mut(block.max(1))
+            .zip(x.par_chunks(self.in_len().max(1)))
+            .for_each(|(c, img)| {
+                for (r, row) in c.chunks_exact_mut(pix).enumerate() {
+                    self.im2col_row(1, img, r, row);
+                }
+            });
+        // Every weight's gradient is one chain over (image, pixel): image after image, each
+        // product continuing the chains where the previous one stored them. The chains run on
+        // the transpose, `[patch, out]`, whose big operand is read in place.
+        let mut dwt = vec![0.0f32; patch * co];
         for i in 0..n {
-            self.im2col(
-                &x[i * self.in_len()..][..self.in_len()],
-                &mut cols,
-                i * pix,
-                wide,
+            matmul_on(
+                path,
+                &mut dwt,
+                MatRef::row_major(&cols[i * block..][..block], patch, pix),
+                MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix).t(),
+                i > 0,
             );
-            for o in 0..co {
-                g[o * wide + i * pix..][..pix]
-                    .copy_from_slice(&dy[i * self.out_len() + o * pix..][..pix]);
+        }
+        for o in 0..co {
+            for r in 0..patch {
+                dw[o * patch + r] = dwt[r * co + o];
             }
         }
-        matmul_on(
-            path,
-            dw,
-            MatRef::row_major(&g, co, wide),
-            MatRef::row_major(&cols, patch, wide).t(),
-            false,
-        );
         if let Some(db) = db {
             assert_eq!(db.len(), co, "conv2d: bias-gradient length");
             for (o, d) in db.iter_mut().enumerate() {
                 let mut s = 0.0;
-                for v in &g[o * wide..][..wide] {
-                    s += v;
+                for img in dy.chunks_exact(self.out_len()) {
+                    for v in &img[o * pix..][..pix] {
+                        s += v;
+                    }
                 }
                 *d = s;
             }
