@@ -40,6 +40,76 @@ fn filled(n: usize, v: f32) -> Vec<f32> {
     (0..n).map(|i| v * ((i % 97) as f32 / 97.0 - 0.5)).collect()
 }
 
+/// Which operations of a layer to run.
+#[derive(Clone, Copy)]
+struct Ops {
+    forward: bool,
+    input: bool,
+    weight: bool,
+}
+
+/// A layer of the stack: a convolution or a transposed one (the same calls).
+trait Layer {
+    fn lens(&self) -> (usize, usize, usize, usize);
+    fn fwd(&self, x: &[f32], w: &[f32], y: &mut [f32]);
+    fn bwd_input(&self, dy: &[f32], w: &[f32], dx: &mut [f32]);
+    fn bwd_weight(&self, x: &[f32], dy: &[f32], dw: &mut [f32], db: &mut [f32]);
+}
+
+macro_rules! layer {
+    ($t:ty) => {
+        impl Layer for $t {
+            fn lens(&self) -> (usize, usize, usize, usize) {
+                (
+                    self.in_len(),
+                    self.out_len(),
+                    self.weight_len(),
+                    self.channels_out,
+                )
+            }
+            fn fwd(&self, x: &[f32], w: &[f32], y: &mut [f32]) {
+                self.forward(BATCH, x, w, None, y)
+            }
+            fn bwd_input(&self, dy: &[f32], w: &[f32], dx: &mut [f32]) {
+                self.backward_input(BATCH, dy, w, dx)
+            }
+            fn bwd_weight(&self, x: &[f32], dy: &[f32], dw: &mut [f32], db: &mut [f32]) {
+                self.backward_weight(BATCH, x, dy, dw, Some(db))
+            }
+        }
+    };
+}
+layer!(Conv2d);
+layer!(ConvTranspose2d);
+
+/// The outputs, reused from layer to layer.
+#[derive(Default)]
+struct Buffers {
+    y: Vec<f32>,
+    dx: Vec<f32>,
+    dw: Vec<f32>,
+    db: Vec<f32>,
+}
+
+impl Buffers {
+    fn layer(&mut self, l: &impl Layer, ops: Ops, x: &[f32], dy: &[f32], w: &[f32]) {
+        let (inl, outl, wl, co) = l.lens();
+        if ops.forward {
+            self.y.resize(BATCH * outl, 0.0);
+            l.fwd(x, w, &mut self.y);
+        }
+        if ops.input {
+            self.dx.resize(BATCH * inl, 0.0);
+            l.bwd_input(dy, w, &mut self.dx);
+        }
+        if ops.weight {
+            self.dw.resize(wl, 0.0);
+            self.db.resize(co, 0.0);
+            l.bwd_weight(x, dy, &mut self.dw, &mut self.db);
+        }
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("conv_stack");
     g.sample_size(10);
@@ -64,81 +134,53 @@ fn bench(c: &mut Criterion) {
         .map(|l| filled(BATCH * l.out_len(), 1.0))
         .collect();
     let tws: Vec<Vec<f32>> = dec.iter().map(|l| filled(l.weight_len(), 0.1)).collect();
-    g.bench_function("encoder_decoder_forward_backward", |b| {
-        let (mut y, mut dx, mut dw) = (Vec::new(), Vec::new(), Vec::new());
-        let mut db = [0.0f32; 32];
-        b.iter(|| {
-            for (i, l) in enc.iter().enumerate() {
-                y.resize(BATCH * l.out_len(), 0.0);
-                l.forward(BATCH, &xs[i], &ws[i], None, &mut y);
-                dx.resize(BATCH * l.in_len(), 0.0);
-                l.backward_input(BATCH, &ys[i], &ws[i], &mut dx);
-                dw.resize(l.weight_len(), 0.0);
-                l.backward_weight(
-                    BATCH,
-                    &xs[i],
-                    &ys[i],
-                    &mut dw,
-                    Some(&mut db[..l.channels_out]),
-                );
-            }
-            for (i, l) in dec.iter().enumerate() {
-                y.resize(BATCH * l.out_len(), 0.0);
-                l.forward(BATCH, &txs[i], &tws[i], None, &mut y);
-                dx.resize(BATCH * l.in_len(), 0.0);
-                l.backward_input(BATCH, &tys[i], &tws[i], &mut dx);
-                dw.resize(l.weight_len(), 0.0);
-                l.backward_weight(
-                    BATCH,
-                    &txs[i],
-                    &tys[i],
-                    &mut dw,
-                    Some(&mut db[..l.channels_out]),
-                );
-            }
-            black_box(&y);
-        })
-    });
+    let mut bufs = Buffers::default();
+    let mut run = |ops: Ops| {
+        for (i, l) in enc.iter().enumerate() {
+            bufs.layer(l, ops, &xs[i], &ys[i], &ws[i]);
+        }
+        for (i, l) in dec.iter().enumerate() {
+            bufs.layer(l, ops, &txs[i], &tys[i], &tws[i]);
+        }
+        black_box(&bufs.y);
+    };
+    let all = Ops {
+        forward: true,
+        input: true,
+        weight: true,
+    };
+    let none = Ops {
+        forward: false,
+        input: false,
+        weight: false,
+    };
+    g.bench_function("encoder_decoder_forward_backward", |b| b.iter(|| run(all)));
     // Each operation alone, over the whole stack (where the time goes).
-    g.bench_function("forward", |b| {
-        let mut y = Vec::new();
-        b.iter(|| {
-            for (i, l) in enc.iter().enumerate() {
-                y.resize(BATCH * l.out_len(), 0.0);
-                l.forward(BATCH, &xs[i], &ws[i], None, &mut y);
-            }
-            for (i, l) in dec.iter().enumerate() {
-                y.resize(BATCH * l.out_len(), 0.0);
-                l.forward(BATCH, &txs[i], &tws[i], None, &mut y);
-            }
-        })
-    });
-    g.bench_function("backward_input", |b| {
-        let mut dx = Vec::new();
-        b.iter(|| {
-            for (i, l) in enc.iter().enumerate() {
-                dx.resize(BATCH * l.in_len(), 0.0);
-                l.backward_input(BATCH, &ys[i], &ws[i], &mut dx);
-            }
-            for (i, l) in dec.iter().enumerate() {
-                dx.resize(BATCH * l.in_len(), 0.0);
-                l.backward_input(BATCH, &tys[i], &tws[i], &mut dx);
-            }
-        })
-    });
-    g.bench_function("backward_weight", |b| {
-        let mut dw = Vec::new();
-        b.iter(|| {
-            for (i, l) in enc.iter().enumerate() {
-                dw.resize(l.weight_len(), 0.0);
-                l.backward_weight(BATCH, &xs[i], &ys[i], &mut dw, None);
-            }
-            for (i, l) in dec.iter().enumerate() {
-                dw.resize(l.weight_len(), 0.0);
-                l.backward_weight(BATCH, &txs[i], &tys[i], &mut dw, None);
-            }
-        })
-    });
+    for (name, ops) in [
+        (
+            "forward",
+            Ops {
+                forward: true,
+                ..none
+            },
+        ),
+        (
+            "backward_input",
+            Ops {
+                input: true,
+                ..none
+            },
+        ),
+        (
+            "backward_weight",
+            Ops {
+                weight: true,
+                ..none
+            },
+        ),
+    ] {
+        g.bench_function(name, |b| b.iter(|| run(ops)));
+    }
     g.finish();
 }
 

@@ -553,8 +553,6 @@ pub fn write_npy(values: &[f32], path: &std::path::Path) -> Result<(), super::re
 /// Write a picture as an RGB PNG a person can look at: 4x nearest-neighbour upscaling, rows
 /// flipped so that larger y is higher, as in the world (CDGE's frames put y downwards).
 pub fn write_png(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
-    use super::render::RenderError;
-    use std::io::Write;
     check_picture(values, path)?;
     const SCALE: usize = 4;
     let side = SIDE * SCALE;
@@ -566,24 +564,7 @@ pub fn write_png(values: &[f32], path: &std::path::Path) -> Result<(), super::re
             data.extend(px.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
         }
     }
-    let io_err = |source| RenderError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let png_err = |source| RenderError::Png {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut buf = std::io::BufWriter::new(std::fs::File::create(path).map_err(io_err)?);
-    {
-        let mut encoder = png::Encoder::new(&mut buf, side as u32, side as u32);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(png_err)?;
-        writer.write_image_data(&data).map_err(png_err)?;
-        writer.finish().map_err(png_err)?;
-    }
-    buf.flush().map_err(io_err)
+    super::render::write_png_bytes(path, side, side, png::ColorType::Rgb, &data)
 }
 
 fn check_picture(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {

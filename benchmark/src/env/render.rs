@@ -851,6 +851,21 @@ pub fn write_png_grid(
             }
         }
     }
+    write_png_bytes(path, width, height, png::ColorType::Grayscale, &data)
+}
+
+/// Encode 8-bit `data` (`height` rows of `width` pixels of `color`) as a PNG file.
+pub(crate) fn write_png_bytes(
+    path: &Path,
+    width: usize,
+    height: usize,
+    color: png::ColorType,
+    data: &[u8],
+) -> Result<(), RenderError> {
+    let io_err = |source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let png_err = |source| RenderError::Png {
         path: path.to_path_buf(),
         source,
@@ -859,10 +874,10 @@ pub fn write_png_grid(
     let mut buf = BufWriter::new(file);
     {
         let mut encoder = png::Encoder::new(&mut buf, width as u32, height as u32);
-        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_color(color);
         encoder.set_depth(png::BitDepth::Eight);
         let mut writer = encoder.write_header().map_err(png_err)?;
-        writer.write_image_data(&data).map_err(png_err)?;
+        writer.write_image_data(data).map_err(png_err)?;
         writer.finish().map_err(png_err)?;
     }
     buf.flush().map_err(io_err)
