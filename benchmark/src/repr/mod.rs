@@ -11,6 +11,7 @@ pub mod bvae;
 pub mod cache;
 pub mod checkpoint;
 pub mod dataset;
+pub mod disentanglement;
 pub mod evidence;
 pub mod external;
 pub mod gaussian_projection;
