@@ -167,7 +167,7 @@ pub fn mig(
     factors: &[f64],
     k: usize,
 ) -> Result<Score, DisentanglementError> {
-    let n = if d > 0 { latents.len() / d } else { 0 };
+    let n = latents.len().checked_div(d).unwrap_or(0);
     check(latents, d, factors, k, n)?;
     let z: Vec<Vec<usize>> = (0..d)
         .map(|j| discretise(column(latents, d, j), BINS))
@@ -220,7 +220,7 @@ pub fn sap(
     factors: &[f64],
     k: usize,
 ) -> Result<Score, DisentanglementError> {
-    let n = if d > 0 { latents.len() / d } else { 0 };
+    let n = latents.len().checked_div(d).unwrap_or(0);
     check(latents, d, factors, k, n)?;
     let z: Vec<Vec<f64>> = (0..d).map(|j| column(latents, d, j).collect()).collect();
     let mut matrix = Vec::with_capacity(k);
