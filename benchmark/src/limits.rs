@@ -139,28 +139,32 @@ pub fn check_fits(key: &str, value: impl std::fmt::Display, bytes: f64) -> Resul
     Ok(())
 }
 
-/// Values of the largest picture of the registry's environments (70 x 70 = 4900 gray values
-/// for the paper's, 64 x 64 x 3 = 12,288 for the follow-up's own ArmBalls): the limits below
-/// hold for every environment.
-fn largest_image() -> f64 {
-    ugl_types::environments()
-        .iter()
-        .map(|e| e.image.len())
-        .max()
-        .unwrap_or(0) as f64
+/// Values of the largest picture among `envs` (70 x 70 = 4900 gray values for the paper's,
+/// 64 x 64 x 3 = 12,288 for the follow-up's own ArmBalls); of the whole registry when `envs` is
+/// empty.
+pub fn image_values(envs: &[crate::env::EnvKind]) -> usize {
+    if envs.is_empty() {
+        ugl_types::environments()
+            .iter()
+            .map(|e| e.image.len())
+            .max()
+            .unwrap_or(0)
+    } else {
+        envs.iter().map(|e| e.spec().image.len()).max().unwrap_or(0)
+    }
 }
 
-/// `ugl.images` (the UGL data set: `n` images of f32, plus a sparse copy).
-pub fn check_images(n: usize) -> Result<(), LimitError> {
-    check_fits("ugl.images", n, n as f64 * largest_image() * 4.0 * 2.0)
+/// `ugl.images` (the UGL data set: `n` pictures of `values` f32, plus a sparse copy).
+pub fn check_images(n: usize, values: usize) -> Result<(), LimitError> {
+    check_fits("ugl.images", n, n as f64 * values as f64 * 4.0 * 2.0)
 }
 
 /// `ugl embed --grid N` (`N x N` rendered images of f32, held with the `images` training
 /// images while they are encoded; the encoders work on an f64 copy of a set). Computed in
 /// floating point, so that no size overflows.
-pub fn check_grid(grid: usize, images: usize) -> Result<(), LimitError> {
+pub fn check_grid(grid: usize, images: usize, values: usize) -> Result<(), LimitError> {
     let grid_images = grid as f64 * grid as f64;
-    let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * largest_image();
+    let bytes = (grid_images * (4.0 + 8.0) + images as f64 * 4.0 * 2.0) * values as f64;
     check_fits("--grid", grid, bytes)
 }
 
@@ -170,10 +174,11 @@ pub fn check_epochs(n: usize) -> Result<(), LimitError> {
 }
 
 /// A network's `hidden` sizes: the weights of the picture-H1-H2 MLP and its mirror, with their
-/// gradients and optimiser state (x5).
+/// gradients and optimiser state (x5), for the registry's largest picture (the network's
+/// configuration does not know its environment).
 pub fn check_hidden(hidden: [usize; 2]) -> Result<(), LimitError> {
     let [h1, h2] = hidden.map(|h| h as f64);
-    let params = 2.0 * (largest_image() * h1 + h1 * h2) + 200.0 * h2;
+    let params = 2.0 * (image_values(&[]) as f64 * h1 + h1 * h2) + 200.0 * h2;
     check_fits("hidden", format!("{hidden:?}"), params * 4.0 * 5.0)
 }
 
@@ -198,19 +203,19 @@ mod tests {
 
     #[test]
     fn absurd_sizes_are_refused_and_real_ones_pass() {
-        assert!(check_images(10_000).is_ok());
+        assert!(check_images(10_000, 4900).is_ok());
         assert!(check_epochs(5000).is_ok());
         assert!(check_hidden([1200, 1200]).is_ok());
-        let e = check_images(100_000_000_000).unwrap_err().to_string();
+        let e = check_images(100_000_000_000, 4900).unwrap_err().to_string();
         assert!(
             e.starts_with("ugl.images = 100000000000 needs about"),
             "{e}"
         );
         assert!(check_epochs(1 << 63).is_err());
-        assert!(check_grid(21, 10_000).is_ok());
-        let e = check_grid(100_000, 300).unwrap_err().to_string();
+        assert!(check_grid(21, 10_000, 4900).is_ok());
+        let e = check_grid(100_000, 300, 4900).unwrap_err().to_string();
         assert!(e.starts_with("--grid = 100000 needs about"), "{e}");
-        assert!(check_grid(usize::MAX, 300).is_err());
+        assert!(check_grid(usize::MAX, 300, 4900).is_err());
         assert!(check_epochs(usize::MAX).is_err());
         assert!(check_hidden([100_000_000, 10]).is_err());
         assert!(check_runs(&[("envs", 2), ("algos", 7), ("reps", 5)]).is_ok());

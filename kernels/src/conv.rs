@@ -80,6 +80,10 @@ impl Conv2d {
             "conv2d: kernel and stride must be at least 1: {self:?}"
         );
         assert!(
+            self.channels_in >= 1 && self.channels_out >= 1 && self.height >= 1 && self.width >= 1,
+            "conv2d: channels and image sides must be at least 1: {self:?}"
+        );
+        assert!(
             self.height + 2 * self.padding >= self.kernel
                 && self.width + 2 * self.padding >= self.kernel,
             "conv2d: the kernel is larger than the padded image: {self:?}"
@@ -169,12 +173,12 @@ impl Conv2d {
         assert_eq!(x.len(), n * self.in_len(), "conv2d: input length");
         assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
         assert_eq!(y.len(), n * self.out_len(), "conv2d: output length");
-        if n == 0 {
-            return;
-        }
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
         if let Some(b) = b {
             assert_eq!(b.len(), co, "conv2d: bias length");
+        }
+        if n == 0 {
+            return;
         }
         // Image by image, in parallel: every output a chain over (c, ky, kx) from its bias.
         let wm = MatRef::row_major(w, co, patch);
@@ -341,17 +345,34 @@ pub struct ConvTranspose2d {
 
 impl ConvTranspose2d {
     /// Output rows.
+    ///
+    /// # Panics
+    /// If a size is 0 or the padding removes the whole output.
     pub fn out_height(&self) -> usize {
-        ((self.height - 1) * self.stride + self.kernel)
-            .checked_sub(2 * self.padding)
-            .expect("conv-transpose: padding larger than the output")
+        self.out_side(self.height)
     }
 
     /// Output columns.
+    ///
+    /// # Panics
+    /// As [`Self::out_height`].
     pub fn out_width(&self) -> usize {
-        ((self.width - 1) * self.stride + self.kernel)
+        self.out_side(self.width)
+    }
+
+    fn out_side(&self, side: usize) -> usize {
+        assert!(
+            side >= 1
+                && self.kernel >= 1
+                && self.stride >= 1
+                && self.channels_in >= 1
+                && self.channels_out >= 1,
+            "conv-transpose: channels, sides, kernel and stride must be at least 1: {self:?}"
+        );
+        ((side - 1) * self.stride + self.kernel)
             .checked_sub(2 * self.padding)
-            .expect("conv-transpose: padding larger than the output")
+            .filter(|s| *s >= 1)
+            .unwrap_or_else(|| panic!("conv-transpose: the padding removes the output: {self:?}"))
     }
 
     /// Values of one input image.

@@ -109,7 +109,8 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
         bail!("--grid must be at least 2, got {}", a.grid);
     }
     // Before anything is fitted or allocated: GRID^2 images must fit in memory.
-    ugl_bench::limits::check_grid(a.grid, cfg.ugl.images).map_err(anyhow::Error::msg)?;
+    ugl_bench::limits::check_grid(a.grid, cfg.ugl.images, a.env.spec().image.len())
+        .map_err(anyhow::Error::msg)?;
     if a.out.extension().and_then(|e| e.to_str()) != Some("npy") {
         bail!("--out {}: the file name must end in .npy", a.out.display());
     }

@@ -317,6 +317,12 @@ impl EnvSpec {
         if self.true_latents == 0 {
             return Err(bad("the true latent size must be at least 1".into()));
         }
+        if self.params == 0 {
+            return Err(bad("an episode needs at least 1 motor parameter".into()));
+        }
+        if self.image.is_empty() {
+            return Err(bad("the picture must hold at least 1 value".into()));
+        }
         Ok(())
     }
 

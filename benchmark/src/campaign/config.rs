@@ -469,8 +469,11 @@ impl CampaignConfig {
             ));
         }
         if learned {
-            crate::limits::check_images(self.ugl.images)
-                .map_err(|e| InvalidValue::new("ugl.images", e.to_string()))?;
+            crate::limits::check_images(
+                self.ugl.images,
+                crate::limits::image_values(&self.matrix.envs),
+            )
+            .map_err(|e| InvalidValue::new("ugl.images", e.to_string()))?;
         }
         if let Some(LatentSize::N(n)) = self
             .matrix

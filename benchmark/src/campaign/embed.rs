@@ -39,7 +39,7 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
             "the grid needs at least 2 x 2 positions, got {grid}"
         )));
     }
-    crate::limits::check_grid(grid, ctx.ugl.images)
+    crate::limits::check_grid(grid, ctx.ugl.images, spec.env.spec().image.len())
         .map_err(|e| ReprError::InvalidInput(e.to_string()))?;
     let (mut repr, data, ds_seed) = fit_with_data(spec, ctx)?;
     let env = make_env(spec.env, ctx.env);

@@ -190,7 +190,7 @@ pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(),
                 format!("--images must be at least 2, got {n}"),
             ));
         }
-        crate::limits::check_images(n)
+        crate::limits::check_images(n, crate::limits::image_values(&cfg.matrix.envs))
             .map_err(|e| InvalidValue::new("--images", format!("--images: {e}")))?;
         cfg.ugl.images = n;
     }

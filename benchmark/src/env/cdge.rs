@@ -276,7 +276,8 @@ impl Environment for CdgeArmBalls {
                 self.kind()
             )
         });
-        let e = self.episode(theta, noise);
+        let theta: [f64; PARAMS] = std::array::from_fn(|k| theta[k].clamp(-1.0, 1.0));
+        let e = self.episode(&theta, noise);
         Rollout {
             state: [
                 e.ball[0].clamp(-1.0, 1.0),

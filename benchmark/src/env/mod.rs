@@ -362,6 +362,12 @@ impl EnvConfig {
             c.distractor_initial = DISTRACTOR_INITIAL;
             c.distractor_noise = DISTRACTOR_NOISE;
         }
+        // The follow-up's own ArmBalls has its own arm and controller ([`cdge`]): the DMP arm's
+        // constants do not change its runs, so they do not enter their hash.
+        if kind == EnvKind::ARMBALLS_CORL {
+            c.arm = ArmConfig::default();
+            c.dmp = DmpConfig::default();
+        }
         c
     }
 }

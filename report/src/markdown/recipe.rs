@@ -64,8 +64,12 @@ pub(crate) fn recipe_lines(
                 .as_ref()
                 .map(|h| h.iter().map(i64::to_string).collect::<Vec<_>>().join("-"))
                 .unwrap_or_else(|| "?".into());
+            // The network's input is the environment's picture (4900 gray values in the
+            // paper's).
+            let input = ugl_types::EnvSpec::by_name(&r.manifest.env)
+                .map_or_else(|| "?".into(), |e| e.image.len().to_string());
             let mut s = format!(
-                "4900-{hidden}, init `{}`",
+                "{input}-{hidden}, init `{}`",
                 t.init.as_deref().unwrap_or("paper")
             );
             if with_iterations {
