@@ -110,30 +110,26 @@ impl Buffers {
     }
 }
 
+/// Inputs, output gradients and weights of every layer of a stack.
+fn tensors(layers: &[impl Layer]) -> (Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<Vec<f32>>) {
+    let mut out = (vec![], vec![], vec![]);
+    for l in layers {
+        let (inl, outl, wl, _) = l.lens();
+        out.0.push(filled(BATCH * inl, 1.0));
+        out.1.push(filled(BATCH * outl, 1.0));
+        out.2.push(filled(wl, 0.1));
+    }
+    out
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("conv_stack");
     g.sample_size(10);
     let enc = encoder();
     let dec = decoder();
     // Activations and gradients of every layer, allocated once.
-    let xs: Vec<Vec<f32>> = enc
-        .iter()
-        .map(|l| filled(BATCH * l.in_len(), 1.0))
-        .collect();
-    let ys: Vec<Vec<f32>> = enc
-        .iter()
-        .map(|l| filled(BATCH * l.out_len(), 1.0))
-        .collect();
-    let ws: Vec<Vec<f32>> = enc.iter().map(|l| filled(l.weight_len(), 0.1)).collect();
-    let txs: Vec<Vec<f32>> = dec
-        .iter()
-        .map(|l| filled(BATCH * l.in_len(), 1.0))
-        .collect();
-    let tys: Vec<Vec<f32>> = dec
-        .iter()
-        .map(|l| filled(BATCH * l.out_len(), 1.0))
-        .collect();
-    let tws: Vec<Vec<f32>> = dec.iter().map(|l| filled(l.weight_len(), 0.1)).collect();
+    let (xs, ys, ws) = tensors(&enc);
+    let (txs, tys, tws) = tensors(&dec);
     let mut bufs = Buffers::default();
     let mut run = |ops: Ops| {
         for (i, l) in enc.iter().enumerate() {

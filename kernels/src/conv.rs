@@ -19,6 +19,21 @@ use crate::matmul::{MatRef, matmul_on};
 use crate::path::{SimdPath, active_path};
 use rayon::prelude::*;
 
+/// Images whose `im2row` matrices a weight gradient builds at once (in parallel).
+const IM2ROW_GROUP: usize = 8;
+
+/// The output positions `lo..hi` (of `n`) whose input column `o * stride + off` lies inside
+/// `0..len`.
+fn inside(off: isize, stride: usize, n: usize, len: usize) -> (usize, usize) {
+    let st = stride as isize;
+    let lo = if off >= 0 { 0 } else { (-off + st - 1) / st };
+    let last = len as isize - 1 - off;
+    let hi = if last < 0 { 0 } else { last / st + 1 };
+    let hi = (hi as usize).min(n);
+    let lo = (lo as usize).min(hi);
+    (lo, hi)
+}
+
 /// The shape of a convolution: `channels_in` images of `height x width`, a square kernel,
 /// a stride and a zero padding on every side.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,13 +124,60 @@ impl Conv2d {
                     continue;
                 }
                 let src = &plane[y as usize * self.width..][..self.width];
-                for (ox, v) in line.iter_mut().enumerate() {
-                    let xx = (ox * s + kx) as isize - p;
-                    *v = if xx < 0 || xx >= self.width as isize {
-                        0.0
-                    } else {
-                        src[xx as usize]
-                    };
+                let off = kx as isize - p;
+                let (lo, hi) = inside(off, s, ow, self.width);
+                line[..lo].fill(0.0);
+                line[hi..].fill(0.0);
+                if lo < hi {
+                    let first = ((lo * s) as isize + off) as usize;
+                    let src = &src[first..];
+                    for (j, v) in line[lo..hi].iter_mut().enumerate() {
+                        *v = src[j * s];
+                    }
+                }
+            }
+        }
+    }
+
+    /// The `im2row` matrix of one image, `[pixels, patch]`: row `(oy, ox)` holds the input values
+    /// under the kernel at output pixel `(oy, ox)`, ordered `(c, ky, kx)` (0 in the padding).
+    fn im2row(&self, img: &[f32], out: &mut [f32]) {
+        let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
+        let (oh, ow, patch) = (self.out_height(), self.out_width(), self.patch());
+        let (h, w) = (self.height as isize, self.width as isize);
+        for oy in 0..oh {
+            for ox in 0..ow {
+                let dst = &mut out[(oy * ow + ox) * patch..][..patch];
+                let x0 = (ox * s) as isize - p;
+                let inside = x0 >= 0 && x0 + k as isize <= w;
+                for c in 0..self.channels_in {
+                    let plane = &img[c * self.height * self.width..][..self.height * self.width];
+                    for ky in 0..k {
+                        let seg = &mut dst[(c * k + ky) * k..][..k];
+                        let y = (oy * s + ky) as isize - p;
+                        if y < 0 || y >= h {
+                            seg.fill(0.0);
+                            continue;
+                        }
+                        let line = &plane[y as usize * self.width..][..self.width];
+                        if inside && k == 4 {
+                            // The follow-up's kernel: a fixed-size move, not a call to memcpy.
+                            let src: [f32; 4] = line[x0 as usize..][..4].try_into().expect("4");
+                            let dst: &mut [f32; 4] = seg.try_into().expect("4");
+                            *dst = src;
+                        } else if inside {
+                            seg.copy_from_slice(&line[x0 as usize..][..k]);
+                        } else {
+                            for (kx, v) in seg.iter_mut().enumerate() {
+                                let xx = x0 + kx as isize;
+                                *v = if xx < 0 || xx >= w {
+                                    0.0
+                                } else {
+                                    line[xx as usize]
+                                };
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -138,11 +200,15 @@ impl Conv2d {
                             continue;
                         }
                         let line = &mut plane[y as usize * self.width..][..self.width];
-                        for ox in 0..ow {
-                            let xx = (ox * s + kx) as isize - p;
-                            if xx >= 0 && xx < self.width as isize {
-                                line[xx as usize] += src[oy * ow + ox];
-                            }
+                        let off = kx as isize - p;
+                        let (lo, hi) = inside(off, s, ow, self.width);
+                        if lo == hi {
+                            continue;
+                        }
+                        let first = ((lo * s) as isize + off) as usize;
+                        let line = &mut line[first..];
+                        for (j, &g) in src[oy * ow + lo..oy * ow + hi].iter().enumerate() {
+                            line[j * s] += g;
                         }
                     }
                 }
@@ -279,32 +345,32 @@ impl Conv2d {
             "conv2d: weight-gradient length"
         );
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
-        let block = patch * pix;
-        let mut cols = vec![0.0f32; n * block];
-        cols.par_chunks_mut(block.max(1))
-            .zip(x.par_chunks(self.in_len().max(1)))
-            .for_each(|(c, img)| {
-                for (r, row) in c.chunks_exact_mut(pix).enumerate() {
-                    self.im2col_row(1, img, r, row);
-                }
-            });
         // Every weight's gradient is one chain over (image, pixel): image after image, each
-        // product continuing the chains where the previous one stored them. The chains run on
-        // the transpose, `[patch, out]`, whose big operand is read in place.
-        let mut dwt = vec![0.0f32; patch * co];
-        for i in 0..n {
-            matmul_on(
-                path,
-                &mut dwt,
-                MatRef::row_major(&cols[i * block..][..block], patch, pix),
-                MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix).t(),
-                i > 0,
-            );
-        }
-        for o in 0..co {
-            for r in 0..patch {
-                dw[o * patch + r] = dwt[r * co + o];
+        // product continuing the chains where the previous one stored them. The big operand,
+        // the image's `im2row` matrix `[pixels, patch]`, is read in place by the product; the
+        // `im2row` matrices of a group of images are built in parallel.
+        let block = patch * pix;
+        let group = n.clamp(1, IM2ROW_GROUP);
+        let mut rows = vec![0.0f32; group * block];
+        for (g, imgs) in x.chunks(group * self.in_len().max(1)).enumerate() {
+            let count = imgs.len() / self.in_len().max(1);
+            rows[..count * block]
+                .par_chunks_mut(block.max(1))
+                .zip(imgs.par_chunks(self.in_len().max(1)))
+                .for_each(|(r, img)| self.im2row(img, r));
+            for j in 0..count {
+                let i = g * group + j;
+                matmul_on(
+                    path,
+                    dw,
+                    MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix),
+                    MatRef::row_major(&rows[j * block..][..block], pix, patch),
+                    i > 0,
+                );
             }
+        }
+        if n == 0 {
+            dw.fill(0.0);
         }
         if let Some(db) = db {
             assert_eq!(db.len(), co, "conv2d: bias-gradient length");

@@ -269,3 +269,65 @@ fn every_path_and_thread_count_gives_the_same_bits() {
         }
     }
 }
+
+/// The contract, bit for bit: every output is one `mul_add` chain from its bias over
+/// `(c, ky, kx)`, and every weight's gradient one chain from 0 over `(image, oy, ox)` (10 images:
+/// more than one group of `im2row` matrices), padding values included as zeros.
+#[test]
+fn the_outputs_and_weight_gradients_are_the_documented_chains() {
+    let n = 10;
+    for (s, c) in SHAPES.iter().enumerate().skip(1) {
+        let seed = 40 + s as u64;
+        let x = random(n * c.in_len(), seed);
+        let w = random(c.weight_len(), seed + 1);
+        let b = random(c.channels_out, seed + 2);
+        let g = random(n * c.out_len(), seed + 3);
+        let (oh, ow, k, ci) = (c.out_height(), c.out_width(), c.kernel, c.channels_in);
+        let value = |i: usize, ch: usize, oy: usize, ox: usize, ky: usize, kx: usize| {
+            let y = (oy * c.stride + ky) as isize - c.padding as isize;
+            let xx = (ox * c.stride + kx) as isize - c.padding as isize;
+            at(c, &x, i, ch, y, xx) as f32
+        };
+        let mut y = vec![0.0; n * c.out_len()];
+        c.forward(n, &x, &w, Some(&b), &mut y);
+        let mut dw = vec![0.0; c.weight_len()];
+        c.backward_weight(n, &x, &g, &mut dw, None);
+        for o in 0..c.channels_out {
+            for (r, (ch, ky, kx)) in (0..ci)
+                .flat_map(|ch| (0..k).flat_map(move |ky| (0..k).map(move |kx| (ch, ky, kx))))
+                .enumerate()
+            {
+                let mut acc = 0.0f32;
+                for i in 0..n {
+                    for oy in 0..oh {
+                        for ox in 0..ow {
+                            let gv = g[((i * c.channels_out + o) * oh + oy) * ow + ox];
+                            acc = gv.mul_add(value(i, ch, oy, ox, ky, kx), acc);
+                        }
+                    }
+                }
+                let got = dw[o * ci * k * k + r];
+                assert_eq!(got.to_bits(), acc.to_bits(), "{c:?}: dw[{o}, {r}]");
+            }
+            for i in [0, n - 1] {
+                for (oy, ox) in [(0, 0), (oh / 2, ow - 1)] {
+                    let mut acc = b[o];
+                    for ch in 0..ci {
+                        for ky in 0..k {
+                            for kx in 0..k {
+                                let wv = w[((o * ci + ch) * k + ky) * k + kx];
+                                acc = wv.mul_add(value(i, ch, oy, ox, ky, kx), acc);
+                            }
+                        }
+                    }
+                    let got = y[((i * c.channels_out + o) * oh + oy) * ow + ox];
+                    assert_eq!(
+                        got.to_bits(),
+                        acc.to_bits(),
+                        "{c:?}: y[{i}, {o}, {oy}, {ox}]"
+                    );
+                }
+            }
+        }
+    }
+}

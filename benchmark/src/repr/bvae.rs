@@ -29,12 +29,24 @@ pub const DEFAULT_BETA: f64 = 4.0;
 
 /// The batch's KL term: `β mean_b KL_b`, or with capacity annealing (Burgess et al. 2018, the
 /// follow-up code's `loss_function`) `β |mean_b KL_b − C|`.
+///
+/// With a warm-up (`warmup` > 0, the follow-up code's `c` ramp), the term is multiplied by
+/// `min(1, 0.01 + step / warmup)`; without one (every dense β-VAE so far) it is left as it was.
 fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<1> {
     let kl = kl_std_normal(mu, logvar);
-    match input.capacity {
+    let term = match input.capacity {
         None => kl.mul_scalar(input.beta).mean(),
         Some(c) => kl.mean().sub_scalar(c).abs().mul_scalar(input.beta),
+    };
+    match warmup_factor(input.step, input.warmup) {
+        Some(f) => term.mul_scalar(f),
+        None => term,
     }
+}
+
+/// The follow-up's KL warm-up factor `min(1, 0.01 + step / warmup)` (None: no warm-up).
+pub fn warmup_factor(step: usize, warmup: usize) -> Option<f64> {
+    (warmup > 0).then(|| (0.01 + step as f64 / warmup as f64).min(1.0))
 }
 
 /// The β-VAE as a [`NeuralModel`]: TF Adam, prior N(0, I).
@@ -64,9 +76,9 @@ impl NeuralModel for Bvae {
         let heads = net.heads(input.x.clone());
         let (z, mu, logvar) = code(heads, &input.latent, Variant::Corrected, rng);
         let rec = bce_with_logits_sum(net.decode(z), input.x);
-        match input.latent.capacity {
-            None => (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean(),
-            Some(_) => rec.mean() + kl_term(mu, logvar, &input.latent),
+        match (input.latent.capacity, input.latent.warmup) {
+            (None, 0) => (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean(),
+            _ => rec.mean() + kl_term(mu, logvar, &input.latent),
         }
     }
     fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {

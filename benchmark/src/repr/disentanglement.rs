@@ -172,28 +172,36 @@ pub fn mig(
     let z: Vec<Vec<usize>> = (0..d)
         .map(|j| discretise(column(latents, d, j), BINS))
         .collect();
+    Ok(score_by_factor(k, |f| {
+        let v = discretise(column(factors, k, f), BINS);
+        let row = z
+            .iter()
+            .map(|zj| mutual_information(zj, &v, BINS))
+            .collect();
+        (row, entropy(&v, BINS))
+    }))
+}
+
+/// The score of `k` factors from each factor's row of latent scores and the number its gap is
+/// divided by (0: the gap counts as 0): the gap, the best latent, and the mean gap.
+fn score_by_factor(k: usize, mut row_of: impl FnMut(usize) -> (Vec<f64>, f64)) -> Score {
     let mut matrix = Vec::with_capacity(k);
     let mut per_factor = Vec::with_capacity(k);
     let mut best_latent = Vec::with_capacity(k);
     for f in 0..k {
-        let v = discretise(column(factors, k, f), BINS);
-        let h = entropy(&v, BINS);
-        let row: Vec<f64> = z
-            .iter()
-            .map(|zj| mutual_information(zj, &v, BINS))
-            .collect();
+        let (row, norm) = row_of(f);
         let (g, best) = gap(&row);
-        per_factor.push(if h > 0.0 { g / h } else { 0.0 });
+        per_factor.push(if norm > 0.0 { g / norm } else { 0.0 });
         best_latent.push(best);
         matrix.push(row);
     }
     let score = per_factor.iter().sum::<f64>() / k as f64;
-    Ok(Score {
+    Score {
         score,
         per_factor,
         best_latent,
         matrix,
-    })
+    }
 }
 
 /// R² of the least-squares line of `y` on `x` (0 when either is constant).
@@ -223,24 +231,10 @@ pub fn sap(
     let n = latents.len().checked_div(d).unwrap_or(0);
     check(latents, d, factors, k, n)?;
     let z: Vec<Vec<f64>> = (0..d).map(|j| column(latents, d, j).collect()).collect();
-    let mut matrix = Vec::with_capacity(k);
-    let mut per_factor = Vec::with_capacity(k);
-    let mut best_latent = Vec::with_capacity(k);
-    for f in 0..k {
+    Ok(score_by_factor(k, |f| {
         let v: Vec<f64> = column(factors, k, f).collect();
-        let row: Vec<f64> = z.iter().map(|zj| r2_linear(zj, &v)).collect();
-        let (g, best) = gap(&row);
-        per_factor.push(g);
-        best_latent.push(best);
-        matrix.push(row);
-    }
-    let score = per_factor.iter().sum::<f64>() / k as f64;
-    Ok(Score {
-        score,
-        per_factor,
-        best_latent,
-        matrix,
-    })
+        (z.iter().map(|zj| r2_linear(zj, &v)).collect(), 1.0)
+    }))
 }
 
 #[cfg(test)]

@@ -57,7 +57,7 @@ fn fill_bias(out: &mut [f32], bias: &[f32]) {
 }
 
 /// `x W + b` of a dense layer on a `rows`-row batch.
-fn dense_forward(layer: &HostLayer, x: &[f32], rows: usize, out: &mut [f32]) {
+pub(super) fn dense_forward(layer: &HostLayer, x: &[f32], rows: usize, out: &mut [f32]) {
     fill_bias(out, &layer.b);
     matmul(
         out,
@@ -67,12 +67,12 @@ fn dense_forward(layer: &HostLayer, x: &[f32], rows: usize, out: &mut [f32]) {
     );
 }
 
-fn relu_in_place(v: &mut [f32]) {
+pub(super) fn relu_in_place(v: &mut [f32]) {
     v.iter_mut().for_each(|x| *x = x.max(0.0));
 }
 
 /// `grad *= [act > 0]` (the ReLU's derivative, from its output).
-fn relu_backward(grad: &mut [f32], act: &[f32]) {
+pub(super) fn relu_backward(grad: &mut [f32], act: &[f32]) {
     for (g, &a) in grad.iter_mut().zip(act) {
         if a <= 0.0 {
             *g = 0.0;
@@ -81,7 +81,7 @@ fn relu_backward(grad: &mut [f32], act: &[f32]) {
 }
 
 /// Column sums of a row-major `rows x cols` matrix, row by row in order.
-fn col_sums(m: &[f32], cols: usize, out: &mut [f32]) {
+pub(super) fn col_sums(m: &[f32], cols: usize, out: &mut [f32]) {
     out.iter_mut().for_each(|v| *v = 0.0);
     for row in m.chunks_exact(cols) {
         for (o, &v) in out.iter_mut().zip(row) {
@@ -92,7 +92,7 @@ fn col_sums(m: &[f32], cols: usize, out: &mut [f32]) {
 
 /// The weight and bias gradients of a dense layer, `dW = x^T dy`, `db = colsum(dy)`, and (if
 /// asked) the input gradient `dx = dy W^T`.
-fn dense_backward(
+pub(super) fn dense_backward(
     layer: &HostLayer,
     x: &[f32],
     dy: &[f32],
@@ -258,7 +258,13 @@ fn sparse_weight_grad(xs: &SparseBatch, dy: &[f32], cols: usize, dw: &mut [f32])
 /// The pixel loss and its gradient in one pass: for each row, the Bernoulli cross-entropy of
 /// the logits summed over the pixels (`softplus(l) - t l`, accumulated in f64), and
 /// `grad = scale (sigmoid(l) - t)`.
-fn bce_and_grad(logits: &[f32], x: &[f32], dim: usize, scale: f32, grad: &mut [f32]) -> Vec<f64> {
+pub(super) fn bce_and_grad(
+    logits: &[f32],
+    x: &[f32],
+    dim: usize,
+    scale: f32,
+    grad: &mut [f32],
+) -> Vec<f64> {
     logits
         .par_chunks(dim)
         .zip(x.par_chunks(dim))
@@ -318,6 +324,42 @@ impl HostOptimizer {
                 m: sizes.iter().map(|&n| vec![0.0; n]).collect(),
                 v: sizes.iter().map(|&n| vec![0.0; n]).collect(),
             },
+        }
+    }
+
+    /// Fresh Adam state with the update rule `rule`, for parameter buffers of `sizes`.
+    pub fn adam(rule: TfAdam, sizes: &[usize]) -> HostOptimizer {
+        HostOptimizer::Adam {
+            rule,
+            time: 0,
+            m: sizes.iter().map(|&n| vec![0.0; n]).collect(),
+            v: sizes.iter().map(|&n| vec![0.0; n]).collect(),
+        }
+    }
+
+    /// One update of every parameter buffer in `params` with the gradients `grads` (same order,
+    /// every gradient dense). Each element is updated alone, so the result does not depend on the
+    /// thread count.
+    pub fn step_all(&mut self, lr: f64, params: Vec<&mut [f32]>, grads: &[Vec<f32>]) {
+        match self {
+            HostOptimizer::Adam { rule, time, m, v } => {
+                *time += 1;
+                let k = rule.constants(lr, *time);
+                for ((p, g), (m, v)) in params.into_iter().zip(grads).zip(m.iter_mut().zip(v)) {
+                    par_chunks(p, g, (m, v), |p, g, (m, v)| {
+                        adam_update(p, Some(g), m, v, &k)
+                    });
+                }
+            }
+            HostOptimizer::Adagrad { rule, acc } => {
+                let (lr, clip) = (lr as f32, rule.clip);
+                for ((p, g), acc) in params.into_iter().zip(grads).zip(acc.iter_mut()) {
+                    p.par_chunks_mut(OPT_CHUNK)
+                        .zip(g.par_chunks(OPT_CHUNK))
+                        .zip(acc.par_chunks_mut(OPT_CHUNK))
+                        .for_each(|((p, g), acc)| adagrad_update(p, g, acc, lr, clip));
+                }
+            }
         }
     }
 
@@ -498,7 +540,7 @@ struct Workspace {
     grads: Vec<Vec<f32>>,
 }
 
-fn sized(v: &mut Vec<f32>, n: usize) -> &mut Vec<f32> {
+pub(super) fn sized(v: &mut Vec<f32>, n: usize) -> &mut Vec<f32> {
     v.resize(n, 0.0);
     v
 }

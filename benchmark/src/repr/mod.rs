@@ -10,6 +10,8 @@ pub mod ae;
 pub mod bvae;
 pub mod cache;
 pub mod checkpoint;
+pub mod conv_net;
+pub mod conv_train;
 pub mod dataset;
 pub mod disentanglement;
 pub mod evidence;

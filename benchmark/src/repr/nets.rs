@@ -483,6 +483,10 @@ pub struct TfAdam {
     pub epsilon: f64,
     /// Element-wise gradient clipping bound (the original: 1).
     pub clip: Option<f32>,
+    /// PyTorch's placement of `eps` (`torch.optim.Adam`, the follow-up's optimiser): after the
+    /// bias correction of `sqrt(v)`, which is TF's rule with `eps sqrt(1 - b2^t)` in place of
+    /// `eps`. False: TF's.
+    pub torch_epsilon: bool,
 }
 
 impl Default for TfAdam {
@@ -492,20 +496,36 @@ impl Default for TfAdam {
             beta2: 0.999,
             epsilon: 1e-8,
             clip: Some(1.0),
+            torch_epsilon: false,
         }
     }
 }
 
 impl TfAdam {
+    /// `torch.optim.Adam` with its defaults (0.9, 0.999, 1e-8), no clipping: the follow-up's.
+    pub fn torch() -> TfAdam {
+        TfAdam {
+            clip: None,
+            torch_epsilon: true,
+            ..TfAdam::default()
+        }
+    }
+
     /// The constants of update number `time` (1-based) at learning rate `lr`.
     pub fn constants(&self, lr: f64, time: usize) -> AdamStep {
         let (b1, b2) = (self.beta1, self.beta2);
-        let lr_t = (lr * (1.0 - b2.powi(time as i32)).sqrt() / (1.0 - b1.powi(time as i32))) as f32;
+        let correction2 = (1.0 - b2.powi(time as i32)).sqrt();
+        let lr_t = (lr * correction2 / (1.0 - b1.powi(time as i32))) as f32;
+        let eps = if self.torch_epsilon {
+            self.epsilon * correction2
+        } else {
+            self.epsilon
+        };
         AdamStep {
             lr_t,
             b1: b1 as f32,
             b2: b2 as f32,
-            eps: self.epsilon as f32,
+            eps: eps as f32,
             clip: self.clip,
         }
     }

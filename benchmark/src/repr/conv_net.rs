@@ -1,0 +1,408 @@
+//! The follow-up's convolutional VAE and β-VAE (Laversanne-Finot, Péré, Oudeyer, CoRL 2018;
+//! `docs/followup.md`), on the host engine: its weights, their initialisation, and the batched
+//! forward passes that encode pictures and decode codes. Training is [`super::conv_train`].
+//!
+//! The architecture, as the authors' `representation_pytorch.py` has it (and the tensor shapes of
+//! their released weights confirm):
+//! - encoder: 4 x [Conv2d `filters` channels, kernel 4, stride 2, padding 1, ReLU]
+//!   (3 -> 32 -> 32 -> 32 -> 32 channels, 64 -> 4 px), flattened channel-major (512 values),
+//!   Linear 512 -> 256, ReLU, Linear 256 -> 256, ReLU, Linear 256 -> 2d (mean | log-variance);
+//! - decoder: Linear d -> 256, ReLU, Linear 256 -> 512, ReLU, reshaped to 32 x 4 x 4,
+//!   3 x [ConvTranspose2d 32 -> 32, kernel 4, stride 2, padding 1, ReLU], ConvTranspose2d
+//!   32 -> 3 (the pixel logits).
+//!
+//! Layouts are PyTorch's for the convolutions (`[out, in, k, k]`, transposed `[in, out, k, k]`,
+//! pictures `NCHW`); the dense layers are [`HostLayer`]s (`[in, out]`, as in the dense networks).
+//! Every product runs on [`ugl_kernels`]' deterministic kernels, so a forward pass has the same
+//! bits on every SIMD path and for every thread count.
+//!
+//! Initialisation: PyTorch's defaults, which the authors' code kept: every weight and bias
+//! uniform in `±1/sqrt(fan_in)` (`kaiming_uniform(a = sqrt(5))` for the weights), with
+//! PyTorch's fan-in (`in x k x k` for a convolution, `out x k x k` for a transposed one: its
+//! weight's second dimension). The draws come from the learner's stream, layer by layer in the
+//! order above, weight then bias.
+
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+use ugl_kernels::{Conv2d, ConvTranspose2d};
+
+use super::host_train::{dense_forward, relu_in_place};
+use super::nets::HostLayer;
+use crate::seed::Stream;
+
+/// Kernel side of every convolution.
+pub const KERNEL: usize = 4;
+/// Stride of every convolution.
+pub const STRIDE: usize = 2;
+/// Zero padding of every convolution.
+pub const PADDING: usize = 1;
+/// Stride-2 convolutions in the encoder (and transposed ones in the decoder).
+pub const CONV_LAYERS: usize = 4;
+
+/// The sizes of a convolutional VAE. [`ConvArch::followup`] is the authors'.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvArch {
+    /// Channels of a picture (3: RGB).
+    pub channels: usize,
+    /// Side of a (square) picture, a multiple of 16 (64).
+    pub side: usize,
+    /// Channels of every hidden convolution (32).
+    pub filters: usize,
+    /// Width of the dense layers (256).
+    pub hidden: usize,
+    /// Latent dimensions d (10).
+    pub latents: usize,
+}
+
+impl ConvArch {
+    /// The follow-up's network: 64x64 RGB pictures, 32 filters, 256 hidden units.
+    pub fn followup(latents: usize) -> ConvArch {
+        ConvArch {
+            channels: 3,
+            side: 64,
+            filters: 32,
+            hidden: 256,
+            latents,
+        }
+    }
+
+    /// Why these sizes cannot make a network, if they cannot.
+    pub fn check(&self) -> Result<(), String> {
+        let side_unit = 1 << CONV_LAYERS;
+        if self.side == 0 || !self.side.is_multiple_of(side_unit) {
+            return Err(format!(
+                "the picture side must be a positive multiple of {side_unit} (four stride-2 \
+                 convolutions), got {}",
+                self.side
+            ));
+        }
+        for (what, v) in [
+            ("channels", self.channels),
+            ("filters", self.filters),
+            ("hidden", self.hidden),
+            ("latents", self.latents),
+        ] {
+            if v == 0 {
+                return Err(format!("{what} must be at least 1"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Values of one picture.
+    pub fn image_len(&self) -> usize {
+        self.channels * self.side * self.side
+    }
+
+    /// Side of the encoder's last feature map.
+    pub fn bottom_side(&self) -> usize {
+        self.side >> CONV_LAYERS
+    }
+
+    /// Values of the flattened last feature map (512).
+    pub fn flat(&self) -> usize {
+        self.filters * self.bottom_side() * self.bottom_side()
+    }
+
+    /// The shape of encoder convolution `i` (0: the picture's).
+    pub fn conv(&self, i: usize) -> Conv2d {
+        let side = self.side >> i;
+        Conv2d {
+            channels_in: if i == 0 { self.channels } else { self.filters },
+            channels_out: self.filters,
+            kernel: KERNEL,
+            stride: STRIDE,
+            padding: PADDING,
+            height: side,
+            width: side,
+        }
+    }
+
+    /// The shape of decoder transposed convolution `i` (the last one: the picture's).
+    pub fn deconv(&self, i: usize) -> ConvTranspose2d {
+        let side = self.bottom_side() << i;
+        ConvTranspose2d {
+            channels_in: self.filters,
+            channels_out: if i + 1 == CONV_LAYERS {
+                self.channels
+            } else {
+                self.filters
+            },
+            kernel: KERNEL,
+            stride: STRIDE,
+            padding: PADDING,
+            height: side,
+            width: side,
+        }
+    }
+}
+
+/// A convolution's weights: `w` `[out, in, k, k]`, `b` `[out]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConvLayer {
+    pub shape: Conv2d,
+    pub w: Vec<f32>,
+    pub b: Vec<f32>,
+}
+
+/// A transposed convolution's weights: `w` `[in, out, k, k]`, `b` `[out]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeconvLayer {
+    pub shape: ConvTranspose2d,
+    pub w: Vec<f32>,
+    pub b: Vec<f32>,
+}
+
+/// The whole convolutional VAE's weights on the host.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConvNet {
+    pub arch: ConvArch,
+    /// Encoder convolutions, picture first.
+    pub enc_conv: Vec<ConvLayer>,
+    /// Encoder dense layers: flat -> hidden, hidden -> hidden.
+    pub enc_fc: [HostLayer; 2],
+    /// hidden -> 2d (mean | log-variance).
+    pub head: HostLayer,
+    /// Decoder dense layers: d -> hidden, hidden -> flat.
+    pub dec_fc: [HostLayer; 2],
+    /// Decoder transposed convolutions, picture last.
+    pub dec_conv: Vec<DeconvLayer>,
+}
+
+/// `n` draws of PyTorch's default initialisation for a fan-in: `U(-1/sqrt(fan_in),
+/// 1/sqrt(fan_in))`.
+fn torch_uniform(rng: &mut Stream, n: usize, fan_in: usize) -> Vec<f32> {
+    let bound = 1.0 / (fan_in as f64).sqrt();
+    (0..n)
+        .map(|_| (bound * (2.0 * rng.random::<f64>() - 1.0)) as f32)
+        .collect()
+}
+
+fn dense(rng: &mut Stream, inp: usize, out: usize) -> HostLayer {
+    HostLayer {
+        inp,
+        out,
+        w: torch_uniform(rng, inp * out, inp),
+        b: torch_uniform(rng, out, inp),
+    }
+}
+
+impl ConvNet {
+    /// Fresh weights from `rng` (PyTorch's default initialisation; module docs).
+    ///
+    /// # Panics
+    /// If `arch` does not pass [`ConvArch::check`] (the learner checks it first).
+    pub fn init(rng: &mut Stream, arch: ConvArch) -> ConvNet {
+        if let Err(e) = arch.check() {
+            panic!("ConvNet::init: {e}");
+        }
+        let k2 = KERNEL * KERNEL;
+        let enc_conv = (0..CONV_LAYERS)
+            .map(|i| {
+                let shape = arch.conv(i);
+                let fan_in = shape.channels_in * k2;
+                ConvLayer {
+                    shape,
+                    w: torch_uniform(rng, shape.weight_len(), fan_in),
+                    b: torch_uniform(rng, shape.channels_out, fan_in),
+                }
+            })
+            .collect();
+        let enc_fc = [
+            dense(rng, arch.flat(), arch.hidden),
+            dense(rng, arch.hidden, arch.hidden),
+        ];
+        let head = dense(rng, arch.hidden, 2 * arch.latents);
+        let dec_fc = [
+            dense(rng, arch.latents, arch.hidden),
+            dense(rng, arch.hidden, arch.flat()),
+        ];
+        let dec_conv = (0..CONV_LAYERS)
+            .map(|i| {
+                let shape = arch.deconv(i);
+                let fan_in = shape.channels_out * k2;
+                DeconvLayer {
+                    shape,
+                    w: torch_uniform(rng, shape.weight_len(), fan_in),
+                    b: torch_uniform(rng, shape.channels_out, fan_in),
+                }
+            })
+            .collect();
+        ConvNet {
+            arch,
+            enc_conv,
+            enc_fc,
+            head,
+            dec_fc,
+            dec_conv,
+        }
+    }
+
+    /// Every parameter buffer, in the order of [`ConvNet::init`] (weight then bias per layer).
+    pub fn params(&self) -> Vec<&[f32]> {
+        let mut out: Vec<&[f32]> = Vec::with_capacity(26);
+        for l in &self.enc_conv {
+            out.extend([l.w.as_slice(), l.b.as_slice()]);
+        }
+        for l in self.enc_fc.iter().chain([&self.head]).chain(&self.dec_fc) {
+            out.extend([l.w.as_slice(), l.b.as_slice()]);
+        }
+        for l in &self.dec_conv {
+            out.extend([l.w.as_slice(), l.b.as_slice()]);
+        }
+        out
+    }
+
+    /// [`ConvNet::params`], mutable.
+    pub fn params_mut(&mut self) -> Vec<&mut [f32]> {
+        let mut out: Vec<&mut [f32]> = Vec::with_capacity(26);
+        for l in &mut self.enc_conv {
+            out.extend([l.w.as_mut_slice(), l.b.as_mut_slice()]);
+        }
+        for l in self
+            .enc_fc
+            .iter_mut()
+            .chain([&mut self.head])
+            .chain(&mut self.dec_fc)
+        {
+            out.extend([l.w.as_mut_slice(), l.b.as_mut_slice()]);
+        }
+        for l in &mut self.dec_conv {
+            out.extend([l.w.as_mut_slice(), l.b.as_mut_slice()]);
+        }
+        out
+    }
+
+    /// The number of weights and biases.
+    pub fn num_params(&self) -> usize {
+        self.params().iter().map(|p| p.len()).sum()
+    }
+
+    /// The encoder's head outputs (`[n, 2d]`: mean | log-variance) of `n` pictures (`NCHW`).
+    pub fn encode_heads(&self, pictures: &[f32], n: usize) -> Vec<f32> {
+        let mut acts = EncoderActivations::default();
+        self.encoder_forward(pictures, n, &mut acts);
+        acts.heads
+    }
+
+    /// The encoder's forward pass, keeping every activation (the trainer's backward reads them).
+    pub(super) fn encoder_forward(&self, x: &[f32], n: usize, acts: &mut EncoderActivations) {
+        acts.conv.resize_with(CONV_LAYERS, Vec::new);
+        for (i, l) in self.enc_conv.iter().enumerate() {
+            let (done, rest) = acts.conv.split_at_mut(i);
+            let input = if i == 0 { x } else { &done[i - 1] };
+            let out = &mut rest[0];
+            out.resize(n * l.shape.out_len(), 0.0);
+            l.shape.forward(n, input, &l.w, Some(&l.b), out);
+            relu_in_place(out);
+        }
+        let h = self.arch.hidden;
+        acts.h1.resize(n * h, 0.0);
+        dense_forward(
+            &self.enc_fc[0],
+            &acts.conv[CONV_LAYERS - 1],
+            n,
+            &mut acts.h1,
+        );
+        relu_in_place(&mut acts.h1);
+        acts.h2.resize(n * h, 0.0);
+        dense_forward(&self.enc_fc[1], &acts.h1, n, &mut acts.h2);
+        relu_in_place(&mut acts.h2);
+        acts.heads.resize(n * 2 * self.arch.latents, 0.0);
+        dense_forward(&self.head, &acts.h2, n, &mut acts.heads);
+    }
+
+    /// The pixel logits (`[n, C, S, S]`) of `n` codes (`[n, d]`).
+    pub fn decode_logits(&self, z: &[f32], n: usize) -> Vec<f32> {
+        let mut acts = DecoderActivations::default();
+        self.decoder_forward(z, n, &mut acts);
+        acts.logits
+    }
+
+    /// The decoder's forward pass, keeping every activation.
+    pub(super) fn decoder_forward(&self, z: &[f32], n: usize, acts: &mut DecoderActivations) {
+        let (h, flat) = (self.arch.hidden, self.arch.flat());
+        acts.g1.resize(n * h, 0.0);
+        dense_forward(&self.dec_fc[0], z, n, &mut acts.g1);
+        relu_in_place(&mut acts.g1);
+        acts.g2.resize(n * flat, 0.0);
+        dense_forward(&self.dec_fc[1], &acts.g1, n, &mut acts.g2);
+        relu_in_place(&mut acts.g2);
+        acts.deconv.resize_with(CONV_LAYERS - 1, Vec::new);
+        for (i, l) in self.dec_conv.iter().enumerate() {
+            let out_len = n * l.shape.out_len();
+            let last = i + 1 == CONV_LAYERS;
+            let (done, rest) = acts.deconv.split_at_mut(i.min(CONV_LAYERS - 1));
+            let input = if i == 0 { &acts.g2 } else { &done[i - 1] };
+            let out = if last { &mut acts.logits } else { &mut rest[0] };
+            out.resize(out_len, 0.0);
+            l.shape.forward(n, input, &l.w, Some(&l.b), out);
+            if !last {
+                relu_in_place(out);
+            }
+        }
+    }
+}
+
+/// The encoder's activations of one batch (after each ReLU; the heads before any).
+#[derive(Default)]
+pub(super) struct EncoderActivations {
+    /// After each convolution's ReLU.
+    pub conv: Vec<Vec<f32>>,
+    pub h1: Vec<f32>,
+    pub h2: Vec<f32>,
+    pub heads: Vec<f32>,
+}
+
+/// The decoder's activations of one batch.
+#[derive(Default)]
+pub(super) struct DecoderActivations {
+    pub g1: Vec<f32>,
+    /// The second dense layer's output after its ReLU: the first transposed convolution's input.
+    pub g2: Vec<f32>,
+    /// After each hidden transposed convolution's ReLU.
+    pub deconv: Vec<Vec<f32>>,
+    pub logits: Vec<f32>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seed::stream_named;
+
+    #[test]
+    fn the_followups_network_has_its_authors_shapes() {
+        let arch = ConvArch::followup(10);
+        arch.check().unwrap();
+        assert_eq!(arch.flat(), 512);
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        // The tensor sizes of the authors' released weights: 4 convolutions (3->32, 3 x 32->32,
+        // 4x4), 512-256-256-20 and 10-256-512 dense layers, 4 transposed convolutions.
+        let conv = 32 * 3 * 16 + 32 + 3 * (32 * 32 * 16 + 32);
+        let fc = (512 * 256 + 256) + (256 * 256 + 256) + (256 * 20 + 20);
+        let dec_fc = (10 * 256 + 256) + (256 * 512 + 512);
+        let deconv = 3 * (32 * 32 * 16 + 32) + (32 * 3 * 16 + 3);
+        assert_eq!(net.num_params(), conv + fc + dec_fc + deconv);
+        assert_eq!(net.dec_conv[3].shape.out_height(), 64);
+        assert_eq!(net.enc_conv[3].shape.out_height(), 4);
+        // PyTorch's bounds: the first convolution's fan-in is 3 x 16.
+        let bound = 1.0 / 48f32.sqrt();
+        assert!(net.enc_conv[0].w.iter().all(|w| w.abs() <= bound));
+        assert!(net.enc_conv[0].w.iter().any(|w| w.abs() > 0.9 * bound));
+        assert_eq!(
+            net.encode_heads(&vec![0.5; 2 * arch.image_len()], 2).len(),
+            40
+        );
+        assert_eq!(net.decode_logits(&[0.1; 20], 2).len(), 2 * 3 * 64 * 64);
+    }
+
+    #[test]
+    fn sizes_that_make_no_network_are_refused() {
+        let arch = ConvArch::followup(10);
+        assert!(ConvArch { side: 60, ..arch }.check().is_err());
+        assert!(ConvArch { side: 0, ..arch }.check().is_err());
+        assert!(ConvArch { latents: 0, ..arch }.check().is_err());
+        assert!(ConvArch { filters: 0, ..arch }.check().is_err());
+    }
+}
