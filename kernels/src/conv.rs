@@ -19,9 +19,6 @@ use crate::matmul::{MatRef, matmul_on};
 use crate::path::{SimdPath, active_path};
 use rayon::prelude::*;
 
-/// Images whose `im2row` matrices a weight gradient builds at once (in parallel).
-const IM2ROW_GROUP: usize = 8;
-
 /// The output positions `lo..hi` (of `n`) whose input column `o * stride + off` lies inside
 /// `0..len`.
 fn inside(off: isize, stride: usize, n: usize, len: usize) -> (usize, usize) {
@@ -131,51 +128,60 @@ impl Conv2d {
                 if lo < hi {
                     let first = ((lo * s) as isize + off) as usize;
                     let src = &src[first..];
-                    for (j, v) in line[lo..hi].iter_mut().enumerate() {
-                        *v = src[j * s];
+                    let line = &mut line[lo..hi];
+                    if s == 2 && src.len() >= 2 * line.len() {
+                        // The follow-up's stride: every other value, in pairs (vectorised).
+                        for (v, pair) in line.iter_mut().zip(src.chunks_exact(2)) {
+                            *v = pair[0];
+                        }
+                    } else {
+                        for (j, v) in line.iter_mut().enumerate() {
+                            *v = src[j * s];
+                        }
                     }
                 }
             }
         }
     }
 
-    /// The `im2row` matrix of one image, `[pixels, patch]`: row `(oy, ox)` holds the input values
-    /// under the kernel at output pixel `(oy, ox)`, ordered `(c, ky, kx)` (0 in the padding).
-    fn im2row(&self, img: &[f32], out: &mut [f32]) {
+    /// Columns `segs.start * k .. segs.end * k` of the `im2row` matrix of one image,
+    /// `[pixels, patch]`: row `(oy, ox)` holds the input values under the kernel at output pixel
+    /// `(oy, ox)`, ordered `(c, ky, kx)` (0 in the padding). A segment is one `(c, ky)`: `k`
+    /// consecutive columns. `out` is `[pixels, segs.len() * k]`.
+    fn im2row(&self, img: &[f32], segs: std::ops::Range<usize>, out: &mut [f32]) {
         let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
-        let (oh, ow, patch) = (self.out_height(), self.out_width(), self.patch());
+        let (oh, ow) = (self.out_height(), self.out_width());
         let (h, w) = (self.height as isize, self.width as isize);
+        let width = segs.len() * k;
         for oy in 0..oh {
             for ox in 0..ow {
-                let dst = &mut out[(oy * ow + ox) * patch..][..patch];
+                let dst = &mut out[(oy * ow + ox) * width..][..width];
                 let x0 = (ox * s) as isize - p;
                 let inside = x0 >= 0 && x0 + k as isize <= w;
-                for c in 0..self.channels_in {
-                    let plane = &img[c * self.height * self.width..][..self.height * self.width];
-                    for ky in 0..k {
-                        let seg = &mut dst[(c * k + ky) * k..][..k];
-                        let y = (oy * s + ky) as isize - p;
-                        if y < 0 || y >= h {
-                            seg.fill(0.0);
-                            continue;
-                        }
-                        let line = &plane[y as usize * self.width..][..self.width];
-                        if inside && k == 4 {
-                            // The follow-up's kernel: a fixed-size move, not a call to memcpy.
-                            let src: [f32; 4] = line[x0 as usize..][..4].try_into().expect("4");
-                            let dst: &mut [f32; 4] = seg.try_into().expect("4");
-                            *dst = src;
-                        } else if inside {
-                            seg.copy_from_slice(&line[x0 as usize..][..k]);
-                        } else {
-                            for (kx, v) in seg.iter_mut().enumerate() {
-                                let xx = x0 + kx as isize;
-                                *v = if xx < 0 || xx >= w {
-                                    0.0
-                                } else {
-                                    line[xx as usize]
-                                };
-                            }
+                for (j, sg) in segs.clone().enumerate() {
+                    let (c, ky) = (sg / k, sg % k);
+                    let seg = &mut dst[j * k..][..k];
+                    let y = (oy * s + ky) as isize - p;
+                    if y < 0 || y >= h {
+                        seg.fill(0.0);
+                        continue;
+                    }
+                    let line = &img[(c * self.height + y as usize) * self.width..][..self.width];
+                    if inside && k == 4 {
+                        // The follow-up's kernel: a fixed-size move, not a call to memcpy.
+                        let src: [f32; 4] = line[x0 as usize..][..4].try_into().expect("4");
+                        let dst: &mut [f32; 4] = seg.try_into().expect("4");
+                        *dst = src;
+                    } else if inside {
+                        seg.copy_from_slice(&line[x0 as usize..][..k]);
+                    } else {
+                        for (kx, v) in seg.iter_mut().enumerate() {
+                            let xx = x0 + kx as isize;
+                            *v = if xx < 0 || xx >= w {
+                                0.0
+                            } else {
+                                line[xx as usize]
+                            };
                         }
                     }
                 }
@@ -207,8 +213,15 @@ impl Conv2d {
                         }
                         let first = ((lo * s) as isize + off) as usize;
                         let line = &mut line[first..];
-                        for (j, &g) in src[oy * ow + lo..oy * ow + hi].iter().enumerate() {
-                            line[j * s] += g;
+                        let src = &src[oy * ow + lo..oy * ow + hi];
+                        if s == 2 && line.len() >= 2 * src.len() {
+                            for (pair, &g) in line.chunks_exact_mut(2).zip(src) {
+                                pair[0] += g;
+                            }
+                        } else {
+                            for (j, &g) in src.iter().enumerate() {
+                                line[j * s] += g;
+                            }
                         }
                     }
                 }
@@ -346,31 +359,45 @@ impl Conv2d {
         );
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
         // Every weight's gradient is one chain over (image, pixel): image after image, each
-        // product continuing the chains where the previous one stored them. The big operand,
-        // the image's `im2row` matrix `[pixels, patch]`, is read in place by the product; the
-        // `im2row` matrices of a group of images are built in parallel.
-        let block = patch * pix;
-        let group = n.clamp(1, IM2ROW_GROUP);
-        let mut rows = vec![0.0f32; group * block];
-        for (g, imgs) in x.chunks(group * self.in_len().max(1)).enumerate() {
-            let count = imgs.len() / self.in_len().max(1);
-            rows[..count * block]
-                .par_chunks_mut(block.max(1))
-                .zip(imgs.par_chunks(self.in_len().max(1)))
-                .for_each(|(r, img)| self.im2row(img, r));
-            for j in 0..count {
-                let i = g * group + j;
-                matmul_on(
-                    path,
-                    dw,
-                    MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix),
-                    MatRef::row_major(&rows[j * block..][..block], pix, patch),
-                    i > 0,
-                );
+        // product continuing the chains where the previous one stored them. The threads share
+        // the weights, not the images: each takes a block of `(c, ky)` segments (columns of
+        // `dw`), builds those columns of every image's `im2row` matrix `[pixels, columns]` and
+        // reads it in place in its product. Which thread computes a weight never changes how.
+        let k = self.kernel;
+        let segs = self.channels_in * k;
+        let parts = rayon::current_num_threads().clamp(1, segs);
+        let per = segs.div_ceil(parts);
+        let blocks: Vec<(usize, Vec<f32>)> = (0..segs)
+            .step_by(per)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|s0| {
+                let range = s0..(s0 + per).min(segs);
+                let cols = range.len() * k;
+                let mut local = vec![0.0f32; co * cols];
+                let mut rows = vec![0.0f32; pix * cols];
+                for i in 0..n {
+                    self.im2row(
+                        &x[i * self.in_len()..][..self.in_len()],
+                        range.clone(),
+                        &mut rows,
+                    );
+                    matmul_on(
+                        path,
+                        &mut local,
+                        MatRef::row_major(&dy[i * self.out_len()..][..self.out_len()], co, pix),
+                        MatRef::row_major(&rows, pix, cols),
+                        i > 0,
+                    );
+                }
+                (s0 * k, local)
+            })
+            .collect();
+        for (c0, local) in blocks {
+            let cols = local.len() / co;
+            for (o, row) in local.chunks_exact(cols).enumerate() {
+                dw[o * patch + c0..][..cols].copy_from_slice(row);
             }
-        }
-        if n == 0 {
-            dw.fill(0.0);
         }
         if let Some(db) = db {
             assert_eq!(db.len(), co, "conv2d: bias-gradient length");
