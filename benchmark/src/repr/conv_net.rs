@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use ugl_kernels::{Conv2d, ConvTranspose2d};
 
 use super::host_train::{dense_forward, relu_in_place};
+use super::model_file::ModelFileError;
 use super::nets::HostLayer;
 use crate::seed::Stream;
 
@@ -345,6 +346,82 @@ impl ConvNet {
     }
 }
 
+/// What a convolutional network's model file says in its header.
+#[derive(Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConvFileHeader {
+    /// Always [`CONV_FILE_KIND`].
+    kind: String,
+    arch: ConvArch,
+}
+
+/// The `kind` of a convolutional network's model file.
+const CONV_FILE_KIND: &str = "conv-vae";
+
+impl ConvNet {
+    /// The weights as a sealed model file ([`super::model_file::seal`]): a JSON header with the
+    /// architecture, then every parameter buffer of [`ConvNet::params`] as little-endian `f32`.
+    pub fn to_model_bytes(&self) -> Vec<u8> {
+        let header = serde_json::to_vec(&ConvFileHeader {
+            kind: CONV_FILE_KIND.to_string(),
+            arch: self.arch,
+        })
+        .expect("a header serialises");
+        let payload: Vec<u8> = self
+            .params()
+            .iter()
+            .flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes()))
+            .collect();
+        super::model_file::seal(&header, &payload)
+    }
+
+    /// Read back [`ConvNet::to_model_bytes`]; `Err` says why the bytes cannot be trusted
+    /// (damaged, another kind of model, sizes that make no network, a payload of another
+    /// length).
+    pub fn from_model_bytes(bytes: &[u8]) -> Result<ConvNet, ModelFileError> {
+        let (header, payload) = super::model_file::unseal(bytes)?;
+        let header: ConvFileHeader =
+            serde_json::from_slice(header).map_err(|e| ModelFileError::Header(e.to_string()))?;
+        if header.kind != CONV_FILE_KIND {
+            return Err(ModelFileError::Content(format!(
+                "a {} model file, not a convolutional VAE's",
+                header.kind
+            )));
+        }
+        header.arch.check().map_err(ModelFileError::Content)?;
+        // Shapes from the architecture; values from the payload.
+        let mut net = ConvNet::init(&mut crate::seed::stream_named(0, "shapes"), header.arch);
+        let want: usize = net.num_params() * 4;
+        if payload.len() != want {
+            return Err(ModelFileError::Content(format!(
+                "the payload holds {} bytes; this architecture needs {want}",
+                payload.len()
+            )));
+        }
+        let mut values = payload
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")));
+        for p in net.params_mut() {
+            for v in p.iter_mut() {
+                *v = values.next().expect("length checked");
+            }
+        }
+        Ok(net)
+    }
+}
+
+/// A picture stored rows first with its channels last (`HWC`, as `armballs-corl` renders and
+/// the data sets store it) in the networks' channel-major layout (`CHW`).
+pub fn channels_first(picture: &[f32], channels: usize, out: &mut [f32]) {
+    assert_eq!(picture.len(), out.len(), "channels_first: lengths differ");
+    let pixels = picture.len() / channels.max(1);
+    for (p, px) in picture.chunks_exact(channels).enumerate() {
+        for (c, &v) in px.iter().enumerate() {
+            out[c * pixels + p] = v;
+        }
+    }
+}
+
 /// The encoder's activations of one batch (after each ReLU; the heads before any).
 #[derive(Default)]
 pub(super) struct EncoderActivations {
@@ -404,5 +481,58 @@ mod tests {
         assert!(ConvArch { side: 0, ..arch }.check().is_err());
         assert!(ConvArch { latents: 0, ..arch }.check().is_err());
         assert!(ConvArch { filters: 0, ..arch }.check().is_err());
+    }
+
+    #[test]
+    fn a_model_file_round_trips_and_damage_is_refused() {
+        let arch = ConvArch {
+            channels: 2,
+            side: 16,
+            filters: 3,
+            hidden: 5,
+            latents: 2,
+        };
+        let net = ConvNet::init(&mut stream_named(4, "conv"), arch);
+        let bytes = net.to_model_bytes();
+        assert_eq!(ConvNet::from_model_bytes(&bytes).unwrap(), net);
+        let mut damaged = bytes.clone();
+        let mid = damaged.len() / 2;
+        damaged[mid] ^= 1;
+        assert_eq!(
+            ConvNet::from_model_bytes(&damaged).unwrap_err(),
+            ModelFileError::Checksum
+        );
+        // A sound file of another payload length (a network of other sizes, same header).
+        let other = ConvNet::init(&mut stream_named(4, "conv"), ConvArch { hidden: 6, ..arch });
+        let (_, payload) = super::super::model_file::unseal(&other.to_model_bytes())
+            .map(|(h, p)| (h.to_vec(), p.to_vec()))
+            .unwrap();
+        let (header, _) = super::super::model_file::unseal(&bytes).unwrap();
+        let mixed = super::super::model_file::seal(header, &payload);
+        let err = ConvNet::from_model_bytes(&mixed).unwrap_err();
+        assert!(err.to_string().contains("payload holds"), "{err}");
+        // Another kind of file.
+        let alien = super::super::model_file::seal(
+            br#"{"kind":"pca","arch":{"channels":2,"side":16,"filters":3,"hidden":5,"latents":2}}"#,
+            &[],
+        );
+        assert!(ConvNet::from_model_bytes(&alien).is_err());
+    }
+
+    #[test]
+    fn the_followups_pictures_go_channel_first() {
+        use crate::env::cdge::{VALUES, normalise, render_rgb};
+        let mut raw = vec![0u8; VALUES];
+        // The yellow ball (red and green) left, the blue distractor right.
+        render_rgb([-0.5, 0.0], [0.5, 0.0], 0.17, 0.15, &mut raw);
+        let mut hwc = vec![0.0f32; VALUES];
+        normalise(&raw, &mut hwc);
+        let mut chw = vec![0.0f32; VALUES];
+        channels_first(&hwc, 3, &mut chw);
+        let plane = |c: usize| &chw[c * 4096..(c + 1) * 4096];
+        // Row 32, the ball's centre column 16 and the distractor's 48.
+        let at = |c: usize, x: usize| plane(c)[32 * 64 + x];
+        assert_eq!([at(0, 16), at(1, 16), at(2, 16)], [1.0, 1.0, 0.0]);
+        assert_eq!([at(0, 48), at(1, 48), at(2, 48)], [0.0, 0.0, 1.0]);
     }
 }
