@@ -1,15 +1,25 @@
 #!/usr/bin/env bash
-# The follow-up's convolution stack side by side: ours (criterion bench `conv` of ugl-kernels) and
-# PyTorch's (scripts/torch_conv_stack.py), the same layers and batch, alternating, at 1 and 2
-# threads. Prints both medians and torch / ugl (> 1: ours faster). Run it on an idle machine.
+# The follow-up's convolutions side by side with PyTorch, the same layers and batch (64),
+# alternating, at 1 and 2 threads. Prints both medians and torch / ugl (> 1: ours faster). Run it
+# on an otherwise idle machine (no build, no campaign).
+#   stack (default): the eight convolution layers, forward and every gradient (criterion bench
+#                    `conv` of ugl-kernels; scripts/torch_conv_stack.py);
+#   step:            one training iteration of the convolutional beta-VAE (criterion bench
+#                    `conv_step` of ugl-bench; scripts/torch_conv_vae_step.py).
 #
-# Usage: scripts/conv_side_by_side.sh [ROUNDS (default 2)]. Needs python3 with torch.
+# Usage: scripts/conv_side_by_side.sh [stack|step] [ROUNDS (default 2)]. Needs python3 with torch.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+what=stack
+case ${1:-} in stack|step) what=$1; shift ;; esac
 rounds=${1:-2}
-bench=$(cargo bench -p ugl-kernels --profile dev --bench conv --no-run 2>&1 |
+case $what in
+  stack) crate=ugl-kernels bench_name=conv torch_script=scripts/torch_conv_stack.py iters=20 ;;
+  step) crate=ugl-bench bench_name=conv_step torch_script=scripts/torch_conv_vae_step.py iters=30 ;;
+esac
+bench=$(cargo bench -p "$crate" --profile dev --bench "$bench_name" --no-run 2>&1 |
   sed -n 's/.*Executable .*(\(.*\))$/\1/p' | tail -1)
-[ -x "$bench" ] || { echo "could not build the conv bench" >&2; exit 1; }
+[ -x "$bench" ] || { echo "could not build the $bench_name bench" >&2; exit 1; }
 ugl_ms() {
   RAYON_NUM_THREADS=$1 "$bench" --bench 2>/dev/null |
     awk '/time:/ { v = $4; u = $5; sub(/\]/, "", u);
@@ -17,7 +27,7 @@ ugl_ms() {
                    print v; exit }'
 }
 torch_ms() {
-  python3 scripts/torch_conv_stack.py --threads "$1" --iters 20 | sed -n 's/.*median \([0-9.]*\) ms.*/\1/p'
+  python3 "$torch_script" --threads "$1" --iters "$iters" | sed -n 's/.*median \([0-9.]*\) ms.*/\1/p'
 }
 printf '%7s %5s %10s %10s %9s\n' threads round ugl_ms torch_ms torch/ugl
 for r in $(seq 1 "$rounds"); do

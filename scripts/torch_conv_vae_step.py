@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """PyTorch (CPU) side of the follow-up's training-speed comparison: one training iteration of
 the authors' convolutional beta-VAE, as `benchmark/benches/conv_step.rs` times it in Rust
-(`scripts/conv_step_side_by_side.sh` alternates the two and prints the ratio).
+(`scripts/conv_side_by_side.sh step` alternates the two and prints the ratio).
 
 The same work per iteration: a batch of 64 RGB pictures of 64x64 (two coloured discs on black,
 values in [0, 1]); encoder 4 x [Conv2d 32, kernel 4, stride 2, padding 1, ReLU] -> 512 -> 256 ReLU

@@ -1,6 +1,6 @@
 //! One training iteration of the follow-up's convolutional β-VAE (`repr/conv_train.rs`): batch
 //! 64 of 64x64 RGB pictures of the follow-up's ArmBalls, forward, the capacity-annealed loss,
-//! backward and the Adam step. `scripts/conv_step_side_by_side.sh` times it against PyTorch's
+//! backward and the Adam step. `scripts/conv_side_by_side.sh step` times it against PyTorch's
 //! same iteration (`scripts/torch_conv_vae_step.py`).
 //! Run: `cargo bench -p ugl-bench --profile dev --bench conv_step`
 //! (threads: `RAYON_NUM_THREADS=1` for a single-thread run).

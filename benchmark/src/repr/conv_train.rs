@@ -19,10 +19,11 @@ use burn::tensor::Device;
 
 use super::ReprError;
 use super::conv_net::{CONV_LAYERS, ConvNet, DecoderActivations, EncoderActivations};
-use super::host_train::{HostOptimizer, bce_and_grad, dense_backward, relu_backward, sized};
+use super::host_train::{
+    HostOptimizer, Middle, bce_and_grad, dense_backward, relu_backward, sized,
+};
 use super::nets::TfAdam;
 use super::neural_config::{Model, NeuralConfig};
-use super::neural_model::{LatentInput, tensor2};
 use crate::seed::Stream;
 
 /// Index of the first gradient buffer of each layer group in [`ConvNet::params`] order.
@@ -120,27 +121,11 @@ impl ConvTrainer {
         net.encoder_forward(x, n, &mut ws.enc);
 
         // The model's middle on burn's autodiff.
-        let heads = tensor2(ws.enc.heads.clone(), n, 2 * d, &self.device).require_grad();
-        let input = LatentInput {
-            batch: n,
-            latents: d,
-            step,
-            warmup: cfg.warmup,
-            beta: cfg.beta.unwrap_or(1.0),
-            capacity: cfg.capacity_at(step),
-            variant: cfg.variant,
-            device: &self.device,
-        };
-        let latent = model.spec().latent(heads.clone(), &input, rng);
-        ws.z = latent
-            .z
-            .clone()
-            .into_data()
-            .try_into_vec::<f32>()
-            .map_err(|e| ReprError::Numerical(format!("reading the latent code: {e:?}")))?;
+        let middle = Middle::forward(model, cfg, &ws.enc.heads, n, d, step, &self.device, rng)?;
+        ws.z.clone_from(&middle.z);
 
         net.decoder_forward(&ws.z, n, &mut ws.dec);
-        let scale = latent.rec_scale / n as f64;
+        let scale = middle.rec_scale() / n as f64;
         let per_image = bce_and_grad(
             &ws.dec.logits,
             x,
@@ -179,21 +164,7 @@ impl ConvTrainer {
             dense_backward(&net.dec_fc[0], &ws.z, dg1, n, gw, gb, Some(dz));
         }
 
-        // The middle's backward: d/dheads of sum(z * dz) + extra.
-        let dz = tensor2(ws.dz.clone(), n, d, &self.device);
-        let mut surrogate = (latent.z * dz).sum();
-        let mut extra_value = 0.0;
-        if let Some(extra) = latent.extra {
-            extra_value = f64::from(extra.clone().into_scalar::<f32>());
-            surrogate = surrogate + extra;
-        }
-        let graph = surrogate.backward();
-        let dheads = heads
-            .grad(&graph)
-            .ok_or_else(|| ReprError::Numerical("no gradient for the encoder heads".into()))?
-            .into_data()
-            .try_into_vec::<f32>()
-            .map_err(|e| ReprError::Numerical(format!("reading head gradients: {e:?}")))?;
+        let (dheads, extra_value) = middle.backward(&ws.dz, &self.device)?;
 
         // Encoder backward: the dense layers, then the convolutions, last first.
         {
@@ -234,6 +205,7 @@ mod tests {
     use super::*;
     use crate::repr::conv_net::ConvArch;
     use crate::repr::nets::bce_with_logits_sum;
+    use crate::repr::neural_model::LatentInput;
     use crate::seed::stream_named;
     use burn::tensor::activation::relu;
     use burn::tensor::module::{conv_transpose2d, conv2d};

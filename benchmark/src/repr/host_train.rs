@@ -29,7 +29,7 @@
 //! last bits (other summation orders); a test checks that both engines compute the same loss and
 //! the same update to float precision.
 
-use burn::tensor::Device;
+use burn::tensor::{Device, Tensor};
 use rayon::prelude::*;
 use ugl_kernels::MatRef;
 
@@ -37,7 +37,7 @@ use super::ReprError;
 use super::model_file::ModelFileError;
 use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
 use super::neural_config::{Model, NeuralConfig};
-use super::neural_model::{LatentInput, Optimiser, tensor2};
+use super::neural_model::{Latent, LatentInput, Optimiser, tensor2};
 use crate::seed::Stream;
 
 type View<'a> = MatRef<'a, f32>;
@@ -545,6 +545,84 @@ pub(super) fn sized(v: &mut Vec<f32>, n: usize) -> &mut Vec<f32> {
     v
 }
 
+/// The middle of one iteration of a host engine (the dense and the convolutional trainers): the
+/// model's code of the encoder's head outputs, on burn's autodiff
+/// ([`super::neural_model::NeuralModel::latent`]: one implementation per model).
+pub(super) struct Middle {
+    heads: Tensor<2>,
+    latent: Latent,
+    /// The latent code fed to the decoder, `[rows, d]`.
+    pub z: Vec<f32>,
+}
+
+impl Middle {
+    /// The code of the head outputs `heads` (`[rows, P]`) at iteration `step`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn forward(
+        model: Model,
+        cfg: &NeuralConfig,
+        heads: &[f32],
+        rows: usize,
+        latents: usize,
+        step: usize,
+        device: &Device,
+        rng: &mut Stream,
+    ) -> Result<Middle, ReprError> {
+        let width = heads.len() / rows.max(1);
+        let heads = tensor2(heads.to_vec(), rows, width, device).require_grad();
+        let input = LatentInput {
+            batch: rows,
+            latents,
+            step,
+            warmup: cfg.warmup,
+            beta: cfg.beta.unwrap_or(1.0),
+            capacity: cfg.capacity_at(step),
+            variant: cfg.variant,
+            device,
+        };
+        let latent = model.spec().latent(heads.clone(), &input, rng);
+        let z = latent
+            .z
+            .clone()
+            .into_data()
+            .try_into_vec::<f32>()
+            .map_err(|e| ReprError::Numerical(format!("reading the latent code: {e:?}")))?;
+        Ok(Middle { heads, latent, z })
+    }
+
+    /// How the loss scales the batch's summed reconstruction: `rec_scale / rows`.
+    pub(super) fn rec_scale(&self) -> f64 {
+        self.latent.rec_scale
+    }
+
+    /// The gradient of the head outputs from the decoder's gradient `dz` of the code, through
+    /// the surrogate `sum(z * dz) + extra` whose gradient is the true one; and the value of the
+    /// model's extra loss terms (the KL and flow terms; 0 for the AE).
+    pub(super) fn backward(
+        self,
+        dz: &[f32],
+        device: &Device,
+    ) -> Result<(Vec<f32>, f64), ReprError> {
+        let [rows, d] = self.latent.z.dims();
+        let dz = tensor2(dz.to_vec(), rows, d, device);
+        let mut surrogate = (self.latent.z * dz).sum();
+        let mut extra_value = 0.0;
+        if let Some(extra) = self.latent.extra {
+            extra_value = f64::from(extra.clone().into_scalar::<f32>());
+            surrogate = surrogate + extra;
+        }
+        let grads = surrogate.backward();
+        let dheads = self
+            .heads
+            .grad(&grads)
+            .ok_or_else(|| ReprError::Numerical("no gradient for the encoder heads".into()))?
+            .into_data()
+            .try_into_vec::<f32>()
+            .map_err(|e| ReprError::Numerical(format!("reading head gradients: {e:?}")))?;
+        Ok((dheads, extra_value))
+    }
+}
+
 /// A training in progress on the host engine: weights, optimiser state, workspace.
 pub struct HostTrainer {
     pub net: HostNet,
@@ -622,24 +700,8 @@ impl HostTrainer {
         dense_forward(&net.head, &ws.h2, rows, sized(&mut ws.heads, rows * p));
 
         // The model's middle on burn's autodiff.
-        let heads = tensor2(ws.heads.clone(), rows, p, &self.device).require_grad();
-        let input = LatentInput {
-            batch: rows,
-            latents: d,
-            step,
-            warmup: cfg.warmup,
-            beta: cfg.beta.unwrap_or(1.0),
-            capacity: cfg.capacity_at(step),
-            variant: cfg.variant,
-            device: &self.device,
-        };
-        let latent = model.spec().latent(heads.clone(), &input, rng);
-        ws.z = latent
-            .z
-            .clone()
-            .into_data()
-            .try_into_vec::<f32>()
-            .map_err(|e| ReprError::Numerical(format!("reading the latent code: {e:?}")))?;
+        let middle = Middle::forward(model, cfg, &ws.heads, rows, d, step, &self.device, rng)?;
+        ws.z.clone_from(&middle.z);
 
         // Decoder forward, the pixel loss and its gradient.
         dense_forward(&net.dec1, &ws.z, rows, sized(&mut ws.g1, rows * h2));
@@ -652,7 +714,7 @@ impl HostTrainer {
             rows,
             sized(&mut ws.logits, rows * dim),
         );
-        let scale = latent.rec_scale / rows as f64;
+        let scale = middle.rec_scale() / rows as f64;
         let per_row = bce_and_grad(
             &ws.logits,
             x,
@@ -710,21 +772,7 @@ impl HostTrainer {
             Some(sized(&mut ws.dz, rows * d)),
         );
 
-        // The middle's backward: d/dheads of sum(z * dz) + extra.
-        let dz = tensor2(ws.dz.clone(), rows, d, &self.device);
-        let mut surrogate = (latent.z * dz).sum();
-        let mut extra_value = 0.0;
-        if let Some(extra) = latent.extra {
-            extra_value = f64::from(extra.clone().into_scalar::<f32>());
-            surrogate = surrogate + extra;
-        }
-        let grads = surrogate.backward();
-        let dheads = heads
-            .grad(&grads)
-            .ok_or_else(|| ReprError::Numerical("no gradient for the encoder heads".into()))?
-            .into_data()
-            .try_into_vec::<f32>()
-            .map_err(|e| ReprError::Numerical(format!("reading head gradients: {e:?}")))?;
+        let (dheads, extra_value) = middle.backward(&ws.dz, &self.device)?;
 
         // Encoder backward.
         dense_backward(
