@@ -447,8 +447,8 @@ mod tests {
     /// below that bound means the codes carry what tells the pictures apart.
     ///
     /// At this tiny size (8 filters, 32 hidden units, 2 latents, 8 pictures) some fits stay on
-    /// the mean-picture plateau: 1 of 6 seeds at the authors' learning rate (1e-3), 2 of 6 at
-    /// 3e-3 (measured). So 4 fits are trained and 3 must leave it.
+    /// the mean-picture plateau: in a sweep by hand, 1 of 6 initial weights at the authors' learning
+    /// rate (1e-3) and 1 of 3 at 3e-3. So 4 fits are trained and 3 must leave it.
     #[test]
     fn training_beats_the_mean_picture() {
         let arch = ConvArch {
