@@ -12,7 +12,7 @@
 //! capacity-annealed objective, whose hyper-parameters are not public (section 2 of the sources):
 //! `[learners.bvae] capacity = C` selects it, the KL term becoming `β |mean_b KL_b − C_t|` with
 //! `C_t` rising linearly from 0 to C nats over the training (the follow-up code's
-//! `loss_function`, "Version 1", with its `c` ramp left out and γ = β). Without `capacity`, the
+//! `loss_function`, "Version 1", with γ = β; its warm-up ramp `c` when `warmup` is set). Without `capacity`, the
 //! plain β-VAE objective. The budget, init and size follow the ICLR recipe of
 //! `data/campaigns/paper.toml` (`docs/neural.md`).
 
