@@ -12,8 +12,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use ugl_bench::env::cdge::{VALUES, normalise, render_rgb};
 use ugl_bench::repr::conv_net::{ConvArch, ConvNet};
-use ugl_bench::repr::conv_train::ConvTrainer;
-use ugl_bench::repr::neural::{Model, NeuralConfig};
+use ugl_bench::repr::conv_train::{ConvConfig, ConvTrainer};
 use ugl_bench::seed::stream_named;
 
 const BATCH: usize = 64;
@@ -39,13 +38,13 @@ fn pictures(n: usize) -> Vec<f32> {
 
 fn bench(c: &mut Criterion) {
     let x = pictures(BATCH);
-    let cfg = NeuralConfig {
+    let cfg = ConvConfig {
         iterations: 100_000,
         warmup: 10_000,
-        beta: Some(4.0),
+        beta: 4.0,
         capacity: Some(12.0),
         batch: BATCH,
-        ..NeuralConfig::paper(Model::Bvae)
+        ..ConvConfig::followup_bvae()
     };
     let mut g = c.benchmark_group("conv_step");
     g.sample_size(10);
@@ -57,11 +56,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("followup-bvae/batch64", |b| {
         b.iter(|| {
             step += 1;
-            black_box(
-                trainer
-                    .step(Model::Bvae, &cfg, &x, BATCH, step, &mut rng)
-                    .unwrap(),
-            )
+            black_box(trainer.step(&cfg, &x, BATCH, step, &mut rng).unwrap())
         })
     });
     g.finish();

@@ -47,6 +47,10 @@ fn learners_config() -> LearnersConfig {
             text.push_str("warmup = 10\n");
         }
     }
+    // And every convolutional one.
+    for model in Learner::all().filter_map(Learner::conv_model) {
+        text.push_str(&format!("[{}]\n{TINY_CONV}", model.name()));
+    }
     let cfg: LearnersConfig = toml::from_str(&text).unwrap();
     cfg.validate().unwrap();
     cfg
@@ -54,6 +58,20 @@ fn learners_config() -> LearnersConfig {
 
 /// Tiny networks and budgets.
 const TINY: &str = "iterations = 20\nhidden = [32, 16]\n";
+const TINY_CONV: &str = "iterations = 6\nfilters = 4\nhidden = 16\nbatch = 8\n";
+
+/// The environments a learner is tried on: those that render the pictures it is built for,
+/// else ArmBall and ArmArrow.
+fn environments(learner: Learner) -> Vec<(EnvKind, usize)> {
+    match learner.entry().image {
+        Some(shape) => EnvKind::all()
+            .into_iter()
+            .filter(|k| k.spec().image == shape)
+            .flat_map(|k| [(k, 2), (k, 10)])
+            .collect(),
+        None => vec![(EnvKind::ARMBALL, 2), (EnvKind::ARMARROW, 10)],
+    }
+}
 
 #[test]
 fn every_registered_learner_conforms() {
@@ -63,7 +81,12 @@ fn every_registered_learner_conforms() {
             eprintln!("SKIPPED: external learner conformance (python3 with numpy not found)");
             continue;
         }
-        for (kind, latents) in [(EnvKind::ARMBALL, 2), (EnvKind::ARMARROW, 10)] {
+        let envs = environments(learner);
+        assert!(
+            !envs.is_empty(),
+            "{learner}: no environment renders its pictures"
+        );
+        for (kind, latents) in envs {
             let set = images(kind, 300);
             let l = make_learner(learner, &cfg, Some(Variant::Corrected)).unwrap();
             let who = format!("{} on {kind} with {latents} latents", learner.name());

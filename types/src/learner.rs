@@ -3,6 +3,8 @@
 //! ones. The science crate's registry (`ugl_bench::repr::registry`) pairs each entry with its
 //! implementation; the report reads this table alone.
 
+use crate::env::{ImageShape, RGB64};
+
 /// Whether a learner's goal space has a prior to sample goals from (`--sampler gaussian`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Prior {
@@ -48,8 +50,11 @@ pub struct LearnerInfo {
     /// Whether the paper evaluated it: the report gives the paper's learners fixed colours and
     /// markers, in the registry's order, and compares them with the paper's numbers.
     pub in_paper: bool,
-    /// The paper's training, for the dense neural learners (None: not a network).
+    /// The paper's training, for the dense neural learners (None: not a dense network).
     pub paper_training: Option<PaperTraining>,
+    /// The pictures it is built for (None: any vector of pixels); its runs need an environment
+    /// that renders them.
+    pub image: Option<ImageShape>,
 }
 
 const fn dense(iterations: usize, optimiser: &'static str, warmup: usize) -> PaperTraining {
@@ -72,6 +77,7 @@ pub static PCA: LearnerInfo = LearnerInfo {
     prior: Prior::None,
     in_paper: true,
     paper_training: None,
+    image: None,
 };
 pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     name: "pca-centred",
@@ -82,6 +88,7 @@ pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     prior: Prior::None,
     in_paper: false,
     paper_training: None,
+    image: None,
 };
 pub static ISOMAP: LearnerInfo = LearnerInfo {
     name: "isomap",
@@ -92,6 +99,7 @@ pub static ISOMAP: LearnerInfo = LearnerInfo {
     prior: Prior::None,
     in_paper: true,
     paper_training: None,
+    image: None,
 };
 pub static AE: LearnerInfo = LearnerInfo {
     name: "ae",
@@ -102,6 +110,7 @@ pub static AE: LearnerInfo = LearnerInfo {
     prior: Prior::None,
     in_paper: true,
     paper_training: Some(dense(200_000, "Adagrad", 0)),
+    image: None,
 };
 pub static VAE: LearnerInfo = LearnerInfo {
     name: "vae",
@@ -112,6 +121,7 @@ pub static VAE: LearnerInfo = LearnerInfo {
     prior: Prior::Always,
     in_paper: true,
     paper_training: Some(dense(100_000, "Adam", 0)),
+    image: None,
 };
 pub static RFVAE: LearnerInfo = LearnerInfo {
     name: "rfvae",
@@ -122,6 +132,7 @@ pub static RFVAE: LearnerInfo = LearnerInfo {
     prior: Prior::Always,
     in_paper: true,
     paper_training: Some(dense(50_000, "Adam", 10_000)),
+    image: None,
 };
 pub static BVAE: LearnerInfo = LearnerInfo {
     name: "bvae",
@@ -132,6 +143,29 @@ pub static BVAE: LearnerInfo = LearnerInfo {
     prior: Prior::Always,
     in_paper: false,
     paper_training: Some(dense(100_000, "Adam", 0)),
+    image: None,
+};
+pub static CONV_VAE: LearnerInfo = LearnerInfo {
+    name: "conv-vae",
+    algo: "rge-conv-vae",
+    display: "conv VAE",
+    description: "the follow-up's convolutional VAE (64x64 RGB pictures; encoding: the mean), Adam",
+    has_variants: false,
+    prior: Prior::Always,
+    in_paper: false,
+    paper_training: None,
+    image: Some(RGB64),
+};
+pub static CONV_BVAE: LearnerInfo = LearnerInfo {
+    name: "conv-bvae",
+    algo: "rge-conv-bvae",
+    display: "conv β-VAE",
+    description: "the follow-up's convolutional β-VAE, capacity-annealed (64x64 RGB pictures; encoding: the mean), Adam",
+    has_variants: false,
+    prior: Prior::Always,
+    in_paper: false,
+    paper_training: None,
+    image: Some(RGB64),
 };
 pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     name: "gaussian-projection",
@@ -142,6 +176,7 @@ pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     prior: Prior::None,
     in_paper: false,
     paper_training: None,
+    image: None,
 };
 pub static EXTERNAL: LearnerInfo = LearnerInfo {
     name: "external",
@@ -152,10 +187,11 @@ pub static EXTERNAL: LearnerInfo = LearnerInfo {
     prior: Prior::Declared,
     in_paper: false,
     paper_training: None,
+    image: None,
 };
 
 /// Every learner, in the report's order.
-pub static LEARNERS: [&LearnerInfo; 9] = [
+pub static LEARNERS: [&LearnerInfo; 11] = [
     &PCA,
     &PCA_CENTRED,
     &ISOMAP,
@@ -163,6 +199,8 @@ pub static LEARNERS: [&LearnerInfo; 9] = [
     &VAE,
     &RFVAE,
     &BVAE,
+    &CONV_VAE,
+    &CONV_BVAE,
     &GAUSSIAN_PROJECTION,
     &EXTERNAL,
 ];

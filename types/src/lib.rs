@@ -57,10 +57,11 @@ pub use learner::{LEARNERS, LearnerInfo, PaperTraining, Prior};
 /// Each learner's entry, by name (`ugl_types::learners::VAE`).
 pub mod learners {
     pub use crate::learner::{
-        AE, BVAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED, RFVAE, VAE,
+        AE, BVAE, CONV_BVAE, CONV_VAE, EXTERNAL, GAUSSIAN_PROJECTION, ISOMAP, PCA, PCA_CENTRED,
+        RFVAE, VAE,
     };
 }
-pub use quality::{GroupR2, LatentQuality, Neighbourhoods, ObjectR2};
+pub use quality::{Disentanglement, GroupR2, LatentQuality, Neighbourhoods, ObjectR2};
 pub use sampler::{SAMPLERS, SamplerInfo, SamplerInfoError};
 /// Each goal sampler's entry, by name (`ugl_types::samplers::KDE`).
 pub mod samplers {

@@ -36,6 +36,15 @@ pub struct LatentQuality {
     /// position explains ; empty otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub per_latent: Vec<ObjectR2>,
+    /// Scenes with several objects: MIG and SAP against the objects' coordinates, on the
+    /// held-out images (None: one object, or not measurable; the reason is logged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub disentanglement: Option<Disentanglement>,
+    /// Scenes with several objects, encoders with a Gaussian posterior: per latent, the mean KL
+    /// divergence of its posterior from the prior N(0, 1) on the held-out images, in nats (the
+    /// follow-up's criterion of an active latent, which orders its modules); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub kl_per_latent: Vec<f64>,
     /// Training and held-out set sizes, and `k`.
     pub n_train: usize,
     pub n_heldout: usize,
@@ -52,6 +61,24 @@ pub struct ObjectR2 {
     pub object: String,
     /// Per latent, in the encoder's order; None for a constant (collapsed) latent.
     pub r2: Vec<Option<f64>>,
+}
+
+/// Disentanglement of a goal space against the scene's factors, the objects' coordinates
+/// (`ugl_bench::repr::disentanglement`): 1 when each factor is captured by one latent alone.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Disentanglement {
+    /// The factors, in order (`ball x`, `ball y`, `distractor x`, `distractor y`).
+    pub factors: Vec<String>,
+    /// The mutual information gap (Chen et al. 2018), averaged over the factors.
+    pub mig: f64,
+    /// Per factor: the gap between its two most informative latents, over its entropy.
+    pub mig_per_factor: Vec<f64>,
+    /// Per factor: the latent that shares the most information with it.
+    pub mig_best_latent: Vec<usize>,
+    /// The separated attribute predictability (Kumar et al. 2018), averaged over the factors.
+    pub sap: f64,
+    /// Per factor: the gap between the R² of its two most predictive latents.
+    pub sap_per_factor: Vec<f64>,
 }
 
 /// The mean R² of one group of targets.

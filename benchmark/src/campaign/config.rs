@@ -461,6 +461,26 @@ impl CampaignConfig {
                 )
             })?;
         }
+        // A learner built for one kind of picture runs only where the environment renders it.
+        for l in self.matrix.algos.iter().filter_map(|a| a.learner()) {
+            if let Some(shape) = l.entry().image
+                && let Some(env) = self.matrix.envs.iter().find(|e| e.spec().image != shape)
+            {
+                let pictures = |s: ugl_types::ImageShape| {
+                    format!("{} x {} x {}", s.width, s.height, s.channels)
+                };
+                return Err(InvalidValue::new(
+                    "matrix.envs",
+                    format!(
+                        "matrix.envs has {env}, which renders {} pictures, but matrix.algos has {}, \
+                         which takes {} pictures only (give it a campaign of its own)",
+                        pictures(env.spec().image),
+                        l.entry().algo,
+                        pictures(shape)
+                    ),
+                ));
+            }
+        }
         let learned = self.matrix.algos.iter().any(|a| a.learner().is_some());
         if learned && self.ugl.images < 2 {
             return Err(InvalidValue::new(
@@ -636,6 +656,10 @@ epochs = 500
                 "explore.random_ratio",
             ),
             (GOOD.replace("\"rpe\", ", "\"rge-efr\", "), "matrix.algos"),
+            (
+                GOOD.replace("\"rpe\", ", "\"rge-conv-bvae\", "),
+                "matrix.envs",
+            ),
         ];
         for (text, key) in cases {
             let e = CampaignConfig::from_toml(&text, Path::new("t.toml"))
@@ -644,5 +668,10 @@ epochs = 500
             assert!(e.contains(key), "{e} should name {key}");
             assert!(!e.contains('\n'), "one line: {e}");
         }
+        // The convolutional networks run where the pictures are theirs.
+        let corl = GOOD
+            .replace("\"armball\"", "\"armballs-corl\"")
+            .replace("\"rpe\", ", "\"rge-conv-bvae\", ");
+        CampaignConfig::from_toml(&corl, Path::new("t.toml")).unwrap();
     }
 }

@@ -135,6 +135,33 @@ fn io(what: &str, p: &Path, e: impl std::fmt::Display) -> ReprError {
     ReprError::Cache(format!("checkpoint: cannot {what} {}: {e}", p.display()))
 }
 
+/// A training's state at a checkpoint, besides the stream (any trainer: the dense networks',
+/// the convolutional ones').
+pub(crate) struct Snapshot<'s> {
+    /// Iterations done.
+    pub step: usize,
+    pub losses: &'s [(usize, f64)],
+    /// The batch permutation.
+    pub perm: &'s [usize],
+    /// burn's parameter ids (zeros where there are none).
+    pub param_ids: [u64; 12],
+    /// The weights, as a sealed model file.
+    pub net: Vec<u8>,
+    /// The optimiser state's file name in the checkpoint directory.
+    pub optim_file: &'static str,
+}
+
+/// What a trusted checkpoint gives back to the trainer that resumes it.
+pub(crate) struct Restored<'s> {
+    pub step: usize,
+    pub perm: &'s [usize],
+    pub param_ids: &'s [u64; 12],
+    /// The weights' model file (its hash checked).
+    pub net: &'s [u8],
+    /// The optimiser state's file (its hash checked).
+    pub optim: &'s Path,
+}
+
 /// Save the trainer's state; older checkpoints of the same key are removed afterwards.
 pub fn save(
     c: &CheckpointSpec,
@@ -142,8 +169,6 @@ pub fn save(
     rng: &Stream,
     losses: &[(usize, f64)],
 ) -> Result<(), ReprError> {
-    let dir = dir_of(c, trainer.step);
-    std::fs::create_dir_all(&dir).map_err(|e| io("create", &dir, e))?;
     let net = trainer.host_net()?;
     let enc = NeuralEncoder::new(
         trainer.model,
@@ -152,22 +177,42 @@ pub fn save(
         losses.to_vec(),
         [0; 32],
     );
-    let net_bytes = neural_encoder::to_bytes(&c.key, &enc);
-    let net_path = dir.join("net.model");
-    crate::fsio::write_atomic(&net_path, &net_bytes).map_err(|e| io("write", &net_path, e))?;
-    let optim_path = dir.join(optim_file(&trainer.cfg));
-    trainer.save_optimizer(&optim_path)?;
-    let optim_bytes = std::fs::read(&optim_path).map_err(|e| io("read", &optim_path, e))?;
     let (ids, perm) = trainer.resume_state();
+    let snapshot = Snapshot {
+        step: trainer.step,
+        losses,
+        perm,
+        param_ids: ids,
+        net: neural_encoder::to_bytes(&c.key, &enc),
+        optim_file: optim_file(&trainer.cfg),
+    };
+    save_snapshot(c, snapshot, rng, |path| trainer.save_optimizer(path))
+}
+
+/// Save a training's state: the weights, the optimiser's (`write_optim` writes its file), then
+/// the sealed `state.json`; older checkpoints of the same key are removed afterwards.
+pub(crate) fn save_snapshot(
+    c: &CheckpointSpec,
+    snapshot: Snapshot<'_>,
+    rng: &Stream,
+    write_optim: impl FnOnce(&Path) -> Result<(), ReprError>,
+) -> Result<(), ReprError> {
+    let dir = dir_of(c, snapshot.step);
+    std::fs::create_dir_all(&dir).map_err(|e| io("create", &dir, e))?;
+    let net_path = dir.join("net.model");
+    crate::fsio::write_atomic(&net_path, &snapshot.net).map_err(|e| io("write", &net_path, e))?;
+    let optim_path = dir.join(snapshot.optim_file);
+    write_optim(&optim_path)?;
+    let optim_bytes = std::fs::read(&optim_path).map_err(|e| io("read", &optim_path, e))?;
     let state = State {
         key: c.key.clone(),
-        step: trainer.step,
-        losses: losses.to_vec(),
+        step: snapshot.step,
+        losses: snapshot.losses.to_vec(),
         rng_seed: hex(&rng.get_seed()),
         rng_word_pos: rng.get_word_pos().to_string(),
-        perm: perm.to_vec(),
-        param_ids: ids,
-        net_blake3: blake3::hash(&net_bytes).to_hex().to_string(),
+        perm: snapshot.perm.to_vec(),
+        param_ids: snapshot.param_ids,
+        net_blake3: blake3::hash(&snapshot.net).to_hex().to_string(),
         optim_blake3: blake3::hash(&optim_bytes).to_hex().to_string(),
     };
     let sealed = Sealed {
@@ -178,7 +223,7 @@ pub fn save(
     let state_path = dir.join("state.json");
     crate::fsio::write_atomic(&state_path, &json).map_err(|e| io("write", &state_path, e))?;
     for (step, old) in existing(c) {
-        if step < trainer.step {
+        if step < snapshot.step {
             let _ = std::fs::remove_dir_all(old);
         }
     }
@@ -202,8 +247,40 @@ pub fn load_latest<'a>(
     latents: usize,
     rng: &mut Stream,
 ) -> Result<Option<(Trainer<'a>, Vec<(usize, f64)>)>, ReprError> {
+    let optim = optim_file(cfg);
+    load_latest_with(c, cfg.max_iterations(), images.n, optim, rng, |r| {
+        let enc = neural_encoder::from_bytes(&c.key, r.net).map_err(|e| e.to_string())?;
+        Trainer::resume(
+            model,
+            cfg,
+            images,
+            latents,
+            ResumeState {
+                net: &enc.net,
+                ids: r.param_ids,
+                optimizer: r.optim,
+                perm: r.perm,
+                step: r.step,
+            },
+        )
+        .map_err(|e| e.to_string())
+    })
+}
+
+/// The latest checkpoint of `c.key` that can be trusted (a training of at most `iterations`
+/// iterations on `images` images, with the optimiser file `optim_file`), rebuilt by `resume`,
+/// with its loss curve so far and `rng` moved to the saved position; None if there is none.
+/// A damaged or inconsistent checkpoint is reported (one warning) and skipped.
+pub(crate) fn load_latest_with<T>(
+    c: &CheckpointSpec,
+    iterations: usize,
+    images: usize,
+    optim_file: &str,
+    rng: &mut Stream,
+    mut resume: impl FnMut(&Restored<'_>) -> Result<T, String>,
+) -> Result<Option<(T, Vec<(usize, f64)>)>, ReprError> {
     for (_, dir) in existing(c) {
-        match try_load(c, &dir, model, cfg, images, latents, rng) {
+        match try_load(c, &dir, iterations, images, optim_file, rng, &mut resume) {
             Ok(r) => {
                 tracing::info!("resuming {} from {}", c.key, dir.display());
                 return Ok(Some(r));
@@ -214,17 +291,17 @@ pub fn load_latest<'a>(
     Ok(None)
 }
 
-fn try_load<'a>(
+fn try_load<T>(
     c: &CheckpointSpec,
     dir: &Path,
-    model: Model,
-    cfg: &NeuralConfig,
-    images: &'a ImageSet,
-    latents: usize,
+    iterations: usize,
+    images: usize,
+    optim_file: &str,
     rng: &mut Stream,
-) -> Result<(Trainer<'a>, Vec<(usize, f64)>), String> {
+    resume: &mut impl FnMut(&Restored<'_>) -> Result<T, String>,
+) -> Result<(T, Vec<(usize, f64)>), String> {
     let text = std::fs::read(dir.join("state.json")).map_err(|e| e.to_string())?;
-    let state = verify(&text, cfg.max_iterations(), images.n)?;
+    let state = verify(&text, iterations, images)?;
     if state.key != c.key || state.rng_seed != hex(&rng.get_seed()) {
         return Err("written for another training".into());
     }
@@ -232,30 +309,22 @@ fn try_load<'a>(
     if blake3::hash(&net_bytes).to_hex().as_str() != state.net_blake3 {
         return Err("net.model does not match its hash".into());
     }
-    let optim_path = dir.join(optim_file(cfg));
+    let optim_path = dir.join(optim_file);
     let optim_bytes = std::fs::read(&optim_path).map_err(|e| e.to_string())?;
     if blake3::hash(&optim_bytes).to_hex().as_str() != state.optim_blake3 {
         return Err(format!("{} does not match its hash", optim_path.display()));
     }
-    let enc = neural_encoder::from_bytes(&c.key, &net_bytes).map_err(|e| e.to_string())?;
     let word_pos: u128 = state
         .rng_word_pos
         .parse()
         .map_err(|_| "bad word position")?;
-    let trainer = Trainer::resume(
-        model,
-        cfg,
-        images,
-        latents,
-        ResumeState {
-            net: &enc.net,
-            ids: &state.param_ids,
-            optimizer: &optim_path,
-            perm: &state.perm,
-            step: state.step,
-        },
-    )
-    .map_err(|e| e.to_string())?;
+    let trainer = resume(&Restored {
+        step: state.step,
+        perm: &state.perm,
+        param_ids: &state.param_ids,
+        net: &net_bytes,
+        optim: &optim_path,
+    })?;
     rng.set_word_pos(word_pos);
     Ok((trainer, state.losses))
 }

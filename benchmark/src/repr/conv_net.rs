@@ -360,19 +360,14 @@ const CONV_FILE_KIND: &str = "conv-vae";
 
 impl ConvNet {
     /// The weights as a sealed model file ([`super::model_file::seal`]): a JSON header with the
-    /// architecture, then every parameter buffer of [`ConvNet::params`] as little-endian `f32`.
+    /// architecture, then the payload ([`ConvNet::payload`]).
     pub fn to_model_bytes(&self) -> Vec<u8> {
         let header = serde_json::to_vec(&ConvFileHeader {
             kind: CONV_FILE_KIND.to_string(),
             arch: self.arch,
         })
         .expect("a header serialises");
-        let payload: Vec<u8> = self
-            .params()
-            .iter()
-            .flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes()))
-            .collect();
-        super::model_file::seal(&header, &payload)
+        super::model_file::seal(&header, &self.payload())
     }
 
     /// Read back [`ConvNet::to_model_bytes`]; `Err` says why the bytes cannot be trusted
@@ -388,9 +383,23 @@ impl ConvNet {
                 header.kind
             )));
         }
-        header.arch.check().map_err(ModelFileError::Content)?;
+        ConvNet::from_payload(header.arch, payload)
+    }
+
+    /// Every parameter buffer of [`ConvNet::params`] as little-endian `f32`.
+    pub fn payload(&self) -> Vec<u8> {
+        self.params()
+            .iter()
+            .flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes()))
+            .collect()
+    }
+
+    /// The network of architecture `arch` with the weights of `payload` ([`ConvNet::payload`]);
+    /// `Err` if the architecture makes no network or the payload has another length.
+    pub fn from_payload(arch: ConvArch, payload: &[u8]) -> Result<ConvNet, ModelFileError> {
+        arch.check().map_err(ModelFileError::Content)?;
         // Shapes from the architecture; values from the payload.
-        let mut net = ConvNet::init(&mut crate::seed::stream_named(0, "shapes"), header.arch);
+        let mut net = ConvNet::init(&mut crate::seed::stream_named(0, "shapes"), arch);
         let want: usize = net.num_params() * 4;
         if payload.len() != want {
             return Err(ModelFileError::Content(format!(

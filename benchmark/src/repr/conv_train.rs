@@ -16,6 +16,7 @@
 //! or the SIMD path (tested).
 
 use burn::tensor::Device;
+use serde::{Deserialize, Serialize};
 
 use super::ReprError;
 use super::conv_net::{CONV_LAYERS, ConvNet, DecoderActivations, EncoderActivations};
@@ -23,8 +24,141 @@ use super::host_train::{
     HostOptimizer, Middle, bce_and_grad, dense_backward, relu_backward, sized,
 };
 use super::nets::TfAdam;
-use super::neural_config::{Model, NeuralConfig};
+use super::neural_config::Model;
+use super::neural_model::{CodeSettings, Variant};
+use super::params::ParamError;
 use crate::seed::Stream;
+
+/// The training recipe of a convolutional network (`[learners.conv-vae]`,
+/// `[learners.conv-bvae]`). The authors' values of β, C, T_C, T_a, the learning rate, the
+/// iterations and the batch are not in their code (`docs/armballs.md`); the defaults
+/// ([`ConvConfig::followup_vae`], [`ConvConfig::followup_bvae`]) are ours.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvConfig {
+    /// Channels of every hidden convolution (the authors': 32).
+    pub filters: usize,
+    /// Width of the dense layers (the authors': 256).
+    pub hidden: usize,
+    /// Optimiser steps.
+    pub iterations: usize,
+    /// Pictures per mini-batch.
+    pub batch: usize,
+    /// Adam's learning rate.
+    pub lr: f64,
+    /// Record the mini-batch loss every this many iterations.
+    pub log_every: usize,
+    /// The weight β of the KL term (1: the VAE).
+    pub beta: f64,
+    /// Capacity annealing: the KL target's final value C, in nats (None: the plain KL term).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
+    /// The iterations over which the target rises linearly from 0 to C (T_C; None: the whole
+    /// training).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub capacity_iterations: Option<usize>,
+    /// The warm-up factor's length T_a: the KL term is multiplied by
+    /// `min(1, 0.01 + t / T_a)` (0: no warm-up).
+    pub warmup: usize,
+}
+
+impl ConvConfig {
+    /// The VAE of the follow-up (β = 1, no capacity), at our default budget.
+    pub fn followup_vae() -> ConvConfig {
+        ConvConfig {
+            filters: 32,
+            hidden: 256,
+            iterations: 5_000,
+            batch: 64,
+            lr: 1e-3,
+            log_every: 50,
+            beta: 1.0,
+            capacity: None,
+            capacity_iterations: None,
+            warmup: 0,
+        }
+    }
+
+    /// The β-VAE of the follow-up: the capacity-annealed objective (Burgess et al. 2018) with
+    /// the warm-up factor, at our default budget and settings.
+    pub fn followup_bvae() -> ConvConfig {
+        ConvConfig {
+            beta: 100.0,
+            capacity: Some(12.0),
+            warmup: 500,
+            ..ConvConfig::followup_vae()
+        }
+    }
+
+    /// The KL target at iteration `step`: `C min(1, step / T_C)`.
+    pub fn capacity_at(&self, step: usize) -> Option<f64> {
+        let ramp = self.capacity_iterations.unwrap_or(self.iterations).max(1);
+        self.capacity
+            .map(|c| c * (step as f64 / ramp as f64).min(1.0))
+    }
+
+    /// The settings of the KL term at iteration `step` (the β-VAE's code; one `eps` per
+    /// picture).
+    pub fn code_at(&self, step: usize) -> CodeSettings {
+        CodeSettings {
+            warmup: self.warmup,
+            beta: self.beta,
+            capacity: self.capacity_at(step),
+            variant: Variant::Corrected,
+        }
+    }
+
+    /// Validate every value; the error names the key.
+    pub fn check(&self) -> Result<(), ParamError> {
+        for (key, v, most) in [
+            ("filters", self.filters, 512),
+            ("hidden", self.hidden, 16_384),
+        ] {
+            if v == 0 || v > most {
+                return Err(ParamError::at(
+                    key,
+                    format!("must be between 1 and {most}, got {v}"),
+                ));
+            }
+        }
+        if self.batch == 0 {
+            return Err(ParamError::at("batch", "must be at least 1"));
+        }
+        if !(self.lr.is_finite() && self.lr > 0.0) {
+            return Err(ParamError::at(
+                "lr",
+                format!("must be positive and finite, got {}", self.lr),
+            ));
+        }
+        if self.log_every == 0 {
+            return Err(ParamError::at("log_every", "must be at least 1"));
+        }
+        if !(self.beta.is_finite() && self.beta > 0.0 && self.beta <= 1e6) {
+            return Err(ParamError::at(
+                "beta",
+                format!("must be positive and at most 1e6, got {}", self.beta),
+            ));
+        }
+        if let Some(c) = self.capacity
+            && !(c.is_finite() && (0.0..=1e4).contains(&c))
+        {
+            return Err(ParamError::at(
+                "capacity",
+                format!("must be between 0 and 1e4 nats, got {c}"),
+            ));
+        }
+        if self.capacity.is_none() && self.capacity_iterations.is_some() {
+            return Err(ParamError::at(
+                "capacity_iterations",
+                "sets the ramp of a capacity: set capacity too",
+            ));
+        }
+        if self.capacity_iterations == Some(0) {
+            return Err(ParamError::at("capacity_iterations", "must be at least 1"));
+        }
+        Ok(())
+    }
+}
 
 /// Index of the first gradient buffer of each layer group in [`ConvNet::params`] order.
 const ENC_FC: usize = 2 * CONV_LAYERS;
@@ -75,14 +209,13 @@ impl ConvTrainer {
     /// checked for finiteness).
     pub fn step(
         &mut self,
-        model: Model,
-        cfg: &NeuralConfig,
+        cfg: &ConvConfig,
         x: &[f32],
         rows: usize,
         step: usize,
         rng: &mut Stream,
     ) -> Result<f64, ReprError> {
-        let loss = self.forward_backward(model, cfg, x, rows, step, rng)?;
+        let loss = self.forward_backward(cfg, x, rows, step, rng)?;
         self.opt
             .step_all(cfg.lr, self.net.params_mut(), &self.ws.grads);
         Ok(loss)
@@ -97,8 +230,7 @@ impl ConvTrainer {
     /// optimiser step. Returns the mini-batch loss.
     pub fn forward_backward(
         &mut self,
-        model: Model,
-        cfg: &NeuralConfig,
+        cfg: &ConvConfig,
         x: &[f32],
         rows: usize,
         step: usize,
@@ -121,7 +253,16 @@ impl ConvTrainer {
         net.encoder_forward(x, n, &mut ws.enc);
 
         // The model's middle on burn's autodiff.
-        let middle = Middle::forward(model, cfg, &ws.enc.heads, n, d, step, &self.device, rng)?;
+        let middle = Middle::forward(
+            Model::Bvae,
+            &cfg.code_at(step),
+            &ws.enc.heads,
+            n,
+            d,
+            step,
+            &self.device,
+            rng,
+        )?;
         ws.z.clone_from(&middle.z);
 
         net.decoder_forward(&ws.z, n, &mut ws.dec);
@@ -236,14 +377,14 @@ mod tests {
     }
 
     /// The β-VAE with capacity annealing and the warm-up, as the follow-up trains it.
-    fn followup_config() -> NeuralConfig {
-        NeuralConfig {
+    fn followup_config() -> ConvConfig {
+        ConvConfig {
             iterations: 100,
             warmup: 10,
-            beta: Some(4.0),
+            beta: 4.0,
             capacity: Some(5.0),
             batch: 3,
-            ..NeuralConfig::paper(Model::Bvae)
+            ..ConvConfig::followup_bvae()
         }
     }
 
@@ -251,7 +392,7 @@ mod tests {
     /// and gradients): the loss and every gradient of the host engine must agree with it.
     fn burn_loss_and_grads(
         net: &ConvNet,
-        cfg: &NeuralConfig,
+        cfg: &ConvConfig,
         x: &[f32],
         n: usize,
         step: usize,
@@ -292,9 +433,9 @@ mod tests {
             latents: d,
             step,
             warmup: cfg.warmup,
-            beta: cfg.beta.unwrap_or(1.0),
+            beta: cfg.beta,
             capacity: cfg.capacity_at(step),
-            variant: cfg.variant,
+            variant: Variant::Corrected,
             device: &device,
         };
         let latent = Model::Bvae.spec().latent(heads, &input, rng);
@@ -341,14 +482,7 @@ mod tests {
         for step in [0, 3, 60] {
             let mut trainer = ConvTrainer::new(net.clone());
             let loss = trainer
-                .forward_backward(
-                    Model::Bvae,
-                    &cfg,
-                    &x,
-                    n,
-                    step,
-                    &mut stream_named(3, "noise"),
-                )
+                .forward_backward(&cfg, &x, n, step, &mut stream_named(3, "noise"))
                 .unwrap();
             let (want, want_grads) =
                 burn_loss_and_grads(&net, &cfg, &x, n, step, &mut stream_named(3, "noise"));
@@ -381,14 +515,14 @@ mod tests {
         let arch = small();
         let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
         let x = pictures(arch, 3, 2);
-        let run = |cfg: &NeuralConfig| {
+        let run = |cfg: &ConvConfig| {
             let mut t = ConvTrainer::new(net.clone());
-            t.forward_backward(Model::Bvae, cfg, &x, 3, 2, &mut stream_named(3, "noise"))
+            t.forward_backward(cfg, &x, 3, 2, &mut stream_named(3, "noise"))
                 .unwrap();
             t.gradients()[HEAD].clone()
         };
         let with = run(&followup_config());
-        let without = run(&NeuralConfig {
+        let without = run(&ConvConfig {
             warmup: 0,
             ..followup_config()
         });
@@ -408,7 +542,7 @@ mod tests {
             let mut rng = stream_named(4, "noise");
             for step in 0..3 {
                 let x = pictures(arch, 3, 10 + step as u64);
-                t.step(Model::Bvae, &cfg, &x, 3, step, &mut rng).unwrap();
+                t.step(&cfg, &x, 3, step, &mut rng).unwrap();
             }
             t.net
                 .params()
@@ -469,10 +603,10 @@ mod tests {
         let mean_picture_loss: f64 = (0..len)
             .map(|p| entropy((0..n).map(|i| f64::from(x[i * len + p])).sum::<f64>() / n as f64))
             .sum();
-        let cfg = NeuralConfig {
+        let cfg = ConvConfig {
             iterations: 1500,
             warmup: 0,
-            beta: Some(1.0),
+            beta: 1.0,
             capacity: None,
             lr: 1e-3,
             batch: n,
@@ -484,7 +618,7 @@ mod tests {
             let mut rng = stream_named(seed, "noise");
             let mut losses = vec![];
             for step in 0..cfg.iterations {
-                losses.push(t.step(Model::Bvae, &cfg, &x, n, step, &mut rng).unwrap());
+                losses.push(t.step(&cfg, &x, n, step, &mut rng).unwrap());
             }
             assert!(
                 losses[0] > mean_picture_loss,
@@ -509,14 +643,7 @@ mod tests {
         let mut t = ConvTrainer::new(ConvNet::init(&mut stream_named(1, "conv"), arch));
         let x = pictures(arch, 2, 1);
         let err = t
-            .forward_backward(
-                Model::Bvae,
-                &followup_config(),
-                &x,
-                3,
-                0,
-                &mut stream_named(3, "n"),
-            )
+            .forward_backward(&followup_config(), &x, 3, 0, &mut stream_named(3, "n"))
             .unwrap_err();
         assert!(err.to_string().contains("a batch of 3 pictures"), "{err}");
     }

@@ -37,7 +37,7 @@ use super::ReprError;
 use super::model_file::ModelFileError;
 use super::nets::{HostLayer, HostNet, OPT_CHUNK, TfAdagrad, TfAdam, adagrad_update, adam_update};
 use super::neural_config::{Model, NeuralConfig};
-use super::neural_model::{Latent, LatentInput, Optimiser, tensor2};
+use super::neural_model::{CodeSettings, Latent, LatentInput, Optimiser, tensor2};
 use crate::seed::Stream;
 
 type View<'a> = MatRef<'a, f32>;
@@ -384,8 +384,14 @@ impl HostOptimizer {
 
     /// Read back a state written by [`HostOptimizer::to_bytes`] for `model` and `net`'s shapes.
     pub fn from_bytes(model: Model, net: &HostNet, bytes: &[u8]) -> Result<Self, ModelFileError> {
+        HostOptimizer::new(model, net).read(bytes)
+    }
+
+    /// This fresh state (its kind, rule and buffer sizes) with the values of a state written by
+    /// [`HostOptimizer::to_bytes`]; `Err` if the bytes hold another kind or other sizes.
+    pub fn read(self, bytes: &[u8]) -> Result<Self, ModelFileError> {
         let bad = |why: &str| ModelFileError::Content(why.to_string());
-        let mut fresh = HostOptimizer::new(model, net);
+        let mut fresh = self;
         let mut at = 0usize;
         let mut take = |n: usize| -> Result<&[u8], ModelFileError> {
             let s = bytes
@@ -556,11 +562,12 @@ pub(super) struct Middle {
 }
 
 impl Middle {
-    /// The code of the head outputs `heads` (`[rows, P]`) at iteration `step`.
+    /// The code of the head outputs `heads` (`[rows, P]`) at iteration `step`, with the KL
+    /// term's settings `code` of that iteration.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn forward(
         model: Model,
-        cfg: &NeuralConfig,
+        code: &CodeSettings,
         heads: &[f32],
         rows: usize,
         latents: usize,
@@ -574,10 +581,10 @@ impl Middle {
             batch: rows,
             latents,
             step,
-            warmup: cfg.warmup,
-            beta: cfg.beta.unwrap_or(1.0),
-            capacity: cfg.capacity_at(step),
-            variant: cfg.variant,
+            warmup: code.warmup,
+            beta: code.beta,
+            capacity: code.capacity,
+            variant: code.variant,
             device,
         };
         let latent = model.spec().latent(heads.clone(), &input, rng);
@@ -700,7 +707,16 @@ impl HostTrainer {
         dense_forward(&net.head, &ws.h2, rows, sized(&mut ws.heads, rows * p));
 
         // The model's middle on burn's autodiff.
-        let middle = Middle::forward(model, cfg, &ws.heads, rows, d, step, &self.device, rng)?;
+        let middle = Middle::forward(
+            model,
+            &cfg.code_at(step),
+            &ws.heads,
+            rows,
+            d,
+            step,
+            &self.device,
+            rng,
+        )?;
         ws.z.clone_from(&middle.z);
 
         // Decoder forward, the pixel loss and its gradient.

@@ -10,6 +10,7 @@ pub mod ae;
 pub mod bvae;
 pub mod cache;
 pub mod checkpoint;
+pub mod conv_learner;
 pub mod conv_net;
 pub mod conv_train;
 pub mod dataset;
@@ -152,6 +153,13 @@ pub trait Encoder: Send {
     /// Deterministic encoders ignore it (the default).
     fn begin_run(&mut self, rng: Stream) {
         let _ = rng;
+    }
+    /// Per latent, the mean KL divergence of the posterior from the prior N(0, 1) over
+    /// `images`, in nats, for encoders with a Gaussian posterior that expose it (the follow-up's
+    /// convolutional networks); None for the others.
+    fn per_latent_kl(&mut self, images: &ImageSet) -> Option<Result<Vec<f64>, ReprError>> {
+        let _ = images;
+        None
     }
     /// The fit time the learner measured itself, where it reports one (an external program's
     /// `READY fit_s=...`: its fit without interpreter start-up, imports and file I/O).

@@ -349,26 +349,15 @@ pub fn train_with_checkpoints(
     let plateau_loss = super::evidence::mean_image_loss(&evidence);
     loop {
         let target = boundaries[at];
-        for step in trainer.step..target {
-            let value = trainer.step(rng)?;
-            if step % cfg.log_every == 0 || step + 1 == target {
-                losses.push((step, value));
-            }
-            if let Some(c) = ckpt
-                && c.every > 0
-                && (step + 1) % c.every == 0
-                && step + 1 < target
-            {
-                super::checkpoint::save(c, &trainer, rng, &losses)?;
-            }
-            if let Some(p) = progress {
-                p(TrainProgress {
-                    iteration: step + 1,
-                    total: target,
-                    loss: value,
-                });
-            }
-        }
+        super::trainer::run_until(
+            &mut trainer,
+            target,
+            cfg.log_every,
+            rng,
+            &mut losses,
+            ckpt,
+            progress,
+        )?;
         if at + 1 >= boundaries.len() {
             break;
         }

@@ -195,6 +195,16 @@ impl NeuralConfig {
             .map_or(self.iterations, |r| r.cap.max(self.iterations))
     }
 
+    /// The settings of the model's KL term at iteration `step`.
+    pub fn code_at(&self, step: usize) -> super::neural_model::CodeSettings {
+        super::neural_model::CodeSettings {
+            warmup: self.warmup,
+            beta: self.beta.unwrap_or(1.0),
+            capacity: self.capacity_at(step),
+            variant: self.variant,
+        }
+    }
+
     /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
     pub fn capacity_at(&self, step: usize) -> Option<f64> {
         self.capacity

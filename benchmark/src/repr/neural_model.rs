@@ -107,6 +107,20 @@ pub struct StepInput<'a> {
     pub latent: LatentInput<'a>,
 }
 
+/// The settings of a model's KL term at one iteration, from its training configuration (the
+/// dense networks' [`super::neural_config::NeuralConfig::code_at`], the convolutional ones'
+/// [`super::conv_train::ConvConfig::code_at`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CodeSettings {
+    /// The warm-up length (RFVAE; the follow-up's `c` ramp of the β-VAE); 0: none.
+    pub warmup: usize,
+    /// The weight of the KL term (1 for every model but the β-VAE).
+    pub beta: f64,
+    /// The KL target C at this iteration (None: plain KL term).
+    pub capacity: Option<f64>,
+    pub variant: Variant,
+}
+
 /// What a model's latent code needs besides the head outputs (both engines).
 pub struct LatentInput<'a> {
     pub batch: usize,

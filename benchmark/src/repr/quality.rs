@@ -163,6 +163,8 @@ pub fn latent_quality(
     Ok(LatentQuality {
         version: MEASURE_VERSION,
         per_latent: Vec::new(),
+        disentanglement: None,
+        kl_per_latent: Vec::new(),
         neighbourhoods,
         targets: names,
         linear_r2_mean: mean(&linear_r2),

@@ -16,6 +16,7 @@ use std::fmt::Debug;
 
 use serde::de::DeserializeOwned;
 
+use super::conv_learner::{ConvModel, ConvSection};
 use super::external::ExternalConfig;
 use super::isomap::IsomapConfig;
 use super::neural::{Model, NeuralConfig, NeuralSection};
@@ -30,6 +31,8 @@ pub enum Kind {
     InProcess,
     /// A dense network trained with the model cache, checkpoints and training evidence.
     Neural(Model),
+    /// One of the follow-up's convolutional networks (the same services as a dense one).
+    Convolutional(ConvModel),
     /// A program outside this project (the external-learner protocol): its stderr is logged.
     External,
 }
@@ -66,7 +69,7 @@ impl LearnerEntry {
 }
 
 /// Every learner of this build, in the report's order.
-pub static LEARNERS: [LearnerEntry; 9] = [
+pub static LEARNERS: [LearnerEntry; 11] = [
     LearnerEntry {
         info: &learners::PCA,
         kind: Kind::InProcess,
@@ -101,6 +104,16 @@ pub static LEARNERS: [LearnerEntry; 9] = [
         info: &learners::BVAE,
         kind: Kind::Neural(Model::Bvae),
         params: neural::<Bvae>,
+    },
+    LearnerEntry {
+        info: &learners::CONV_VAE,
+        kind: Kind::Convolutional(ConvModel::ConvVae),
+        params: convolutional::<ConvVae>,
+    },
+    LearnerEntry {
+        info: &learners::CONV_BVAE,
+        kind: Kind::Convolutional(ConvModel::ConvBvae),
+        params: convolutional::<ConvBvae>,
     },
     LearnerEntry {
         info: &learners::GAUSSIAN_PROJECTION,
@@ -153,6 +166,14 @@ impl Learner {
     pub fn model(self) -> Option<Model> {
         match self.entry().kind {
             Kind::Neural(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The network of a convolutional learner.
+    pub fn conv_model(self) -> Option<ConvModel> {
+        match self.entry().kind {
+            Kind::Convolutional(m) => Some(m),
             _ => None,
         }
     }
@@ -227,6 +248,29 @@ impl ModelOf for Rfvae {
 fn neural<M: ModelOf>(table: Option<&toml::Value>) -> Result<Box<dyn LearnerParams>, ParamError> {
     let section: NeuralSection = match table {
         None => NeuralSection::default(),
+        Some(t) => typed(t)?,
+    };
+    Ok(Box::new((M::MODEL, section).check()?))
+}
+
+/// The network of a convolutional entry, as a type.
+trait ConvModelOf {
+    const MODEL: ConvModel;
+}
+struct ConvVae;
+struct ConvBvae;
+impl ConvModelOf for ConvVae {
+    const MODEL: ConvModel = ConvModel::ConvVae;
+}
+impl ConvModelOf for ConvBvae {
+    const MODEL: ConvModel = ConvModel::ConvBvae;
+}
+
+fn convolutional<M: ConvModelOf>(
+    table: Option<&toml::Value>,
+) -> Result<Box<dyn LearnerParams>, ParamError> {
+    let section: ConvSection = match table {
+        None => ConvSection::default(),
         Some(t) => typed(t)?,
     };
     Ok(Box::new((M::MODEL, section).check()?))

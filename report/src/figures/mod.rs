@@ -60,7 +60,7 @@ pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<
 pub const FONT: &str = "sans-serif";
 
 /// Okabe–Ito without its yellow (too pale on white), one per algorithm of [`style_algos`].
-pub const ALGO_COLOURS: [RGBColor; 13] = [
+pub const ALGO_COLOURS: [RGBColor; 15] = [
     RGBColor(0x00, 0x00, 0x00), // rpe: black
     RGBColor(0xE6, 0x9F, 0x00), // efr: orange
     RGBColor(0x56, 0xB4, 0xE9), // pca: sky blue
@@ -71,6 +71,8 @@ pub const ALGO_COLOURS: [RGBColor; 13] = [
     RGBColor(0x8C, 0x51, 0x0A), // efr, position only: brown
     RGBColor(0x33, 0x22, 0x88), // pca-centred: indigo
     RGBColor(0x88, 0x22, 0x55), // bvae: wine
+    RGBColor(0xCC, 0x66, 0x77), // conv-vae: rose
+    RGBColor(0xDD, 0xCC, 0x77), // conv-bvae: sand
     RGBColor(0x77, 0x77, 0x77), // gaussian-projection (a control): grey
     RGBColor(0x44, 0xAA, 0x99), // external: teal
     RGBColor(0x99, 0x99, 0x33), // others: olive
