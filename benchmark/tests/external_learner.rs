@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use ugl_bench::env::render::render_ball_into;
 use ugl_bench::repr::external::{ExternalEncoder, ExternalLearner};
-use ugl_bench::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
+use ugl_bench::repr::{Encoder, FitContext, ImageSet, Latents, ReprError, RepresentationLearner};
 use ugl_bench::seed::stream_named;
 
 const DIM: usize = 4900;
@@ -658,4 +658,33 @@ while True:
     enc.begin_run(stream_named(0, "encoding"));
     enc.encode_one(set.row(0), &mut out).unwrap();
     assert_eq!(out[0], 4.0, "the cache is per run");
+}
+
+/// The harness tells the program the pictures' shape (`UGL_IMAGE`, from the environment through
+/// the fit context); a fit without one does not set it.
+#[test]
+fn the_program_is_told_the_pictures_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let seen = dir.path().join("seen");
+    let l = sh(
+        "shape",
+        &format!(
+            "echo \"${{UGL_IMAGE-unset}}\" > '{}'; exit 1",
+            seen.display()
+        ),
+    );
+    let ctx = FitContext {
+        image: Some(ugl_types::RGB64),
+        ..FitContext::default()
+    };
+    assert!(
+        l.fit_in(&images(3), 2, &mut stream_named(0, "learner"), &ctx)
+            .is_err()
+    );
+    assert_eq!(std::fs::read_to_string(&seen).unwrap().trim(), "64x64x3");
+    assert!(
+        l.fit(&images(3), 2, &mut stream_named(0, "learner"))
+            .is_err()
+    );
+    assert_eq!(std::fs::read_to_string(&seen).unwrap().trim(), "unset");
 }

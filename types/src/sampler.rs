@@ -66,7 +66,7 @@ pub static KDE: SamplerInfo = SamplerInfo {
 pub static GAUSSIAN: SamplerInfo = SamplerInfo {
     name: "gaussian",
     display: "Gaussian",
-    description: "the isotropic prior N(0, I) of a goal space that has one (VAE, RFVAE, β-VAE)",
+    description: "the isotropic prior N(0, I) of a goal space that has one (the VAE-type networks: VAE, RFVAE, β-VAE, conv VAE, conv β-VAE)",
     draws_goals: true,
     learned: true,
     needs_prior: true,

@@ -74,8 +74,14 @@ pub struct Harness<'a> {
 impl Harness<'_> {
     /// What the fit of the representation `label` gets: its progress and messages under the
     /// label, its log file, checkpoints in the model cache under `key` when the learner's
-    /// encoders are kept there (`persists`), the training's threads.
-    pub fn fit_context(&self, label: &str, key: &str, persists: bool) -> FitContext {
+    /// encoders are kept there (`persists`), the training's threads, the pictures' shape.
+    pub fn fit_context(
+        &self,
+        label: &str,
+        key: &str,
+        persists: bool,
+        image: ugl_types::ImageShape,
+    ) -> FitContext {
         FitContext {
             progress: self.train_progress.as_ref().map(|sink| {
                 let (sink, label) = (sink.clone(), label.to_string());
@@ -95,6 +101,7 @@ impl Harness<'_> {
                 let (sink, label) = (sink.clone(), label.to_string());
                 LineSink(Arc::new(move |line| sink(&label, Some(line))))
             }),
+            image: Some(image),
         }
     }
 }

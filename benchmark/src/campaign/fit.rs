@@ -226,7 +226,9 @@ fn fit_or_load(
                 c.check_writable()?;
             }
             let label = representation_label(spec);
-            let fit_ctx = ctx.harness.fit_context(&label, &key, cache.is_some());
+            let fit_ctx =
+                ctx.harness
+                    .fit_context(&label, &key, cache.is_some(), spec.env.spec().image);
             let fitted = fitter.fit_in(images, spec.latents, rng, &fit_ctx);
             if let Some(sink) = &ctx.harness.learner_messages {
                 sink(&label, None);

@@ -179,6 +179,9 @@ pub struct ExternalLearner {
     pub log_file: Option<PathBuf>,
     /// Called with each stderr line (e.g. to show the last one under a progress bar).
     pub on_stderr: Option<LineSink>,
+    /// The pictures' shape, told to the program as `UGL_IMAGE=WIDTHxHEIGHTxCHANNELS` (None:
+    /// not told; the harness sets it from the environment, [`super::FitContext::image`]).
+    pub image: Option<ugl_types::ImageShape>,
 }
 
 /// A callback receiving the lines of a learner's stderr.
@@ -207,6 +210,7 @@ impl ExternalLearner {
             answer_timeout: DEFAULT_ANSWER_TIMEOUT,
             log_file: None,
             on_stderr: None,
+            image: None,
         }
     }
 }
@@ -238,6 +242,7 @@ impl RepresentationLearner for ExternalLearner {
         let mut l = self.clone();
         l.log_file = ctx.log_file.clone().or(l.log_file);
         l.on_stderr = ctx.messages.clone().or(l.on_stderr);
+        l.image = ctx.image.or(l.image);
         l.fit(images, latents, rng)
     }
 }
@@ -271,6 +276,12 @@ impl ExternalLearner {
             .env("UGL_PRIOR", &prior_path)
             .env("UGL_WORKDIR", &workdir.path)
             .env("UGL_HARNESS_PID", std::process::id().to_string());
+        if let Some(s) = self.image {
+            cmd.env(
+                "UGL_IMAGE",
+                format!("{}x{}x{}", s.width, s.height, s.channels),
+            );
+        }
         tracing::info!(learner = %self.name, command = %self.command, n = images.n, latents, seed,
             workdir = %workdir.path.display(), "starting external learner");
         let mut session = Session::spawn(self, cmd, workdir)?;

@@ -215,6 +215,9 @@ pub struct FitContext {
     pub log_file: Option<PathBuf>,
     /// The learner's messages, line by line as they come.
     pub messages: Option<external::LineSink>,
+    /// The shape of the pictures (the environment's), for learners that need more than their
+    /// values (an external program is told it as `UGL_IMAGE`).
+    pub image: Option<ugl_types::ImageShape>,
 }
 
 impl std::fmt::Debug for FitContext {
@@ -225,6 +228,7 @@ impl std::fmt::Debug for FitContext {
             .field("threads", &self.threads)
             .field("log_file", &self.log_file)
             .field("messages", &self.messages.is_some())
+            .field("image", &self.image)
             .finish()
     }
 }
