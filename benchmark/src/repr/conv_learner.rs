@@ -28,7 +28,8 @@ use super::model_file::{ModelFileError, seal, unseal};
 use super::nets::TfAdam;
 use super::neural_model::Variant;
 use super::params::{LearnerParams, ParamError, ParamGuard};
-use super::trainer::{Iterations, ProgressFn, draw_batch, run_until};
+use super::trainer::{ProgressFn, draw_batch};
+use super::training_loop::{Iterations, run_until};
 use super::{
     Encoder, FitContext, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner,
     TrainingRecord, check_fit_input,
@@ -229,7 +230,7 @@ impl RepresentationLearner for ConvLearner {
         ctx: &FitContext,
     ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         let progress = ctx.progress.as_ref().or(self.progress.as_ref());
-        let mut train = || {
+        let train = || {
             train(
                 self.model,
                 &self.config,
@@ -240,15 +241,7 @@ impl RepresentationLearner for ConvLearner {
                 ctx.checkpoint.as_ref(),
             )
         };
-        let mut enc = if ctx.threads > 0 {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(ctx.threads)
-                .build()
-                .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
-                .install(train)?
-        } else {
-            train()?
-        };
+        let mut enc = ctx.in_pool(train)?;
         let z = enc.encode(images)?;
         Ok((Box::new(enc), z))
     }
@@ -727,16 +720,20 @@ mod tests {
     fn a_resumed_training_is_the_uninterrupted_one() {
         let images = pictures(10);
         let cfg = small();
-        let through = train(
-            ConvModel::ConvBvae,
-            &cfg,
-            &images,
-            2,
-            &mut stream_named(5, "learner"),
-            None,
-            None,
-        )
-        .unwrap();
+        let fit = |progress: Option<&ProgressFn>, ckpt: Option<&CheckpointSpec>| {
+            let mut rng = stream_named(5, "learner");
+            train(
+                ConvModel::ConvBvae,
+                &cfg,
+                &images,
+                2,
+                &mut rng,
+                progress,
+                ckpt,
+            )
+            .unwrap()
+        };
+        let through = fit(None, None);
         let dir = tempfile::tempdir().unwrap();
         let spec = CheckpointSpec {
             dir: dir.path().to_path_buf(),
@@ -779,16 +776,7 @@ mod tests {
             (n, f)
         };
         let (done, progress) = counter();
-        let resumed = train(
-            ConvModel::ConvBvae,
-            &cfg,
-            &images,
-            2,
-            &mut stream_named(5, "learner"),
-            Some(&progress),
-            Some(&spec),
-        )
-        .unwrap();
+        let resumed = fit(Some(&progress), Some(&spec));
         assert_eq!(resumed, through);
         assert_eq!(
             done.load(std::sync::atomic::Ordering::Relaxed),
@@ -820,16 +808,7 @@ mod tests {
         .unwrap();
         std::fs::write(dir.path().join("k.ckpt.5").join(OPTIM_FILE), b"junk").unwrap();
         let (done, progress) = counter();
-        let fresh = train(
-            ConvModel::ConvBvae,
-            &cfg,
-            &images,
-            2,
-            &mut stream_named(5, "learner"),
-            Some(&progress),
-            Some(&spec),
-        )
-        .unwrap();
+        let fresh = fit(Some(&progress), Some(&spec));
         assert_eq!(fresh, through);
         assert_eq!(
             done.load(std::sync::atomic::Ordering::Relaxed),

@@ -34,6 +34,7 @@ pub mod registry;
 pub mod rfvae;
 pub mod sparse;
 pub mod trainer;
+pub mod training_loop;
 pub mod vae;
 
 use std::path::PathBuf;
@@ -218,6 +219,24 @@ pub struct FitContext {
     /// The shape of the pictures (the environment's), for learners that need more than their
     /// values (an external program is told it as `UGL_IMAGE`).
     pub image: Option<ugl_types::ImageShape>,
+}
+
+impl FitContext {
+    /// Run `f` on the context's threads (a pool of [`FitContext::threads`]; 0: the calling
+    /// pool's).
+    pub fn in_pool<T: Send>(
+        &self,
+        f: impl FnOnce() -> Result<T, ReprError> + Send,
+    ) -> Result<T, ReprError> {
+        if self.threads == 0 {
+            return f();
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads)
+            .build()
+            .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
+            .install(f)
+    }
 }
 
 impl std::fmt::Debug for FitContext {

@@ -251,7 +251,7 @@ impl super::RepresentationLearner for NeuralLearner {
         ctx: &super::FitContext,
     ) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
         let progress = ctx.progress.as_ref().or(self.progress.as_ref());
-        let mut train = || {
+        let train = || {
             train_with_checkpoints(
                 self.model,
                 &self.config,
@@ -262,15 +262,7 @@ impl super::RepresentationLearner for NeuralLearner {
                 ctx.checkpoint.as_ref(),
             )
         };
-        let mut enc = if ctx.threads > 0 {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(ctx.threads)
-                .build()
-                .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
-                .install(train)?
-        } else {
-            train()?
-        };
+        let mut enc = ctx.in_pool(train)?;
         let z = enc.training_latents(images)?;
         Ok((Box::new(enc), z))
     }
@@ -349,7 +341,7 @@ pub fn train_with_checkpoints(
     let plateau_loss = super::evidence::mean_image_loss(&evidence);
     loop {
         let target = boundaries[at];
-        super::trainer::run_until(
+        super::training_loop::run_until(
             &mut trainer,
             target,
             cfg.log_every,

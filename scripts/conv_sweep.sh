@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The sweep that chooses the follow-up's convolutional β-VAE settings (issue 44, item 3; its
+# measurements and the choice: docs/neural.md). Each SETTING is a comma-separated list of
+# [learners.conv-bvae] keys (or `vae` for the conv-vae at its defaults); each is trained on the
+# repetition seeds SEEDS (default 1000 1001 1002: seeds the campaigns do not use, so nothing is
+# tuned on a campaign's own repetitions) with `ugl run` on armballs-corl, 10 latents, and
+# scripts/conv_sweep_summary.py tabulates what each network's manifest records: its loss
+# fraction, the per-latent KL, the latents active and which object each encodes, MIG and SAP.
+#
+#   scripts/conv_sweep.sh OUT SETTING...
+#   e.g. scripts/conv_sweep.sh /tmp/sweep beta=100,capacity=12,iterations=5000 vae
+#
+# Resumable: a (setting, seed) whose manifest exists is skipped. Environment: UGL (the binary;
+# default target/debug/ugl, built first), SEEDS, IMAGES (training pictures, default 10000),
+# EPOCHS (exploration epochs of each run, default 200: the exploration is not what is measured).
+set -euo pipefail
+out="${1:?usage: scripts/conv_sweep.sh OUT SETTING...}"
+shift
+[ $# -gt 0 ] || { echo "error: give at least one SETTING (e.g. beta=100,capacity=12)" >&2; exit 2; }
+cd "$(dirname "$0")/.."
+ugl="${UGL:-target/debug/ugl}"
+if [ -z "${UGL:-}" ]; then cargo build --quiet --bin ugl; fi
+seeds="${SEEDS:-1000 1001 1002}"
+images="${IMAGES:-10000}"
+epochs="${EPOCHS:-200}"
+mkdir -p "$out"
+for setting in "$@"; do
+  tag="$(echo "$setting" | tr ',=' '_-')"
+  dir="$out/$tag"
+  mkdir -p "$dir"
+  if [ "$setting" = vae ]; then
+    algo=rge-conv-vae table="[learners.conv-vae]"
+  else
+    algo=rge-conv-bvae table="[learners.conv-bvae]"
+  fi
+  {
+    printf '[campaign]\nname = "conv-sweep"\nseed = 0\nreps = 1\n'
+    printf '[matrix]\nenvs = ["armballs-corl"]\nalgos = ["%s"]\nlatents = [10]\n' "$algo"
+    printf '[ugl]\nimages = %s\n[explore]\nepochs = %s\neval_every = %s\n' "$images" "$epochs" "$epochs"
+    printf '%s\n' "$table"
+    if [ "$setting" != vae ]; then
+      echo "$setting" | tr ',' '\n' | sed 's/=/ = /'
+    fi
+  } > "$dir/profile.toml"
+  for seed in $seeds; do
+    if ls "$dir"/*.s"$seed".json >/dev/null 2>&1; then
+      echo "$tag seed $seed: done"
+      continue
+    fi
+    echo "$tag seed $seed: training ($(date +%H:%M))"
+    "$ugl" run --env armballs-corl --algo "$algo" --latents 10 --seed "$seed" \
+      --profile "$dir/profile.toml" --out "$dir" --cache "$out/models" > "$dir/s$seed.log"
+  done
+done
+python3 scripts/conv_sweep_summary.py "$out"
