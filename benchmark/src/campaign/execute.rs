@@ -86,6 +86,7 @@ pub fn explore(
             })?;
             let goals = LearnedGoals {
                 dim: repr.encoder.latents(),
+                spread: module_order(repr),
                 train: &repr.train,
                 prior: repr.encoder.prior(),
                 sampler: spec.sampler,
@@ -113,6 +114,8 @@ pub fn explore(
 /// (`sampler`), and modules of latents ordered by their spread.
 struct LearnedGoals<'r> {
     dim: usize,
+    /// What orders the latents into modules ([`module_order`]).
+    spread: Vec<f64>,
     train: &'r Latents,
     prior: Option<GaussianPrior>,
     sampler: SamplerKind,
@@ -121,14 +124,8 @@ struct LearnedGoals<'r> {
 
 impl GoalSource for LearnedGoals<'_> {
     fn modules(&self, choice: Modules, module_size: usize) -> Result<Vec<GoalModule>, ReprError> {
-        goal_modules(
-            choice,
-            self.dim,
-            None,
-            &latent_spread(self.train),
-            module_size,
-        )
-        .map_err(|e| ReprError::InvalidInput(e.to_string()))
+        goal_modules(choice, self.dim, None, &self.spread, module_size)
+            .map_err(|e| ReprError::InvalidInput(e.to_string()))
     }
 
     /// Over every latent (`dims` None) or over one module's latents (the KDE of those latents
@@ -162,8 +159,20 @@ impl GoalSource for LearnedGoals<'_> {
     }
 }
 
-/// The spread of each latent over the training encodings (its variance), which orders the
-/// latents into modules ([`goal_modules`]).
+/// What orders a representation's latents into modules ([`goal_modules`], largest first): the
+/// follow-up's criterion, each latent's mean KL divergence from the prior on the 1000 held-out
+/// images, where the encoder has a posterior and the latent-quality measure recorded it
+/// (`latent_quality.kl_per_latent`: the convolutional networks, on scenes with several
+/// objects); else the variance of its training encodings, which every learner has (a collapsed
+/// latent has none).
+fn module_order(repr: &Representation) -> Vec<f64> {
+    match repr.quality.as_ref().map(|q| &q.kl_per_latent) {
+        Some(kl) if !kl.is_empty() && kl.len() == repr.train.latents => kl.clone(),
+        _ => latent_spread(&repr.train),
+    }
+}
+
+/// The spread of each latent over the training encodings (its variance).
 fn latent_spread(train: &Latents) -> Vec<f64> {
     let (n, d) = (train.n as f64, train.latents);
     (0..d)
@@ -301,4 +310,52 @@ pub fn execute(
     };
     store::write_run(out, spec, &log, &manifest)?;
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::repr::{Encoder, ImageSet};
+
+    struct NoEncoder;
+    impl Encoder for NoEncoder {
+        fn latents(&self) -> usize {
+            3
+        }
+        fn encode(&mut self, _: &ImageSet) -> Result<Latents, ReprError> {
+            Err(ReprError::InvalidInput("not used".into()))
+        }
+    }
+
+    /// The latents are ordered by their KL from the prior where the measure recorded it, else
+    /// by the variance of their training encodings.
+    #[test]
+    fn modules_follow_the_per_latent_kl_where_there_is_one() {
+        let quality = |kl: &[f64]| -> ugl_types::LatentQuality {
+            serde_json::from_value(serde_json::json!({
+                "targets": [], "linear_r2": [], "knn_r2": [], "linear_r2_mean": 0.0,
+                "knn_r2_mean": 0.0, "n_train": 4, "n_heldout": 4, "k": 1, "kl_per_latent": kl,
+            }))
+            .unwrap()
+        };
+        // Variances 0, 1.25, 5 (latent 2 spreads most); KL puts latent 0 first.
+        let train = Latents {
+            n: 4,
+            latents: 3,
+            data: vec![1.0, 0.0, 0.0, 1.0, 1.0, 2.0, 1.0, 2.0, 4.0, 1.0, 3.0, 6.0],
+        };
+        let mut repr = Representation {
+            encoder: Box::new(NoEncoder),
+            train,
+            fit_s: 0.0,
+            learner_name: "x".into(),
+            training: None,
+            quality: Some(quality(&[3.1, 0.0, 2.9])),
+        };
+        assert_eq!(module_order(&repr), [3.1, 0.0, 2.9]);
+        repr.quality = Some(quality(&[]));
+        assert_eq!(module_order(&repr), [0.0, 1.25, 5.0]);
+        repr.quality = None;
+        assert_eq!(module_order(&repr), [0.0, 1.25, 5.0]);
+    }
 }
