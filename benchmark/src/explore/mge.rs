@@ -94,6 +94,11 @@ pub struct MgeConfig {
     pub interest_window: f64,
     /// Learning-progress choice: a uniformly random module with this probability (0.1).
     pub eps: f64,
+    /// Every goal coordinate clipped to `[-goal_bound, goal_bound]` (the follow-up code's
+    /// `goal_bound`, 2.5, on its N(0, I) goals); None: not clipped (the default, as every run
+    /// before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal_bound: Option<f64>,
 }
 
 impl Default for MgeConfig {
@@ -103,6 +108,7 @@ impl Default for MgeConfig {
             n_explore: 4,
             interest_window: 1000.0,
             eps: 0.1,
+            goal_bound: None,
         }
     }
 }
@@ -129,6 +135,14 @@ impl MgeConfig {
             return Err(InvalidValue::new(
                 "mge.eps",
                 format!("mge.eps must be in [0, 1], got {}", self.eps),
+            ));
+        }
+        if let Some(b) = self.goal_bound
+            && !(b.is_finite() && b > 0.0)
+        {
+            return Err(InvalidValue::new(
+                "mge.goal_bound",
+                format!("mge.goal_bound must be positive and finite, got {b}"),
             ));
         }
         Ok(())
@@ -324,6 +338,7 @@ pub fn run_mge(
         chosen[m] += 1;
         goal.resize(modules[m].dims.len(), 0.0);
         samplers[m].sample(&mut goal_rng, &mut goal);
+        bound_goal(&mut goal, mge.goal_bound);
         for k in 0..=mge.n_explore {
             if epoch == cfg.epochs {
                 break;
@@ -348,6 +363,13 @@ pub fn run_mge(
         }
     }
     Ok(rec.finish())
+}
+
+/// Clip every coordinate of `goal` to `[-bound, bound]` (no bound: unchanged).
+fn bound_goal(goal: &mut [f64], bound: Option<f64>) {
+    if let Some(b) = bound {
+        goal.iter_mut().for_each(|g| *g = g.clamp(-b, b));
+    }
 }
 
 /// MGE as an [`Explorer`]: in `space`, with its modules and one goal sampler per module.
@@ -384,6 +406,27 @@ mod tests {
     use super::*;
     use crate::env::{EnvConfig, EnvKind, make_env};
     use crate::explore::EngineeredSpace;
+
+    /// The goal bound clips each coordinate (the follow-up's 2.5 on N(0, I) goals), is off by
+    /// default (every earlier run's configuration hash is kept: the key is not written), and
+    /// refuses a bound that clips nothing sensible.
+    #[test]
+    fn the_goal_bound() {
+        let mut g = [3.0, -0.5, -7.0, 2.5];
+        bound_goal(&mut g, Some(2.5));
+        assert_eq!(g, [2.5, -0.5, -2.5, 2.5]);
+        bound_goal(&mut g, None);
+        assert_eq!(g, [2.5, -0.5, -2.5, 2.5]);
+        let json = serde_json::to_string(&MgeConfig::default()).unwrap();
+        assert!(!json.contains("goal_bound"), "{json}");
+        for bad in [0.0, -1.0, f64::NAN] {
+            let cfg = MgeConfig {
+                goal_bound: Some(bad),
+                ..MgeConfig::default()
+            };
+            assert!(cfg.validate().is_err(), "{bad}");
+        }
+    }
     use crate::goals::UniformGoals;
 
     fn efr_run(env: EnvKind, choice: Modules, seed: u64) -> ExplorationLog {
