@@ -365,11 +365,12 @@ pub(crate) fn algo_help() -> String {
     let algos: Vec<&str> = Learner::all().map(|l| l.entry().algo).collect();
     format!(
         "rpe, rge-efr, rge-efr-position (the engineered features without the angle, paired \
-         with rge-efr: a control on ArmArrow), or a learned goal space rge-NAME: {} \
-         (parameters in the profile's \
-         [learners.NAME]; `ugl learners` describes them); the follow-up paper's modular goal \
-         exploration (docs/armballs.md): mge-efr-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one \
-         module), random or lp (learning progress), constants in the profile's [mge]",
+         with rge-efr: a control on ArmArrow), rge-efr-mixed (the engineered features through a \
+         fixed rotation that mixes the objects: an entangled control), or a learned goal space \
+         rge-NAME: {} (parameters in the profile's [learners.NAME]; `ugl learners` describes \
+         them); the follow-up paper's modular goal exploration (docs/armballs.md): \
+         mge-efr-CHOICE, mge-efr-mixed-CHOICE or mge-NAME-CHOICE, CHOICE = flat (one module), \
+         random or lp (learning progress), constants in the profile's [mge]",
         algos.join(", ")
     )
 }

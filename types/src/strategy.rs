@@ -45,8 +45,18 @@ pub static RGE_EFR_POSITION: StrategyInfo = StrategyInfo {
     in_paper: false,
 };
 
+/// RGE in the engineered features through a fixed rotation of all their coordinates: the same
+/// information, no coordinate for one object alone (the follow-up's entangled control).
+pub static RGE_EFR_MIXED: StrategyInfo = StrategyInfo {
+    algo: "rge-efr-mixed",
+    display: "RGE-EFR (mixed)",
+    description: "RGE in the engineered features through a fixed rotation of all their coordinates (an entangled control)",
+    sampler: &sampler::UNIFORM,
+    in_paper: false,
+};
+
 /// Every strategy without a learned goal space, in the report's order.
-pub static STRATEGIES: [&StrategyInfo; 3] = [&RPE, &RGE_EFR, &RGE_EFR_POSITION];
+pub static STRATEGIES: [&StrategyInfo; 4] = [&RPE, &RGE_EFR, &RGE_EFR_POSITION, &RGE_EFR_MIXED];
 
 impl StrategyInfo {
     /// Every strategy, in the registry's order.
@@ -148,6 +158,9 @@ pub static MODULE_CHOICES: [&ModuleChoiceInfo; 3] = [&FLAT, &RANDOM_MODULE, &LEA
 
 /// The engineered features as a modular goal space's name (`mge-efr-lp`), and its display name.
 pub const ENGINEERED_SPACE: (&str, &str) = ("efr", "EFR");
+
+/// The mixed engineered space of modular algorithms (`mge-efr-mixed-lp`), and its report name.
+pub const MIXED_SPACE: (&str, &str) = ("efr-mixed", "EFR (mixed)");
 
 /// The prefix of the modular algorithms' names (`mge-vae-lp`).
 pub const MODULAR_PREFIX: &str = "mge-";

@@ -22,6 +22,7 @@ use super::context::RunContext;
 use super::error::RunError;
 use super::fit::{Representation, fit_representation};
 use super::provenance::{crate_versions, git_revision_for};
+use crate::explore::mixed::{MixedGoals, MixedSpace};
 
 /// What an exploration produced, with its timings.
 pub struct Explored {
@@ -70,6 +71,19 @@ pub fn explore(
             };
             let log = strategy
                 .explorer(&mut space, &goals, ctx.mge)
+                .map_err(run_err)?
+                .explore(env, ctx.explore, seed)
+                .map_err(explore_err)?;
+            Ok(Explored {
+                log,
+                encode_s: None,
+            })
+        }
+        GoalSpaceKind::EngineeredMixed => {
+            let objects: Vec<_> = spec.env.objects().into_iter().map(|(_, r)| r).collect();
+            let mut space = MixedSpace::new(d, &objects);
+            let log = strategy
+                .explorer(&mut space, &MixedGoals::new(d, &objects), ctx.mge)
                 .map_err(run_err)?
                 .explore(env, ctx.explore, seed)
                 .map_err(explore_err)?;

@@ -13,6 +13,7 @@ pub mod imgep;
 pub mod interest;
 pub mod meta_policy;
 pub mod mge;
+pub mod mixed;
 /// The k-d tree (in `ugl-types`, shared with the discovery measures).
 pub use ugl_types::nn;
 pub mod rpe;
@@ -250,6 +251,10 @@ pub enum GoalSpaceKind {
     /// ([`ugl_types::EnvSpec::position_dims`]). On ArmArrow it is the control that tells what
     /// exploring the angle adds; elsewhere it is EFR itself.
     EngineeredPosition,
+    /// The engineered features through a fixed rotation of all their coordinates
+    /// ([`mixed`]): the same information, no coordinate for one object alone (the follow-up's
+    /// entangled control without a network).
+    EngineeredMixed,
     /// A space learned from images (IMGEP-UGL, RGE-REP).
     Learned(Learner),
 }
@@ -279,6 +284,12 @@ impl Algo {
     pub const RGE_EFR_POSITION: Algo = Algo {
         strategy: Strategy::Rge,
         space: GoalSpaceKind::EngineeredPosition,
+    };
+
+    /// Random goal exploration in the mixed engineered space (`rge-efr-mixed`).
+    pub const RGE_EFR_MIXED: Algo = Algo {
+        strategy: Strategy::Rge,
+        space: GoalSpaceKind::EngineeredMixed,
     };
 
     /// `strategy` in `space`; `Err` for RPE in a goal space or goal exploration without one.
@@ -315,9 +326,15 @@ impl Algo {
     /// All algorithms known to this build, in their order (`Ord`).
     pub fn all() -> Vec<Algo> {
         let goal = |strategy, space| Algo { strategy, space };
-        let mut v = vec![Algo::RPE, Algo::RGE_EFR, Algo::RGE_EFR_POSITION];
+        let mut v = vec![
+            Algo::RPE,
+            Algo::RGE_EFR,
+            Algo::RGE_EFR_POSITION,
+            Algo::RGE_EFR_MIXED,
+        ];
         v.extend(Learner::all().map(Algo::rge));
         v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::Engineered)));
+        v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::EngineeredMixed)));
         for l in Learner::all() {
             v.extend(Modules::ALL.map(|m| goal(Strategy::Mge(m), GoalSpaceKind::Learned(l))));
         }
@@ -331,12 +348,14 @@ impl Algo {
             GoalSpaceKind::None => "",
             GoalSpaceKind::Engineered => ugl_types::ENGINEERED_SPACE.0,
             GoalSpaceKind::EngineeredPosition => "efr-position",
+            GoalSpaceKind::EngineeredMixed => ugl_types::MIXED_SPACE.0,
             GoalSpaceKind::Learned(l) => l.name(),
         };
         match (self.strategy, self.space) {
             (Strategy::Rpe, _) => "rpe".into(),
             (Strategy::Rge, GoalSpaceKind::Learned(l)) => l.entry().algo.into(),
             (Strategy::Rge, GoalSpaceKind::EngineeredPosition) => "rge-efr-position".into(),
+            (Strategy::Rge, GoalSpaceKind::EngineeredMixed) => ugl_types::RGE_EFR_MIXED.algo.into(),
             (Strategy::Rge, _) => "rge-efr".into(),
             (Strategy::Mge(m), _) => {
                 format!("{}{space}-{}", ugl_types::MODULAR_PREFIX, m.name()).into()
@@ -437,9 +456,18 @@ mod tests {
             "rpe".to_string(),
             "rge-efr".into(),
             "rge-efr-position".into(),
+            "rge-efr-mixed".into(),
         ];
         names.extend(Learner::all().map(|l| format!("rge-{}", l.name())));
         names.extend(["mge-efr-flat", "mge-efr-random", "mge-efr-lp"].map(String::from));
+        names.extend(
+            [
+                "mge-efr-mixed-flat",
+                "mge-efr-mixed-random",
+                "mge-efr-mixed-lp",
+            ]
+            .map(String::from),
+        );
         for l in Learner::all() {
             for m in ["flat", "random", "lp"] {
                 names.push(format!("mge-{}-{m}", l.name()));

@@ -85,6 +85,8 @@ impl Condition {
             (space, Some(choice)) => {
                 let space = if space == ENGINEERED_SPACE.0 {
                     ENGINEERED_SPACE.1.to_string()
+                } else if space == ugl_types::MIXED_SPACE.0 {
+                    ugl_types::MIXED_SPACE.1.to_string()
                 } else {
                     learner_name(space)
                 };

@@ -60,7 +60,7 @@ pub type MarkerElement<C, DB> = ComposedElement<C, DB, Polygon<Px>, PathElement<
 pub const FONT: &str = "sans-serif";
 
 /// Okabe–Ito without its yellow (too pale on white), one per algorithm of [`style_algos`].
-pub const ALGO_COLOURS: [RGBColor; 15] = [
+pub const ALGO_COLOURS: [RGBColor; 16] = [
     RGBColor(0x00, 0x00, 0x00), // rpe: black
     RGBColor(0xE6, 0x9F, 0x00), // efr: orange
     RGBColor(0x56, 0xB4, 0xE9), // pca: sky blue
@@ -69,6 +69,7 @@ pub const ALGO_COLOURS: [RGBColor; 15] = [
     RGBColor(0xD5, 0x5E, 0x00), // vae: vermillion
     RGBColor(0xCC, 0x79, 0xA7), // rfvae: reddish purple
     RGBColor(0x8C, 0x51, 0x0A), // efr, position only: brown
+    RGBColor(0xEE, 0x33, 0x77), // efr, mixed (a control): magenta
     RGBColor(0x33, 0x22, 0x88), // pca-centred: indigo
     RGBColor(0x88, 0x22, 0x55), // bvae: wine
     RGBColor(0xCC, 0x66, 0x77), // conv-vae: rose
