@@ -11,7 +11,8 @@ use super::store::{self, Manifest, Summary};
 use crate::env::{Environment, make_env};
 use crate::explore::{
     Algo, EngineeredGoals, EngineeredSpace, ExplorationLog, ExploreConfig, Explorer, GoalModule,
-    GoalSource, GoalSpaceKind, LearnedSpace, Learner, Modules, Rpe, SamplerKind, goal_modules,
+    GoalSource, GoalSpaceKind, LearnedSpace, Learner, Modules, OutcomeSpace, Rpe, SamplerKind,
+    goal_modules,
 };
 use crate::goals::{GoalSampler, TrainingLatents};
 use crate::repr::{GaussianPrior, Latents, ReprError};
@@ -55,35 +56,34 @@ pub fn explore(
             log: Rpe.explore(env, ctx.explore, seed).map_err(explore_err)?,
             encode_s: None,
         }),
-        GoalSpaceKind::Engineered | GoalSpaceKind::EngineeredPosition => {
-            let (mut space, goals) = if spec.algo.space() == GoalSpaceKind::Engineered {
-                (
-                    EngineeredSpace::new(d),
-                    EngineeredGoals::new(d, spec.env.objects()),
-                )
-            } else {
-                let dims = spec.env.spec().position_dims();
-                let n = dims.len();
-                (
-                    EngineeredSpace::of(dims),
-                    EngineeredGoals::new(n, Vec::new()),
-                )
-            };
+        GoalSpaceKind::Engineered
+        | GoalSpaceKind::EngineeredPosition
+        | GoalSpaceKind::EngineeredMixed => {
+            let (mut space, goals): (Box<dyn OutcomeSpace>, Box<dyn GoalSource>) =
+                match spec.algo.space() {
+                    GoalSpaceKind::Engineered => (
+                        Box::new(EngineeredSpace::new(d)),
+                        Box::new(EngineeredGoals::new(d, spec.env.objects())),
+                    ),
+                    GoalSpaceKind::EngineeredMixed => {
+                        let objects: Vec<_> =
+                            spec.env.objects().into_iter().map(|(_, r)| r).collect();
+                        (
+                            Box::new(MixedSpace::new(d, &objects)),
+                            Box::new(MixedGoals::new(d, &objects)),
+                        )
+                    }
+                    _ => {
+                        let dims = spec.env.spec().position_dims();
+                        let n = dims.len();
+                        (
+                            Box::new(EngineeredSpace::of(dims)),
+                            Box::new(EngineeredGoals::new(n, Vec::new())),
+                        )
+                    }
+                };
             let log = strategy
-                .explorer(&mut space, &goals, ctx.mge)
-                .map_err(run_err)?
-                .explore(env, ctx.explore, seed)
-                .map_err(explore_err)?;
-            Ok(Explored {
-                log,
-                encode_s: None,
-            })
-        }
-        GoalSpaceKind::EngineeredMixed => {
-            let objects: Vec<_> = spec.env.objects().into_iter().map(|(_, r)| r).collect();
-            let mut space = MixedSpace::new(d, &objects);
-            let log = strategy
-                .explorer(&mut space, &MixedGoals::new(d, &objects), ctx.mge)
+                .explorer(space.as_mut(), goals.as_ref(), ctx.mge)
                 .map_err(run_err)?
                 .explore(env, ctx.explore, seed)
                 .map_err(explore_err)?;
