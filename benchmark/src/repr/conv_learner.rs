@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::checkpoint::{self, CheckpointSpec, Restored, Snapshot};
 use super::conv_net::{ConvArch, ConvNet, channels_first};
 use super::conv_train::{ConvConfig, ConvTrainer};
-use super::evidence::{EVIDENCE_IMAGES, TrainingEvidence, mean_image_loss};
+use super::evidence::{EVIDENCE_IMAGES, TrainingEvidence, bce_of_logit, mean_image_loss};
 use super::host_train::HostOptimizer;
 use super::model_file::{ModelFileError, seal, unseal};
 use super::nets::TfAdam;
@@ -538,17 +538,25 @@ impl ConvEncoder {
         let heads = self.heads(&set)?;
         let mut total = 0.0f64;
         let mut chw = vec![0.0f32; set.dim];
-        for (i, h) in heads.chunks_exact(2 * d).enumerate() {
-            let logits = self.net.decode_logits(&h[..d], 1);
-            channels_first(set.row(i), self.net.arch.channels, &mut chw);
-            total += logits
-                .iter()
-                .zip(&chw)
-                .map(|(&l, &t)| {
-                    let l = f64::from(l);
-                    l.max(0.0) + libm::log1p(libm::exp(-l.abs())) - f64::from(t) * l
-                })
-                .sum::<f64>();
+        for (c, group) in heads.chunks(ENCODE_CHUNK * 2 * d).enumerate() {
+            let m = group.len() / (2 * d);
+            let z: Vec<f32> = group
+                .chunks_exact(2 * d)
+                .flat_map(|h| h[..d].iter().copied())
+                .collect();
+            let logits = self.net.decode_logits(&z, m);
+            for (j, picture) in logits.chunks_exact(set.dim).enumerate() {
+                channels_first(
+                    set.row(c * ENCODE_CHUNK + j),
+                    self.net.arch.channels,
+                    &mut chw,
+                );
+                total += picture
+                    .iter()
+                    .zip(&chw)
+                    .map(|(&l, &t)| bce_of_logit(l, t))
+                    .sum::<f64>();
+            }
         }
         Ok(total / set.n.max(1) as f64)
     }
@@ -856,6 +864,36 @@ mod tests {
         let kl = enc.per_latent_kl(&images).unwrap();
         assert_eq!(kl[0], 0.0);
         assert!(kl[1] > 0.0);
+    }
+
+    /// The reconstruction loss of a set decoded in groups is the mean of each picture's own
+    /// (150 pictures: two groups).
+    #[test]
+    fn the_reconstruction_loss_is_the_mean_over_pictures() {
+        let images = pictures(150);
+        let enc = train(
+            ConvModel::ConvBvae,
+            &small(),
+            &images,
+            2,
+            &mut stream_named(1, "learner"),
+            None,
+            None,
+        )
+        .unwrap();
+        let all = enc.reconstruction_loss(&images, 150).unwrap();
+        let each: f64 = (0..150)
+            .map(|i| {
+                let one = ImageSet::new(1, images.dim, images.row(i).to_vec()).unwrap();
+                enc.reconstruction_loss(&one, 1).unwrap()
+            })
+            .sum::<f64>()
+            / 150.0;
+        assert!((all - each).abs() < 1e-9 * each, "{all} vs {each}");
+        assert!(
+            enc.reconstruction_loss(&images, 10).unwrap() != all,
+            "max is honoured"
+        );
     }
 
     #[test]

@@ -51,6 +51,13 @@ pub fn mean_image_loss(images: &ImageSet) -> f64 {
 }
 
 /// How a training ended, compared with the plateau.
+/// The Bernoulli cross-entropy of a pixel value `t` under the logit `l`, `softplus(l) - t l`,
+/// computed stably in `f64` (the reconstruction losses of every network).
+pub fn bce_of_logit(l: f32, t: f32) -> f64 {
+    let l = f64::from(l);
+    l.max(0.0) + libm::log1p(libm::exp(-l.abs())) - f64::from(t) * l
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainingEvidence {
     /// The mean-image loss of the evaluation images (the plateau level).

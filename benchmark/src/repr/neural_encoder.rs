@@ -331,14 +331,10 @@ pub fn reconstruction_loss(model: Model, net: &HostNet, images: &ImageSet, max: 
         .map_init(Scratch::default, |scratch, i| {
             let x = images.row(i);
             let logits = noise_free_logits(model, net, x, scratch);
-            // softplus(l) - x l, stably.
             logits
                 .iter()
                 .zip(x)
-                .map(|(&l, &t)| {
-                    let l = f64::from(l);
-                    l.max(0.0) + libm::log1p(libm::exp(-l.abs())) - f64::from(t) * l
-                })
+                .map(|(&l, &t)| super::evidence::bce_of_logit(l, t))
                 .sum::<f64>()
         })
         .collect();
