@@ -516,6 +516,17 @@ impl CampaignConfig {
                 .iter()
                 .any(|a| a.strategy() != crate::explore::Strategy::Rpe),
         )?;
+        if self.matrix.algos.iter().any(|a| a.space().is_engineered()) {
+            self.mge
+                .engineered_explore(&self.explore)
+                .check_goal_epochs(true)
+                .map_err(|e| {
+                    InvalidValue::new(
+                        "mge.engineered_bootstrap_epochs",
+                        format!("mge.engineered_bootstrap_epochs: {e}"),
+                    )
+                })?;
+        }
         self.env.validate()
     }
 }
@@ -659,6 +670,10 @@ epochs = 500
             (
                 GOOD.replace("\"rpe\", ", "\"rge-conv-bvae\", "),
                 "matrix.envs",
+            ),
+            (
+                format!("{GOOD}[mge]\nengineered_bootstrap_epochs = 500\n"),
+                "mge.engineered_bootstrap_epochs",
             ),
         ];
         for (text, key) in cases {

@@ -82,10 +82,11 @@ pub fn explore(
                         )
                     }
                 };
+            let explore = ctx.mge.engineered_explore(ctx.explore);
             let log = strategy
                 .explorer(space.as_mut(), goals.as_ref(), ctx.mge)
                 .map_err(run_err)?
-                .explore(env, ctx.explore, seed)
+                .explore(env, &explore, seed)
                 .map_err(explore_err)?;
             Ok(Explored {
                 log,

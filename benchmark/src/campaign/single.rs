@@ -55,6 +55,17 @@ impl RunRequest {
                 Some(e) => InvalidValue::new("--epochs", format!("--epochs {e}: {m}")),
                 None => m,
             })?;
+        if goal_directed && self.algo.space().is_engineered() {
+            cfg.mge
+                .engineered_explore(&cfg.explore)
+                .check_goal_epochs(true)
+                .map_err(|m| {
+                    InvalidValue::new(
+                        "mge.engineered_bootstrap_epochs",
+                        format!("mge.engineered_bootstrap_epochs: {m}"),
+                    )
+                })?;
+        }
         if self.algo.space() == crate::explore::GoalSpaceKind::EngineeredPosition
             && !self.env.spec().has_orientation()
         {

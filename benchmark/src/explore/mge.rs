@@ -99,6 +99,26 @@ pub struct MgeConfig {
     /// before it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub goal_bound: Option<f64>,
+    /// true (the default, this project's rule): the bootstrap goes on past
+    /// `explore.bootstrap_epochs` until an outcome has moved the object and two distinct outcome
+    /// encodings are stored. false: exactly `explore.bootstrap_epochs` random episodes, the
+    /// warm-up episode included, whatever they did (the follow-up's loop: its `n_bootstrap`
+    /// random rollouts, then goals).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub bootstrap_until_moved: bool,
+    /// The bootstrap of the engineered goal spaces (the follow-up's EFR runs: 100 random
+    /// rollouts, against 400 for its learned spaces); None (the default): `explore.bootstrap_epochs`
+    /// for every space.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub engineered_bootstrap_epochs: Option<usize>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 impl Default for MgeConfig {
@@ -109,6 +129,8 @@ impl Default for MgeConfig {
             interest_window: 1000.0,
             eps: 0.1,
             goal_bound: None,
+            bootstrap_until_moved: true,
+            engineered_bootstrap_epochs: None,
         }
     }
 }
@@ -146,6 +168,28 @@ impl MgeConfig {
             ));
         }
         Ok(())
+    }
+
+    /// The exploration constants of a run in an engineered goal space:
+    /// `engineered_bootstrap_epochs` in place of `explore.bootstrap_epochs` when it is set.
+    pub fn engineered_explore(&self, explore: &ExploreConfig) -> ExploreConfig {
+        ExploreConfig {
+            bootstrap_epochs: self
+                .engineered_bootstrap_epochs
+                .unwrap_or(explore.bootstrap_epochs),
+            ..explore.clone()
+        }
+    }
+
+    /// Whether iteration `epoch` (the one about to run is `epoch + 1`) is still a bootstrap
+    /// (random) episode: see `bootstrap_until_moved`.
+    fn bootstrapping(&self, explore: &ExploreConfig, epoch: usize, history: &History) -> bool {
+        if self.bootstrap_until_moved {
+            !history.ever_moved || history.index.n_distinct() < 2 || epoch < explore.bootstrap_epochs
+        } else {
+            // The warm-up episode (epoch 0) is the first of the `bootstrap_epochs`.
+            epoch + 1 < explore.bootstrap_epochs
+        }
     }
 }
 
@@ -315,10 +359,7 @@ pub fn run_mge(
     let mut goal = Vec::new();
     let mut epoch = 0;
     while epoch < cfg.epochs {
-        let bootstrapping = !mem.history.ever_moved
-            || mem.history.index.n_distinct() < 2
-            || epoch < cfg.bootstrap_epochs;
-        if bootstrapping {
+        if mge.bootstrapping(cfg, epoch, &mem.history) {
             epoch += 1;
             let theta = random_params(&mut params_rng, env.param_dim());
             mem.store(env, space, modules, &mut rec, theta, epoch, true);
@@ -430,6 +471,10 @@ mod tests {
     use crate::goals::UniformGoals;
 
     fn efr_run(env: EnvKind, choice: Modules, seed: u64) -> ExplorationLog {
+        efr_run_with(env, choice, seed, &MgeConfig::default())
+    }
+
+    fn efr_run_with(env: EnvKind, choice: Modules, seed: u64, mge: &MgeConfig) -> ExplorationLog {
         let env = make_env(env, &EnvConfig::default());
         let d = env.state_dim();
         let objects = env.kind().objects();
@@ -450,10 +495,53 @@ mod tests {
             &mut samplers,
             choice,
             &cfg,
-            &MgeConfig::default(),
+            mge,
             seed,
         )
         .unwrap()
+    }
+
+    /// The follow-up's bootstrap is exactly `bootstrap_epochs` random episodes (the warm-up
+    /// counted); ours goes on until the ball moved. The engineered spaces' own bootstrap
+    /// replaces `explore.bootstrap_epochs`, and neither key is written at its default (every
+    /// earlier run's configuration hash is kept).
+    #[test]
+    fn the_follow_ups_fixed_bootstrap() {
+        let fixed = MgeConfig {
+            bootstrap_until_moved: false,
+            ..MgeConfig::default()
+        };
+        for seed in 0..4 {
+            let log = efr_run_with(EnvKind::ARMBALLS, Modules::Progress, seed, &fixed);
+            // `n_random` leaves out the warm-up episode: 1 + 49 random episodes.
+            assert_eq!(log.n_random, 49, "seed {seed}");
+            assert_eq!(log.n_random + log.n_goal, 600);
+        }
+        // Ours: the warm-up and at least the 50 bootstrap iterations.
+        let log = efr_run(EnvKind::ARMBALLS, Modules::Progress, 0);
+        assert!(log.n_random >= 50, "{}", log.n_random);
+        let explore = ExploreConfig {
+            bootstrap_epochs: 400,
+            ..ExploreConfig::default()
+        };
+        let efr = MgeConfig {
+            engineered_bootstrap_epochs: Some(100),
+            ..MgeConfig::default()
+        };
+        assert_eq!(efr.engineered_explore(&explore).bootstrap_epochs, 100);
+        assert_eq!(
+            MgeConfig::default().engineered_explore(&explore).bootstrap_epochs,
+            400
+        );
+        let json = serde_json::to_string(&MgeConfig::default()).unwrap();
+        assert!(
+            !json.contains("bootstrap_until_moved") && !json.contains("engineered_bootstrap"),
+            "{json}"
+        );
+        let back: MgeConfig = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, MgeConfig::default());
+        let json = serde_json::to_string(&fixed).unwrap();
+        assert!(json.contains("\"bootstrap_until_moved\":false"), "{json}");
     }
 
     #[test]

@@ -259,6 +259,18 @@ pub enum GoalSpaceKind {
     Learned(Learner),
 }
 
+impl GoalSpaceKind {
+    /// Engineered features, whole, positions only or mixed.
+    pub fn is_engineered(self) -> bool {
+        matches!(
+            self,
+            GoalSpaceKind::Engineered
+                | GoalSpaceKind::EngineeredPosition
+                | GoalSpaceKind::EngineeredMixed
+        )
+    }
+}
+
 /// An exploration algorithm: a strategy in a goal space. Only the valid pairs exist (RPE has no
 /// goal space, goal exploration has one; [`Algo::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
