@@ -11,12 +11,13 @@ JOBS ?=
 MIN_RUST := 1.95
 UGL := $(CARGO) run --quiet --bin ugl --
 
-.PHONY: help report test test-cargo test-slurm lint campaign bench verify verify-update verify-store check-toolchain check-shared-build
+.PHONY: help report test test-cargo test-python test-slurm lint campaign bench verify verify-update verify-store check-toolchain check-shared-build
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
-	@echo "make test                the test suite (what CI runs): make test-cargo, then make test-slurm"
+	@echo "make test                the test suite (what CI runs): test-cargo, test-python, test-slurm, verify-store"
 	@echo "make test-cargo          cargo test --workspace (no cluster needed)"
+	@echo "make test-python         build the Python package into a virtual environment (target/py-venv) and run pytest"
 	@echo "make test-slurm          the cluster path on a private single-node Slurm (root; slurm-wlm, munge)"
 	@echo "make lint                cargo fmt --check and cargo clippy -D warnings (CI runs it first)"
 	@echo "make campaign PROFILE=p  run data/campaigns/p.toml into data/results/p (resumable)"
@@ -44,10 +45,23 @@ report: check-toolchain
 	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT) --main $(MAIN)
 	@echo "report: $(REPORT_OUT)/REPORT.md"
 
-test: test-cargo test-slurm verify-store
+test: test-cargo test-python test-slurm verify-store
 
 test-cargo: check-toolchain
 	$(CARGO) test --workspace
+
+# The Python package (python/, docs/python.md): a virtual environment under target/, the package
+# built by maturin in the workspace's one build profile (so it reuses target/), and its pytest
+# cases, which compare it with the command line's rollouts and pictures (the ugl binary).
+PYTHON ?= python3
+PY_VENV ?= target/py-venv
+test-python: check-toolchain
+	@$(PYTHON) -m venv --help >/dev/null 2>&1 || { echo "error: $(PYTHON) has no venv module (Debian: apt-get install python3-venv)" >&2; exit 1; }
+	$(CARGO) build --bin ugl --quiet
+	$(PYTHON) -m venv $(PY_VENV)
+	$(PY_VENV)/bin/python -m pip install --quiet --disable-pip-version-check "maturin>=1.8,<2" "numpy>=1.21" "gymnasium>=0.29" "pytest>=7"
+	PATH="$(CURDIR)/$(PY_VENV)/bin:$$PATH" $(PY_VENV)/bin/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --force-reinstall --no-deps ./python
+	UGL_BIN=$(CURDIR)/target/debug/ugl $(PY_VENV)/bin/python -m pytest -q -p no:cacheprovider python/tests
 
 # The cluster path on a real Slurm: a private single-node cluster started and stopped by the
 # test (tests/slurm/real_cluster.sh). Needs root and Debian's slurm-wlm + munge (.ci/run installs

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Golden images for the Rust renderer (benchmark/src/env/render.rs).
+"""Golden images for the Rust renderer (env/src/render.rs).
 
 Renders ArmBall / ArmArrow states exactly the way the original code does
 (flowersteam/Unsupervised_Goal_Space_Learning, src/rendering.py; see

@@ -6,16 +6,15 @@
 //! the campaign machinery that writes the results store.
 
 pub mod campaign;
+/// The environments, renderers, seeded streams and `.npy` codec (the light `ugl-env` crate,
+/// which the Python package shares).
+pub use ugl_env as env;
+pub use ugl_env::{invalid, npy, seed};
 /// The deterministic float kernels and their paths (`UGL_SIMD`).
 pub use ugl_kernels as kernels;
-pub mod env;
 pub mod explore;
 pub mod fsio;
 pub mod goals;
-pub mod invalid;
 pub mod limits;
 pub mod metrics;
-pub mod npy;
 pub mod repr;
-pub mod seed;
-mod ziggurat_tables;

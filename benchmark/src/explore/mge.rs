@@ -185,7 +185,9 @@ impl MgeConfig {
     /// (random) episode: see `bootstrap_until_moved`.
     fn bootstrapping(&self, explore: &ExploreConfig, epoch: usize, history: &History) -> bool {
         if self.bootstrap_until_moved {
-            !history.ever_moved || history.index.n_distinct() < 2 || epoch < explore.bootstrap_epochs
+            !history.ever_moved
+                || history.index.n_distinct() < 2
+                || epoch < explore.bootstrap_epochs
         } else {
             // The warm-up episode (epoch 0) is the first of the `bootstrap_epochs`.
             epoch + 1 < explore.bootstrap_epochs
@@ -530,7 +532,9 @@ mod tests {
         };
         assert_eq!(efr.engineered_explore(&explore).bootstrap_epochs, 100);
         assert_eq!(
-            MgeConfig::default().engineered_explore(&explore).bootstrap_epochs,
+            MgeConfig::default()
+                .engineered_explore(&explore)
+                .bootstrap_epochs,
             400
         );
         let json = serde_json::to_string(&MgeConfig::default()).unwrap();

@@ -267,6 +267,10 @@ impl Environment for CdgeArmBalls {
         &self.initial
     }
 
+    fn draws_noise(&self) -> bool {
+        true
+    }
+
     /// The outcome: ball (x, y), then distractor (x, y), at the last step.
     fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout {
         let theta: &[f64; PARAMS] = theta.try_into().unwrap_or_else(|_| {

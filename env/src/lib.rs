@@ -4,6 +4,11 @@
 //! A rollout runs one 50-step DMP movement of the 7-joint arm from rest; the object (ball or
 //! arrow) is caught, stickily, as soon as the hand comes within `object_size` of it, and then
 //! follows the hand. The outcome is the object state at the last step, clipped to [-1,1].
+//!
+//! This crate is the light part of ugl-bench: the environments, their renderers, the seeded
+//! random streams (`seed`) and the `.npy` codec, with no training stack, so that the Python
+//! package (`python/`) and the benchmark (`ugl-bench`, which re-exports it as `ugl_bench::env`)
+//! share one implementation.
 
 pub mod arm;
 pub mod armarrow;
@@ -12,6 +17,11 @@ pub mod armballs;
 pub mod cdge;
 pub mod dmp;
 pub mod render;
+
+pub mod invalid;
+pub mod npy;
+pub mod seed;
+mod ziggurat_tables;
 
 use crate::invalid::InvalidValue;
 use std::fmt;
@@ -110,8 +120,8 @@ pub fn register(entry: &'static EnvEntry) -> Result<EnvKind, RegisterError> {
             dim: spec.state_dim,
         });
     }
-    let measured = crate::metrics::KlCoverage::new(spec.klc.dims).map(|m| m.n_achievable());
-    if spec.klc.bins != crate::metrics::klc::BINS
+    let measured = ugl_types::klc::KlCoverage::new(spec.klc.dims).map(|m| m.n_achievable());
+    if spec.klc.bins != ugl_types::klc::BINS
         || measured.as_ref().ok() != Some(&spec.klc.achievable_cells)
     {
         return Err(RegisterError::Grid {
@@ -119,7 +129,7 @@ pub fn register(entry: &'static EnvEntry) -> Result<EnvKind, RegisterError> {
             dims: spec.klc.dims,
             cells: spec.klc.achievable_cells,
             measured: match measured {
-                Ok(n) => format!("{n} cells of {} bins", crate::metrics::klc::BINS),
+                Ok(n) => format!("{n} cells of {} bins", ugl_types::klc::BINS),
                 Err(e) => e.to_string(),
             },
         });
@@ -543,6 +553,12 @@ pub trait Environment: Send + Sync {
     /// episode by the environments that move on their own (ArmBalls' distractor); ArmBall and
     /// ArmArrow draw nothing from it.
     fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout;
+    /// Whether [`Environment::rollout`] draws from `noise` (an object that moves on its own):
+    /// then episodes must run in order, each continuing the stream where the last left it;
+    /// otherwise they may run in parallel (the Python package's batched rollout).
+    fn draws_noise(&self) -> bool {
+        false
+    }
     /// Values of one picture (the declaration's: 70 x 70 gray, 4900, in the paper's).
     fn image_len(&self) -> usize {
         self.kind().spec().image.len()
@@ -651,6 +667,22 @@ impl Body {
 mod tests {
     use super::*;
 
+    /// `draws_noise` tells the truth: an environment that says no leaves the stream where it
+    /// was (its episodes may run in parallel), one that says yes moves it.
+    #[test]
+    fn draws_noise_says_whether_the_stream_moves() {
+        use rand::RngExt;
+        for kind in EnvKind::all() {
+            let env = make_env(kind, &EnvConfig::default());
+            let theta = vec![0.3; env.param_dim()];
+            let mut noise = crate::seed::stream(7, crate::seed::Component::Distractor);
+            env.rollout(&theta, &mut noise);
+            let mut fresh = crate::seed::stream(7, crate::seed::Component::Distractor);
+            let moved = noise.random::<u64>() != fresh.random::<u64>();
+            assert_eq!(moved, env.draws_noise(), "{kind}");
+        }
+    }
+
     #[test]
     fn the_paper_constants_pass_the_checks_and_each_range_is_enforced() {
         let ok = EnvConfig::default();
@@ -717,9 +749,9 @@ mod tests {
     fn registry_klc_grids_are_the_measures() {
         for k in EnvKind::all() {
             let grid = k.spec().klc;
-            let m = crate::metrics::KlCoverage::new(grid.dims).unwrap();
+            let m = ugl_types::klc::KlCoverage::new(grid.dims).unwrap();
             assert_eq!(m.n_achievable(), grid.achievable_cells, "{k}");
-            assert_eq!(crate::metrics::klc::BINS, grid.bins, "{k}");
+            assert_eq!(ugl_types::klc::BINS, grid.bins, "{k}");
             assert_eq!(m.max_klc(), grid.max_klc(), "{k}");
             assert_eq!(k.metric_dims().len(), grid.dims, "{k}");
         }

@@ -63,6 +63,10 @@ impl Environment for ArmBalls {
         &self.initial
     }
 
+    fn draws_noise(&self) -> bool {
+        true
+    }
+
     fn rollout(&self, theta: &[f64], noise: &mut Stream) -> Rollout {
         let theta = super::dmp_params(theta);
         let (caught, pose) = self.body.run(theta, [self.initial[0], self.initial[1]]);
@@ -88,8 +92,9 @@ impl Environment for ArmBalls {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::env::PARAMS;
+    use crate::PARAMS;
     use crate::seed::{Component, stream};
+    use rand::RngExt;
 
     fn env(noise: f64) -> ArmBalls {
         ArmBalls::new(&EnvConfig {
@@ -132,7 +137,9 @@ mod tests {
         let mut rng = stream(4, Component::Params);
         let mut caught = 0;
         for _ in 0..3000 {
-            let theta = crate::explore::meta_policy::random_params(&mut rng, PARAMS);
+            let theta = (0..PARAMS)
+                .map(|_| rng.random_range(-1.0..1.0))
+                .collect::<Vec<f64>>();
             let mut noise = stream(1, Component::Distractor);
             let r = e.rollout(&theta, &mut noise);
             let b = ball.rollout(&theta, &mut noise);
@@ -146,7 +153,7 @@ mod tests {
 
     #[test]
     fn both_balls_are_rendered_the_ball_white_and_the_distractor_gray() {
-        use crate::env::render::{PIXELS, SIDE, render_ball_into};
+        use crate::render::{PIXELS, SIDE, render_ball_into};
         let e = env(0.1);
         let mut img = vec![0f32; PIXELS];
         e.render_into(&[0.5, 0.5, -0.5, -0.5], &mut img);
