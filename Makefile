@@ -59,7 +59,7 @@ test-python: check-toolchain
 	@$(PYTHON) -m venv --help >/dev/null 2>&1 || { echo "error: $(PYTHON) has no venv module (Debian: apt-get install python3-venv)" >&2; exit 1; }
 	$(CARGO) build --bin ugl --quiet
 	$(PYTHON) -m venv $(PY_VENV)
-	$(PY_VENV)/bin/python -m pip install --quiet --disable-pip-version-check "maturin>=1.8,<2" "numpy>=1.21" "gymnasium>=0.29" "pytest>=7"
+	$(PY_VENV)/bin/python -m pip install --quiet --disable-pip-version-check "maturin>=1.8,<2" "numpy>=1.21" "gymnasium>=0.29" "pytest>=7" "cloudpickle>=2"
 	PATH="$(CURDIR)/$(PY_VENV)/bin:$$PATH" $(PY_VENV)/bin/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --force-reinstall --no-deps ./python
 	UGL_BIN=$(CURDIR)/target/debug/ugl $(PY_VENV)/bin/python -m pytest -q -p no:cacheprovider python/tests
 

@@ -7,6 +7,8 @@ the same Rust code as the ``ugl`` command line, so their outcomes are byte-ident
 * :func:`rollout` scores a batch of motor parameters (a quality-diversity library's
   ``scheduler.ask()``) in one call, without the GIL and on every core;
 * :class:`Env` runs one episode at a time;
+* :func:`compare` ranks a learner written as a Python object (``fit``, ``encode``) as
+  ``ugl compare --command`` ranks a program;
 * :mod:`ugl_bench.gym` registers the Gymnasium environments ``ugl_bench/ArmBall-v0``,
   ``ugl_bench/ArmArrow-v0``, ``ugl_bench/ArmBalls-v0`` and ``ugl_bench/ArmBallsCoRL-v0``
   (``import ugl_bench`` registers them when gymnasium is installed).
@@ -24,7 +26,7 @@ import numpy as np
 from . import _native
 from ._native import Env as _NativeEnv
 
-__all__ = ["Env", "environments", "environment", "rollout", "ENV_NAMES"]
+__all__ = ["Env", "environments", "environment", "rollout", "ENV_NAMES", "compare", "CompareResult"]
 
 
 def environments() -> list:
@@ -145,6 +147,8 @@ def rollout(
     a = _as_params(params, p, one=False)
     return _native.rollout(name, a, int(seed), bool(images), _config_json(config))
 
+
+from .comparison import CompareResult, compare  # noqa: E402
 
 # The Gymnasium environments, registered on import when gymnasium is installed (Gymnasium 1.x
 # has no plugin hook; `gymnasium.make("ugl_bench.gym:ugl_bench/ArmBall-v0")` also works).
