@@ -183,12 +183,15 @@ impl Algo {
             .collect()
     }
 
-    /// [`Algo::styled`], as names.
+    /// [`Algo::styled`], as names: every strategy and learner in the order of its entry's
+    /// `style` slot (slot `i` at index `i`).
     pub fn styled_names() -> Vec<&'static str> {
-        let mut v = Algo::paper_names();
-        v.extend(StrategyInfo::all().filter(|s| !s.in_paper).map(|s| s.algo));
-        v.extend(LearnerInfo::all().filter(|l| !l.in_paper).map(|l| l.algo));
-        v
+        let mut v: Vec<(usize, &'static str)> = StrategyInfo::all()
+            .map(|s| (s.style, s.algo))
+            .chain(LearnerInfo::all().map(|l| (l.style, l.algo)))
+            .collect();
+        v.sort();
+        v.into_iter().map(|(_, a)| a).collect()
     }
 
     const fn borrowed(name: &'static str) -> Algo {
@@ -205,9 +208,10 @@ impl Algo {
         }
     }
 
-    /// The algorithms with a fixed style, in slot order: the paper's ([`Algo::paper`]), the
-    /// other strategies, then the registry's other learners. An algorithm looks the same in
-    /// every figure; one outside the registries takes the following slots.
+    /// The algorithms with a fixed style, in slot order (each entry's `style`: the paper's
+    /// first, as [`Algo::paper`] lists them). An algorithm looks the same in every figure, and
+    /// adding an entry moves no other's style; one outside the registries takes the following
+    /// slots.
     pub fn styled() -> Vec<Algo> {
         Algo::styled_names()
             .into_iter()
@@ -370,6 +374,23 @@ fn rank<'a>(known: impl ExactSizeIterator<Item = &'a str>, name: &str) -> usize 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every strategy and learner has its own style slot, the slots run from 0 without a gap,
+    /// and the paper's algorithms hold the first ones in the paper's order: a new entry takes
+    /// the next free slot and moves no other algorithm's colour or marker.
+    #[test]
+    fn style_slots_are_distinct_contiguous_and_the_papers_first() {
+        let mut slots: Vec<usize> = StrategyInfo::all()
+            .map(|s| s.style)
+            .chain(LearnerInfo::all().map(|l| l.style))
+            .collect();
+        slots.sort();
+        assert_eq!(slots, (0..slots.len()).collect::<Vec<_>>());
+        let styled = Algo::styled_names();
+        let paper = Algo::paper_names();
+        assert_eq!(&styled[..paper.len()], &paper[..]);
+        assert_eq!(styled.len(), slots.len());
+    }
 
     #[test]
     fn names_know_their_registry_entries() {

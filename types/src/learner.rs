@@ -55,6 +55,11 @@ pub struct LearnerInfo {
     /// The pictures it is built for (None: any vector of pixels); its runs need an environment
     /// that renders them.
     pub image: Option<ImageShape>,
+    /// Its style slot in the report's figures: the colour and marker its algorithm has in every
+    /// figure. Fixed per entry (never its position in the registry), so that adding a learner
+    /// moves no other; the slots of all strategies and learners are distinct and run from 0
+    /// without a gap (`Algo::styled`).
+    pub style: usize,
 }
 
 const fn dense(iterations: usize, optimiser: &'static str, warmup: usize) -> PaperTraining {
@@ -78,6 +83,7 @@ pub static PCA: LearnerInfo = LearnerInfo {
     in_paper: true,
     paper_training: None,
     image: None,
+    style: 2,
 };
 pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     name: "pca-centred",
@@ -89,6 +95,7 @@ pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: None,
     image: None,
+    style: 9,
 };
 pub static ISOMAP: LearnerInfo = LearnerInfo {
     name: "isomap",
@@ -100,6 +107,7 @@ pub static ISOMAP: LearnerInfo = LearnerInfo {
     in_paper: true,
     paper_training: None,
     image: None,
+    style: 3,
 };
 pub static AE: LearnerInfo = LearnerInfo {
     name: "ae",
@@ -111,6 +119,7 @@ pub static AE: LearnerInfo = LearnerInfo {
     in_paper: true,
     paper_training: Some(dense(200_000, "Adagrad", 0)),
     image: None,
+    style: 4,
 };
 pub static VAE: LearnerInfo = LearnerInfo {
     name: "vae",
@@ -122,6 +131,7 @@ pub static VAE: LearnerInfo = LearnerInfo {
     in_paper: true,
     paper_training: Some(dense(100_000, "Adam", 0)),
     image: None,
+    style: 5,
 };
 pub static RFVAE: LearnerInfo = LearnerInfo {
     name: "rfvae",
@@ -133,6 +143,7 @@ pub static RFVAE: LearnerInfo = LearnerInfo {
     in_paper: true,
     paper_training: Some(dense(50_000, "Adam", 10_000)),
     image: None,
+    style: 6,
 };
 pub static BVAE: LearnerInfo = LearnerInfo {
     name: "bvae",
@@ -144,6 +155,7 @@ pub static BVAE: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: Some(dense(100_000, "Adam", 0)),
     image: None,
+    style: 10,
 };
 pub static CONV_VAE: LearnerInfo = LearnerInfo {
     name: "conv-vae",
@@ -155,6 +167,7 @@ pub static CONV_VAE: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: None,
     image: Some(RGB64),
+    style: 11,
 };
 pub static CONV_BVAE: LearnerInfo = LearnerInfo {
     name: "conv-bvae",
@@ -166,6 +179,7 @@ pub static CONV_BVAE: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: None,
     image: Some(RGB64),
+    style: 12,
 };
 pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     name: "gaussian-projection",
@@ -177,6 +191,7 @@ pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: None,
     image: None,
+    style: 13,
 };
 pub static EXTERNAL: LearnerInfo = LearnerInfo {
     name: "external",
@@ -188,6 +203,7 @@ pub static EXTERNAL: LearnerInfo = LearnerInfo {
     in_paper: false,
     paper_training: None,
     image: None,
+    style: 14,
 };
 
 /// Every learner, in the report's order.

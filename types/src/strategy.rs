@@ -18,6 +18,11 @@ pub struct StrategyInfo {
     pub sampler: &'static SamplerInfo,
     /// Whether the paper evaluated it (the paper's algorithms come first, with fixed styles).
     pub in_paper: bool,
+    /// Its style slot in the report's figures: the colour and marker it has in every figure.
+    /// Fixed per entry (never its position in a list), so that adding an entry moves no other;
+    /// the slots of all strategies and learners are distinct and run from 0 without a gap
+    /// (`Algo::styled`).
+    pub style: usize,
 }
 
 /// Random parameter exploration: the floor.
@@ -27,6 +32,7 @@ pub static RPE: StrategyInfo = StrategyInfo {
     description: "random parameter exploration: motor parameters uniform in their box",
     sampler: &sampler::NONE,
     in_paper: true,
+    style: 0,
 };
 /// Random goal exploration in the engineered features (the object's true state).
 pub static RGE_EFR: StrategyInfo = StrategyInfo {
@@ -35,6 +41,7 @@ pub static RGE_EFR: StrategyInfo = StrategyInfo {
     description: "random goal exploration in the engineered features (the object's state)",
     sampler: &sampler::UNIFORM,
     in_paper: true,
+    style: 1,
 };
 /// RGE-EFR with the object's position alone (ArmArrow without its angle).
 pub static RGE_EFR_POSITION: StrategyInfo = StrategyInfo {
@@ -43,6 +50,7 @@ pub static RGE_EFR_POSITION: StrategyInfo = StrategyInfo {
     description: "RGE-EFR on the object's position alone, without the angle (ArmArrow)",
     sampler: &sampler::UNIFORM,
     in_paper: false,
+    style: 7,
 };
 
 /// RGE in the engineered features through a fixed rotation of all their coordinates: the same
@@ -53,6 +61,7 @@ pub static RGE_EFR_MIXED: StrategyInfo = StrategyInfo {
     description: "RGE in the engineered features through a fixed rotation of all their coordinates (an entangled control)",
     sampler: &sampler::UNIFORM,
     in_paper: false,
+    style: 8,
 };
 
 /// Every strategy without a learned goal space, in the report's order.

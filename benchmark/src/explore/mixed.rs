@@ -117,8 +117,18 @@ impl MixedGoals {
 
 impl super::goal_source::GoalSource for MixedGoals {
     fn modules(&self, choice: Modules, module_size: usize) -> Result<Vec<GoalModule>, ReprError> {
-        goal_modules(choice, self.dim, None, &vec![1.0; self.dim], module_size)
-            .map_err(|e| ReprError::InvalidInput(e.to_string()))
+        let mut modules = goal_modules(choice, self.dim, None, &vec![1.0; self.dim], module_size)
+            .map_err(|e| ReprError::InvalidInput(e.to_string()))?;
+        // Named by the mixed coordinates `y = R s` they hold (`y0,y1`), not as latents.
+        for m in modules.iter_mut().filter(|m| m.name != "all") {
+            m.name = m
+                .dims
+                .iter()
+                .map(|k| format!("y{k}"))
+                .collect::<Vec<_>>()
+                .join(",");
+        }
+        Ok(modules)
     }
     fn sampler(&self, dims: Option<&[usize]>) -> Result<Box<dyn GoalSampler>, ReprError> {
         Ok(Box::new(MixedSampler {
@@ -197,6 +207,12 @@ mod tests {
             m.iter().map(|m| m.dims.clone()).collect::<Vec<_>>(),
             [vec![0, 1], vec![2, 3]]
         );
+        // Named by the mixed coordinates they hold, not as latents.
+        assert_eq!(
+            m.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(),
+            ["y0,y1", "y2,y3"]
+        );
+        assert_eq!(goals.modules(Modules::Flat, 2).unwrap()[0].name, "all");
         let mut all = goals.sampler(None).unwrap();
         let mut g = [0.0; 4];
         let mut rng = stream_named(1, "goals");
