@@ -102,42 +102,38 @@ impl Conv2d {
         );
     }
 
-    /// Row `r = (c, ky, kx)` of the `im2col` matrix of a batch, `[patch, n * pixels]`: the
-    /// input value under kernel position `r` for every output pixel of every image, image after
-    /// image (0 in the padding).
-    fn im2col_row(&self, n: usize, x: &[f32], r: usize, row: &mut [f32]) {
+    /// Row `r = (c, ky, kx)` of the `im2col` matrix of one image, `[patch, pixels]`: the input
+    /// value under kernel position `r` for every output pixel (0 in the padding).
+    fn im2col_row(&self, x: &[f32], r: usize, row: &mut [f32]) {
         let (k, s, p) = (self.kernel, self.stride, self.padding as isize);
         let (oh, ow) = (self.out_height(), self.out_width());
         let (c, ky, kx) = (r / (k * k), r / k % k, r % k);
-        for i in 0..n {
-            let plane =
-                &x[i * self.in_len() + c * self.height * self.width..][..self.height * self.width];
-            let dst = &mut row[i * oh * ow..][..oh * ow];
-            for oy in 0..oh {
-                let y = (oy * s + ky) as isize - p;
-                let line = &mut dst[oy * ow..][..ow];
-                if y < 0 || y >= self.height as isize {
-                    line.fill(0.0);
-                    continue;
-                }
-                let src = &plane[y as usize * self.width..][..self.width];
-                let off = kx as isize - p;
-                let (lo, hi) = inside(off, s, ow, self.width);
-                line[..lo].fill(0.0);
-                line[hi..].fill(0.0);
-                if lo < hi {
-                    let first = ((lo * s) as isize + off) as usize;
-                    let src = &src[first..];
-                    let line = &mut line[lo..hi];
-                    if s == 2 && src.len() >= 2 * line.len() {
-                        // The follow-up's stride: every other value, in pairs (vectorised).
-                        for (v, pair) in line.iter_mut().zip(src.chunks_exact(2)) {
-                            *v = pair[0];
-                        }
-                    } else {
-                        for (j, v) in line.iter_mut().enumerate() {
-                            *v = src[j * s];
-                        }
+        let plane = &x[c * self.height * self.width..][..self.height * self.width];
+        let dst = &mut row[..oh * ow];
+        for oy in 0..oh {
+            let y = (oy * s + ky) as isize - p;
+            let line = &mut dst[oy * ow..][..ow];
+            if y < 0 || y >= self.height as isize {
+                line.fill(0.0);
+                continue;
+            }
+            let src = &plane[y as usize * self.width..][..self.width];
+            let off = kx as isize - p;
+            let (lo, hi) = inside(off, s, ow, self.width);
+            line[..lo].fill(0.0);
+            line[hi..].fill(0.0);
+            if lo < hi {
+                let first = ((lo * s) as isize + off) as usize;
+                let src = &src[first..];
+                let line = &mut line[lo..hi];
+                if s == 2 && src.len() >= 2 * line.len() {
+                    // The follow-up's stride: every other value, in pairs (vectorised).
+                    for (v, pair) in line.iter_mut().zip(src.chunks_exact(2)) {
+                        *v = pair[0];
+                    }
+                } else {
+                    for (j, v) in line.iter_mut().enumerate() {
+                        *v = src[j * s];
                     }
                 }
             }
@@ -267,7 +263,7 @@ impl Conv2d {
                 || vec![0.0f32; patch * pix],
                 |cols, (out, img)| {
                     for (r, row) in cols.chunks_exact_mut(pix).enumerate() {
-                        self.im2col_row(1, img, r, row);
+                        self.im2col_row(img, r, row);
                     }
                     match b {
                         Some(b) => {

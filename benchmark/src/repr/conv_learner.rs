@@ -677,6 +677,20 @@ mod tests {
         ImageSet::new(n, dim, data).unwrap()
     }
 
+    /// The small β-VAE of [`small`], 2 latents, trained on `images` from learner seed 1.
+    fn small_bvae(images: &ImageSet) -> ConvEncoder {
+        train(
+            ConvModel::ConvBvae,
+            &small(),
+            images,
+            2,
+            &mut stream_named(1, "learner"),
+            None,
+            None,
+        )
+        .unwrap()
+    }
+
     fn small() -> ConvConfig {
         ConvConfig {
             filters: 3,
@@ -830,17 +844,7 @@ mod tests {
     #[test]
     fn the_per_latent_kl() {
         let images = pictures(6);
-        let cfg = small();
-        let mut enc = train(
-            ConvModel::ConvBvae,
-            &cfg,
-            &images,
-            2,
-            &mut stream_named(1, "learner"),
-            None,
-            None,
-        )
-        .unwrap();
+        let mut enc = small_bvae(&images);
         let heads = enc.heads(&images).unwrap();
         let kl = enc.per_latent_kl(&images).unwrap();
         let want: f64 = heads
@@ -871,16 +875,7 @@ mod tests {
     #[test]
     fn the_reconstruction_loss_is_the_mean_over_pictures() {
         let images = pictures(150);
-        let enc = train(
-            ConvModel::ConvBvae,
-            &small(),
-            &images,
-            2,
-            &mut stream_named(1, "learner"),
-            None,
-            None,
-        )
-        .unwrap();
+        let enc = small_bvae(&images);
         let all = enc.reconstruction_loss(&images, 150).unwrap();
         let each: f64 = (0..150)
             .map(|i| {
@@ -899,16 +894,7 @@ mod tests {
     #[test]
     fn a_model_file_of_the_other_network_is_refused() {
         let images = pictures(6);
-        let enc = train(
-            ConvModel::ConvBvae,
-            &small(),
-            &images,
-            2,
-            &mut stream_named(1, "learner"),
-            None,
-            None,
-        )
-        .unwrap();
+        let enc = small_bvae(&images);
         let bytes = enc.save("k").unwrap();
         let vae = ConvLearner::new(ConvModel::ConvVae, ConvConfig::followup_vae());
         assert!(vae.load("k", &bytes).is_err());
