@@ -250,7 +250,7 @@ mod followup {
 
 /// Random motor parameters explore the ball of `armballs-corl` as far as in the authors' own
 /// runs: the fraction of the 900 cells of a 30 x 30 grid over [-1, 1]² holding a final ball
-/// position after 9666 rollouts (their last point; `data/followup/`). Our DMP variant,
+/// position after 9666 rollouts (their last point; `data/paper/followup_authors_curves.csv`). Our DMP variant,
 /// `armballs`, reaches about half of it (0.078): the test tells the two environments apart.
 #[test]
 fn random_exploration_reaches_the_authors_exploration_ratio() {
@@ -259,7 +259,7 @@ fn random_exploration_reaches_the_authors_exploration_ratio() {
     use ugl_bench::seed::{Component, stream};
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../data/followup/authors_exploration30_curves.csv"
+        "/../data/paper/followup_authors_curves.csv"
     );
     let text = std::fs::read_to_string(path).expect("the authors' curves are committed");
     let row: Vec<&str> = text

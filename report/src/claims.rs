@@ -200,6 +200,14 @@ pub trait Observations {
         let _ = premise;
         None
     }
+    /// A condition known only by a published summary of `statistic` (the follow-up's
+    /// authors' runs: their number, mean and standard deviation), for a condition without
+    /// [`Observations::values`]: a claim compares with it by Welch's interval from the
+    /// summaries. None (the default): no such condition.
+    fn summary(&self, key: &ConditionKey, statistic: Statistic) -> Option<stats::SampleSummary> {
+        let _ = (key, statistic);
+        None
+    }
 }
 
 /// The conditions of one campaign, with the runs of its store.
@@ -1259,17 +1267,30 @@ fn compare(
         {
             let sy = obs.values(r, statistic);
             let unusable = |v: &[(i64, f64)]| v.is_empty() || v.iter().any(|x| x.1.is_nan());
-            if unusable(&sx) || unusable(&sy) {
+            let published = if sy.is_empty() {
+                obs.summary(r, statistic)
+            } else {
+                None
+            };
+            if unusable(&sx) || (unusable(&sy) && published.is_none()) {
                 continue;
             }
             let xs: Vec<f64> = sx.iter().map(|v| v.1).collect();
             let ys: Vec<f64> = sy.iter().map(|v| v.1).collect();
-            let (subject_mean, reference_mean) = (stats::mean(&xs), stats::mean(&ys));
+            let subject_mean = stats::mean(&xs);
+            let (reference_mean, n_reference) = match published {
+                Some(p) => (p.mean, p.n),
+                None => (stats::mean(&ys), ys.len()),
+            };
             let Some(margin) = margin(s, reference_mean) else {
                 continue;
             };
-            let paired = is_paired(&sx, &sy);
-            let interval = if paired {
+            let paired = published.is_none() && is_paired(&sx, &sy);
+            let interval = if let Some(p) = published {
+                stats::SampleSummary::of_values(&xs)
+                    .and_then(|x| stats::welch_interval_of(x, p, confidence))
+                    .ok()
+            } else if paired {
                 let d: Vec<f64> = xs.iter().zip(&ys).map(|(x, y)| x - y).collect();
                 stats::t_interval(&d, confidence).ok()
             } else {
@@ -1285,7 +1306,7 @@ fn compare(
                 statistic,
                 relation,
                 n_subject: xs.len(),
-                n_reference: ys.len(),
+                n_reference,
                 paired,
                 subject_mean,
                 reference_mean,

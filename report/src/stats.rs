@@ -20,7 +20,8 @@ pub(crate) mod coverage;
 pub mod interval;
 pub mod rliable;
 pub use interval::{
-    IntervalError, TInterval, prediction_interval, student_t_quantile, t_interval, welch_interval,
+    IntervalError, SampleSummary, TInterval, prediction_interval, student_t_quantile, t_interval,
+    welch_interval, welch_interval_of,
 };
 pub use rliable::{
     AucError, area_under_curve, exact_bound_at_extreme, improvement_counts, iqm,

@@ -5,28 +5,29 @@
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use super::labels::f3;
+use super::authors::{self, Authors};
+use super::labels::{Condition, f3};
 use super::runs::{FollowupRun, display, role};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
+use crate::stats::SampleSummary;
 
 /// The claims file of the follow-up, in the paper directory.
 pub const FILE: &str = "followup_claims.toml";
 
-/// The environment of the follow-up's conditions.
-const ENV: &str = "armballs";
-
-/// The follow-up's runs as the claims engine sees them.
+/// The follow-up's runs as the claims engine sees them, with the authors' published runs
+/// where they are of the same environment (conditions tagged `authors`: `mge-efr-lp@authors`,
+/// known by their summaries only).
 pub struct FollowupObservations<'a> {
     pub runs: &'a [FollowupRun],
+    pub authors: Option<&'a Authors>,
 }
 
-/// A run's condition as the engine sees it: the algorithm with its campaign's tag, the goal
-/// sampler and the latent size (selectors and `pair_on` work on these).
+/// A run's condition as the engine sees it: the environment, the algorithm with its campaign's
+/// tag, the goal sampler and the latent size (selectors and `pair_on` work on these).
 fn key(r: &FollowupRun) -> ConditionKey {
     ConditionKey {
-        env: ENV.into(),
         // The follow-up's conditions have no variant.
         variant: String::new().into(),
         ..r.key.clone()
@@ -35,10 +36,34 @@ fn key(r: &FollowupRun) -> ConditionKey {
 
 /// The page's name of the condition `k`.
 fn name(runs: &[FollowupRun], k: &ConditionKey) -> String {
+    if k.tag.as_deref() == Some(authors::TAG) {
+        return format!(
+            "{}, the authors' runs",
+            Condition::of(&k.tagged(None), false).algo_label()
+        );
+    }
     runs.iter()
         .find(|r| key(r) == *k)
         .map(|r| display(runs, &r.cond))
         .unwrap_or_else(|| k.tagged_algo())
+}
+
+impl FollowupObservations<'_> {
+    /// The authors' curves, where some of our runs are of their environment.
+    fn comparable_authors(&self) -> Option<&Authors> {
+        self.authors
+            .filter(|a| self.runs.iter().any(|r| r.key.env == a.env))
+    }
+
+    /// The ball's ratio of a run as the claims compare it: at the authors' last point where the
+    /// run is of their environment (our last evaluation at or before it: their runs end there),
+    /// else at the run's last epoch.
+    fn ratio(&self, r: &FollowupRun) -> f64 {
+        match self.comparable_authors() {
+            Some(a) if r.key.env == a.env => r.ratio_before(a.last_rollouts),
+            _ => r.final_ratio(),
+        }
+    }
 }
 
 impl Observations for FollowupObservations<'_> {
@@ -50,13 +75,46 @@ impl Observations for FollowupObservations<'_> {
                 keys.push(k);
             }
         }
+        if let Some(a) = self.comparable_authors() {
+            for c in &a.curves {
+                // Their condition is ours of the same algorithm, goal sampler and latent size.
+                let ours = keys
+                    .iter()
+                    .find(|k| k.env == a.env && k.algo == c.algo && k.tag.is_none())
+                    .cloned();
+                let k = ConditionKey {
+                    tag: Some(authors::TAG.into()),
+                    ..ours.unwrap_or_else(|| ConditionKey {
+                        env: a.env.clone(),
+                        algo: c.algo.clone(),
+                        sampler: String::new().into(),
+                        latents: 0,
+                        variant: String::new().into(),
+                        tag: None,
+                    })
+                };
+                keys.push(k);
+            }
+        }
         keys
+    }
+
+    fn summary(&self, k: &ConditionKey, statistic: Statistic) -> Option<SampleSummary> {
+        let a = self.comparable_authors()?;
+        if k.tag.as_deref() != Some(authors::TAG) || statistic != Statistic::BallRatio {
+            return None;
+        }
+        a.of(&k.algo)?.at(a.last_rollouts)
     }
 
     fn values(&self, k: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
         let runs: Vec<&FollowupRun> = self.runs.iter().filter(|r| key(r) == *k).collect();
         let mut v: Vec<(i64, f64)> = match statistic {
-            Statistic::BallRatio => runs.iter().map(|r| (r.seed, r.final_ratio())).collect(),
+            Statistic::BallRatio => runs.iter().map(|r| (r.seed, self.ratio(r))).collect(),
+            Statistic::GoalError => runs
+                .iter()
+                .filter_map(|r| Some((r.seed, r.goal_error?)))
+                .collect(),
             Statistic::BallModuleGoals => runs
                 .iter()
                 .filter_map(|r| Some((r.seed, ball_module_goals(r)?)))
@@ -127,7 +185,9 @@ fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
 
 /// A claim's verdict in words: the engine's, or "premise not met" with it.
 pub fn verdict(r: &ClaimResult) -> String {
-    let v = if r.comparisons.is_empty() {
+    let v = if let (true, Some(envs)) = (r.comparisons.is_empty(), &r.claim.subject.env) {
+        format!("not run (no {} runs in these results)", envs.join(", "))
+    } else if r.comparisons.is_empty() {
         let missing: Vec<String> = r
             .claim
             .subject
@@ -204,7 +264,9 @@ pub fn table(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
 }
 
 /// How many claims are reproduced, not reproduced, inconclusive (premise not met counts apart).
-pub fn counts(results: &[ClaimResult]) -> (usize, usize, usize, usize) {
+/// How many claims are reproduced, not reproduced, inconclusive, have their premise not met,
+/// and were not run (no comparison: their conditions are not in these results).
+pub fn counts(results: &[ClaimResult]) -> (usize, usize, usize, usize, usize) {
     let premise_not_met = |r: &&ClaimResult| r.premise.as_ref().is_some_and(|p| !p.met);
     let n = |v: Verdict| {
         results
@@ -217,6 +279,10 @@ pub fn counts(results: &[ClaimResult]) -> (usize, usize, usize, usize) {
         n(Verdict::NotReproduced),
         n(Verdict::Inconclusive),
         results.iter().filter(premise_not_met).count(),
+        results
+            .iter()
+            .filter(|r| !premise_not_met(r) && r.comparisons.is_empty())
+            .count(),
     )
 }
 
@@ -234,7 +300,7 @@ mod tests {
             None => (algo, None),
         };
         let key = ConditionKey {
-            env: ENV.into(),
+            env: "armballs".into(),
             algo: name.into(),
             sampler: if algo == "rpe" { "none" } else { "gaussian" }.into(),
             latents: if algo.contains("efr") || algo == "rpe" {
@@ -264,6 +330,7 @@ mod tests {
             knn_ball: None,
             knn_distractor: None,
             per_latent: None,
+            goal_error: None,
             variant_label: algo.contains('@').then(|| "still distractor".into()),
         }
     }
@@ -291,7 +358,13 @@ mod tests {
             "RGE-EFR (flat), still distractor"
         );
         let file = committed();
-        let c = evaluate_on(&file, &FollowupObservations { runs: &runs });
+        let c = evaluate_on(
+            &file,
+            &FollowupObservations {
+                runs: &runs,
+                authors: None,
+            },
+        );
         let get = |id: &str| c.iter().find(|c| c.claim.id == id).unwrap();
         assert_eq!(verdict(get("C4")), "reproduced");
         assert_eq!(get("C4").comparisons.len(), 2);
@@ -315,9 +388,79 @@ mod tests {
                 r.ball_coverage[0] *= 3.0;
             }
         }
-        let c = evaluate_on(&file, &FollowupObservations { runs: &runs });
+        let c = evaluate_on(
+            &file,
+            &FollowupObservations {
+                runs: &runs,
+                authors: None,
+            },
+        );
         let c4 = c.iter().find(|c| c.claim.id == "C4").unwrap();
         assert_eq!(verdict(c4), "not reproduced");
+    }
+
+    /// Our runs in the authors' environment are compared with their published summary at their
+    /// last point (9666 rollouts): our ratio at the last evaluation before it, Welch's interval
+    /// from their n, mean and sd; a run of another environment is not compared with them.
+    #[test]
+    fn runs_are_compared_with_the_authors_at_their_last_point() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper");
+        let authors = authors::load(&dir).unwrap().unwrap();
+        let theirs = authors.of(&"mge-efr-lp".into()).unwrap().at(9666).unwrap();
+        let claims = parse_claims(
+            "[settings]\nconfidence = 0.95\nmargin = 0.0\n[[claim]]\nid = \"A\"\nsource = \"s\"\n\
+             quote = \"q\"\nstatement = \"s\"\nstatistic = \"ball_ratio\"\n\
+             relation = \"similar\"\nrelative_margin = 0.1\n\
+             subject = { algo = [\"mge-efr-lp\"] }\nreference = { algo = [\"mge-efr-lp@authors\"] }\n\
+             pair_on = [\"learner\"]\n",
+            std::path::Path::new("t.toml"),
+        )
+        .unwrap();
+        let (reachable, all) = ball_cells();
+        let corl = |seed: i64, at_9657: f64| {
+            let mut r = run("mge-efr-lp", seed, 0.0);
+            r.key.env = "armballs-corl".into();
+            r.epochs = vec![333, 9657, 9990];
+            // The last evaluation (after their last point) must not be the one compared.
+            r.ball_coverage = vec![0.01, at_9657, 0.99]
+                .into_iter()
+                .map(|v| v * all / reachable)
+                .collect();
+            r
+        };
+        let near: Vec<FollowupRun> = (0..20)
+            .map(|s| corl(s, theirs.mean + 0.002 * (s % 5) as f64 - 0.004))
+            .collect();
+        let obs = FollowupObservations {
+            runs: &near,
+            authors: Some(&authors),
+        };
+        let c = evaluate_on(&claims, &obs);
+        let cmp = &c[0].comparisons;
+        assert_eq!(cmp.len(), 1, "{cmp:?}");
+        assert_eq!(cmp[0].n_reference, theirs.n);
+        assert!((cmp[0].reference_mean - theirs.mean).abs() < 1e-15);
+        assert!(
+            (cmp[0].subject_mean - theirs.mean).abs() < 1e-9,
+            "{}",
+            cmp[0].subject_mean
+        );
+        assert_eq!(verdict(&c[0]), "reproduced");
+        assert!(name(&near, &cmp[0].reference).ends_with("the authors' runs"));
+        // Far below theirs: not reproduced.
+        let far: Vec<FollowupRun> = (0..20).map(|s| corl(s, 0.3 + 0.001 * s as f64)).collect();
+        let obs = FollowupObservations {
+            runs: &far,
+            authors: Some(&authors),
+        };
+        assert_eq!(verdict(&evaluate_on(&claims, &obs)[0]), "not reproduced");
+        // Runs of another environment: the authors' conditions are not there to compare with.
+        let dmp: Vec<FollowupRun> = (0..5).map(|s| run("mge-efr-lp", s, 0.5)).collect();
+        let obs = FollowupObservations {
+            runs: &dmp,
+            authors: Some(&authors),
+        };
+        assert!(evaluate_on(&claims, &obs)[0].comparisons.is_empty());
     }
 
     #[test]

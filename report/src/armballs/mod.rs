@@ -11,6 +11,7 @@
 //! `REPORT.md`. One module per concern: `runs` (reading), `labels` (names and order), `claims`
 //! (the engine's view of the runs, and the claims table), `figures`, `page`.
 
+mod authors;
 mod claims;
 mod figures;
 mod labels;
@@ -80,9 +81,14 @@ pub fn render(
     let mut figures = vec![figures::draw_coverage(&runs, fig_dir)?];
     figures.extend(figures::draw_interest(&runs, fig_dir)?);
     let path = paper_dir.join(CLAIMS_FILE);
+    let published = authors::load(paper_dir)?;
     let followup_claims = if path.exists() {
         let file = crate::claims::load_claims(&path)?;
-        let results = crate::claims::evaluate_on(&file, &FollowupObservations { runs: &runs });
+        let obs = FollowupObservations {
+            runs: &runs,
+            authors: published.as_ref(),
+        };
+        let results = crate::claims::evaluate_on(&file, &obs);
         FollowupClaims::Evaluated {
             path: &path,
             confidence: file.settings.confidence,
@@ -132,6 +138,7 @@ mod tests {
             knn_ball: None,
             knn_distractor: None,
             per_latent: None,
+            goal_error: None,
             variant_label: None,
         }
     }

@@ -299,7 +299,12 @@ pub(super) fn write(
             confidence,
             results,
         } => {
-            let (yes, no, open, premise) = claims::counts(results);
+            let (yes, no, open, premise, not_run) = claims::counts(results);
+            let not_run = if not_run > 0 {
+                format!(", {not_run} not run (their conditions are not in these results)")
+            } else {
+                String::new()
+            };
             (
                 format!(
                     "The follow-up's text gives no number we could read \
@@ -308,7 +313,7 @@ pub(super) fn write(
                      the same engine as the paper's claims. {} **Premise not met** when the \
                      claim is about a disentangled space and no network here is one. Of {} \
                      claims: {yes} reproduced, {no} not reproduced, {open} inconclusive, \
-                     {premise} with the premise not met.",
+                     {premise} with the premise not met{not_run}.",
                     path.display(),
                     crate::markdown::claims::method_text(*confidence),
                     results.len()

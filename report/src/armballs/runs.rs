@@ -62,16 +62,30 @@ pub struct FollowupRun {
     pub knn_ball: Option<f64>,
     pub knn_distractor: Option<f64>,
     pub per_latent: Option<(Vec<f64>, Vec<f64>)>,
+    /// The goal-reaching error at the last epoch (the manifest's discovery record; None in
+    /// records written before it was kept).
+    pub goal_error: Option<f64>,
     /// A variant campaign's declared label (`[campaign] label`).
     pub variant_label: Option<String>,
 }
 
 impl FollowupRun {
     pub(super) fn final_ratio(&self) -> f64 {
-        {
-            let (reachable, all) = ball_cells();
-            self.ball_coverage.last().copied().unwrap_or(f64::NAN) * reachable / all
-        }
+        let (reachable, all) = ball_cells();
+        self.ball_coverage.last().copied().unwrap_or(f64::NAN) * reachable / all
+    }
+
+    /// The ratio at the last evaluation before `rollouts` episodes (the warm-up episode is
+    /// epoch 0, so epoch `e` has run `e + 1`): where a published curve ends. NaN before the
+    /// first evaluation.
+    pub(super) fn ratio_before(&self, rollouts: i64) -> f64 {
+        let (reachable, all) = ball_cells();
+        self.epochs
+            .iter()
+            .zip(&self.ball_coverage)
+            .filter(|(e, _)| **e < rollouts)
+            .last()
+            .map_or(f64::NAN, |(_, c)| c * reachable / all)
     }
 
     /// Per module: (ball R², distractor R²), the means over the module's latents.
@@ -159,6 +173,11 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
             knn_ball: group("position"),
             knn_distractor: group("distractor"),
             per_latent,
+            goal_error: run
+                .manifest
+                .discovery
+                .as_ref()
+                .map(|d| d.at_end.goal_error_mean),
             variant_label: decl.label.clone(),
         });
     }

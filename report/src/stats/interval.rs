@@ -160,6 +160,40 @@ pub fn t_interval(xs: &[f64], level: f64) -> Result<TInterval, IntervalError> {
     Ok(TInterval::new(m, (v / n).sqrt(), n - 1.0, level))
 }
 
+/// A sample known by its size, mean and standard deviation only: a published result (the
+/// follow-up's authors give, per algorithm, the number of runs and the mean and standard
+/// deviation of the exploration ratio, not the runs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleSummary {
+    pub n: usize,
+    pub mean: f64,
+    /// Standard deviation with `n − 1` in the denominator.
+    pub sd: f64,
+}
+
+impl SampleSummary {
+    /// The summary of `xs` (at least 2 finite values).
+    pub fn of_values(xs: &[f64]) -> Result<SampleSummary, IntervalError> {
+        check(xs, Side::First)?;
+        let (mean, var) = mean_var(xs);
+        Ok(SampleSummary {
+            n: xs.len(),
+            mean,
+            sd: var.sqrt(),
+        })
+    }
+
+    fn checked(self, side: Side) -> Result<Self, IntervalError> {
+        if self.n < 2 {
+            return Err(IntervalError::TooFew { side, n: self.n });
+        }
+        if !(self.mean.is_finite() && self.sd.is_finite() && self.sd >= 0.0) {
+            return Err(IntervalError::NotFinite { side });
+        }
+        Ok(self)
+    }
+}
+
 /// Welch's interval of `mean(x) − mean(y)` for two independent samples at `level` (Welch 1947;
 /// Satterthwaite 1946 degrees of freedom). When one side has no spread, `ν` is the other side's
 /// `n − 1`; when neither has, the interval has zero width.
@@ -169,15 +203,37 @@ pub fn welch_interval(x: &[f64], y: &[f64], level: f64) -> Result<TInterval, Int
     check(y, Side::Second)?;
     let (mx, vx) = mean_var(x);
     let (my, vy) = mean_var(y);
-    let (nx, ny) = (x.len() as f64, y.len() as f64);
-    let (ax, ay) = (vx / nx, vy / ny);
+    Ok(welch_of((mx, vx, x.len()), (my, vy, y.len()), level))
+}
+
+/// Welch's interval from two samples' summaries: [`welch_interval`] on samples of these sizes,
+/// means and standard deviations (it depends on nothing else). For a published result known
+/// only by its summary.
+pub fn welch_interval_of(
+    x: SampleSummary,
+    y: SampleSummary,
+    level: f64,
+) -> Result<TInterval, IntervalError> {
+    check_level(level)?;
+    let (x, y) = (x.checked(Side::First)?, y.checked(Side::Second)?);
+    Ok(welch_of(
+        (x.mean, x.sd * x.sd, x.n),
+        (y.mean, y.sd * y.sd, y.n),
+        level,
+    ))
+}
+
+/// Welch's interval from each side's (mean, sample variance, size).
+fn welch_of(x: (f64, f64, usize), y: (f64, f64, usize), level: f64) -> TInterval {
+    let (nx, ny) = (x.2 as f64, y.2 as f64);
+    let (ax, ay) = (x.1 / nx, y.1 / ny);
     let se2 = ax + ay;
     let df = if se2 == 0.0 {
         nx + ny - 2.0
     } else {
         se2 * se2 / (ax * ax / (nx - 1.0) + ay * ay / (ny - 1.0))
     };
-    Ok(TInterval::new(mx - my, se2.sqrt(), df, level))
+    TInterval::new(x.0 - y.0, se2.sqrt(), df, level)
 }
 
 /// The `level` prediction interval for one more draw from the population `xs` was drawn from
@@ -333,6 +389,43 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    /// The interval from summaries is the interval from the samples (to rounding), and a
+    /// summary too small or not finite is refused.
+    #[test]
+    fn welch_from_summaries_is_welch_from_the_samples() {
+        let x = [0.61, 0.7, 0.66, 0.8, 0.58, 0.72];
+        let y = [0.5, 0.41, 0.62, 0.47, 0.55, 0.39, 0.6, 0.44];
+        let of = |v: &[f64]| {
+            let n = v.len() as f64;
+            let m = v.iter().sum::<f64>() / n;
+            let sd = (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / (n - 1.0)).sqrt();
+            SampleSummary {
+                n: v.len(),
+                mean: m,
+                sd,
+            }
+        };
+        let a = welch_interval(&x, &y, 0.95).unwrap();
+        let b = welch_interval_of(of(&x), of(&y), 0.95).unwrap();
+        assert!(
+            (a.lo - b.lo).abs() < 1e-12 && (a.hi - b.hi).abs() < 1e-12,
+            "{a:?} {b:?}"
+        );
+        assert!((a.df - b.df).abs() < 1e-9);
+        let one = SampleSummary {
+            n: 1,
+            mean: 0.5,
+            sd: 0.0,
+        };
+        assert!(welch_interval_of(of(&x), one, 0.95).is_err());
+        let bad = SampleSummary {
+            n: 5,
+            mean: f64::NAN,
+            sd: 0.1,
+        };
+        assert!(welch_interval_of(bad, of(&y), 0.95).is_err());
+    }
+
     /// The prediction interval for one more draw: a known case, and its coverage of a new draw
     /// from the same normal population in a seeded simulation (n = 30, as one condition's runs).
     #[test]
