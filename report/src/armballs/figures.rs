@@ -9,6 +9,7 @@ use std::path::Path;
 
 use plotters::style::RGBColor;
 
+use super::authors::Authors;
 use super::labels::Condition;
 use super::runs::{FollowupRun, algos, ball_cells, display, of};
 use super::{COVERAGE_FIGURE, INTEREST_FIGURE};
@@ -47,9 +48,47 @@ fn seeds_text(counts: &[usize]) -> String {
     format!("{n} seed{}", if hi == 1 { "" } else { "s" })
 }
 
-/// Ball (left) and distractor (right) exploration ratio against the iterations, mean over seeds.
+/// The authors' mean curves of the conditions of `runs` in their environment, each in its
+/// condition's style drawn thin (their `x` is rollouts with the bootstrap counted: one more than
+/// our epoch, whose 0 is the warm-up episode).
+fn authors_curves(
+    runs: &[FollowupRun],
+    conditions: &[Condition],
+    styles: &[crate::figures::LineStyle],
+    authors: Option<&Authors>,
+) -> Vec<Curve> {
+    let Some(a) = authors else {
+        return Vec::new();
+    };
+    conditions
+        .iter()
+        .zip(styles)
+        .filter(|(c, _)| c.tag.is_none() && of(runs, c).iter().any(|r| r.key.env == a.env))
+        .filter_map(|(c, style)| {
+            let theirs = a.of(&c.algo)?;
+            let n = theirs.at(a.last_rollouts)?.n;
+            Some(Curve {
+                label: format!("{}, the authors' mean, n={n}", display(runs, c)),
+                style: crate::figures::LineStyle {
+                    width: 1,
+                    ..style.clone()
+                },
+                points: theirs
+                    .points
+                    .iter()
+                    .map(|(r, s)| (((*r - 1).max(0)) as f64, s.mean))
+                    .collect(),
+                band: Vec::new(),
+            })
+        })
+        .collect()
+}
+
+/// Ball (left) and distractor (right) exploration ratio against the iterations, mean over seeds;
+/// in the authors' environment, their mean curves of the same algorithms beside ours.
 pub(super) fn draw_coverage(
     runs: &[FollowupRun],
+    authors: Option<&Authors>,
     fig_dir: &Path,
 ) -> Result<FigureFile, ReportError> {
     let path = fig_dir.join(COVERAGE_FIGURE);
@@ -78,7 +117,15 @@ pub(super) fn draw_coverage(
             .collect()
     };
     let (reachable, all) = ball_cells();
-    let ball = curves(&|r, i| r.ball_coverage.get(i).map(|c| c * reachable / all));
+    let mut ball = curves(&|r, i| r.ball_coverage.get(i).map(|c| c * reachable / all));
+    let theirs = authors_curves(
+        runs,
+        &conditions,
+        &ball.iter().map(|c| c.style.clone()).collect::<Vec<_>>(),
+        authors,
+    );
+    let with_authors = !theirs.is_empty();
+    ball.extend(theirs);
     let distractor = curves(&|r, i| r.distractor_coverage.get(i).copied().flatten());
     let y_desc = format!("exploration ratio (cells visited / {all:.0})");
     let panel = |title: &str, curves: Vec<Curve>| LinePanel {
@@ -104,9 +151,14 @@ pub(super) fn draw_coverage(
         notes: vec![format!(
             "Lines: the mean over the seeds (n in the legend); no interval is drawn. The table \
              above gives each condition's final ball ratio with its {:.0}% t interval. The ball \
-             can reach {reachable:.0} of the {all:.0} cells (ratio at most {:.2}).",
+             can reach {reachable:.0} of the {all:.0} cells (ratio at most {:.2}).{}",
             CONFIDENCE * 100.0,
-            reachable / all
+            reachable / all,
+            if with_authors {
+                " Thin lines: the authors' mean over their runs (their figure's data)."
+            } else {
+                ""
+            }
         )],
         font: 15,
     };

@@ -78,10 +78,10 @@ pub fn render(
     if runs.is_empty() {
         return Ok(None);
     }
-    let mut figures = vec![figures::draw_coverage(&runs, fig_dir)?];
+    let published = authors::load(paper_dir)?;
+    let mut figures = vec![figures::draw_coverage(&runs, published.as_ref(), fig_dir)?];
     figures.extend(figures::draw_interest(&runs, fig_dir)?);
     let path = paper_dir.join(CLAIMS_FILE);
-    let published = authors::load(paper_dir)?;
     let followup_claims = if path.exists() {
         let file = crate::claims::load_claims(&path)?;
         let obs = FollowupObservations {
@@ -141,6 +141,33 @@ mod tests {
             goal_error: None,
             variant_label: None,
         }
+    }
+
+    /// In the authors' environment the coverage figure draws their mean curves beside ours
+    /// (thin, in the condition's colour); elsewhere it does not.
+    #[test]
+    fn the_authors_curves_are_drawn_in_their_environment_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let paper = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper");
+        let published = authors::load(&paper).unwrap().unwrap();
+        let mut rs: Vec<FollowupRun> = (0..2)
+            .map(|s| run("mge-efr-lp", "uniform", 0, s, 0.5))
+            .collect();
+        let svg = |rs: &[FollowupRun]| {
+            let f = figures::draw_coverage(rs, Some(&published), dir.path()).unwrap();
+            std::fs::read_to_string(&f.path).unwrap()
+        };
+        assert!(!svg(&rs).contains("the authors"));
+        for r in &mut rs {
+            r.key.env = "armballs-corl".into();
+        }
+        let text = svg(&rs);
+        assert!(
+            text.contains("the authors&apos; mean, n=30")
+                || text.contains("the authors' mean, n=30"),
+            "no authors' curve"
+        );
+        assert!(text.contains("Thin lines: the authors"));
     }
 
     /// One algorithm run with two goal samplers and two latent sizes is four conditions of the
