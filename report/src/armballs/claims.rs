@@ -330,6 +330,9 @@ mod tests {
             knn_ball: None,
             knn_distractor: None,
             per_latent: None,
+            mig: None,
+            sap: None,
+            kl_per_latent: Vec::new(),
             goal_error: None,
             variant_label: algo.contains('@').then(|| "still distractor".into()),
         }

@@ -138,6 +138,9 @@ mod tests {
             knn_ball: None,
             knn_distractor: None,
             per_latent: None,
+            mig: None,
+            sap: None,
+            kl_per_latent: Vec::new(),
             goal_error: None,
             variant_label: None,
         }
@@ -168,6 +171,40 @@ mod tests {
             "no authors' curve"
         );
         assert!(text.contains("Thin lines: the authors"));
+    }
+
+    /// The disentanglement table gives MIG, SAP and the active latents with their kinds where
+    /// the networks record them, and keeps its columns otherwise.
+    #[test]
+    fn the_disentanglement_table_shows_mig_sap_and_active_latents() {
+        let campaign = Campaign {
+            name: "followup".into(),
+            path: "followup".into(),
+            decl: Default::default(),
+            configurations: 1,
+            store: Store {
+                runs: Vec::new(),
+                incomplete: Vec::new(),
+            },
+        };
+        let claims = FollowupClaims::Missing(Path::new("none.toml"));
+        let mut r = run("mge-conv-bvae-lp", "gaussian", 3, 0, 0.4);
+        r.learner = Some("conv-bvae".into());
+        r.per_latent = Some((vec![0.9, 0.01, 0.02], vec![0.0, 0.8, 0.01]));
+        let (page, _) = page::write(&campaign, &[], std::slice::from_ref(&r), &[], &claims);
+        assert!(
+            !page.contains("| MIG |"),
+            "no MIG column without the measure"
+        );
+        r.mig = Some(0.45);
+        r.sap = Some(0.3);
+        r.kl_per_latent = vec![3.1, 2.9, 0.004];
+        let (page, _) = page::write(&campaign, &[], &[r], &[], &claims);
+        assert!(page.contains("| MIG | SAP | active latents |"), "{page}");
+        assert!(
+            page.contains("| 0.45 | 0.30 | 2 (ball, distractor) |"),
+            "{page}"
+        );
     }
 
     /// One algorithm run with two goal samplers and two latent sizes is four conditions of the

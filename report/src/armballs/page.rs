@@ -5,7 +5,8 @@ use std::fmt::Write as _;
 
 use super::labels::{Condition, f2, f3};
 use super::runs::{
-    ENCODES, FollowupRun, IGNORES, algos, ball_cells, ball_grid, display, of, ratios, role,
+    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, algos, ball_cells, ball_grid, display, of, ratios,
+    role,
 };
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
@@ -254,9 +255,32 @@ pub(super) fn write(
              disentangled space in the follow-up's sense has ball-only and distractor-only \
              latents.\n"
         );
+        // MIG, SAP and the active latents, where the networks record them.
+        let measured = learned
+            .iter()
+            .any(|r| r.mig.is_some() || !r.kl_per_latent.is_empty());
+        if measured {
+            let _ = writeln!(
+                p,
+                "*MIG* (mutual information gap, Chen et al. 2018) and *SAP* (separated attribute \
+                 predictability, Kumar et al. 2018) score the latents against the four \
+                 coordinates of the two objects on the held-out images: 1 when each coordinate \
+                 is captured by one latent alone. *Active*: latents whose posterior's mean KL \
+                 divergence from the prior exceeds {ACTIVE_NATS} nats (the follow-up's \
+                 criterion), with their kinds.\n"
+            );
+        }
         p.push_str(
-            "| learner | seed | loss / plateau | ball k-NN R² | distractor k-NN R² | ball-only latents | distractor-only | both | none | per latent: ball R² / distractor R² |\n|---|---|---|---|---|---|---|---|---|---|\n",
+            "| learner | seed | loss / plateau | ball k-NN R² | distractor k-NN R² | ball-only latents | distractor-only | both | none |",
         );
+        p.push_str(if measured {
+            " MIG | SAP | active latents |"
+        } else {
+            ""
+        });
+        p.push_str(" per latent: ball R² / distractor R² |\n|---|---|---|---|---|---|---|---|---|");
+        p.push_str(if measured { "---|---|---|" } else { "" });
+        p.push_str("---|\n");
         for r in &learned {
             let (b, d) = r.per_latent.as_ref().expect("filtered");
             let roles: Vec<&str> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
@@ -266,9 +290,30 @@ pub(super) fn write(
                 .zip(d)
                 .map(|(b, d)| format!("{b:.2}/{d:.2}"))
                 .collect();
+            let extra = if measured {
+                let active: Vec<&str> = r
+                    .kl_per_latent
+                    .iter()
+                    .zip(&roles)
+                    .filter(|(kl, _)| **kl > ACTIVE_NATS)
+                    .map(|(_, role)| *role)
+                    .collect();
+                format!(
+                    " {} | {} | {} |",
+                    r.mig.map(f2).unwrap_or_else(|| "n/a".into()),
+                    r.sap.map(f2).unwrap_or_else(|| "n/a".into()),
+                    if r.kl_per_latent.is_empty() {
+                        "n/a".to_string()
+                    } else {
+                        format!("{} ({})", active.len(), active.join(", "))
+                    }
+                )
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 p,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |{extra} {} |",
                 match (r.learner.as_deref().map(learner_name), r.cond.tag()) {
                     (Some(l), "") => l,
                     (Some(l), t) => format!("{l}, {t}"),

@@ -35,6 +35,11 @@ pub(super) fn ball_cells() -> (f64, f64) {
 pub(super) const ENCODES: f64 = 0.5;
 pub(super) const IGNORES: f64 = 0.1;
 
+/// A latent is active when its posterior's mean KL divergence from the prior is above this many
+/// nats (the follow-up's criterion: the authors' β-VAE has 4 latents at 3.1-3.3 nats and 6 below
+/// 0.01; `scripts/conv_sweep_summary.py` uses the same threshold).
+pub(super) const ACTIVE_NATS: f64 = 0.5;
+
 /// One run of the campaign, as this section reads it.
 #[derive(Debug, Clone)]
 pub struct FollowupRun {
@@ -62,6 +67,11 @@ pub struct FollowupRun {
     pub knn_ball: Option<f64>,
     pub knn_distractor: Option<f64>,
     pub per_latent: Option<(Vec<f64>, Vec<f64>)>,
+    /// MIG and SAP against the four coordinates of the two objects, and the per-latent KL
+    /// from the prior (nats), where the manifest records them (the convolutional networks).
+    pub mig: Option<f64>,
+    pub sap: Option<f64>,
+    pub kl_per_latent: Vec<f64>,
     /// The goal-reaching error at the last epoch (the manifest's discovery record; None in
     /// records written before it was kept).
     pub goal_error: Option<f64>,
@@ -173,6 +183,13 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
             knn_ball: group("position"),
             knn_distractor: group("distractor"),
             per_latent,
+            mig: quality
+                .and_then(|q| q.disentanglement.as_ref())
+                .map(|d| d.mig),
+            sap: quality
+                .and_then(|q| q.disentanglement.as_ref())
+                .map(|d| d.sap),
+            kl_per_latent: quality.map(|q| q.kl_per_latent.clone()).unwrap_or_default(),
             goal_error: run
                 .manifest
                 .discovery
