@@ -202,9 +202,11 @@ pub(super) fn draw_interest(
         .map(|a| {
             let rs = of(runs, a);
             counts.push(rs.len());
-            let mut modules: Vec<i64> = rs.iter().flat_map(|r| r.modules.keys().copied()).collect();
-            modules.sort();
-            modules.dedup();
+            // Aligned across seeds (`FollowupRun::aligned_modules`): slot k is module k where
+            // modules are named by what they hold, the k-th most ball-selective in a learned space.
+            let slots = rs.iter().map(|r| r.modules.len()).max().unwrap_or(0);
+            let ranked = rs.iter().any(|r| r.modules_ranked());
+            let modules: Vec<i64> = (0..slots as i64).collect();
             let requests: Vec<StyleRequest> = modules
                 .iter()
                 .map(|&m| StyleRequest {
@@ -220,15 +222,21 @@ pub(super) fn draw_interest(
                 .iter()
                 .zip(styles)
                 .map(|(&m, style)| {
-                    let label = rs
-                        .iter()
-                        .find_map(|r| r.modules.get(&m))
-                        .filter(|_| a.engineered())
-                        .map(|(n, _)| format!("module {m} ({n})"))
-                        .unwrap_or_else(|| format!("module {m}"));
+                    let label = if ranked {
+                        format!("module of ball-selectivity rank {}", m + 1)
+                    } else {
+                        rs.iter()
+                            .find_map(|r| r.modules.get(&m))
+                            .filter(|_| a.engineered())
+                            .map(|(n, _)| format!("module {m} ({n})"))
+                            .unwrap_or_else(|| format!("module {m}"))
+                    };
                     let mut pts: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
                     for r in &rs {
-                        for p in r.interest.iter().filter(|p| p.1 == m) {
+                        let Some(&module) = r.aligned_modules().get(m as usize) else {
+                            continue;
+                        };
+                        for p in r.interest.iter().filter(|p| p.1 == module) {
                             pts.entry(p.0).or_default().push(p.2);
                         }
                     }

@@ -151,11 +151,12 @@ pub(super) fn write(
             "## Interest per module\n\n\
              The follow-up's key figure: with learning-progress choice, interest (|learning \
              progress|, `docs/learning-progress.md`) should concentrate on the modules that \
-             encode the controllable ball. Modules of a learned space are pairs of latents in \
-             decreasing order of their variance over the training images (module 0 holds the \
-             two most spread latents), so a module's latents differ between seeds; its *ball \
-             R²* and *distractor R²* are the mean, over its latents and the seeds, of the \
-             held-out k-NN R² of each latent from that object's position (section \
+             encode the controllable ball. Modules of a learned space are pairs of latents \
+             (in decreasing order of their variance over the training images, or of their KL \
+             where the network records it), so module k holds other latents in every seed: \
+             they are aligned across seeds by their *ball R²* − *distractor R²* (*rank 1*: the \
+             most ball-selective module of its seed), the mean, over the module's latents, of \
+             the held-out k-NN R² of each latent from that object's position (section \
              *Disentanglement*). Values at the last iteration, mean over seeds; *goals* is the \
              share of goals drawn in the module.\n"
         );
@@ -164,18 +165,19 @@ pub(super) fn write(
         );
         for a in &lp {
             let rs = of(runs, a);
-            let modules: Vec<i64> = {
-                let mut m: Vec<i64> = rs.iter().flat_map(|r| r.modules.keys().copied()).collect();
-                m.sort();
-                m.dedup();
-                m
-            };
-            for m in modules {
+            let slots = rs.iter().map(|r| r.modules.len()).max().unwrap_or(0);
+            let ranked = rs.iter().any(|r| r.modules_ranked());
+            for slot in 0..slots {
                 let mut interest = Vec::new();
                 let mut share = Vec::new();
                 let mut objects = Vec::new();
                 let mut name = String::new();
+                let mut index = None;
                 for r in &rs {
+                    let Some(&m) = r.aligned_modules().get(slot) else {
+                        continue;
+                    };
+                    index.get_or_insert(m);
                     let fin = r.final_interest();
                     let total: i64 = fin.values().map(|v| v.1).sum();
                     if let Some(&(i, n)) = fin.get(&m) {
@@ -195,10 +197,10 @@ pub(super) fn write(
                         name = n.clone();
                     }
                 }
-                let module = if name.is_empty() {
-                    format!("{m}")
-                } else {
-                    format!("{m} ({name})")
+                let module = match (ranked, name.is_empty()) {
+                    (true, _) => format!("rank {}", slot + 1),
+                    (false, true) => format!("{}", index.unwrap_or(slot as i64)),
+                    (false, false) => format!("{} ({name})", index.unwrap_or(slot as i64)),
                 };
                 let (b, d) = if objects.is_empty() {
                     ("n/a".to_string(), "n/a".to_string())

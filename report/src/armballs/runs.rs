@@ -106,6 +106,33 @@ impl FollowupRun {
         Some((pick(b), pick(d)))
     }
 
+    /// The run's modules in the order the page aligns them across repetitions: a learned
+    /// space's by ball R² − distractor R² (the most ball-selective first: its module `k` holds
+    /// other latents in every repetition, so the index means nothing across them); modules named
+    /// by what they hold (the engineered features' `ball`, `distractor`), or without the per-latent
+    /// measure, by index.
+    pub(super) fn aligned_modules(&self) -> Vec<i64> {
+        let mut ms: Vec<i64> = self.modules.keys().copied().collect();
+        let selectivity = |m: i64| self.module_objects(m).map(|(b, d)| b - d);
+        if !ms.is_empty() && ms.iter().all(|&m| selectivity(m).is_some()) {
+            ms.sort_by(|&a, &b| {
+                let (sa, sb) = (selectivity(a).unwrap_or(0.0), selectivity(b).unwrap_or(0.0));
+                sb.total_cmp(&sa).then(a.cmp(&b))
+            });
+        }
+        ms
+    }
+
+    /// Whether [`FollowupRun::aligned_modules`] ranks this run's modules (a learned space with
+    /// the per-latent measure) rather than keeping their indices.
+    pub(super) fn modules_ranked(&self) -> bool {
+        !self.modules.is_empty()
+            && self
+                .modules
+                .keys()
+                .all(|&m| self.module_objects(m).is_some())
+    }
+
     /// Final interest and goals chosen, per module.
     pub(super) fn final_interest(&self) -> BTreeMap<i64, (f64, i64)> {
         let last = self.interest.iter().map(|p| p.0).max();
@@ -316,6 +343,61 @@ pub(super) fn role(b: f64, d: f64) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A learned space's modules are aligned by ball R² − distractor R², most ball-selective
+    /// first; named modules without the per-latent measure keep their order.
+    #[test]
+    fn modules_align_by_ball_selectivity() {
+        let mut r = FollowupRun {
+            key: ConditionKey {
+                env: "armballs".into(),
+                algo: "mge-bvae-lp".into(),
+                sampler: "gaussian".into(),
+                latents: 4,
+                variant: "none".into(),
+                tag: None,
+            },
+            cond: Condition::of(
+                &ConditionKey {
+                    env: "armballs".into(),
+                    algo: "mge-bvae-lp".into(),
+                    sampler: "gaussian".into(),
+                    latents: 4,
+                    variant: "none".into(),
+                    tag: None,
+                },
+                false,
+            ),
+            seed: 0,
+            epochs: Vec::new(),
+            ball_coverage: Vec::new(),
+            ball_klc: Vec::new(),
+            distractor_coverage: Vec::new(),
+            distractor_klc: Vec::new(),
+            modules: [
+                (0, ("z0,z1".into(), vec![0, 1])),
+                (1, ("z2,z3".into(), vec![2, 3])),
+            ]
+            .into(),
+            interest: Vec::new(),
+            learner: None,
+            loss_fraction: None,
+            knn_ball: None,
+            knn_distractor: None,
+            per_latent: None,
+            mig: None,
+            sap: None,
+            kl_per_latent: Vec::new(),
+            goal_error: None,
+            variant_label: None,
+        };
+        assert_eq!(r.aligned_modules(), [0, 1]);
+        assert!(!r.modules_ranked());
+        // Module 1 holds the ball's latents: it comes first.
+        r.per_latent = Some((vec![0.1, 0.0, 0.9, 0.8], vec![0.7, 0.9, 0.0, 0.05]));
+        assert_eq!(r.aligned_modules(), [1, 0]);
+        assert!(r.modules_ranked());
+    }
 
     #[test]
     fn latent_roles() {
