@@ -93,8 +93,7 @@ impl FollowupRun {
         self.epochs
             .iter()
             .zip(&self.ball_coverage)
-            .filter(|(e, _)| **e < rollouts)
-            .last()
+            .rfind(|(e, _)| **e < rollouts)
             .map_or(f64::NAN, |(_, c)| c * reachable / all)
     }
 
