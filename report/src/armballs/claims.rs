@@ -288,8 +288,6 @@ pub fn counts(results: &[ClaimResult]) -> (usize, usize, usize, usize, usize) {
 
 #[cfg(test)]
 mod tests {
-    use std::collections::BTreeMap;
-
     use super::*;
     use crate::armballs::runs::ball_cells;
     use crate::claims::{evaluate_on, parse_claims};
@@ -312,29 +310,8 @@ mod tests {
             tag,
         };
         FollowupRun {
-            cond: super::super::labels::Condition::of(&key, false),
-            key,
-            seed,
-            epochs: vec![100],
-            ball_coverage: vec![{
-                let (reachable, all) = ball_cells();
-                ratio * all / reachable
-            }],
-            ball_klc: vec![1.0],
-            distractor_coverage: vec![Some(0.3)],
-            distractor_klc: vec![Some(2.0)],
-            modules: BTreeMap::new(),
-            interest: Vec::new(),
-            learner: None,
-            loss_fraction: None,
-            knn_ball: None,
-            knn_distractor: None,
-            per_latent: None,
-            mig: None,
-            sap: None,
-            kl_per_latent: Vec::new(),
-            goal_error: None,
             variant_label: algo.contains('@').then(|| "still distractor".into()),
+            ..FollowupRun::test_run(key, seed, ratio)
         }
     }
 

@@ -107,13 +107,10 @@ pub fn render(
 
 #[cfg(test)]
 mod tests {
-    use std::collections::BTreeMap;
-
     use super::*;
     use crate::load::Store;
 
     fn run(algo: &str, sampler: &str, latents: i64, seed: i64, ratio: f64) -> FollowupRun {
-        let (reachable, all) = runs::ball_cells();
         let key = ugl_types::ConditionKey {
             env: "armballs".into(),
             algo: algo.into(),
@@ -123,26 +120,8 @@ mod tests {
             tag: None,
         };
         FollowupRun {
-            cond: labels::Condition::of(&key, false),
-            key,
-            seed,
-            epochs: vec![100],
-            ball_coverage: vec![ratio * all / reachable],
-            ball_klc: vec![1.0],
-            distractor_coverage: vec![Some(0.3)],
-            distractor_klc: vec![Some(2.0)],
-            modules: BTreeMap::new(),
-            interest: Vec::new(),
             learner: (latents > 0).then(|| "vae".into()),
-            loss_fraction: None,
-            knn_ball: None,
-            knn_distractor: None,
-            per_latent: None,
-            mig: None,
-            sap: None,
-            kl_per_latent: Vec::new(),
-            goal_error: None,
-            variant_label: None,
+            ..FollowupRun::test_run(key, seed, ratio)
         }
     }
 

@@ -227,6 +227,37 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
     Ok(out)
 }
 
+#[cfg(test)]
+impl FollowupRun {
+    /// A run of `key` and `seed` with one evaluation (epoch 100) at the ball ratio `ratio`, the
+    /// distractor at 0.3, and nothing else recorded (the tests' runs).
+    pub(super) fn test_run(key: ConditionKey, seed: i64, ratio: f64) -> FollowupRun {
+        let (reachable, all) = ball_cells();
+        FollowupRun {
+            cond: Condition::of(&key, false),
+            key,
+            seed,
+            epochs: vec![100],
+            ball_coverage: vec![ratio * all / reachable],
+            ball_klc: vec![1.0],
+            distractor_coverage: vec![Some(0.3)],
+            distractor_klc: vec![Some(2.0)],
+            modules: BTreeMap::new(),
+            interest: Vec::new(),
+            learner: None,
+            loss_fraction: None,
+            knn_ball: None,
+            knn_distractor: None,
+            per_latent: None,
+            mig: None,
+            sap: None,
+            kl_per_latent: Vec::new(),
+            goal_error: None,
+            variant_label: None,
+        }
+    }
+}
+
 type Interest = (
     BTreeMap<i64, (String, Vec<usize>)>,
     Vec<(i64, i64, f64, i64)>,
@@ -347,49 +378,20 @@ mod tests {
     /// first; named modules without the per-latent measure keep their order.
     #[test]
     fn modules_align_by_ball_selectivity() {
-        let mut r = FollowupRun {
-            key: ConditionKey {
-                env: "armballs".into(),
-                algo: "mge-bvae-lp".into(),
-                sampler: "gaussian".into(),
-                latents: 4,
-                variant: "none".into(),
-                tag: None,
-            },
-            cond: Condition::of(
-                &ConditionKey {
-                    env: "armballs".into(),
-                    algo: "mge-bvae-lp".into(),
-                    sampler: "gaussian".into(),
-                    latents: 4,
-                    variant: "none".into(),
-                    tag: None,
-                },
-                false,
-            ),
-            seed: 0,
-            epochs: Vec::new(),
-            ball_coverage: Vec::new(),
-            ball_klc: Vec::new(),
-            distractor_coverage: Vec::new(),
-            distractor_klc: Vec::new(),
-            modules: [
-                (0, ("z0,z1".into(), vec![0, 1])),
-                (1, ("z2,z3".into(), vec![2, 3])),
-            ]
-            .into(),
-            interest: Vec::new(),
-            learner: None,
-            loss_fraction: None,
-            knn_ball: None,
-            knn_distractor: None,
-            per_latent: None,
-            mig: None,
-            sap: None,
-            kl_per_latent: Vec::new(),
-            goal_error: None,
-            variant_label: None,
+        let key = ConditionKey {
+            env: "armballs".into(),
+            algo: "mge-bvae-lp".into(),
+            sampler: "gaussian".into(),
+            latents: 4,
+            variant: "none".into(),
+            tag: None,
         };
+        let mut r = FollowupRun::test_run(key, 0, 0.3);
+        r.modules = [
+            (0, ("z0,z1".into(), vec![0, 1])),
+            (1, ("z2,z3".into(), vec![2, 3])),
+        ]
+        .into();
         assert_eq!(r.aligned_modules(), [0, 1]);
         assert!(!r.modules_ranked());
         // Module 1 holds the ball's latents: it comes first.
