@@ -15,7 +15,7 @@ UGL := $(CARGO) run --quiet --bin ugl --
 
 help:
 	@echo "make report              regenerate report/out/REPORT.md and its SVG figures from data/results"
-	@echo "make test                the test suite (what CI runs): test-cargo, test-python, test-slurm, verify-store"
+	@echo "make test                the test suite (what CI runs): test-cargo, check-shared-build, test-python, test-slurm, verify-store"
 	@echo "make test-cargo          cargo test --workspace, but the Python extension (no cluster needed)"
 	@echo "make test-python         build the Python package into a virtual environment (target/py-venv) and run pytest"
 	@echo "make test-slurm          the cluster path on a private single-node Slurm (root; slurm-wlm, munge)"
@@ -45,7 +45,7 @@ report: check-toolchain
 	$(UGL) report --results $(RESULTS) --out $(REPORT_OUT) --main $(MAIN)
 	@echo "report: $(REPORT_OUT)/REPORT.md"
 
-test: test-cargo test-python test-slurm verify-store
+test: test-cargo check-shared-build test-python test-slurm verify-store
 
 # The Python extension (python/) is left out here and built by test-python: its macros turn on a
 # feature of a shared build dependency (syn's visit-mut, for pyo3's macros), and with it in the
@@ -97,8 +97,9 @@ verify: check-toolchain
 	$(CARGO) test --test verify_smoke
 
 # `make report` / `make campaign` (cargo run) must reuse the artifacts of `make test` (cargo test
-# --workspace): one feature resolution for both (root Cargo.toml, "Feature unification"). Run after
-# `make test` (CI does): fails if building the binary would compile any crate again.
+# --workspace): one feature resolution for both (root Cargo.toml, "Feature unification"). `make
+# test` runs it right after test-cargo (before test-python and test-slurm build the binary, which
+# would hide a divergence); it fails if building the binary would compile any crate again.
 check-shared-build: check-toolchain
 	@rebuilt=$$($(CARGO) build --bin ugl --message-format=json 2>/dev/null | grep -c '"fresh":false' || true); \
 	if [ "$$rebuilt" != "0" ]; then \
