@@ -1044,7 +1044,7 @@ fn zero_iterations_keep_the_initial_weights_and_are_flagged_untrained() {
         let init = init_net(model, &cfg, set.dim, 2, &mut stream_named(5, "twin"));
         assert_eq!(twin.net, init, "{}", model.name());
         assert!(twin.losses.is_empty());
-        let record = twin.training_record(&set).unwrap();
+        let record = twin.training_outcome(&set).unwrap();
         assert!(
             !record.evidence.trained,
             "{}: {:?}",

@@ -93,45 +93,25 @@ pub struct Training {
 
 /// The `train` object of a manifest, if the run trained a neural representation.
 pub fn training(m: &Manifest) -> Option<Training> {
-    let t = m.train.as_ref()?.as_object()?;
-    let cfg = t.get("config").and_then(Value::as_object);
-    let int = |name: &str| {
-        cfg.and_then(|c| c.get(name))
-            .and_then(|v| v.as_i64().or_else(|| v.as_f64().map(|f| f as i64)))
-    };
-    let hidden = cfg
-        .and_then(|c| c.get("hidden"))
-        .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_i64).collect());
-    let mut losses: Vec<(i64, f64)> = t
-        .get("losses")
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(|p| {
-                    let p = p.as_array()?;
-                    Some((p.first()?.as_i64()?, p.get(1)?.as_f64()?))
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let t = m.train.as_ref()?;
+    let mut losses: Vec<(i64, f64)> = t.losses.iter().map(|&(i, l)| (i as i64, l)).collect();
     losses.sort_by_key(|&(i, _)| i);
     Some(Training {
-        iterations: int("iterations"),
-        hidden,
-        batch: int("batch"),
-        lr: cfg.and_then(|c| c.get("lr")).and_then(Value::as_f64),
-        warmup: int("warmup"),
-        init: cfg
-            .and_then(|c| c.get("init"))
-            .and_then(Value::as_str)
-            .map(str::to_string),
-        cache: t.get("cache").and_then(Value::as_str).map(str::to_string),
-        key: t.get("key").and_then(Value::as_str).map(str::to_string),
+        iterations: t.config_int("iterations"),
+        hidden: t
+            .config_field("hidden")
+            .and_then(Value::as_array)
+            .map(|a| a.iter().filter_map(Value::as_i64).collect()),
+        batch: t.config_int("batch"),
+        lr: t.config_f64("lr"),
+        warmup: t.config_int("warmup"),
+        init: t.config_str("init").map(str::to_string),
+        cache: t.cache.map(|c| c.as_str().to_string()),
+        key: (!t.key.is_empty()).then(|| t.key.clone()),
         losses,
-        iterations_used: t.get("iterations").and_then(Value::as_i64),
-        plateau: cfg
-            .and_then(|c| c.get("plateau"))
+        iterations_used: t.iterations.map(|i| i as i64),
+        plateau: t
+            .config_field("plateau")
             .and_then(Value::as_object)
             .and_then(|p| Some((p.get("chunk")?.as_i64()?, p.get("cap")?.as_i64()?))),
     })
@@ -496,11 +476,7 @@ pub fn loss_curves(store: &Store) -> Vec<LossCurve> {
             continue;
         }
         let key = t.key.clone().unwrap_or_else(|| r.run_id.clone());
-        let plateau = r
-            .manifest
-            .train_field("evidence")
-            .and_then(|e| e.get("plateau_loss"))
-            .and_then(|v| v.as_f64());
+        let plateau = r.manifest.training_evidence().map(|e| e.plateau_loss);
         groups
             .entry((
                 r.key.env.clone(),

@@ -179,7 +179,8 @@ fn write_run(dir: &Path, s: &Spec) {
                 // One training per (env, learner, latents, variant, seed): shared by the samplers.
                 "key": format!("{}-{l}-{}-{}-{}-{it}", s.env, s.latents, s.variant, s.seed),
                 // Seed 0 stays on the plateau, the others learn.
-                "evidence": {"plateau_loss": 440.0, "final_loss": if s.seed == 0 { 430.0 } else { 88.0 },
+                "evidence": {"images": 2000, "plateau_loss": 440.0,
+                             "reconstruction_loss": if s.seed == 0 { 430.0 } else { 88.0 },
                              "loss_fraction": if s.seed == 0 { 430.0 / 440.0 } else { 0.2 },
                              "trained": s.seed != 0, "untrained_fraction": 0.8},
             }),

@@ -24,9 +24,8 @@ struct Pick {
 fn trained_iterations(m: &Manifest) -> u64 {
     m.train
         .as_ref()
-        .and_then(|t| t.get("iterations"))
-        .and_then(serde_json::Value::as_u64)
-        .unwrap_or(0)
+        .and_then(|t| t.iterations)
+        .map_or(0, |i| i as u64)
 }
 
 /// The condition of a run: its id with the repetition and replicate set to 0.

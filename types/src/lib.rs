@@ -16,7 +16,8 @@
 //! - [`Diagnostics`]: measures taken after a run, beside it (manifests are immutable);
 //! - [`RunDiscovery`]: what a run discovered (KL-coverage, cells, goal-reaching error), measured
 //!   from its [`Outcome`]s by [`EnvMeasures`], recorded in its manifest;
-//! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs.
+//! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs;
+//! - [`TrainingRecord`]: how a run's trained network was obtained (its manifest's `train`).
 //!
 //! ```
 //! let ball = ugl_types::EnvSpec::by_name("armball").unwrap();
@@ -40,6 +41,7 @@ mod quality;
 mod sampler;
 mod strategy;
 mod summary;
+mod training;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use condition::{Algo, AlgoInfo, ConditionKey, Sampler, Variant};
@@ -77,3 +79,4 @@ pub use strategy::{
     MODULE_CHOICES, ModuleChoiceInfo, NO_VARIANT, RANDOM_MODULE, RGE_EFR, RGE_EFR_MIXED,
     RGE_EFR_POSITION, RPE, STRATEGIES, StrategyInfo, VARIANTS, VariantInfo,
 };
+pub use training::{CacheStatus, TrainingEvidence, TrainingRecord, UNTRAINED_FRACTION};

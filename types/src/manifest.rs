@@ -99,9 +99,10 @@ pub struct Manifest {
     /// Seconds spent rendering and encoding outcomes during exploration.
     #[serde(default)]
     pub encode_s: Option<f64>,
-    /// Training of a neural representation: configuration, loss curve, model-cache status.
+    /// Training of a neural representation: configuration, loss curve, model-cache status,
+    /// evidence that it left the plateau.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub train: Option<serde_json::Value>,
+    pub train: Option<crate::TrainingRecord>,
     /// The external learner program (`[learners.external]`: name, command) of an `rge-external`
     /// run, so that the run can be reproduced from its manifest.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -162,15 +163,16 @@ impl Manifest {
         }
     }
 
-    /// A field of the `train` object (neural learners).
-    pub fn train_field(&self, name: &str) -> Option<&serde_json::Value> {
-        self.train.as_ref()?.get(name)
+    /// The evidence that the run's network left the mean-image plateau (`train.evidence`);
+    /// None for other learners.
+    pub fn training_evidence(&self) -> Option<&crate::TrainingEvidence> {
+        self.train.as_ref()?.evidence.as_ref()
     }
 
     /// Whether the run's neural representation left the mean-image plateau
     /// (`train.evidence.trained`); None for other learners and older manifests.
     pub fn trained(&self) -> Option<bool> {
-        self.train_field("evidence")?.get("trained")?.as_bool()
+        self.train.as_ref()?.trained()
     }
 
     /// The (linear, k-NN) R² of a group of targets (`position`, `angle`, `angle_mod_120`) in

@@ -308,7 +308,7 @@ pub fn execute(
         fit_s,
         learner_fit_s,
         encode_s: explored.encode_s,
-        train: train.map(|t| serde_json::to_value(t).expect("serialisable")),
+        train,
         external: spec
             .algo
             .learner()

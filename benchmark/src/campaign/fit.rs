@@ -3,22 +3,19 @@
 
 use std::time::Instant;
 
-use serde::Serialize;
-
 use super::config::LearnersConfig;
 use super::plan::RunSpec;
 use crate::env::{Environment, make_env};
 use crate::explore::Learner;
 use crate::repr::cache::CacheEntry;
 use crate::repr::dataset::{dataset_identity, generate};
-use crate::repr::evidence::TrainingEvidence;
 use crate::repr::neural::{self, Variant};
 use crate::repr::quality::{self, LatentQuality};
 use crate::repr::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
 use crate::seed::{Component, run_seed, stream};
 
 use super::context::RunContext;
-use ugl_types::RESULTS_VERSION;
+use ugl_types::{CacheStatus, RESULTS_VERSION, TrainingRecord};
 
 /// A fitted representation, shared by the runs that use it (every sampler of a cell).
 pub struct Representation {
@@ -30,7 +27,7 @@ pub struct Representation {
     /// Name of the learner (the external program's configured name for `external`).
     pub learner_name: String,
     /// Training details of a neural representation.
-    pub training: Option<TrainInfo>,
+    pub training: Option<TrainingRecord>,
     /// How well the true object state can be read off the latents (None if it could not be
     /// measured; the reason is logged).
     pub quality: Option<LatentQuality>,
@@ -123,26 +120,6 @@ fn disentanglement(
     })
 }
 
-/// How a trained network was obtained, recorded in the manifests of its runs.
-#[derive(Clone, Debug, Serialize)]
-pub struct TrainInfo {
-    /// The complete training configuration (the learner's parameters, resolved).
-    pub config: serde_json::Value,
-    /// The recorded loss curve, `(iteration, mini-batch loss)`.
-    pub losses: Vec<(usize, f64)>,
-    /// The iterations trained: `config.iterations`, or more where the plateau rule
-    /// (`config.plateau`) trained on.
-    pub iterations: usize,
-    /// `hit` (loaded from the model cache), `miss` (trained and stored), `rebuilt` (a cache
-    /// file was invalid: trained again and overwritten) or `off` (no cache).
-    pub cache: &'static str,
-    /// The cache key (BLAKE3 of everything the model depends on).
-    pub key: String,
-    /// The reconstruction loss against the mean-image loss (the plateau) of the first training
-    /// images, and whether the network left it ([`TrainingEvidence`]).
-    pub evidence: TrainingEvidence,
-}
-
 /// Build the learner of an algorithm from its checked `[learners.NAME]` parameters (the
 /// registry's entry parses them); `variant` is used by the learners that have variants.
 pub fn make_learner(
@@ -190,7 +167,7 @@ fn fit_or_load(
     learner: Learner,
     images: &ImageSet,
     rng: &mut crate::seed::Stream,
-) -> Result<(Box<dyn Encoder>, Latents, Option<TrainInfo>, String), ReprError> {
+) -> Result<(Box<dyn Encoder>, Latents, Option<TrainingRecord>, String), ReprError> {
     let params = ctx
         .learners
         .params(learner)
@@ -199,19 +176,19 @@ fn fit_or_load(
     let fitter = params.build(spec.variant);
     let key = model_key(spec, ctx, &identity);
     let cache = ctx.harness.cache.filter(|_| fitter.persists());
-    let mut status = "off";
+    let mut status = CacheStatus::Off;
     let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
         Some(CacheEntry::Hit(enc)) => {
-            status = "hit";
+            status = CacheStatus::Hit;
             Some(enc)
         }
         Some(CacheEntry::Invalid(why)) => {
             tracing::warn!("model cache: ignoring an invalid file ({why}); fitting again");
-            status = "rebuilt";
+            status = CacheStatus::Rebuilt;
             None
         }
         Some(CacheEntry::Miss) => {
-            status = "miss";
+            status = CacheStatus::Miss;
             None
         }
         None => None,
@@ -242,13 +219,13 @@ fn fit_or_load(
             (enc, z)
         }
     };
-    let info = encoder.training_record(images).map(|r| TrainInfo {
+    let info = encoder.training_outcome(images).map(|r| TrainingRecord {
+        cache: Some(status),
         config: identity,
-        losses: r.losses,
-        iterations: r.iterations,
-        cache: status,
+        evidence: Some(r.evidence),
+        iterations: Some(r.iterations),
         key,
-        evidence: r.evidence,
+        losses: r.losses,
     });
     Ok((encoder, z, info, fitter.name().to_string()))
 }

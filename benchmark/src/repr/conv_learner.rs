@@ -32,7 +32,7 @@ use super::trainer::{ProgressFn, draw_batch};
 use super::training_loop::{Iterations, run_until};
 use super::{
     Encoder, FitContext, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner,
-    TrainingRecord, check_fit_input,
+    TrainingOutcome, check_fit_input,
 };
 use crate::seed::Stream;
 
@@ -643,10 +643,10 @@ impl Encoder for ConvEncoder {
         Some(seal(&header, &self.net.payload()))
     }
 
-    fn training_record(&self, images: &ImageSet) -> Option<TrainingRecord> {
+    fn training_outcome(&self, images: &ImageSet) -> Option<TrainingOutcome> {
         let evidence = images.head(EVIDENCE_IMAGES);
         let rec = self.reconstruction_loss(&evidence, evidence.n).ok()?;
-        Some(TrainingRecord {
+        Some(TrainingOutcome {
             losses: self.losses.clone(),
             iterations: self.iterations,
             evidence: TrainingEvidence::new(mean_image_loss(&evidence), rec, evidence.n),

@@ -11,14 +11,11 @@
 //! the VAE adds its KL term, and the faithful RFVAE's broadcast log-determinant makes its loss
 //! meaningless as a level.)
 
-use serde::{Deserialize, Serialize};
-
 use super::ImageSet;
 
-/// A run is *untrained* when its reconstruction loss is above this fraction of the plateau.
-/// Trained networks end far below it (a VAE's training loss, KL included, of 60-150 against a
-/// plateau of 443 on ArmBall, `docs/neural.md`), networks on the plateau at about 1.
-pub const UNTRAINED_FRACTION: f64 = 0.8;
+/// A run is *untrained* when its reconstruction loss is above this fraction of the plateau,
+/// and the evidence recorded in its manifest (declared in `ugl-types`, read by the report).
+pub use ugl_types::{TrainingEvidence, UNTRAINED_FRACTION};
 
 /// The number of training images (the first ones) on which the plateau and the reconstruction
 /// loss are measured.
@@ -56,37 +53,6 @@ pub fn mean_image_loss(images: &ImageSet) -> f64 {
 pub fn bce_of_logit(l: f32, t: f32) -> f64 {
     let l = f64::from(l);
     l.max(0.0) + libm::log1p(libm::exp(-l.abs())) - f64::from(t) * l
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TrainingEvidence {
-    /// The mean-image loss of the evaluation images (the plateau level).
-    pub plateau_loss: f64,
-    /// The trained network's reconstruction loss on the same images.
-    pub reconstruction_loss: f64,
-    /// `reconstruction_loss / plateau_loss`.
-    pub loss_fraction: f64,
-    /// `loss_fraction < untrained_fraction`.
-    pub trained: bool,
-    /// The threshold used ([`UNTRAINED_FRACTION`]).
-    pub untrained_fraction: f64,
-    /// The evaluation images: the first `images` of the training set.
-    pub images: usize,
-}
-
-impl TrainingEvidence {
-    /// From the mean-image loss and the reconstruction loss measured on the same `images`.
-    pub fn new(plateau_loss: f64, reconstruction_loss: f64, images: usize) -> Self {
-        let loss_fraction = reconstruction_loss / plateau_loss;
-        TrainingEvidence {
-            plateau_loss,
-            reconstruction_loss,
-            loss_fraction,
-            trained: loss_fraction < UNTRAINED_FRACTION,
-            untrained_fraction: UNTRAINED_FRACTION,
-            images,
-        }
-    }
 }
 
 #[cfg(test)]

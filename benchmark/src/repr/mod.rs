@@ -183,15 +183,15 @@ pub trait Encoder: Send {
     /// How a trained network got here (its loss curve, and its reconstruction loss against the
     /// mean-image plateau on the first [`evidence::EVIDENCE_IMAGES`] of `images`), recorded in
     /// the manifests; None for learners that are not trained by iterations.
-    fn training_record(&self, images: &ImageSet) -> Option<TrainingRecord> {
+    fn training_outcome(&self, images: &ImageSet) -> Option<TrainingOutcome> {
         let _ = images;
         None
     }
 }
 
-/// The training of an iteratively trained encoder ([`Encoder::training_record`]).
+/// The training of an iteratively trained encoder ([`Encoder::training_outcome`]).
 #[derive(Clone, Debug)]
-pub struct TrainingRecord {
+pub struct TrainingOutcome {
     /// The recorded loss curve, `(iteration, mini-batch loss)`.
     pub losses: Vec<(usize, f64)>,
     /// The iterations trained (more than configured where the plateau rule trained on).

@@ -137,10 +137,10 @@ impl Encoder for NeuralEncoder {
         Some(to_bytes(key, self))
     }
 
-    fn training_record(&self, images: &ImageSet) -> Option<super::TrainingRecord> {
+    fn training_outcome(&self, images: &ImageSet) -> Option<super::TrainingOutcome> {
         let head = images.head(super::evidence::EVIDENCE_IMAGES);
         let rec = reconstruction_loss(self.model, &self.net, &head, head.n);
-        Some(super::TrainingRecord {
+        Some(super::TrainingOutcome {
             losses: self.losses.clone(),
             // The last iteration is always logged.
             iterations: self.losses.last().map_or(0, |&(step, _)| step + 1),

@@ -5,8 +5,6 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-use serde_json::Value;
-
 use super::labels::Condition;
 use crate::campaigns::Campaign;
 use crate::error::ReportError;
@@ -201,11 +199,7 @@ pub fn load(campaign: &Campaign) -> Result<Vec<FollowupRun>, ReportError> {
             modules,
             interest,
             learner: run.manifest.learner.clone(),
-            loss_fraction: run
-                .manifest
-                .train_field("evidence")
-                .and_then(|e| e.get("loss_fraction"))
-                .and_then(Value::as_f64),
+            loss_fraction: run.manifest.training_evidence().map(|e| e.loss_fraction),
             knn_ball: group("position"),
             knn_distractor: group("distractor"),
             per_latent,

@@ -73,7 +73,7 @@ pub fn write(out: &mut Output, camps: &Campaigns) -> Result<Vec<PathBuf>, Report
         for r in runs_in_order(camp) {
             let key = key_fields(camp, r);
             let f = r.final_point();
-            let evidence = r.manifest.train_field("evidence");
+            let evidence = r.manifest.training_evidence();
             let quality = r.manifest.latent_quality.as_ref();
             let _ = writeln!(
                 finals,
@@ -87,9 +87,7 @@ pub fn write(out: &mut Output, camps: &Campaigns) -> Result<Vec<PathBuf>, Report
                     .trained()
                     .map(|t| t.to_string())
                     .unwrap_or_default(),
-                num(evidence
-                    .and_then(|e| e.get("loss_fraction"))
-                    .and_then(|v| v.as_f64())),
+                num(evidence.map(|e| e.loss_fraction)),
                 num(quality.map(|q| q.linear_r2_mean)),
                 num(quality.map(|q| q.knn_r2_mean)),
                 quality.map(|q| q.version.to_string()).unwrap_or_default(),

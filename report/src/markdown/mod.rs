@@ -354,7 +354,7 @@ fn campaigns_table(w: &mut String, inp: &Context<'_>) {
         // learner -> distinct (iterations, hidden layers)
         let mut training: BTreeMap<String, BTreeSet<(u64, String)>> = BTreeMap::new();
         for r in runs {
-            let Some(config) = r.manifest.train_field("config") else {
+            let Some(config) = r.manifest.train.as_ref().map(|t| &t.config) else {
                 continue;
             };
             if let Some(it) = config.get("iterations").and_then(|i| i.as_u64()) {

@@ -49,8 +49,8 @@ pub fn neighbourhoods(m: &Manifest, space: &str) -> Option<(f64, f64)> {
 }
 
 pub(crate) fn evidence(m: &Manifest) -> Option<(f64, bool)> {
-    let e = m.train_field("evidence")?;
-    Some((e.get("loss_fraction")?.as_f64()?, m.trained()?))
+    let e = m.training_evidence()?;
+    Some((e.loss_fraction, e.trained))
 }
 
 /// The (linear, k-NN) R² of a group of targets ([`Manifest::group_r2`]).

@@ -19,21 +19,13 @@ use crate::load::{ConditionKey, Run};
 use crate::names::{algo_name, env_name};
 use crate::neural::{learner, training};
 
-/// The threshold of "left the plateau" when a manifest does not record it (the runner's
-/// `UNTRAINED_FRACTION`).
-const DEFAULT_FRACTION: f64 = 0.8;
-
 /// The first logged iteration whose training loss is below `fraction` of the plateau, skipping
 /// the RFVAE's KL warm-up (its loss is annealed, hence small, during the warm-up). `None` when
 /// the run records no losses or no plateau, `Some(None)` when the loss never got there.
 pub fn left_plateau_at(run: &Run) -> Option<Option<i64>> {
     let t = training(&run.manifest)?;
-    let e = run.manifest.train_field("evidence")?;
-    let plateau = e.get("plateau_loss")?.as_f64()?;
-    let fraction = e
-        .get("untrained_fraction")
-        .and_then(|v| v.as_f64())
-        .unwrap_or(DEFAULT_FRACTION);
+    let e = run.manifest.training_evidence()?;
+    let (plateau, fraction) = (e.plateau_loss, e.untrained_fraction);
     if t.losses.is_empty() {
         return None;
     }
@@ -406,7 +398,9 @@ mod tests {
             diagnostics: None,
             manifest: crate::load::test_manifest(json!({"train": {
                 "config": {"warmup": warmup, "iterations": 1000},
-                "evidence": {"plateau_loss": 400.0, "untrained_fraction": 0.8},
+                "evidence": {"images": 2000, "loss_fraction": 0.25, "plateau_loss": 400.0,
+                             "reconstruction_loss": 100.0, "trained": true,
+                             "untrained_fraction": 0.8},
                 "losses": losses,
             }})),
             curve_path: PathBuf::new(),
