@@ -33,6 +33,15 @@ fn tiny(model: Model, variant: Variant, iterations: usize) -> NeuralConfig {
     }
 }
 
+/// `cfg` with the KL warm-up `w` where the model has one (the RFVAE's knob).
+fn warmup(cfg: NeuralConfig, model: Model, w: usize) -> NeuralConfig {
+    if model.spec().own_knobs().contains(&"warmup") {
+        cfg.with_knob("warmup", w)
+    } else {
+        cfg
+    }
+}
+
 fn learner(model: Model, cfg: NeuralConfig) -> Box<dyn RepresentationLearner> {
     Box::new(NeuralLearner::new(model, cfg))
 }
@@ -476,14 +485,17 @@ fn configuration_serde() {
         (c.iterations, c.variant, c.hidden, c.batch),
         (500, Variant::Corrected, [512, 256], 100)
     );
+    // Keys beyond the shared ones are the model's own knobs: the check refuses the others.
+    let check = |t: &str| {
+        use ugl_bench::repr::params::ParamGuard;
+        (Model::Vae, toml::from_str::<NeuralSection>(t).unwrap()).check()
+    };
+    assert!(check("iteration = 5").is_err(), "unknown keys are rejected");
     assert!(
-        toml::from_str::<NeuralSection>("iteration = 5").is_err(),
-        "unknown keys are rejected"
-    );
-    assert!(
-        toml::from_str::<NeuralSection>("variant = \"corrected\"").is_err(),
+        check("variant = \"corrected\"").is_err(),
         "the variant is a matrix dimension, not a learner setting"
     );
+    assert!(check("iterations = 5").is_ok());
     assert!(
         toml::from_str::<NeuralConfig>("iterations = 5").is_err(),
         "the complete form needs every key"
@@ -567,11 +579,14 @@ fn host_engine_gradients_match_burn_autodiff() {
     let x: Vec<f32> = (0..rows).flat_map(|i| set.row(i).to_vec()).collect();
     for model in Model::ALL {
         for variant in [Variant::Faithful, Variant::Corrected] {
-            let cfg = NeuralConfig {
-                warmup: 10,
-                init: Init::He,
-                ..tiny(model, variant, 5)
-            };
+            let cfg = warmup(
+                NeuralConfig {
+                    init: Init::He,
+                    ..tiny(model, variant, 5)
+                },
+                model,
+                10,
+            );
             let net = init_net(model, &cfg, set.dim, d, &mut stream_named(4, "grad"));
             let mut host = HostTrainer::new(net.clone(), HostOptimizer::new(model, &net));
             let host_loss = host
@@ -587,9 +602,9 @@ fn host_engine_gradients_match_burn_autodiff() {
                     batch: rows,
                     latents: d,
                     step,
-                    warmup: cfg.warmup,
-                    beta: cfg.beta.unwrap_or(1.0),
-                    capacity: cfg.capacity_at(step),
+                    warmup: cfg.code_at(model, step).warmup,
+                    beta: cfg.code_at(model, step).beta,
+                    capacity: cfg.capacity_at(model, step),
                     variant,
                     device: &device,
                 },
@@ -634,13 +649,16 @@ fn host_engine_is_bit_identical_across_thread_counts() {
     use ugl_bench::repr::neural::{Engine, Init, train};
     let set = images(EnvKind::ARMBALL, 150);
     for model in Model::ALL {
-        let cfg = NeuralConfig {
-            hidden: [256, 128],
-            warmup: 4,
-            init: Init::He,
-            engine: Engine::Host,
-            ..tiny(model, Variant::Corrected, 6)
-        };
+        let cfg = warmup(
+            NeuralConfig {
+                hidden: [256, 128],
+                init: Init::He,
+                engine: Engine::Host,
+                ..tiny(model, Variant::Corrected, 6)
+            },
+            model,
+            4,
+        );
         let run = |threads: usize| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -714,12 +732,15 @@ fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
         .into_iter()
         .flat_map(|m| Engine::ALL.map(|e| (m, e)))
     {
-        let cfg = NeuralConfig {
-            log_every: 5,
-            warmup: 10,
-            engine,
-            ..tiny(model, Variant::Faithful, 60)
-        };
+        let cfg = warmup(
+            NeuralConfig {
+                log_every: 5,
+                engine,
+                ..tiny(model, Variant::Faithful, 60)
+            },
+            model,
+            10,
+        );
         let learner_stream = || stream_named(9, "checkpoint-learner");
         let reference = train(model, &cfg, &set, 3, &mut learner_stream(), None).unwrap();
 
@@ -982,10 +1003,12 @@ fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
             engine,
             ..tiny(Model::Vae, Variant::Corrected, 25)
         };
-        let beta = |b: f64| NeuralConfig {
-            engine,
-            beta: Some(b),
-            ..tiny(Model::Bvae, Variant::Faithful, 25)
+        let beta = |b: f64| {
+            NeuralConfig {
+                engine,
+                ..tiny(Model::Bvae, Variant::Faithful, 25)
+            }
+            .with_knob("beta", b)
         };
         let (v, zv) = fit_neural(Model::Vae, vae, &set, 3, 4);
         let (b1, zb1) = fit_neural(Model::Bvae, beta(1.0), &set, 3, 4);
@@ -1001,18 +1024,24 @@ fn a_beta_vae_with_beta_one_is_the_corrected_vae() {
 fn capacity_annealing_is_the_beta_kl_against_a_rising_target() {
     use ugl_bench::repr::neural::Engine;
     let set = images(EnvKind::ARMBALL, 150);
-    let cfg = |capacity: Option<f64>| NeuralConfig {
-        engine: Engine::Host,
-        beta: Some(4.0),
-        capacity,
-        ..tiny(Model::Bvae, Variant::Faithful, 25)
+    let cfg = |capacity: Option<f64>| {
+        let c = NeuralConfig {
+            engine: Engine::Host,
+            ..tiny(Model::Bvae, Variant::Faithful, 25)
+        }
+        .with_knob("beta", 4.0);
+        match capacity {
+            Some(capacity) => c.with_knob("capacity", capacity),
+            None => c,
+        }
     };
     // C rises linearly to `capacity` over the training.
     let c = cfg(Some(20.0));
-    assert_eq!(c.capacity_at(0), Some(0.0));
-    assert_eq!(c.capacity_at(c.iterations / 5), Some(4.0));
-    assert_eq!(c.capacity_at(c.iterations * 2), Some(20.0));
-    assert_eq!(cfg(None).capacity_at(3), None);
+    let bvae = Model::Bvae;
+    assert_eq!(c.capacity_at(bvae, 0), Some(0.0));
+    assert_eq!(c.capacity_at(bvae, c.iterations / 5), Some(4.0));
+    assert_eq!(c.capacity_at(bvae, c.iterations * 2), Some(20.0));
+    assert_eq!(cfg(None).capacity_at(bvae, 3), None);
     // A target of 0 nats is the plain objective (β |KL - 0| = β KL: the same loss up to the
     // order of the sums); a rising target trains another network.
     let (plain, zp) = fit_neural(Model::Bvae, cfg(None), &set, 3, 4);
@@ -1122,7 +1151,7 @@ fn the_plateau_rule_trains_on_until_the_network_leaves_the_plateau() {
     let fewer = NeuralConfig {
         iterations: done - 40,
         plateau: None,
-        ..cfg
+        ..cfg.clone()
     };
     let before = train(model, &fewer, &set, 2, &mut stream(), None).unwrap();
     assert!(fraction(&before) >= UNTRAINED_FRACTION);
@@ -1133,7 +1162,7 @@ fn the_plateau_rule_trains_on_until_the_network_leaves_the_plateau() {
                 chunk: 40,
                 cap: done - 40,
             }),
-            ..cfg
+            ..cfg.clone()
         };
         train(model, &capped, &set, 2, &mut stream(), None)
             .unwrap()
@@ -1142,7 +1171,7 @@ fn the_plateau_rule_trains_on_until_the_network_leaves_the_plateau() {
     // A network that left the plateau within its iterations is not trained on.
     let long = NeuralConfig {
         iterations: done,
-        ..cfg
+        ..cfg.clone()
     };
     let at_once = train(model, &long, &set, 2, &mut stream(), None).unwrap();
     assert_eq!(at_once.losses.last().unwrap().0 + 1, done);

@@ -19,7 +19,10 @@
 use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
-use super::neural_model::{Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant};
+use super::neural_model::{
+    CodeSettings, Knobs, Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant,
+    knob_number,
+};
 use super::vae::{code, encoding};
 use crate::seed::Stream;
 
@@ -63,8 +66,47 @@ impl NeuralModel for Bvae {
     fn paper_iterations(&self) -> usize {
         100_000
     }
-    fn default_beta(&self) -> Option<f64> {
-        Some(DEFAULT_BETA)
+    fn own_knobs(&self) -> &'static [&'static str] {
+        &["beta", "capacity"]
+    }
+    /// β = [`DEFAULT_BETA`]; no capacity (the plain β-VAE).
+    fn default_knobs(&self) -> Knobs {
+        let mut k = Knobs::new();
+        k.insert("beta".into(), DEFAULT_BETA.into());
+        k
+    }
+    /// `beta`: the weight of the KL term, in (0, 1e6]. `capacity`: Burgess et al.'s capacity
+    /// annealing (the follow-up's objective): the KL term becomes `β |mean_b KL_b − C|`, C rising
+    /// linearly from 0 to `capacity` nats over the training, in [0, 1e4].
+    fn knob_value(
+        &self,
+        key: &str,
+        value: &serde_json::Value,
+    ) -> Result<serde_json::Value, String> {
+        let v = knob_number(value)?;
+        match key {
+            "beta" if v.is_finite() && v > 0.0 && v <= 1e6 => Ok(v.into()),
+            "beta" => Err(format!("must be positive and at most 1e6, got {v}")),
+            "capacity" if v.is_finite() && (0.0..=1e4).contains(&v) => Ok(v.into()),
+            "capacity" => Err(format!("must be between 0 and 1e4 nats, got {v}")),
+            _ => Err(format!("bvae has no knob '{key}'")),
+        }
+    }
+    fn code_settings(
+        &self,
+        knobs: &Knobs,
+        step: usize,
+        iterations: usize,
+        variant: Variant,
+    ) -> CodeSettings {
+        let number = |key: &str| knobs.get(key).and_then(serde_json::Value::as_f64);
+        CodeSettings {
+            warmup: 0,
+            beta: number("beta").unwrap_or(DEFAULT_BETA),
+            capacity: number("capacity")
+                .map(|c| c * (step as f64 / iterations.max(1) as f64).min(1.0)),
+            variant,
+        }
     }
     fn optimiser(&self) -> Optimiser {
         Optimiser::Adam

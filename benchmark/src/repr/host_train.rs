@@ -709,7 +709,7 @@ impl HostTrainer {
         // The model's middle on burn's autodiff.
         let middle = Middle::forward(
             model,
-            &cfg.code_at(step),
+            &cfg.code_at(model, step),
             &ws.heads,
             rows,
             d,

@@ -24,7 +24,8 @@ use super::model_file::ModelFileError;
 pub use super::nets::Init;
 pub use super::neural_encoder::{reconstruct, reconstruction_loss};
 pub use super::neural_model::{
-    Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, normals, tensor2,
+    Knobs, Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, knob_count,
+    knob_number, normals, tensor2,
 };
 use super::params::{LearnerParams, ParamError, ParamGuard};
 use super::{Encoder, ImageSet, Latents, ReprError, RepresentationLearner};
@@ -32,7 +33,7 @@ use crate::seed::Stream;
 
 pub use super::checkpoint::CheckpointSpec;
 pub use super::neural_config::{
-    BACKEND, Engine, Model, NeuralConfig, PlateauRule, training_device,
+    BACKEND, Engine, LEGACY_WARMUP, Model, NeuralConfig, PlateauRule, training_device, unknown_knob,
 };
 pub use super::neural_encoder::NeuralEncoder;
 pub use super::trainer::{ProgressFn, ResumeState, TrainProgress, Trainer, draw_batch, init_net};
@@ -40,33 +41,41 @@ pub use super::trainer::{ProgressFn, ResumeState, TrainProgress, Trainer, draw_b
 /// The partial form of [`NeuralConfig`] for configuration files (`[learners.vae]` etc.):
 /// missing keys take the paper's value for the model ([`NeuralSection::resolve`]). The variant
 /// is not here: it is a dimension of the run matrix (`matrix.variants`, `ugl run --variant`).
+/// Keys beyond the shared ones are the model's own knobs (the RFVAE's `warmup`, the β-VAE's
+/// `beta` and `capacity`: [`NeuralModel::own_knobs`]); the model checks them, and a key no model
+/// has is refused with its name.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct NeuralSection {
     pub iterations: Option<usize>,
     pub hidden: Option<[usize; 2]>,
     pub batch: Option<usize>,
     pub lr: Option<f64>,
     pub log_every: Option<usize>,
-    /// RFVAE warm-up iterations (only valid in `[learners.rfvae]`).
-    pub warmup: Option<usize>,
     /// Weight initialisation: `paper`, `he` or `glorot` ([`Init`]).
     pub init: Option<Init>,
     /// Training engine: `host` (default) or `burn` ([`Engine`]).
     pub engine: Option<Engine>,
-    /// β-VAE: the weight of the KL term (only valid in `[learners.bvae]`).
-    pub beta: Option<f64>,
-    /// β-VAE: capacity annealing, the KL target's final value in nats (only valid in
-    /// `[learners.bvae]`).
-    pub capacity: Option<f64>,
     /// The plateau rule: `{ chunk = N, cap = M }` ([`PlateauRule`]).
     pub plateau: Option<PlateauRule>,
+    /// The model's own knobs, as written in the table.
+    #[serde(flatten)]
+    pub knobs: Knobs,
 }
 
 impl NeuralSection {
-    /// The complete configuration for `model` and `variant`.
+    /// The complete configuration for `model` and `variant` (the knobs as the model records
+    /// them; [`ParamGuard::check`] has refused any it does not accept).
     pub fn resolve(&self, model: Model, variant: Variant) -> NeuralConfig {
         let p = NeuralConfig::paper(model);
+        let spec = model.spec();
+        let mut knobs = p.knobs;
+        for (key, value) in &self.knobs {
+            let value = spec
+                .knob_value(key, value)
+                .unwrap_or_else(|_| value.clone());
+            knobs.insert(key.clone(), value);
+        }
         NeuralConfig {
             iterations: self.iterations.unwrap_or(p.iterations),
             hidden: self.hidden.unwrap_or(p.hidden),
@@ -74,12 +83,10 @@ impl NeuralSection {
             lr: self.lr.unwrap_or(p.lr),
             variant,
             log_every: self.log_every.unwrap_or(p.log_every),
-            warmup: self.warmup.unwrap_or(p.warmup),
             init: self.init.unwrap_or(p.init),
             engine: self.engine.unwrap_or(p.engine),
-            beta: p.beta.map(|b| self.beta.unwrap_or(b)),
-            capacity: p.beta.and(self.capacity),
             plateau: self.plateau,
+            knobs,
         }
     }
 }
@@ -88,17 +95,13 @@ impl ParamGuard for (Model, NeuralSection) {
     type Checked = NeuralParams;
     fn check(self) -> Result<NeuralParams, ParamError> {
         let (model, section) = self;
-        if model.spec().paper_warmup() == 0 && section.warmup.is_some() {
-            return Err(ParamError::at("warmup", "only the rfvae has a KL warm-up"));
-        }
-        if model.spec().default_beta().is_none() && section.beta.is_some() {
-            return Err(ParamError::at("beta", "only the bvae has a KL weight"));
-        }
-        if model.spec().default_beta().is_none() && section.capacity.is_some() {
-            return Err(ParamError::at(
-                "capacity",
-                "only the bvae anneals a KL capacity",
-            ));
+        let spec = model.spec();
+        for (key, value) in &section.knobs {
+            if !spec.own_knobs().contains(&key.as_str()) {
+                return Err(unknown_knob(model, key));
+            }
+            spec.knob_value(key, value)
+                .map_err(|e| ParamError::at(key, e))?;
         }
         section.resolve(model, Variant::Faithful).check(model)?;
         Ok(NeuralParams { model, section })

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::ReprError;
 use super::nets::Init;
-use super::neural_model::{NeuralModel, Variant};
+use super::neural_model::{CodeSettings, Knobs, NeuralModel, Variant};
 use super::params::ParamError;
 use crate::repr::{ae, bvae, rfvae, vae};
 
@@ -115,11 +115,13 @@ impl Model {
     }
 }
 
-/// Training configuration of a neural learner. Every field is required in serde form (it is the
-/// complete, hashable description of a training run); [`NeuralSection`] is the partial form for
-/// configuration files, with the paper's values per model as defaults.
+/// Training configuration of a dense neural learner: what every dense network shares, and the
+/// model's own knobs ([`Knobs`]: the RFVAE's warm-up, the β-VAE's weight and capacity), which the
+/// model declares, checks and reads ([`NeuralModel::own_knobs`]). Every field is required in
+/// serde form (it is the complete, hashable description of a training run); `NeuralSection`
+/// (`neural.rs`) is the partial form for configuration files, with the paper's values per model
+/// as defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct NeuralConfig {
     /// Optimiser steps. 0 keeps the initial weights: the *untrained twin* of a trained network
     /// (same architecture, init, data set and exploration streams), the control of
@@ -135,9 +137,6 @@ pub struct NeuralConfig {
     pub variant: Variant,
     /// Record the loss every this many iterations (the original logged every 100).
     pub log_every: usize,
-    /// RFVAE only: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000
-    /// of 50,000); ignored by the AE and VAE.
-    pub warmup: usize,
     /// How the weights are drawn (paper: truncated normal, std 0.001). Absent in manifests
     /// written before it was configurable, which all used the paper's.
     #[serde(default)]
@@ -146,21 +145,21 @@ pub struct NeuralConfig {
     /// all trained on burn.
     #[serde(default = "Engine::before_v3")]
     pub engine: Engine,
-    /// β-VAE only: the weight of the KL term (absent for the other models, which weigh it by
-    /// 1, so their configurations and hashes are what they were before the β-VAE existed).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub beta: Option<f64>,
-    /// β-VAE only: Burgess et al.'s capacity annealing (the follow-up's objective): the KL term
-    /// becomes `β |mean_b KL_b − C|`, C rising linearly from 0 to `capacity` nats over the
-    /// training. Absent: the plain β-VAE (and every other model).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub capacity: Option<f64>,
     /// The plateau rule ([`PlateauRule`]): train on past `iterations`, in fixed chunks, while the
     /// network is still on the mean-image plateau. Absent: train exactly `iterations` (and the
     /// configurations and hashes of profiles without it are what they were).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plateau: Option<PlateauRule>,
+    /// The model's own knobs, resolved (the table's values, the model's defaults for the rest),
+    /// and `warmup` = 0 for the models without one ([`LEGACY_WARMUP`]).
+    #[serde(flatten)]
+    pub knobs: Knobs,
 }
+
+/// Every dense network recorded a `warmup` (0 where the model has none) before the knobs moved
+/// to their models; a configuration still records it, so that its hash, and with it every
+/// committed store's, holds. It is not a key of those models' tables.
+pub const LEGACY_WARMUP: &str = "warmup";
 
 /// Train on while on the plateau: after `iterations`, and after every further `chunk`
 /// iterations, the reconstruction loss of the first [`super::evidence::EVIDENCE_IMAGES`]
@@ -196,19 +195,16 @@ impl NeuralConfig {
     }
 
     /// The settings of the model's KL term at iteration `step`.
-    pub fn code_at(&self, step: usize) -> super::neural_model::CodeSettings {
-        super::neural_model::CodeSettings {
-            warmup: self.warmup,
-            beta: self.beta.unwrap_or(1.0),
-            capacity: self.capacity_at(step),
-            variant: self.variant,
-        }
+    pub fn code_at(&self, model: Model, step: usize) -> CodeSettings {
+        model
+            .spec()
+            .code_settings(&self.knobs, step, self.iterations, self.variant)
     }
 
-    /// The capacity C of the annealed β-VAE objective at 0-based iteration `step`.
-    pub fn capacity_at(&self, step: usize) -> Option<f64> {
-        self.capacity
-            .map(|c| c * (step as f64 / self.iterations.max(1) as f64).min(1.0))
+    /// The capacity C of the annealed β-VAE objective at 0-based iteration `step` (None: a plain
+    /// KL term).
+    pub fn capacity_at(&self, model: Model, step: usize) -> Option<f64> {
+        self.code_at(model, step).capacity
     }
 
     /// The paper's configuration of `model`, faithful variant.
@@ -220,13 +216,18 @@ impl NeuralConfig {
             lr: 1e-3,
             variant: Variant::Faithful,
             log_every: 100,
-            warmup: model.spec().paper_warmup(),
-            beta: model.spec().default_beta(),
-            capacity: None,
             init: Init::Paper,
             engine: Engine::Host,
             plateau: None,
+            knobs: with_legacy_warmup(model.spec().default_knobs()),
         }
+    }
+
+    /// This configuration with the model's knob `key` set to `value` (checked by
+    /// [`NeuralConfig::check`]).
+    pub fn with_knob(mut self, key: &str, value: impl Into<serde_json::Value>) -> Self {
+        self.knobs.insert(key.to_string(), value.into());
+        self
     }
 
     /// Check every value for `model`, as a learner's `who` at fit time.
@@ -281,27 +282,50 @@ impl NeuralConfig {
                 ));
             }
         }
-        if let Some(b) = self.beta
-            && !(b.is_finite() && b > 0.0 && b <= 1e6)
-        {
-            return Err(ParamError::at(
-                "beta",
-                format!("must be positive and at most 1e6, got {b}"),
-            ));
-        }
-        if let Some(c) = self.capacity
-            && !(c.is_finite() && (0.0..=1e4).contains(&c))
-        {
-            return Err(ParamError::at(
-                "capacity",
-                format!("must be between 0 and 1e4 nats, got {c}"),
-            ));
-        }
-        if model.spec().paper_warmup() > 0 && self.warmup == 0 {
-            return Err(ParamError::at("warmup", "must be at least 1"));
+        let spec = model.spec();
+        for (key, value) in &self.knobs {
+            if spec.own_knobs().contains(&key.as_str()) {
+                spec.knob_value(key, value)
+                    .map_err(|e| ParamError::at(key, e))?;
+            } else if !(key == LEGACY_WARMUP && value.as_u64() == Some(0)) {
+                return Err(unknown_knob(model, key));
+            }
         }
         Ok(())
     }
+}
+
+/// The error of a key that is neither shared by the dense networks nor one of `model`'s knobs:
+/// it names the models that have it, if any.
+pub fn unknown_knob(model: Model, key: &str) -> ParamError {
+    let owners: Vec<&str> = Model::ALL
+        .iter()
+        .filter(|m| m.spec().own_knobs().contains(&key))
+        .map(|m| m.name())
+        .collect();
+    let why = if owners.is_empty() {
+        let own = model.spec().own_knobs();
+        format!(
+            "not a key of [learners.{}] (its own keys besides the shared ones: {})",
+            model.name(),
+            if own.is_empty() {
+                "none".to_string()
+            } else {
+                own.join(", ")
+            }
+        )
+    } else {
+        format!("only the {} has this key", owners.join(" and the "))
+    };
+    ParamError::at(key, why)
+}
+
+/// `knobs` with `warmup` = 0 added where the model has none ([`LEGACY_WARMUP`]).
+pub fn with_legacy_warmup(mut knobs: Knobs) -> Knobs {
+    knobs
+        .entry(LEGACY_WARMUP)
+        .or_insert(serde_json::Value::from(0u64));
+    knobs
 }
 
 impl std::fmt::Display for Variant {

@@ -33,10 +33,44 @@ pub trait NeuralModel: Sync {
     fn paper_warmup(&self) -> usize {
         0
     }
-    /// The weight β of the KL term when the configuration does not set one (None: the model
-    /// has no such weight and `beta` may not be set; the others weigh their KL by 1).
-    fn default_beta(&self) -> Option<f64> {
-        None
+    /// The model's own knobs: the keys of `[learners.NAME]` beyond those every dense network
+    /// shares ([`super::neural_config::NeuralConfig`]), e.g. the RFVAE's `warmup`, the β-VAE's
+    /// `beta` and `capacity`. None by default.
+    fn own_knobs(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// The values of the knobs that a table does not set (the paper's): every own knob with a
+    /// default, none of the others.
+    fn default_knobs(&self) -> Knobs {
+        Knobs::new()
+    }
+    /// Check the value of one of [`NeuralModel::own_knobs`] and return it as recorded (e.g. an
+    /// integer `beta = 4` as the float 4.0); the message says what is wrong.
+    fn knob_value(
+        &self,
+        key: &str,
+        value: &serde_json::Value,
+    ) -> Result<serde_json::Value, String> {
+        let _ = value;
+        Err(format!("{} has no knob '{key}'", self.name()))
+    }
+    /// The settings of the KL term at 0-based iteration `step` of a training of `iterations`,
+    /// from the resolved knobs: a KL weighed by 1, no warm-up and no capacity unless the model
+    /// says otherwise.
+    fn code_settings(
+        &self,
+        knobs: &Knobs,
+        step: usize,
+        iterations: usize,
+        variant: Variant,
+    ) -> CodeSettings {
+        let _ = (knobs, step, iterations);
+        CodeSettings {
+            warmup: 0,
+            beta: 1.0,
+            capacity: None,
+            variant,
+        }
     }
     /// The original's optimiser.
     fn optimiser(&self) -> Optimiser;
@@ -72,6 +106,32 @@ pub trait NeuralModel: Sync {
     fn training_sample(&self, head: &[f32], d: usize, _rng: &mut Stream, out: &mut [f64]) {
         self.mean_code(head, d, out);
     }
+}
+
+/// A dense network's own training knobs by name ([`NeuralModel::own_knobs`]), as recorded in its
+/// configuration (a sorted JSON map). The model declares, checks and reads them, so a knob of
+/// one model is an edit of that model's file.
+pub type Knobs = serde_json::Map<String, serde_json::Value>;
+
+/// A knob's value as a count: a non-negative integer (or a float with no fractional part).
+pub fn knob_count(value: &serde_json::Value) -> Result<usize, String> {
+    value
+        .as_u64()
+        .or_else(|| {
+            value
+                .as_f64()
+                .filter(|f| f.fract() == 0.0 && *f >= 0.0 && *f < 1e15)
+                .map(|f| f as u64)
+        })
+        .map(|v| v as usize)
+        .ok_or_else(|| format!("must be a non-negative integer, got {value}"))
+}
+
+/// A knob's value as a number.
+pub fn knob_number(value: &serde_json::Value) -> Result<f64, String> {
+    value
+        .as_f64()
+        .ok_or_else(|| format!("must be a number, got {value}"))
 }
 
 /// Paper-faithful or corrected behaviour where the original code has a defect.

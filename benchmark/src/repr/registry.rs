@@ -333,7 +333,7 @@ mod tests {
                 assert_eq!(ours.hidden, shared.hidden, "{}", e.name);
                 assert_eq!(ours.batch, shared.batch, "{}", e.name);
                 assert_eq!(ours.lr, shared.lr, "{}", e.name);
-                assert_eq!(ours.warmup, shared.warmup, "{}", e.name);
+                assert_eq!(ours.code_at(model, 0).warmup, shared.warmup, "{}", e.name);
                 let opt = format!("{:?}", model.spec().optimiser());
                 assert_eq!(opt, shared.optimiser, "{}", e.name);
             }
@@ -360,6 +360,42 @@ mod tests {
             let p = (l.entry().params)(None);
             assert_eq!(p.is_ok(), !l.is_external(), "{l}");
         }
+    }
+
+    /// A model's own knobs live in its file: another model's table refuses them, naming the
+    /// owner; their values are checked and recorded as the model records them; and every dense
+    /// network still records `warmup` (0 where it has none), so configuration hashes hold.
+    #[test]
+    fn model_knobs_are_owned_checked_and_recorded() {
+        let params = |learner: &str, toml: &str| {
+            let t: toml::Value = toml::from_str(toml).unwrap();
+            (Learner::by_name(learner).unwrap().entry().params)(Some(&t))
+        };
+        let e = params("vae", "warmup = 5").unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("warmup"));
+        assert!(e.to_string().contains("only the rfvae"), "{e}");
+        let e = params("ae", "capacity = 5.0").unwrap_err();
+        assert!(e.to_string().contains("only the bvae"), "{e}");
+        let e = params("rfvae", "warmup = 0").unwrap_err();
+        assert!(e.to_string().contains("at least 1"), "{e}");
+        let e = params("bvae", "beta = -1").unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("beta"));
+        let e = params("vae", "iteration = 5").unwrap_err();
+        assert!(e.to_string().contains("not a key of [learners.vae]"), "{e}");
+        // An integer β is recorded as the float it was before (4.0, not 4).
+        let bvae = params("bvae", "beta = 4\ncapacity = 12").unwrap();
+        let id = bvae.identity(None);
+        assert_eq!(id["beta"], serde_json::json!(4.0));
+        assert!(id["beta"].is_f64() && id["capacity"].is_f64(), "{id}");
+        assert_eq!(id["warmup"], serde_json::json!(0));
+        let vae = params("vae", "iterations = 10").unwrap().identity(None);
+        assert_eq!(vae["warmup"], serde_json::json!(0));
+        assert!(
+            vae.get("beta").is_none() && vae.get("capacity").is_none(),
+            "{vae}"
+        );
+        let rfvae = params("rfvae", "warmup = 120").unwrap().identity(None);
+        assert_eq!(rfvae["warmup"], serde_json::json!(120));
     }
 
     #[test]

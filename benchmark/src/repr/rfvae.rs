@@ -44,7 +44,8 @@ use burn::tensor::{Device, Tensor};
 use super::host_ops::{exp, log, powf, softplus};
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
 use super::neural_model::{
-    Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant, tensor2,
+    CodeSettings, Knobs, Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant,
+    knob_count, tensor2,
 };
 use super::vae::eps;
 use crate::seed::Stream;
@@ -316,6 +317,48 @@ impl NeuralModel for Rfvae {
     }
     fn paper_warmup(&self) -> usize {
         ANNEAL_STEPS
+    }
+    fn own_knobs(&self) -> &'static [&'static str] {
+        &["warmup"]
+    }
+    /// The paper's warm-up, [`ANNEAL_STEPS`].
+    fn default_knobs(&self) -> Knobs {
+        let mut k = Knobs::new();
+        k.insert("warmup".into(), ANNEAL_STEPS.into());
+        k
+    }
+    /// `warmup`: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000 of
+    /// 50,000), at least 1.
+    fn knob_value(
+        &self,
+        key: &str,
+        value: &serde_json::Value,
+    ) -> Result<serde_json::Value, String> {
+        match key {
+            "warmup" => match knob_count(value)? {
+                0 => Err("must be at least 1".into()),
+                n => Ok(n.into()),
+            },
+            _ => Err(format!("rfvae has no knob '{key}'")),
+        }
+    }
+    fn code_settings(
+        &self,
+        knobs: &Knobs,
+        step: usize,
+        iterations: usize,
+        variant: Variant,
+    ) -> CodeSettings {
+        let _ = (step, iterations);
+        CodeSettings {
+            warmup: knobs
+                .get("warmup")
+                .and_then(serde_json::Value::as_u64)
+                .map_or(ANNEAL_STEPS, |w| w as usize),
+            beta: 1.0,
+            capacity: None,
+            variant,
+        }
     }
     fn optimiser(&self) -> Optimiser {
         Optimiser::Adam

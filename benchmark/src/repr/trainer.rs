@@ -163,16 +163,17 @@ impl<'a> Trainer<'a> {
                 let BurnState { device, net, opt } = &mut **burn;
                 let x = tensor2(self.xbuf.clone(), k, dim, device);
                 let module = net.take().expect("the module is present between steps");
+                let code = self.cfg.code_at(self.model, self.step);
                 let input = StepInput {
                     x,
                     latent: LatentInput {
                         batch: k,
                         latents: self.latents,
                         step: self.step,
-                        warmup: self.cfg.warmup,
-                        beta: self.cfg.beta.unwrap_or(1.0),
-                        capacity: self.cfg.capacity_at(self.step),
-                        variant: self.cfg.variant,
+                        warmup: code.warmup,
+                        beta: code.beta,
+                        capacity: code.capacity,
+                        variant: code.variant,
                         device,
                     },
                 };
