@@ -71,9 +71,7 @@ impl NeuralModel for Bvae {
     }
     /// β = [`DEFAULT_BETA`]; no capacity (the plain β-VAE).
     fn default_knobs(&self) -> Knobs {
-        let mut k = Knobs::new();
-        k.insert("beta".into(), DEFAULT_BETA.into());
-        k
+        Knobs::from_iter([("beta".into(), DEFAULT_BETA.into())])
     }
     /// `beta`: the weight of the KL term, in (0, 1e6]. `capacity`: Burgess et al.'s capacity
     /// annealing (the follow-up's objective): the KL term becomes `β |mean_b KL_b − C|`, C rising

@@ -323,9 +323,7 @@ impl NeuralModel for Rfvae {
     }
     /// The paper's warm-up, [`ANNEAL_STEPS`].
     fn default_knobs(&self) -> Knobs {
-        let mut k = Knobs::new();
-        k.insert("warmup".into(), ANNEAL_STEPS.into());
-        k
+        Knobs::from_iter([("warmup".into(), ANNEAL_STEPS.into())])
     }
     /// `warmup`: iterations of the KL warm-up `min(1, 0.01 + step / warmup)` (paper: 10,000 of
     /// 50,000), at least 1.

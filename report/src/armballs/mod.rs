@@ -110,6 +110,20 @@ mod tests {
     use super::*;
     use crate::load::Store;
 
+    /// A campaign of no runs named `name` (the page reads the runs it is given).
+    fn empty_campaign(name: &str) -> Campaign {
+        Campaign {
+            name: name.into(),
+            path: name.into(),
+            decl: Default::default(),
+            configurations: 1,
+            store: Store {
+                runs: Vec::new(),
+                incomplete: Vec::new(),
+            },
+        }
+    }
+
     fn run(algo: &str, sampler: &str, latents: i64, seed: i64, ratio: f64) -> FollowupRun {
         let key = ugl_types::ConditionKey {
             env: "armballs".into(),
@@ -156,16 +170,7 @@ mod tests {
     /// the networks record them, and keeps its columns otherwise.
     #[test]
     fn the_disentanglement_table_shows_mig_sap_and_active_latents() {
-        let campaign = Campaign {
-            name: "followup".into(),
-            path: "followup".into(),
-            decl: Default::default(),
-            configurations: 1,
-            store: Store {
-                runs: Vec::new(),
-                incomplete: Vec::new(),
-            },
-        };
+        let campaign = empty_campaign("followup");
         let claims = FollowupClaims::Missing(Path::new("none.toml"));
         let mut r = run("mge-conv-bvae-lp", "gaussian", 3, 0, 0.4);
         r.learner = Some("conv-bvae".into());
@@ -210,16 +215,7 @@ mod tests {
                 .any(|r| r.cond.algo == "rpe" && r.cond.split.is_none()),
             "an algorithm run one way keeps its name"
         );
-        let campaign = Campaign {
-            name: "armballs".into(),
-            path: "armballs".into(),
-            decl: Default::default(),
-            configurations: 1,
-            store: Store {
-                runs: Vec::new(),
-                incomplete: Vec::new(),
-            },
-        };
+        let campaign = empty_campaign("armballs");
         let claims = FollowupClaims::Missing(Path::new("none.toml"));
         let (page, _) = page::write(&campaign, &[], &rs, &[], &claims);
         assert!(page.contains("(10 runs, 2 seeds)"), "{page}");

@@ -120,6 +120,20 @@ fn fmt_epochs(e: &[i64]) -> String {
     e.iter().map(i64::to_string).collect::<Vec<_>>().join(", ")
 }
 
+/// What holds of the runs' bytes across machines, by their results version: from version 5 a
+/// run's bytes are the same on every x86-64 CPU and kernel path; before, within one SIMD level.
+fn reproducibility(runs: &[crate::load::Run]) -> &'static str {
+    let cross_machine = |r: &crate::load::Run| r.manifest.results_version().is_some_and(|v| v >= 5);
+    if runs.iter().all(cross_machine) {
+        "Results are bit-for-bit the same on every x86-64 CPU, whatever its SIMD level"
+    } else if runs.iter().any(cross_machine) {
+        "Results of version 5 on are bit-for-bit the same on every x86-64 CPU, whatever its SIMD \
+         level; earlier ones within one SIMD level"
+    } else {
+        "Results are bit-for-bit reproducible within one SIMD level"
+    }
+}
+
 /// The campaign's compute: exploration plus representation fits, a shared fit (the KDE and
 /// Gaussian runs of a neural cell share one training, identified by `train.key`) counted once.
 fn compute_line(w: &mut String, runs: &[crate::load::Run]) {
@@ -545,9 +559,9 @@ pub fn what_was_run(w: &mut String, inp: &Context<'_>) {
     );
     let _ = writeln!(
         w,
-        "- **CPU (SIMD level):** {}. Results are bit-for-bit reproducible within one SIMD level \
-         (README, Reproducibility).",
-        distinct(runs.iter().map(|r| r.manifest.cpu_label()))
+        "- **CPU (SIMD level):** {}. {} (README, Reproducibility).",
+        distinct(runs.iter().map(|r| r.manifest.cpu_label())),
+        reproducibility(runs)
     );
     let _ = writeln!(
         w,
