@@ -1,7 +1,8 @@
 //! A new environment is one file plus one registry entry: this file declares ArmReach (the
-//! outcome is where the hand ends; no object), registers it, and runs it through the command
-//! line (`ugl run`, `ugl campaign`, `ugl report`) in this process, as a program that adds its
-//! own environment would. Nothing outside this file knows it.
+//! outcome is where the hand ends; no object) and its own constant (`[env.armreach] clip`),
+//! registers it, and runs it through the command line (`ugl run`, `ugl campaign`, `ugl
+//! report`) in this process, as a program that adds its own environment would. Nothing outside
+//! this file knows it.
 
 #[path = "common/in_process.rs"]
 mod in_process;
@@ -9,8 +10,14 @@ mod in_process;
 use std::process::ExitCode;
 
 use in_process::{manifest, ok, p, ugl};
+use serde::{Deserialize, Serialize};
+use ugl_bench::env::config::within;
+use ugl_bench::env::invalid::InvalidValue;
 use ugl_bench::env::render::render_ball_into;
-use ugl_bench::env::{EnvConfig, EnvEntry, EnvKind, Environment, PARAMS, Rollout, dmp, register};
+use ugl_bench::env::{
+    EnvConfig, EnvEntry, EnvKind, Environment, OwnConstants, OwnTable, PARAMS, Rollout, dmp,
+    register,
+};
 use ugl_bench::seed::Stream;
 use ugl_types::{DISK, EnvSpec, GRAY70, ObjectSpec};
 
@@ -34,9 +41,31 @@ static SPEC: EnvSpec = EnvSpec {
     image: GRAY70,
 };
 
+/// Its own constant, `[env.armreach] clip`: the outcome is clipped to [-clip, clip]².
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct Constants {
+    /// In (0, 1].
+    clip: f64,
+}
+
+impl Default for Constants {
+    fn default() -> Self {
+        Constants { clip: 1.0 }
+    }
+}
+
+impl OwnConstants for Constants {
+    fn check(&self, key: &dyn Fn(&str) -> String) -> Result<(), InvalidValue> {
+        within(&key("clip"), self.clip, f64::MIN_POSITIVE, 1.0)
+    }
+}
+
 /// Its registry entry.
 static ENTRY: EnvEntry = EnvEntry {
     spec: &SPEC,
+    constants: OwnTable::of::<Constants>(),
+    uses_arm: true,
     build: |cfg| Box::new(ArmReach::new(cfg)),
 };
 
@@ -44,6 +73,7 @@ static ENTRY: EnvEntry = EnvEntry {
 struct ArmReach {
     cfg: EnvConfig,
     rest: [f64; 2],
+    clip: f64,
 }
 
 impl ArmReach {
@@ -52,6 +82,7 @@ impl ArmReach {
         ArmReach {
             cfg: cfg.clone(),
             rest,
+            clip: cfg.own::<Constants>(EnvKind::of(&ENTRY)).clip,
         }
     }
 }
@@ -72,7 +103,12 @@ impl Environment for ArmReach {
             .last()
             .map_or(self.rest, |q| self.cfg.arm.forward(q).hand);
         Rollout {
-            state: [hand[0].clamp(-1.0, 1.0), hand[1].clamp(-1.0, 1.0), 0.0, 0.0],
+            state: [
+                hand[0].clamp(-self.clip, self.clip),
+                hand[1].clamp(-self.clip, self.clip),
+                0.0,
+                0.0,
+            ],
             dim: 2,
             caught: hand != self.rest,
             hand,
@@ -120,6 +156,8 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
     };
     static WRONG: EnvEntry = EnvEntry {
         spec: &WRONG_GRID,
+        constants: OwnTable::NONE,
+        uses_arm: true,
         build: |cfg| Box::new(ArmReach::new(cfg)),
     };
     let e = register(&WRONG).unwrap_err().to_string();
@@ -156,6 +194,48 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
     let m = manifest(&single.join("armreach.rge-pca.kde.l2.s1.json"));
     assert_eq!((m.env.as_str(), m.latents), ("armreach", 2));
     assert!(m.summary.final_klc > 0.0 && m.summary.final_klc <= DISK.max_klc());
+
+    // Its own constant, set in its table: the outcomes obey it, and its range is checked.
+    let clipped = dir.path().join("clipped.toml");
+    let with_clip = |clip: &str| {
+        std::fs::read_to_string(&profile).unwrap() + &format!("[env.armreach]\nclip = {clip}\n")
+    };
+    std::fs::write(&clipped, with_clip("0.25")).unwrap();
+    let clip_out = dir.path().join("clip");
+    ok(&[
+        "run",
+        "--env",
+        "armreach",
+        "--algo",
+        "rpe",
+        "--profile",
+        p(&clipped),
+        "--out",
+        p(&clip_out),
+    ]);
+    let run = ugl_report::load::load_run(&clip_out.join("armreach.rpe.s0"), String::new()).unwrap();
+    let coords = || run.outcomes.iter().flat_map(|o| [o.x, o.y]);
+    assert!(coords().all(|v| v.abs() <= 0.25), "clip = 0.25 not obeyed");
+    assert!(
+        coords().any(|v| v.abs() == 0.25),
+        "no outcome reaches the clip"
+    );
+    std::fs::write(&clipped, with_clip("2.0")).unwrap();
+    assert_eq!(
+        ugl(&[
+            "run",
+            "--env",
+            "armreach",
+            "--algo",
+            "rpe",
+            "--profile",
+            p(&clipped),
+            "--out",
+            p(&clip_out)
+        ]),
+        ExitCode::from(2),
+        "env.armreach.clip = 2 must be refused"
+    );
 
     // A campaign: the same bytes as `ugl run` for the same identity.
     let results = dir.path().join("results");

@@ -3,7 +3,34 @@
 //! [-1, 1). The engineered outcome is (x, y, angle). The angle is a linear coordinate everywhere
 //! (no wrap-around in distances or bins), as in the original code.
 
+use serde::{Deserialize, Serialize};
+
 use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
+use crate::config::{OwnConstants, exactly, within_each};
+use crate::invalid::InvalidValue;
+
+/// ArmArrow's own constants (its `[env.armarrow]` table).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Constants {
+    /// Initial arrow pose (x, y, angle in units of pi), each in [-1, 1].
+    #[serde(deserialize_with = "exactly")]
+    pub arrow_initial: [f64; 3],
+}
+
+impl Default for Constants {
+    fn default() -> Self {
+        Constants {
+            arrow_initial: [0.6, 0.6, 0.6],
+        }
+    }
+}
+
+impl OwnConstants for Constants {
+    fn check(&self, key: &dyn Fn(&str) -> String) -> Result<(), InvalidValue> {
+        within_each(key, "arrow_initial", &self.arrow_initial, -1.0, 1.0)
+    }
+}
 
 /// The ArmArrow environment.
 #[derive(Clone, Debug)]
@@ -24,7 +51,7 @@ impl ArmArrow {
     pub fn new(cfg: &EnvConfig) -> Self {
         ArmArrow {
             body: Body::new(cfg),
-            initial: cfg.arrow_initial,
+            initial: cfg.own::<Constants>(EnvKind::ARMARROW).arrow_initial,
         }
     }
 }

@@ -1,7 +1,34 @@
 //! ArmBall (paper Section 4.1): the arm can catch a ball of radius 0.1 at (0.6, 0.6) and move it.
 //! The engineered outcome is the ball's final (x, y).
 
+use serde::{Deserialize, Serialize};
+
 use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
+use crate::config::{OwnConstants, exactly, within_each};
+use crate::invalid::InvalidValue;
+
+/// ArmBall's own constants (its `[env.armball]` table).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Constants {
+    /// Initial ball position, in [-1, 1]² (the scene).
+    #[serde(deserialize_with = "exactly")]
+    pub ball_initial: [f64; 2],
+}
+
+impl Default for Constants {
+    fn default() -> Self {
+        Constants {
+            ball_initial: [0.6, 0.6],
+        }
+    }
+}
+
+impl OwnConstants for Constants {
+    fn check(&self, key: &dyn Fn(&str) -> String) -> Result<(), InvalidValue> {
+        within_each(key, "ball_initial", &self.ball_initial, -1.0, 1.0)
+    }
+}
 
 /// The ArmBall environment.
 #[derive(Clone, Debug)]
@@ -15,7 +42,7 @@ impl ArmBall {
     pub fn new(cfg: &EnvConfig) -> Self {
         ArmBall {
             body: Body::new(cfg),
-            initial: cfg.ball_initial,
+            initial: cfg.own::<Constants>(EnvKind::ARMBALL).ball_initial,
         }
     }
 }

@@ -16,6 +16,10 @@ use crate::seed::standard_normal;
 use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
 use crate::seed::Stream;
 
+/// ArmBalls' own constants (its `[env.armballs]` table): the follow-up's scene, declared with
+/// its ArmBalls ([`crate::cdge::Constants`]: the ball's start, the distractor's start and step).
+pub type Constants = crate::cdge::Constants;
+
 /// The distractor's walk is clipped to this box (CDGE `np.clip(…, -.95, 0.95)`).
 pub const DISTRACTOR_BOUND: f64 = 0.95;
 
@@ -32,12 +36,13 @@ pub struct ArmBalls {
 impl ArmBalls {
     /// Build from the environment constants.
     pub fn new(cfg: &EnvConfig) -> Self {
-        let [bx, by] = cfg.ball_initial;
-        let [dx, dy] = cfg.distractor_initial;
+        let own = cfg.own::<Constants>(EnvKind::ARMBALLS);
+        let [bx, by] = own.ball_initial;
+        let [dx, dy] = own.distractor_initial;
         ArmBalls {
             body: Body::new(cfg),
             initial: [bx, by, dx, dy],
-            noise: cfg.distractor_noise,
+            noise: own.distractor_noise,
         }
     }
 
@@ -97,10 +102,11 @@ mod tests {
     use rand::RngExt;
 
     fn env(noise: f64) -> ArmBalls {
-        ArmBalls::new(&EnvConfig {
-            distractor_noise: noise,
-            ..EnvConfig::default()
-        })
+        ArmBalls::new(
+            &EnvConfig::default()
+                .with("armballs.distractor_noise", noise)
+                .unwrap(),
+        )
     }
 
     #[test]

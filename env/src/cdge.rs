@@ -16,7 +16,11 @@
 //! from the first step on), and the distractor's walk (reset every episode to (0.7, -0.45), a
 //! step of `N(0, noise^2)` per coordinate and time step, clipped to +-0.95) are the same as ours.
 
+use serde::{Deserialize, Serialize};
+
 use super::{EnvConfig, EnvKind, Environment, Rollout};
+use crate::config::{OwnConstants, exactly, within, within_each};
+use crate::invalid::InvalidValue;
 use crate::seed::{Stream, standard_normal};
 
 /// Joints of the arm.
@@ -138,9 +142,46 @@ fn numpy_sum(a: &[f64]) -> f64 {
     res
 }
 
-/// The constants of an episode (CDGE's defaults for the plotted runs). In a campaign they come
-/// from the `[env]` table's `object_size`, `ball_initial`, `distractor_initial` and
-/// `distractor_noise` (whose defaults are these); its arm and DMP constants do not apply.
+/// The follow-up's ArmBalls' own constants (its `[env.armballs-corl]` table; our DMP ArmBalls
+/// has the same, in its own `[env.armballs]`): CDGE's defaults for the plotted runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Constants {
+    /// The ball's start, in [-1, 1]² (the scene).
+    #[serde(deserialize_with = "exactly")]
+    pub ball_initial: [f64; 2],
+    /// The distractor's position at the start of every episode (CDGE
+    /// `distract_initial_pose`), inside the square [-0.95, 0.95]² it walks in.
+    #[serde(deserialize_with = "exactly")]
+    pub distractor_initial: [f64; 2],
+    /// Standard deviation of the distractor's step per time step (CDGE `--distract_noise`; 0
+    /// keeps it still), in [0, 1] (a step the size of the scene's half-width already jumps
+    /// across the distractor's square).
+    pub distractor_noise: f64,
+}
+
+impl Default for Constants {
+    fn default() -> Self {
+        Constants {
+            ball_initial: [0.6, 0.6],
+            distractor_initial: [0.7, -0.45],
+            distractor_noise: 0.1,
+        }
+    }
+}
+
+impl OwnConstants for Constants {
+    fn check(&self, key: &dyn Fn(&str) -> String) -> Result<(), InvalidValue> {
+        within_each(key, "ball_initial", &self.ball_initial, -1.0, 1.0)?;
+        let b = crate::armballs::DISTRACTOR_BOUND;
+        within_each(key, "distractor_initial", &self.distractor_initial, -b, b)?;
+        within(&key("distractor_noise"), self.distractor_noise, 0.0, 1.0)
+    }
+}
+
+/// The constants of an episode. In a campaign they come from the `[env]` table's shared
+/// `object_size` and the environment's own [`Constants`]; the shared arm and DMP constants do
+/// not apply.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// Catch radius (CDGE `--object_size`; the plotted runs: 0.1).
@@ -156,23 +197,19 @@ pub struct Scene {
 impl Scene {
     /// The scene of an `[env]` table.
     pub fn of(cfg: &EnvConfig) -> Scene {
+        let own = cfg.own::<Constants>(EnvKind::ARMBALLS_CORL);
         Scene {
             object_size: cfg.object_size,
-            ball_initial: cfg.ball_initial,
-            distractor_initial: cfg.distractor_initial,
-            distractor_noise: cfg.distractor_noise,
+            ball_initial: own.ball_initial,
+            distractor_initial: own.distractor_initial,
+            distractor_noise: own.distractor_noise,
         }
     }
 }
 
 impl Default for Scene {
     fn default() -> Self {
-        Scene {
-            object_size: 0.1,
-            ball_initial: [0.6, 0.6],
-            distractor_initial: [0.7, -0.45],
-            distractor_noise: 0.1,
-        }
+        Scene::of(&EnvConfig::default())
     }
 }
 

@@ -15,6 +15,7 @@ pub mod armarrow;
 pub mod armball;
 pub mod armballs;
 pub mod cdge;
+pub mod config;
 pub mod dmp;
 pub mod render;
 
@@ -23,7 +24,6 @@ pub mod npy;
 pub mod seed;
 mod ziggurat_tables;
 
-use crate::invalid::InvalidValue;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::RwLock;
@@ -37,6 +37,7 @@ pub use arm::{ArmConfig, ArmPose, JOINTS};
 pub use armarrow::ArmArrow;
 pub use armball::ArmBall;
 pub use armballs::ArmBalls;
+pub use config::{EnvConfig, NoConstants, OwnConstants, OwnTable, RunConstants};
 pub use dmp::{DmpConfig, DmpTable, DmpWidths, PARAMS};
 
 /// One environment of the registry: its declaration (names, objects, KL-coverage grid; shared
@@ -49,6 +50,12 @@ pub use dmp::{DmpConfig, DmpTable, DmpWidths, PARAMS};
 pub struct EnvEntry {
     /// Its declaration.
     pub spec: &'static EnvSpec,
+    /// Its own constants (its `[env.NAME]` table): `OwnTable::of::<S>()` of the struct `S` of
+    /// its file, or [`OwnTable::NONE`].
+    pub constants: OwnTable,
+    /// Whether it moves the shared arm with the shared motor primitive (`[env]`'s `arm` and
+    /// `dmp`): when not, they do not enter its runs' config hashes.
+    pub uses_arm: bool,
     /// Build it.
     pub build: fn(&EnvConfig) -> Box<dyn Environment>,
 }
@@ -57,18 +64,26 @@ pub struct EnvEntry {
 pub static BUILT_IN: [EnvEntry; 4] = [
     EnvEntry {
         spec: &ugl_types::ARMBALL,
+        constants: OwnTable::of::<armball::Constants>(),
+        uses_arm: true,
         build: |cfg| Box::new(ArmBall::new(cfg)),
     },
     EnvEntry {
         spec: &ugl_types::ARMARROW,
+        constants: OwnTable::of::<armarrow::Constants>(),
+        uses_arm: true,
         build: |cfg| Box::new(ArmArrow::new(cfg)),
     },
     EnvEntry {
         spec: &ugl_types::ARMBALLS,
+        constants: OwnTable::of::<armballs::Constants>(),
+        uses_arm: true,
         build: |cfg| Box::new(ArmBalls::new(cfg)),
     },
     EnvEntry {
         spec: &ugl_types::ARMBALLS_CORL,
+        constants: OwnTable::of::<cdge::Constants>(),
+        uses_arm: false,
         build: |cfg| Box::new(cdge::CdgeArmBalls::new(cdge::Scene::of(cfg))),
     },
 ];
@@ -291,220 +306,6 @@ impl<'de> Deserialize<'de> for EnvKind {
     }
 }
 
-/// Constants of the environments; the defaults are the paper's code's (docs/original-code.md section 1).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct EnvConfig {
-    /// Arm geometry.
-    pub arm: ArmConfig,
-    /// Motor primitive.
-    pub dmp: DmpConfig,
-    /// Catch radius: the object is caught when the squared hand-object distance is below its square.
-    /// In (0, 1].
-    pub object_size: f64,
-    /// Initial ball position, in [-1, 1]² (the scene).
-    #[serde(deserialize_with = "ball_initial")]
-    pub ball_initial: [f64; 2],
-    /// Initial arrow pose (x, y, angle in units of pi), each in [-1, 1].
-    #[serde(deserialize_with = "arrow_initial")]
-    pub arrow_initial: [f64; 3],
-    /// ArmBalls: the distractor's position at the start of every episode (CDGE
-    /// `distract_initial_pose`), inside the square [-0.95, 0.95]² it walks in. Serialised only
-    /// when it differs from the default, so that the other environments' config hashes do not
-    /// depend on it.
-    #[serde(
-        skip_serializing_if = "is_default_distractor_initial",
-        deserialize_with = "distractor_initial"
-    )]
-    pub distractor_initial: [f64; 2],
-    /// ArmBalls: standard deviation of the distractor's step per time step (CDGE
-    /// `distract_noise`; 0 keeps it still), in [0, 1] (a step the size of the scene's half-width
-    /// already jumps across the distractor's square). Serialised only when it differs from the
-    /// default.
-    #[serde(skip_serializing_if = "is_default_distractor_noise")]
-    pub distractor_noise: f64,
-}
-
-/// The follow-up's distractor start (CDGE `distract_initial_pose`).
-const DISTRACTOR_INITIAL: [f64; 2] = [0.7, -0.45];
-/// The follow-up's distractor step (CDGE `--distract_noise`, committed configs).
-const DISTRACTOR_NOISE: f64 = 0.1;
-
-/// Exactly `N` numbers for the key `env.KEY`: serde's fixed-size arrays read the first `N`
-/// elements of a longer TOML array and silently drop the rest.
-pub(crate) fn exactly<'de, D, const N: usize>(d: D, key: &str) -> Result<[f64; N], D::Error>
-where
-    D: serde::Deserializer<'de>,
-{
-    let v = Vec::<f64>::deserialize(d)?;
-    let n = v.len();
-    v.try_into()
-        .map_err(|_| serde::de::Error::custom(format!("env.{key} must have {N} numbers, got {n}")))
-}
-
-fn ball_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    exactly(d, "ball_initial")
-}
-
-fn arrow_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
-    exactly(d, "arrow_initial")
-}
-
-fn distractor_initial<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    exactly(d, "distractor_initial")
-}
-
-fn is_default_distractor_initial(v: &[f64; 2]) -> bool {
-    *v == DISTRACTOR_INITIAL
-}
-
-fn is_default_distractor_noise(v: &f64) -> bool {
-    *v == DISTRACTOR_NOISE
-}
-
-impl EnvConfig {
-    /// The constants a run in `kind` depends on: the distractor's are reset to their defaults
-    /// (which are not serialised) in scenes without a distractor, so that they never enter the
-    /// config hash of, say, an ArmBall run (its bytes do not depend on them).
-    pub fn relevant_to(&self, kind: EnvKind) -> EnvConfig {
-        let mut c = self.clone();
-        if kind.control_dims().is_none() {
-            c.distractor_initial = DISTRACTOR_INITIAL;
-            c.distractor_noise = DISTRACTOR_NOISE;
-        }
-        // The follow-up's own ArmBalls has its own arm and controller ([`cdge`]): the DMP arm's
-        // constants do not change its runs, so they do not enter their hash.
-        if kind == EnvKind::ARMBALLS_CORL {
-            c.arm = ArmConfig::default();
-            c.dmp = DmpConfig::default();
-        }
-        c
-    }
-}
-
-impl Default for EnvConfig {
-    fn default() -> Self {
-        EnvConfig {
-            arm: ArmConfig::default(),
-            dmp: DmpConfig::default(),
-            object_size: 0.1,
-            ball_initial: [0.6, 0.6],
-            arrow_initial: [0.6, 0.6, 0.6],
-            distractor_initial: DISTRACTOR_INITIAL,
-            distractor_noise: DISTRACTOR_NOISE,
-        }
-    }
-}
-
-impl EnvConfig {
-    /// Check every value of the `[env]` table against its range (the fields' documentation);
-    /// the message names the key. Ranges keep each value finite and meaningful: an object
-    /// starts in the scene, the arm's reach fits in it, and the motor primitive's movement is
-    /// finite for every motor command (checked on the extreme commands, where a linear
-    /// movement is largest).
-    pub fn validate(&self) -> Result<(), InvalidValue> {
-        let within = |key: &str, v: f64, lo: f64, hi: f64| {
-            if v.is_finite() && (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(InvalidValue::new(
-                    key,
-                    format!(
-                        "{key} must be a finite number in [{lo}, {hi}], got {}",
-                        num(v)
-                    ),
-                ))
-            }
-        };
-        let a = &self.arm;
-        if let Some(l) = a.lengths.iter().find(|l| !(l.is_finite() && **l >= 0.0)) {
-            return Err(InvalidValue::new(
-                "env.arm.lengths",
-                format!("env.arm.lengths must be finite and >= 0, got {l}"),
-            ));
-        }
-        let reach: f64 = a.lengths.iter().sum();
-        if !(reach > 0.0 && reach <= 1.0 + 1e-9) {
-            return Err(InvalidValue::new(
-                "env.arm.lengths",
-                format!(
-                    "env.arm.lengths must add up to a reach in (0, 1] (the scene), got {reach}"
-                ),
-            ));
-        }
-        within("env.arm.angle_shift", a.angle_shift, -2.0, 2.0)?;
-        let d = &self.dmp;
-        if !(1..=MAX_TIMESTEPS).contains(&d.timesteps) {
-            return Err(InvalidValue::new(
-                "env.dmp.timesteps",
-                format!(
-                    "env.dmp.timesteps must be between 1 and {MAX_TIMESTEPS}, got {}",
-                    d.timesteps
-                ),
-            ));
-        }
-        for (k, v, lo, hi) in [
-            ("env.dmp.run_time", d.run_time, f64::MIN_POSITIVE, 1e3),
-            ("env.dmp.ay", d.ay, f64::MIN_POSITIVE, 1e4),
-            ("env.dmp.ax", d.ax, f64::MIN_POSITIVE, 1e4),
-            ("env.dmp.max_params", d.max_params, 0.0, 1e6),
-            ("env.object_size", self.object_size, f64::MIN_POSITIVE, 1.0),
-        ] {
-            if !(v.is_finite() && v >= lo && v <= hi) {
-                let lo = if lo > 0.0 {
-                    "(0".to_string()
-                } else {
-                    format!("[{lo}")
-                };
-                return Err(InvalidValue::new(
-                    k,
-                    format!("{k} must be a finite number in {lo}, {hi}], got {}", num(v)),
-                ));
-            }
-        }
-        // The joint angles are linear in the 3 weights of their joint, so their largest
-        // magnitude over [-1, 1]^21 is reached at a vertex: the 8 sign patterns, shared by all
-        // joints, cover every vertex of every joint.
-        for signs in 0..8u32 {
-            let theta: [f64; PARAMS] =
-                std::array::from_fn(|k| if signs >> (k % 3) & 1 == 1 { 1.0 } else { -1.0 });
-            if dmp::trajectory(d, &theta)
-                .iter()
-                .any(|q| q.iter().any(|v| !v.is_finite()))
-            {
-                return Err(InvalidValue::new(
-                    "env.dmp",
-                    format!(
-                        "env.dmp: the movement is not finite with these constants (timesteps = {}, \
-                     run_time = {}, ay = {}, ax = {}, max_params = {})",
-                        d.timesteps, d.run_time, d.ay, d.ax, d.max_params
-                    ),
-                ));
-            }
-        }
-        for (i, v) in self.ball_initial.iter().enumerate() {
-            within(&format!("env.ball_initial[{i}]"), *v, -1.0, 1.0)?;
-        }
-        for (i, v) in self.arrow_initial.iter().enumerate() {
-            within(&format!("env.arrow_initial[{i}]"), *v, -1.0, 1.0)?;
-        }
-        let b = armballs::DISTRACTOR_BOUND;
-        for (i, v) in self.distractor_initial.iter().enumerate() {
-            within(&format!("env.distractor_initial[{i}]"), *v, -b, b)?;
-        }
-        within("env.distractor_noise", self.distractor_noise, 0.0, 1.0)
-    }
-}
-
-/// A number as a person writes it: `1e300`, not three hundred digits.
-fn num(v: f64) -> String {
-    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
-}
-
 /// At most this many DMP steps per episode (the paper: 50).
 pub const MAX_TIMESTEPS: usize = 10_000;
 
@@ -687,30 +488,42 @@ mod tests {
     fn the_paper_constants_pass_the_checks_and_each_range_is_enforced() {
         let ok = EnvConfig::default();
         ok.validate().unwrap();
-        let head = EnvConfig {
-            dmp: DmpConfig {
-                widths: DmpWidths::ExplautoHead,
-                ..DmpConfig::default()
-            },
-            ..EnvConfig::default()
-        };
+        let mut head = EnvConfig::default();
+        head.dmp.widths = DmpWidths::ExplautoHead;
         head.validate().unwrap();
-        let still = EnvConfig {
-            distractor_noise: 0.0,
-            ..EnvConfig::default()
-        };
+        let still = EnvConfig::default().with("distractor_noise", 0.0).unwrap();
         still.validate().unwrap();
-        let bad: [(fn(&mut EnvConfig), &str); 8] = [
-            (|e| e.distractor_noise = -0.1, "env.distractor_noise"),
-            (|e| e.distractor_noise = f64::NAN, "env.distractor_noise"),
+        let own = |key: &str, v: serde_json::Value| EnvConfig::default().with(key, v).unwrap();
+        for (e, key) in [
             (
-                |e| e.distractor_initial = [0.0, 0.96],
+                own("distractor_noise", (-0.1).into()),
+                "env.distractor_noise",
+            ),
+            (
+                own("armballs-corl.distractor_noise", 1.5.into()),
+                "env.armballs-corl.distractor_noise",
+            ),
+            (
+                own("distractor_initial", serde_json::json!([0.0, 0.96])),
                 "env.distractor_initial[1]",
             ),
             (
-                |e| e.ball_initial = [f64::INFINITY, 0.0],
-                "env.ball_initial[0]",
+                own("armball.ball_initial", serde_json::json!([1.5, 0.0])),
+                "env.armball.ball_initial[0]",
             ),
+            (
+                own(
+                    "armarrow.arrow_initial",
+                    serde_json::json!([0.0, 0.0, -1.5]),
+                ),
+                "env.armarrow.arrow_initial[2]",
+            ),
+        ] {
+            let m = e.validate().unwrap_err();
+            assert_eq!(m.key, key, "{m}");
+            assert!(m.message.starts_with(key), "{m} should start with {key}");
+        }
+        let bad: [(fn(&mut EnvConfig), &str); 4] = [
             (|e| e.arm.lengths[6] = 0.5, "env.arm.lengths"),
             (|e| e.dmp.timesteps = MAX_TIMESTEPS + 1, "env.dmp.timesteps"),
             (|e| e.dmp.ay = -1.0, "env.dmp.ay"),
@@ -780,7 +593,7 @@ mod tests {
             // Random parameters, and small ones that keep the hand near the object for long.
             let scale = if i % 2 == 0 { 1.0 } else { 0.05 };
             let theta: [f64; PARAMS] = std::array::from_fn(|_| scale * rng.random_range(-1.0..1.0));
-            for obj in [cfg.ball_initial, [0.0, 0.95], [0.3, -0.2]] {
+            for obj in [[0.6, 0.6], [0.0, 0.95], [0.3, -0.2]] {
                 let fast = body.run(&theta, obj);
                 assert_eq!(
                     fast,

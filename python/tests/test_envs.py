@@ -97,8 +97,16 @@ def test_config_sets_env_constants_and_is_checked():
     x = params_for("armballs", 10, 5)
     still = ugl_bench.rollout("armballs", x, seed=1, config={"distractor_noise": 0.0})
     assert np.all(still[:, 2:] == np.array([0.7, -0.45]))
+    # The environment's own table: the same episodes; another environment's table leaves it be.
+    own = ugl_bench.rollout("armballs", x, seed=1, config={"armballs": {"distractor_noise": 0.0}})
+    assert np.array_equal(own, still)
+    other = ugl_bench.rollout("armballs", x, seed=1, config={"armballs-corl": {"distractor_noise": 0.0}})
+    assert np.array_equal(other, ugl_bench.rollout("armballs", x, seed=1))
+    assert not np.array_equal(other, still)
     with pytest.raises(ValueError, match="distractor_noise"):
         ugl_bench.rollout("armballs", x, config={"distractor_noise": -1.0})
+    with pytest.raises(ValueError, match="env.armball.distractor_noise is not a constant of ArmBall"):
+        ugl_bench.rollout("armball", params_for("armball", 10, 1), config={"armball": {"distractor_noise": 0.0}})
     with pytest.raises(ValueError, match="bogus"):
         ugl_bench.Env("armballs", config={"bogus": 1})
 

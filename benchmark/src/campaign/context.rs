@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::config::{CampaignConfig, LearnersConfig, UglConfig};
 use super::plan::RunSpec;
-use crate::env::EnvConfig;
+use crate::env::{EnvConfig, RunConstants};
 use crate::explore::{ExploreConfig, MgeConfig};
 use crate::repr::FitContext;
 use crate::repr::cache::ModelCache;
@@ -26,7 +26,7 @@ struct HashInput<'a> {
     campaign_seed: u64,
     explore: &'a ExploreConfig,
     /// Only the constants the run's environment uses ([`EnvConfig::relevant_to`]).
-    env: EnvConfig,
+    env: RunConstants,
     #[serde(skip_serializing_if = "Option::is_none")]
     ugl: Option<&'a UglConfig>,
     #[serde(skip_serializing_if = "Option::is_none")]

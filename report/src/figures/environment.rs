@@ -90,14 +90,20 @@ where
     Ok(())
 }
 
+/// The object's initial state in `kind` with the constants `cfg`.
+fn initial(cfg: &EnvConfig, kind: EnvKind) -> Vec<f64> {
+    make_env(kind, cfg).initial_state().to_vec()
+}
+
 /// Figure 1: the arm at rest with the ball at its initial position, and the rendered images of
 /// both environments at their initial states.
 pub fn draw_environments(fig_dir: &Path) -> Result<FigureFile, ReportError> {
     let cfg = EnvConfig::default();
     let path = fig_dir.join(FIG1);
     let mut ball = vec![0f32; PIXELS];
-    render_ball_into(cfg.ball_initial[0], cfg.ball_initial[1], &mut ball);
-    let a = cfg.arrow_initial;
+    let ball_initial = initial(&cfg, EnvKind::ARMBALL);
+    render_ball_into(ball_initial[0], ball_initial[1], &mut ball);
+    let a = initial(&cfg, EnvKind::ARMARROW);
     let mut arrow = vec![0f32; PIXELS];
     render_arrow_into(a[0], a[1], a[2], &mut arrow);
     write_svg(&path, (PANEL * 3, PANEL + TITLE_H), |root| {
@@ -113,7 +119,7 @@ pub fn draw_environments(fig_dir: &Path) -> Result<FigureFile, ReportError> {
             BLACK.stroke_width(3),
         )))?;
         chart.draw_series(arm.iter().map(|&p| Circle::new(p, 3, BLACK.filled())))?;
-        let b = (cfg.ball_initial[0], cfg.ball_initial[1]);
+        let b = (ball_initial[0], ball_initial[1]);
         chart.draw_series(std::iter::once(Circle::new(
             b,
             6,
@@ -234,7 +240,8 @@ pub fn draw_dmp_episode(fig_dir: &Path) -> Result<Option<FigureFile>, ReportErro
             hand,
             RGBColor(0x00, 0x72, 0xB2).stroke_width(2),
         )))?;
-        let b = (cfg.ball_initial[0], cfg.ball_initial[1]);
+        let ball = initial(&cfg, EnvKind::ARMBALL);
+        let b = (ball[0], ball[1]);
         chart.draw_series(std::iter::once(Circle::new(
             b,
             6,
