@@ -11,8 +11,7 @@ use std::process::ExitCode;
 
 use in_process::{manifest, ok, p, ugl};
 use serde::{Deserialize, Serialize};
-use ugl_bench::env::config::within;
-use ugl_bench::env::invalid::InvalidValue;
+use ugl_bench::env::invalid::{InvalidValue, within};
 use ugl_bench::env::render::render_ball_into;
 use ugl_bench::env::{
     EnvConfig, EnvEntry, EnvKind, Environment, OwnConstants, OwnTable, PARAMS, Rollout, dmp,
@@ -202,7 +201,7 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
     };
     std::fs::write(&clipped, with_clip("0.25")).unwrap();
     let clip_out = dir.path().join("clip");
-    ok(&[
+    let clip_run = [
         "run",
         "--env",
         "armreach",
@@ -212,7 +211,8 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
         p(&clipped),
         "--out",
         p(&clip_out),
-    ]);
+    ];
+    ok(&clip_run);
     let run = ugl_report::load::load_run(&clip_out.join("armreach.rpe.s0"), String::new()).unwrap();
     let coords = || run.outcomes.iter().flat_map(|o| [o.x, o.y]);
     assert!(coords().all(|v| v.abs() <= 0.25), "clip = 0.25 not obeyed");
@@ -222,17 +222,7 @@ fn an_environment_added_in_one_file_runs_in_a_campaign_and_the_report() {
     );
     std::fs::write(&clipped, with_clip("2.0")).unwrap();
     assert_eq!(
-        ugl(&[
-            "run",
-            "--env",
-            "armreach",
-            "--algo",
-            "rpe",
-            "--profile",
-            p(&clipped),
-            "--out",
-            p(&clip_out)
-        ]),
+        ugl(&clip_run),
         ExitCode::from(2),
         "env.armreach.clip = 2 must be refused"
     );

@@ -20,7 +20,7 @@ pub struct ArmConfig {
 }
 
 fn lengths<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; JOINTS], D::Error> {
-    crate::config::exactly_as(d, "env.arm.lengths")
+    crate::invalid::exactly_as(d, "env.arm.lengths")
 }
 
 impl Default for ArmConfig {

@@ -6,8 +6,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
-use crate::config::{OwnConstants, exactly, within_each};
-use crate::invalid::InvalidValue;
+use crate::config::OwnConstants;
+use crate::invalid::{InvalidValue, exactly, within_each};
 
 /// ArmArrow's own constants (its `[env.armarrow]` table).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

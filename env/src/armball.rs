@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Body, EnvConfig, EnvKind, Environment, Rollout};
-use crate::config::{OwnConstants, exactly, within_each};
-use crate::invalid::InvalidValue;
+use crate::config::OwnConstants;
+use crate::invalid::{InvalidValue, exactly, within_each};
 
 /// ArmBall's own constants (its `[env.armball]` table).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

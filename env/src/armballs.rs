@@ -21,7 +21,7 @@ use crate::seed::Stream;
 pub type Constants = crate::cdge::Constants;
 
 /// The distractor's walk is clipped to this box (CDGE `np.clip(…, -.95, 0.95)`).
-pub const DISTRACTOR_BOUND: f64 = 0.95;
+pub use crate::cdge::DISTRACTOR_BOUND;
 
 pub use super::render::DISTRACTOR_GRAY;
 

@@ -19,8 +19,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::{EnvConfig, EnvKind, Environment, Rollout};
-use crate::config::{OwnConstants, exactly, within, within_each};
-use crate::invalid::InvalidValue;
+use crate::config::OwnConstants;
+use crate::invalid::{InvalidValue, exactly, within, within_each};
 use crate::seed::{Stream, standard_normal};
 
 /// Joints of the arm.
@@ -173,7 +173,7 @@ impl Default for Constants {
 impl OwnConstants for Constants {
     fn check(&self, key: &dyn Fn(&str) -> String) -> Result<(), InvalidValue> {
         within_each(key, "ball_initial", &self.ball_initial, -1.0, 1.0)?;
-        let b = crate::armballs::DISTRACTOR_BOUND;
+        let b = DISTRACTOR_BOUND;
         within_each(key, "distractor_initial", &self.distractor_initial, -b, b)?;
         within(&key("distractor_noise"), self.distractor_noise, 0.0, 1.0)
     }

@@ -22,7 +22,7 @@ use serde::ser::SerializeMap;
 use serde::{Deserialize, Serialize};
 use toml::Value;
 
-use crate::invalid::InvalidValue;
+use crate::invalid::{InvalidValue, within};
 use crate::{ArmConfig, DmpConfig, EnvKind, MAX_TIMESTEPS, PARAMS, dmp};
 
 /// Constants as a TOML table (whose numbers, unlike JSON's, may be NaN or infinite: such a
@@ -454,72 +454,6 @@ impl EnvConfig {
         }
         Ok(())
     }
-}
-
-/// `key` must be a finite number in `[lo, hi]` (`(0, hi]` when `lo` is the smallest positive
-/// number): the error names the key.
-pub fn within(key: &str, v: f64, lo: f64, hi: f64) -> Result<(), InvalidValue> {
-    if v.is_finite() && v >= lo && v <= hi {
-        return Ok(());
-    }
-    let lo = if lo == f64::MIN_POSITIVE {
-        "(0".to_string()
-    } else {
-        format!("[{lo}")
-    };
-    Err(InvalidValue::new(
-        key,
-        format!(
-            "{key} must be a finite number in {lo}, {hi}], got {}",
-            num(v)
-        ),
-    ))
-}
-
-/// Every coordinate of the point `key` within `[lo, hi]`.
-pub fn within_each(
-    key: &dyn Fn(&str) -> String,
-    name: &str,
-    point: &[f64],
-    lo: f64,
-    hi: f64,
-) -> Result<(), InvalidValue> {
-    for (i, v) in point.iter().enumerate() {
-        within(&key(&format!("{name}[{i}]")), *v, lo, hi)?;
-    }
-    Ok(())
-}
-
-/// A number as a person writes it: `1e300`, not three hundred digits.
-fn num(v: f64) -> String {
-    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
-}
-
-/// Exactly `N` numbers: serde's fixed-size arrays read the first `N` elements of a longer
-/// TOML array and silently drop the rest (`#[serde(deserialize_with = "exactly")]`).
-pub fn exactly<'de, D, const N: usize>(d: D) -> Result<[f64; N], D::Error>
-where
-    D: serde::Deserializer<'de>,
-{
-    let v = Vec::<f64>::deserialize(d)?;
-    let n = v.len();
-    v.try_into()
-        .map_err(|_| serde::de::Error::custom(format!("must have {N} numbers, got {n}")))
-}
-
-/// [`exactly`], the message naming the key `name` (`env.arm.lengths`).
-pub fn exactly_as<'de, D, const N: usize>(d: D, name: &str) -> Result<[f64; N], D::Error>
-where
-    D: serde::Deserializer<'de>,
-{
-    let v = Vec::<f64>::deserialize(d)?;
-    let n = v.len();
-    v.try_into()
-        .map_err(|_| serde::de::Error::custom(format!("{name} must have {N} numbers, got {n}")))
 }
 
 impl<'de> Deserialize<'de> for EnvConfig {
