@@ -75,9 +75,9 @@ test-slurm: check-toolchain
 
 # The committed results themselves, not only the smoke campaign: `ugl verify` checks every run's
 # files against its manifest, then reruns VERIFY_SAMPLE runs (stratified over the conditions, a
-# trained network among them) from the campaign's profile and compares their bytes. The stores
-# of the current results version (the version-5 rerun fills data/results-pending/ first).
-VERIFY_STORES ?= data/results-pending/paper
+# trained network among them) from the campaign's profile and compares their bytes. The main
+# store, of the current results version (a rerun fills data/results-pending/ first).
+VERIFY_STORES ?= data/results/paper
 VERIFY_SAMPLE ?= 3
 verify-store: check-toolchain
 	@for d in $(VERIFY_STORES); do $(UGL) verify --results $$d --sample $(VERIFY_SAMPLE) || exit 1; done

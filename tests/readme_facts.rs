@@ -201,24 +201,43 @@ fn the_claims_counts_are_those_of_the_committed_report() {
 }
 
 #[test]
-fn the_rerun_runs_without_a_discovery_record_are_counted_right() {
+fn the_runs_discovery_records_and_kept_outcomes_are_counted_right() {
     let text = readme();
     let c = captures(
         &text,
-        "the first {} runs of `paper`, written before the record was kept, keep theirs",
+        "exploration replicate 0: {} of the {} runs; all {} record their measures)",
     );
-    let without: Vec<String> = manifests("data/results/paper")
-        .into_iter()
-        .filter(|m| m.get("discovery").is_none())
-        .map(|m| m["run_id"].as_str().unwrap().to_string())
+    let runs = manifests("data/results/paper");
+    assert_eq!(runs.len(), number(&c[1]), "runs");
+    let recorded = runs.iter().filter(|m| m.get("discovery").is_some()).count();
+    assert_eq!(recorded, number(&c[2]), "runs with a discovery record");
+    let kept: Vec<&serde_json::Value> = runs
+        .iter()
+        .filter(|m| {
+            let id = m["run_id"].as_str().unwrap();
+            root()
+                .join("data/results/paper")
+                .join(format!("{id}.outcomes.parquet"))
+                .exists()
+        })
         .collect();
-    assert_eq!(without.len(), number(&c[0]));
-    for id in &without {
-        let outcomes = root()
-            .join("data/results/paper")
-            .join(format!("{id}.outcomes.parquet"));
+    assert_eq!(kept.len(), number(&c[0]), "kept outcomes files");
+    for m in kept {
         assert!(
-            outcomes.exists(),
+            // Replicate 0 is written without its `exploration` (its identity predates replicates).
+            m["seed"].as_u64().unwrap() <= 2 && m["exploration"].as_u64().unwrap_or(0) == 0,
+            "{}: an outcomes file outside repetitions 0-2, replicate 0",
+            m["run_id"]
+        );
+    }
+    // A run without its record needs its outcomes file.
+    for m in runs.iter().filter(|m| m.get("discovery").is_none()) {
+        let id = m["run_id"].as_str().unwrap();
+        assert!(
+            root()
+                .join("data/results/paper")
+                .join(format!("{id}.outcomes.parquet"))
+                .exists(),
             "{id}: no discovery record and no outcomes file"
         );
     }
