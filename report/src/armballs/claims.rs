@@ -323,6 +323,54 @@ mod tests {
         parse_claims(&text, &path).unwrap()
     }
 
+    /// Every condition a committed follow-up claim names (but the authors' own) is run by a
+    /// committed campaign of the follow-up (`followup` and its tagged variants): a claim retargeted
+    /// to an algorithm no campaign runs would print "not run" for ever.
+    #[test]
+    fn the_committed_claims_name_conditions_the_followup_campaigns_run() {
+        let campaigns = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/campaigns");
+        let mut run = BTreeSet::new();
+        for name in ["followup", "followup-still"] {
+            let text = std::fs::read_to_string(campaigns.join(format!("{name}.toml"))).unwrap();
+            let t: toml::Table = toml::from_str(&text).unwrap();
+            let tag = t["campaign"].get("tag").and_then(|v| v.as_str());
+            for algo in t["matrix"]["algos"].as_array().unwrap() {
+                let algo = algo.as_str().unwrap();
+                run.insert(tag.map_or(algo.to_string(), |t| format!("{algo}@{t}")));
+            }
+        }
+        let file = committed();
+        assert!(file.claims.len() >= 17, "{} claims", file.claims.len());
+        for c in &file.claims {
+            for sel in [&c.subject, &c.reference] {
+                for algo in sel.algo.iter().flatten() {
+                    if algo.ends_with(&format!("@{}", authors::TAG)) {
+                        continue;
+                    }
+                    assert!(
+                        run.contains(algo),
+                        "{}: no follow-up campaign runs {algo}",
+                        c.id
+                    );
+                }
+            }
+        }
+        // Each claim on the exploration ratio has its twin on the goal-reaching error.
+        for c in file
+            .claims
+            .iter()
+            .filter(|c| c.statistic == Statistic::BallRatio && !c.ours)
+        {
+            let twin = format!("{}-goal-error", c.id);
+            let t = file.claims.iter().find(|t| t.id == twin);
+            assert!(
+                t.is_some_and(|t| t.statistic == Statistic::GoalError),
+                "{}: no {twin}",
+                c.id
+            );
+        }
+    }
+
     #[test]
     fn verdicts_follow_the_intervals() {
         let mut runs = Vec::new();
