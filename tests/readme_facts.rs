@@ -305,3 +305,57 @@ fn the_validity_check_says_what_the_readme_says() {
         }
     }
 }
+
+/// The README's list of verdicts that changed from results version 4 to 5 states each claim's
+/// verdict now as the committed report's `data/claims.csv` has it (version 4's side is in the
+/// history, not in the tree), and its precision as the report's.
+#[test]
+fn the_changed_verdicts_are_those_of_the_committed_claims() {
+    let text = readme();
+    let claims = read("report/out/data/claims.csv");
+    let verdict_of = |id: &str| -> BTreeSet<String> {
+        let mut lines = claims.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+        let (c, e, v) = (col("claim"), col("evaluation"), col("evaluation_verdict"));
+        lines
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|f| f[c] == id && f[e] == "claim")
+            .map(|f| f[v].to_string())
+            .collect()
+    };
+    let word = |w: &str| {
+        if w == "undecided" {
+            "inconclusive".to_string()
+        } else {
+            w.to_string()
+        }
+    };
+    let few = captures(
+        &text,
+        "`rfvae-few-moves` went from {} to {} on the paper's own measure",
+    );
+    assert_eq!(
+        verdict_of("rfvae-few-moves"),
+        BTreeSet::from([word(&few[1])])
+    );
+    let rp = captures(
+        &text,
+        "`learners-beat-random-projection-armarrow-goal-error` (on the goal-reaching error) from {} \
+         to {}.",
+    );
+    assert_eq!(
+        verdict_of("learners-beat-random-projection-armarrow-goal-error"),
+        BTreeSet::from([word(&rp[1])])
+    );
+    let precision = captures(&text, "KL-coverage intervals is now {} nats");
+    let report = read("report/out/REPORT.md");
+    assert!(
+        report.contains(&format!(
+            "on KL-coverage is {} nats, **wider than",
+            precision[0]
+        )),
+        "the README's precision {} is not the report's",
+        precision[0]
+    );
+}
