@@ -530,8 +530,7 @@ mod tests {
             "paper/armarrow.rge-pca.kde.l3.s2",
             "compare-random-projection/armarrow.rge-external.kde.l3.s0",
             "paper-untrained/armball.rge-ae.kde.l2.s0",
-            "armballs/armballs.rpe.s0",
-            "armballs/armballs.mge-bvae-flat.gaussian.l10.s0",
+            "paper-validation/armball.rge-isomap.kde.l2.s0",
         ];
         for stem in stems {
             let path = results().join(stem);
@@ -632,8 +631,9 @@ mod tests {
 
     /// The validity check on the committed results: every measure that does not count repeats
     /// ranks the position-encoding goal spaces ahead of every kind of control in both paper
-    /// environments, with P(better) ≥ 0.75; the runs' own final KLC fails in both, with
-    /// P(better) below 0.4 against the random projection (it mostly counts moves).
+    /// environments, with P(better) ≥ 0.7 (the lowest, 0.75, is ArmArrow's cells reached); the
+    /// runs' own final KLC fails in both, with P(better) below 0.4 against the random projection
+    /// (it mostly counts moves).
     #[test]
     fn the_validity_check_on_the_committed_results() {
         let camps = committed();
@@ -656,15 +656,17 @@ mod tests {
                 assert_eq!(Some(verdict(m, env)), expected, "{m:?} in {env}");
             }
         }
+        // The check runs on the held-out campaigns (`paper-validation` and its untrained twins:
+        // 5 repetitions of campaign seed 1), never on the runs the claims use.
         for c in &checks {
-            assert_eq!(c.repetitions, 10, "{c:?}");
+            assert_eq!(c.repetitions, 5, "{c:?}");
             if c.measure == Measure::FinalKlc {
                 if c.control == Control::RandomProjection {
                     assert!(c.p_better < 0.4, "{c:?}");
                 }
             } else {
                 assert!(
-                    c.p_better >= 0.75,
+                    c.p_better >= 0.7,
                     "{:?} in {}: {}",
                     c.measure,
                     c.env,
@@ -672,25 +674,22 @@ mod tests {
                 );
             }
         }
-        // The groups, in runs: ArmBall 426 position-encoding runs against 663 controls (60
-        // random projections of `paper`, 60 of `compare-random-projection`, 540 untrained twins
-        // and the 3 runs of `paper-long`'s AE, which stays on the plateau); ArmArrow 600 against
-        // 663 (the same, with the 3 runs of `paper`'s AE with 3 latents of repetition 5 on the
-        // plateau).
+        // The groups, in runs of the held-out campaigns (5 repetitions, one replicate): ArmBall
+        // 30 position-encoding runs against 40 controls, ArmArrow 40 against 40 (the random
+        // projections and the untrained twins; results version 5, where no trained network
+        // stayed on the plateau).
         let count = |env: &str, g: Group| {
             rows.iter()
                 .filter(|r| r.in_check && r.group == Some(g) && r.run.key.env == env)
                 .count()
         };
-        assert_eq!(
-            [
-                count("armball", Group::Encodes),
-                count("armball", Group::Control),
-                count("armarrow", Group::Encodes),
-                count("armarrow", Group::Control)
-            ],
-            [426, 663, 600, 663]
-        );
+        let counts = [
+            count("armball", Group::Encodes),
+            count("armball", Group::Control),
+            count("armarrow", Group::Encodes),
+            count("armarrow", Group::Control),
+        ];
+        assert_eq!(counts, [30, 40, 40, 40]);
     }
 
     /// ArmArrow's runs are measured on the position apart: a position cell holds 1 to 30
