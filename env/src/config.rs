@@ -482,16 +482,12 @@ impl Serialize for EnvConfig {
             let Some(own) = self.tables.get(kind.name()) else {
                 continue;
             };
+            // What the environment would read without its table: `[env]`'s key, else its own
+            // default (not the key's first owner's, which another environment may declare apart).
+            let defaults = kind.defaults();
             let differs: Table = own
                 .iter()
-                .filter(|(k, v)| {
-                    self.every
-                        .get(*k)
-                        .cloned()
-                        .or_else(|| default_of(k))
-                        .as_ref()
-                        != Some(*v)
-                })
+                .filter(|(k, v)| self.every.get(*k).or_else(|| defaults.get(*k)) != Some(*v))
                 .map(|(k, v)| (k.clone(), v.clone()))
                 .collect();
             if !differs.is_empty() {
