@@ -5,10 +5,12 @@
 
 mod conv;
 mod eigen;
+mod flush;
 mod matmul;
 mod path;
 
 pub use conv::{Conv2d, ConvTranspose2d};
 pub use eigen::{EigenError, SymmetricEigen, cholesky_solve};
+pub use flush::{FlushError, flushing_pool, this_thread_flushes};
 pub use matmul::{Element, MatRef, matmul, matmul_on, matmul_reference};
 pub use path::{PathError, SIMD_VAR, SimdPath, active_path, check_active_path, path_from_env};

@@ -92,6 +92,7 @@ pub struct ConvSection {
     pub capacity_iterations: Option<usize>,
     /// `conv-bvae` only.
     pub warmup: Option<usize>,
+    pub flush_subnormals: Option<bool>,
 }
 
 impl ConvSection {
@@ -109,6 +110,7 @@ impl ConvSection {
             capacity: self.capacity.or(d.capacity),
             capacity_iterations: self.capacity_iterations.or(d.capacity_iterations),
             warmup: self.warmup.unwrap_or(d.warmup),
+            flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
         }
     }
 }
@@ -154,18 +156,33 @@ impl LearnerParams for ConvParams {
         serde_json::to_value(&self.config).expect("serialisable")
     }
     fn deviations(&self, _variant: Option<Variant>) -> Vec<String> {
-        vec![format!(
-            "{}: training settings of ours (the authors' are not public): {} iterations, batch {}, \
+        vec![
+            format!(
+                "{}: training settings of ours (the authors' are not public): {} iterations, batch {}, \
              lr {}{}",
-            self.model.name(),
-            self.config.iterations,
-            self.config.batch,
-            self.config.lr,
-            match self.config.capacity {
-                Some(c) => format!(", β {} and capacity {c} nats", self.config.beta),
-                None => String::new(),
-            }
-        )]
+                self.model.name(),
+                self.config.iterations,
+                self.config.batch,
+                self.config.lr,
+                match self.config.capacity {
+                    Some(c) => format!(", β {} and capacity {c} nats", self.config.beta),
+                    None => String::new(),
+                },
+            ),
+            if self.config.flush_subnormals {
+                format!(
+                    "{}: trained with subnormal numbers flushed to zero (x86-64 FTZ and DAZ; \
+                 PyTorch's CPU default keeps them): the same bits on every x86-64 CPU, without \
+                 Intel's slow subnormal assists",
+                    self.model.name()
+                )
+            } else {
+                format!(
+                    "{}: trained with IEEE subnormals (flush_subnormals = false)",
+                    self.model.name()
+                )
+            },
+        ]
     }
     fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
         Box::new(ConvLearner::new(self.model, self.config.clone()))
@@ -241,7 +258,13 @@ impl RepresentationLearner for ConvLearner {
                 ctx.checkpoint.as_ref(),
             )
         };
-        let mut enc = ctx.in_pool(train)?;
+        let mut enc = if self.config.flush_subnormals {
+            ugl_kernels::flushing_pool(ctx.threads)
+                .map_err(|e| ReprError::InvalidInput(e.to_string()))?
+                .install(train)?
+        } else {
+            ctx.in_pool(train)?
+        };
         let z = enc.encode(images)?;
         Ok((Box::new(enc), z))
     }
@@ -712,6 +735,36 @@ mod tests {
         let e = arch_for(&small(), &odd, 2).unwrap_err().to_string();
         assert!(e.contains("multiple of 16"), "{e}");
         assert_eq!(arch_for(&small(), &pictures(3), 2).unwrap().side, 16);
+    }
+
+    /// The flush is on by default, can be turned off for both networks, and is part of the
+    /// run's identity and its listed deviations.
+    #[test]
+    fn the_flush_of_subnormals_is_a_recorded_choice() {
+        for model in [ConvModel::ConvVae, ConvModel::ConvBvae] {
+            let on = (model, ConvSection::default()).check().unwrap();
+            let off = (
+                model,
+                ConvSection {
+                    flush_subnormals: Some(false),
+                    ..ConvSection::default()
+                },
+            )
+                .check()
+                .unwrap();
+            assert!(on.config.flush_subnormals && !off.config.flush_subnormals);
+            assert_ne!(on.identity(None), off.identity(None));
+            assert!(
+                on.deviations(None)
+                    .iter()
+                    .any(|d| d.contains("flushed to zero"))
+            );
+            assert!(
+                off.deviations(None)
+                    .iter()
+                    .any(|d| d.contains("IEEE subnormals"))
+            );
+        }
     }
 
     #[test]
