@@ -4,8 +4,8 @@
 //! Why: on Intel CPUs an operation that reads or produces a subnormal `f32` takes a microcode
 //! assist of about a hundred cycles. A trained convolutional VAE's background logits go below
 //! -87, so the gradients of its black pixels are subnormal, and so are the products they reach:
-//! one training iteration of the follow-up's VAE took 6 times longer after it left the
-//! mean-picture plateau than before, on an Intel Xeon, and the same with FTZ and DAZ set
+//! on an Intel Xeon, one training iteration of the follow-up's VAE took 6 times longer once it
+//! had left the mean-picture plateau, and no longer than before with FTZ and DAZ set
 //! (docs/neural.md, "Subnormals").
 //!
 //! What it computes: every SSE / AVX / AVX-512 operation, scalar or vector, reads a subnormal

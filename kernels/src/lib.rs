@@ -1,7 +1,8 @@
 //! Floating-point kernels whose results depend only on their inputs, on any x86-64 machine
 //! (scalar, AVX2+FMA or AVX-512) and any thread count: see [`matmul`] for the contract and
 //! [`SimdPath`] for how the path is chosen or forced (`UGL_SIMD`). The convolutions
-//! ([`Conv2d`], [`ConvTranspose2d`]) are built on the same products.
+//! ([`Conv2d`], [`ConvTranspose2d`]) are built on the same products. [`flushing_pool`] runs
+//! work with subnormal numbers flushed to zero, by x86-64 rules that every path obeys alike.
 
 mod conv;
 mod eigen;
