@@ -89,7 +89,7 @@ impl ConvConfig {
     /// the warm-up factor, at our default budget and settings.
     pub fn followup_bvae() -> ConvConfig {
         ConvConfig {
-            beta: 100.0,
+            beta: 4.0,
             capacity: Some(12.0),
             warmup: 500,
             ..ConvConfig::followup_vae()
