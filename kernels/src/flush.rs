@@ -2,9 +2,9 @@
 //! flush-to-zero (FTZ) and denormals-are-zero (DAZ) bits set in `MXCSR`.
 //!
 //! Why: on Intel CPUs an operation that reads or produces a subnormal `f32` takes a microcode
-//! assist of about a hundred cycles. A trained convolutional VAE's background logits go below
-//! -87, so the gradients of its black pixels are subnormal, and so are the products they reach:
-//! on an Intel Xeon, one training iteration of the follow-up's VAE took 6 times longer once it
+//! assist of about a hundred cycles. In a trained convolutional VAE, the gradients of the black
+//! pixels whose logits are far below zero are subnormal (our reading), and so are the products
+//! they reach: on an Intel Xeon, one training iteration of the follow-up's VAE took 6 times longer once it
 //! had left the mean-picture plateau, and no longer than before with FTZ and DAZ set
 //! (docs/neural.md, "Subnormals").
 //!
