@@ -4,9 +4,9 @@
 //! Why: on Intel CPUs an operation that reads or produces a subnormal `f32` takes a microcode
 //! assist of about a hundred cycles. In a trained convolutional VAE, the gradients of the black
 //! pixels whose logits are far below zero are subnormal (our reading), and so are the products
-//! they reach: on an Intel Xeon, one training iteration of the follow-up's VAE took 6 times longer once it
-//! had left the mean-picture plateau, and no longer than before with FTZ and DAZ set
-//! (docs/neural.md, "Subnormals").
+//! they reach: on an Intel Xeon, one training iteration of the follow-up's VAE took 6 times
+//! longer once it had left the mean-picture plateau, and no longer than before with FTZ and DAZ
+//! set (docs/neural.md, "Subnormals").
 //!
 //! What it computes: every SSE / AVX / AVX-512 operation, scalar or vector, reads a subnormal
 //! operand as a zero of its sign (DAZ) and returns a zero of its sign for a result that is
@@ -16,9 +16,9 @@
 //! refuses to run there rather than compute other bits.
 //!
 //! Rust and LLVM assume the default floating-point environment, so a constant folded at compile
-//! time is computed without the flush. The code run in these pools has no such constant in its
-//! float paths that could reach the subnormal range; the tests compare the flushed kernels with
-//! the flushed reference and check that the flush took effect.
+//! time is computed without the flush. We know of no such constant reaching the subnormal range
+//! in the code run in these pools (not proven); the tests compare the flushed kernels across
+//! paths and check that the flush took effect.
 
 /// The two `MXCSR` bits: flush-to-zero (15) and denormals-are-zero (6).
 #[cfg(target_arch = "x86_64")]

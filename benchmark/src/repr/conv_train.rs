@@ -142,11 +142,7 @@ impl ConvConfig {
         if self.flush_subnormals && !cfg!(target_arch = "x86_64") {
             return Err(ParamError::at(
                 "flush_subnormals",
-                format!(
-                    "flushing subnormals to zero needs an x86-64 CPU (its MXCSR rules); this is \
-                     {}: set flush_subnormals = false (other bits)",
-                    std::env::consts::ARCH
-                ),
+                ugl_kernels::FlushError::Unsupported(std::env::consts::ARCH).to_string(),
             ));
         }
         if !(self.beta.is_finite() && self.beta > 0.0 && self.beta <= 1e6) {
