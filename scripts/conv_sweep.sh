@@ -4,8 +4,8 @@
 # [learners.conv-bvae] keys (or `vae` for the conv-vae at its defaults); each is trained on the
 # repetition seeds SEEDS (default 1000 1001 1002: seeds the campaigns do not use, so nothing is
 # tuned on a campaign's own repetitions) with `ugl run` on armballs-corl, 10 latents, and
-# scripts/conv_sweep_summary.py tabulates what each network's manifest records: its loss
-# fraction, the per-latent KL, the latents active and which object each encodes, MIG and SAP.
+# `ugl sweep-table OUT` tabulates what each network's manifest records: its loss fraction, the
+# per-latent KL, the latents active and which object each encodes, MIG and SAP.
 #
 #   scripts/conv_sweep.sh OUT SETTING...
 #   e.g. scripts/conv_sweep.sh /tmp/sweep beta=100,capacity=12,iterations=5000 vae
@@ -52,4 +52,4 @@ for setting in "$@"; do
       --profile "$dir/profile.toml" --out "$dir" --cache "$out/models" > "$dir/s$seed.log"
   done
 done
-python3 scripts/conv_sweep_summary.py "$out"
+"$ugl" sweep-table "$out"

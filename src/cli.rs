@@ -199,6 +199,14 @@ pub(crate) enum Command {
         #[arg(required = true)]
         sources: Vec<PathBuf>,
     },
+    /// Tabulate a convolutional-network sweep (the OUT of scripts/conv_sweep.sh): one markdown
+    /// row per trained network, read from its run's manifest: its setting, whether it left the
+    /// mean-picture plateau, the per-latent KL, the active latents and which object each encodes,
+    /// the k-NN R² of each object, MIG and SAP.
+    SweepTable {
+        /// The sweep's directory: one sub-directory per setting, holding its runs.
+        dir: PathBuf,
+    },
     /// Render the report (markdown + SVG figures) from a results store.
     Report {
         /// Results directory (run files, or one sub-directory per campaign).

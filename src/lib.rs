@@ -193,6 +193,11 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Learners => learners(),
         Command::Compare(a) => compare(a),
         Command::Embed(a) => embed(a),
+        Command::SweepTable { dir } => {
+            let table = ugl_report::armballs::sweep::table(&dir)?;
+            output::outln!("{}", table.trim_end())?;
+            Ok(())
+        }
         Command::Report {
             results,
             out,

@@ -1,7 +1,8 @@
 //! The numbers the README states about the committed results are those of the committed data
 //! and of the committed report: each sentence is found by its wording, its numbers are read and
 //! compared with what the manifests and `report/out/REPORT.md` say. A README edited without the
-//! data, or data committed without the README, fails here.
+//! data, or data committed without the README, fails here. The same holds for the tables the
+//! docs generate from committed data (the convolutional sweep's, in `docs/neural.md`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -357,5 +358,52 @@ fn the_changed_verdicts_are_those_of_the_committed_claims() {
         )),
         "the README's precision {} is not the report's",
         precision[0]
+    );
+}
+
+/// The sweep table of `docs/neural.md` (between its `<!-- sweep-table DIR` and
+/// `<!-- end sweep-table -->` lines) is `ugl sweep-table DIR`'s output on the committed sweep,
+/// and that sweep holds a network on each side of the acceptance's question: the VAE encodes
+/// both objects (distractor k-NN R² above 0.5) and at least one β-VAE does not (below 0.1), so a
+/// table that lost its distractor column, or a sweep whose manifests all read alike, fails.
+#[test]
+fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
+    let doc = read("docs/neural.md");
+    let start = doc
+        .find("<!-- sweep-table ")
+        .expect("docs/neural.md has a <!-- sweep-table DIR --> marker");
+    let head_end = start + doc[start..].find("-->").expect("the marker is closed") + 3;
+    let dir = doc[start + "<!-- sweep-table ".len()..head_end - 3].trim();
+    let end = head_end
+        + doc[head_end..]
+            .find("<!-- end sweep-table -->")
+            .expect("the table has its end marker");
+    let in_docs = doc[head_end..end].trim();
+    let generated = ugl_report::armballs::sweep::table(&root().join(dir))
+        .unwrap_or_else(|e| panic!("{dir}: {e}"));
+    assert_eq!(
+        in_docs,
+        generated.trim(),
+        "docs/neural.md's sweep table is not `ugl sweep-table {dir}`'s output: regenerate it"
+    );
+    let distractor_r2: Vec<(String, f64)> = generated
+        .lines()
+        .skip(2)
+        .map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            (cells[1].to_string(), cells[12].parse().unwrap_or(f64::NAN))
+        })
+        .collect();
+    assert!(
+        distractor_r2
+            .iter()
+            .any(|(s, r)| s.starts_with("VAE") && *r > 0.5),
+        "no VAE of the sweep encodes the distractor: {distractor_r2:?}"
+    );
+    assert!(
+        distractor_r2
+            .iter()
+            .any(|(s, r)| s.starts_with("β-VAE") && *r < 0.1),
+        "{distractor_r2:?}"
     );
 }

@@ -350,7 +350,7 @@ fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+pub(crate) fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
     let io = |source| ReportError::Io {
         path: dir.to_path_buf(),
         source,
@@ -366,7 +366,7 @@ fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
 /// Reads a run's manifest, then checks its data files against the lengths and BLAKE3 hashes it
 /// records ([`ugl_types::verify_files`]; manifests written before results version 3 have none
 /// and pass). A truncated or damaged file is an error naming it, before polars tries to parse it.
-fn read_manifest(manifest_path: &Path) -> Result<Manifest, ReportError> {
+pub(crate) fn read_manifest(manifest_path: &Path) -> Result<Manifest, ReportError> {
     let text = std::fs::read_to_string(manifest_path).map_err(|source| ReportError::Io {
         path: manifest_path.to_path_buf(),
         source,

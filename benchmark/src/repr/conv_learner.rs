@@ -32,7 +32,7 @@ use super::trainer::{ProgressFn, draw_batch};
 use super::training_loop::{Iterations, run_until};
 use super::{
     Encoder, FitContext, GaussianPrior, ImageSet, Latents, ReprError, RepresentationLearner,
-    TrainingOutcome, check_fit_input,
+    Subnormals, TrainingOutcome, check_fit_input,
 };
 use crate::seed::Stream;
 
@@ -258,13 +258,12 @@ impl RepresentationLearner for ConvLearner {
                 ctx.checkpoint.as_ref(),
             )
         };
-        let mut enc = if self.config.flush_subnormals {
-            ugl_kernels::flushing_pool(ctx.threads)
-                .map_err(|e| ReprError::InvalidInput(e.to_string()))?
-                .install(train)?
+        let subnormals = if self.config.flush_subnormals {
+            Subnormals::Flushed
         } else {
-            ctx.in_pool(train)?
+            Subnormals::Kept
         };
+        let mut enc = ctx.in_pool_with(subnormals, train)?;
         let z = enc.encode(images)?;
         Ok((Box::new(enc), z))
     }

@@ -221,21 +221,45 @@ pub struct FitContext {
     pub image: Option<ugl_types::ImageShape>,
 }
 
+/// How the threads of a training pool treat subnormal numbers ([`FitContext::in_pool_with`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Subnormals {
+    /// IEEE arithmetic (the dense networks, and PyTorch's CPU default).
+    Kept,
+    /// Flushed to zero, operands and results (x86-64 FTZ and DAZ, set on every thread of the
+    /// pool; [`ugl_kernels::flushing_pool`]); an error on other architectures.
+    Flushed,
+}
+
 impl FitContext {
     /// Run `f` on the context's threads (a pool of [`FitContext::threads`]; 0: the calling
-    /// pool's).
+    /// pool's), with IEEE subnormals.
     pub fn in_pool<T: Send>(
         &self,
         f: impl FnOnce() -> Result<T, ReprError> + Send,
     ) -> Result<T, ReprError> {
-        if self.threads == 0 {
-            return f();
+        self.in_pool_with(Subnormals::Kept, f)
+    }
+
+    /// Run `f` on the context's threads, treating subnormals as `subnormals` says. The one
+    /// place a training pool is built: a flushing pool is always a pool of its own (0 threads:
+    /// as many as the calling pool's), since the calling pool's threads must stay IEEE.
+    pub fn in_pool_with<T: Send>(
+        &self,
+        subnormals: Subnormals,
+        f: impl FnOnce() -> Result<T, ReprError> + Send,
+    ) -> Result<T, ReprError> {
+        match subnormals {
+            Subnormals::Kept if self.threads == 0 => f(),
+            Subnormals::Kept => rayon::ThreadPoolBuilder::new()
+                .num_threads(self.threads)
+                .build()
+                .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
+                .install(f),
+            Subnormals::Flushed => ugl_kernels::flushing_pool(self.threads)
+                .map_err(|e| ReprError::InvalidInput(e.to_string()))?
+                .install(f),
         }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(self.threads)
-            .build()
-            .map_err(|e| ReprError::InvalidInput(format!("training pool: {e}")))?
-            .install(f)
     }
 }
 

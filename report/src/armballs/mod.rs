@@ -17,6 +17,7 @@ mod figures;
 mod labels;
 mod page;
 mod runs;
+pub mod sweep;
 
 use std::path::Path;
 

@@ -35,7 +35,7 @@ pub(super) const IGNORES: f64 = 0.1;
 
 /// A latent is active when its posterior's mean KL divergence from the prior is above this many
 /// nats (the follow-up's criterion: the authors' β-VAE has 4 latents at 3.1-3.3 nats and 6 below
-/// 0.01; `scripts/conv_sweep_summary.py` uses the same threshold).
+/// 0.01; the sweep's table, [`super::sweep::table`], uses it too).
 pub(super) const ACTIVE_NATS: f64 = 0.5;
 
 /// One run of the campaign, as this section reads it.

@@ -1,0 +1,178 @@
+//! The table of a convolutional-network sweep (`scripts/conv_sweep.sh OUT SETTING...`, which
+//! trains each setting with `ugl run` into `OUT/<setting>/`): one row per trained network, read
+//! from its run's manifest. It is how the follow-up's β-VAE settings were chosen (issue 44,
+//! `docs/neural.md`, "The sweep"), and the table there is this function's output on the
+//! committed sweep (`data/sweeps/conv`), checked by a test.
+//!
+//! The columns use the ArmBalls page's rules ([`ACTIVE_NATS`], [`role`]), so that a network is
+//! called disentangled by one definition wherever it is shown.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ugl_types::Manifest;
+
+use super::labels::f2;
+use super::runs::{ACTIVE_NATS, role};
+use crate::error::ReportError;
+
+/// The header of [`table`]: what each column holds.
+const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | per-latent KL, sorted | \
+                      active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | MIG | SAP |";
+
+/// A network's setting in words, from the training configuration its manifest records: the
+/// learner (`conv-vae`, `conv-bvae`), then, for a β-VAE, β, the capacity C and how it is ramped,
+/// the warm-up; then the learning rate, the iterations, and whether subnormals were flushed.
+fn setting(m: &Manifest) -> String {
+    let Some(train) = &m.train else {
+        return m.learner.clone().unwrap_or_else(|| m.algo.clone());
+    };
+    let num = |k: &str| train.config_field(k).and_then(|v| v.as_f64());
+    let int = |k: &str| train.config_field(k).and_then(|v| v.as_u64());
+    let mut parts = Vec::new();
+    match m.learner.as_deref() {
+        Some("conv-vae") => parts.push("VAE".to_string()),
+        other => {
+            parts.push(match other {
+                Some("conv-bvae") => "β-VAE".to_string(),
+                other => other.unwrap_or(&m.algo).to_string(),
+            });
+            if let Some(b) = num("beta") {
+                parts.push(format!("β {b}"));
+            }
+            if let Some(c) = num("capacity") {
+                parts.push(match int("capacity_iterations") {
+                    Some(1) => format!("C {c} from the start"),
+                    Some(t) => format!("C {c} reached at {t}"),
+                    None => format!("C {c} reached at the end"),
+                });
+            }
+            if let Some(w) = int("warmup") {
+                parts.push(format!("warm-up {w}"));
+            }
+        }
+    }
+    if let Some(lr) = num("lr") {
+        parts.push(format!("lr {lr}"));
+    }
+    parts.push(format!(
+        "{} it",
+        train
+            .iterations
+            .or(int("iterations").map(|i| i as usize))
+            .map_or("?".into(), |i| i.to_string())
+    ));
+    if train
+        .config_field("flush_subnormals")
+        .and_then(|v| v.as_bool())
+        != Some(true)
+    {
+        parts.push("subnormals kept".into());
+    }
+    parts.join(", ")
+}
+
+/// One row of [`table`].
+fn row(m: &Manifest) -> String {
+    let evidence = m.training_evidence();
+    let q = m.latent_quality.as_ref();
+    let kl: Vec<f64> = q.map(|q| q.kl_per_latent.clone()).unwrap_or_default();
+    let r2 = |object: &str| -> Vec<f64> {
+        q.and_then(|q| q.object(object))
+            .map(|o| o.r2.iter().map(|v| v.unwrap_or(0.0)).collect())
+            .unwrap_or_default()
+    };
+    let (ball, distractor) = (r2("ball"), r2("distractor"));
+    let roles: Vec<&str> = kl
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| **k > ACTIVE_NATS)
+        .filter_map(|(j, _)| Some(role(*ball.get(j)?, *distractor.get(j)?)))
+        .collect();
+    let active = kl.iter().filter(|k| **k > ACTIVE_NATS).count();
+    let count = |kind: &str| roles.iter().filter(|r| **r == kind).count();
+    let mut sorted = kl.clone();
+    sorted.sort_by(|a, b| b.total_cmp(a));
+    let knn = |group: &str| {
+        q.and_then(|q| q.group(group))
+            .map_or("n/a".into(), |g| f2(g.knn_r2))
+    };
+    let dis = q.and_then(|q| q.disentanglement.as_ref());
+    format!(
+        "| {} | {} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} |",
+        setting(m),
+        m.seed,
+        match evidence.map(|e| e.trained) {
+            Some(true) => "yes",
+            Some(false) => "no",
+            None => "n/a",
+        },
+        evidence.map_or("n/a".into(), |e| format!("{:.3}", e.loss_fraction)),
+        if kl.is_empty() {
+            "n/a".into()
+        } else {
+            format!("{:.1}", kl.iter().sum::<f64>())
+        },
+        sorted
+            .iter()
+            .map(|k| format!("{k:.2}"))
+            .collect::<Vec<_>>()
+            .join(" "),
+        count("ball"),
+        count("distractor"),
+        count("both"),
+        knn("position"),
+        knn("distractor"),
+        dis.map_or("n/a".into(), |d| format!("{:.3}", d.mig)),
+        dis.map_or("n/a".into(), |d| format!("{:.3}", d.sap)),
+    )
+}
+
+/// The markdown table of the sweep under `dir`: one row per run manifest in each setting's
+/// sub-directory (the model cache, `models/`, is skipped), settings in directory order and runs
+/// in file order. Each manifest is read as the report reads a run's (its data files checked
+/// against their recorded hashes). An error if `dir` holds no run.
+pub fn table(dir: &Path) -> Result<String, ReportError> {
+    let mut settings = crate::load::sorted_entries(dir)?;
+    settings.retain(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "models"));
+    let mut out = format!(
+        "{HEADER}\n|{}\n",
+        "---|".repeat(HEADER.matches(" | ").count() + 1)
+    );
+    let mut rows = 0;
+    for s in settings {
+        let manifests = crate::load::sorted_entries(&s)?;
+        for path in manifests
+            .iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        {
+            let _ = writeln!(out, "{}", row(&crate::load::read_manifest(path)?));
+            rows += 1;
+        }
+    }
+    if rows == 0 {
+        return Err(ReportError::Invalid {
+            path: dir.to_path_buf(),
+            problem: "holds no sweep run (expected SETTING/<run>.json manifests, as \
+                      scripts/conv_sweep.sh writes them)"
+                .into(),
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A directory without runs (only a model cache) is an error that says what was expected,
+    /// not an empty table.
+    #[test]
+    fn a_sweep_without_runs_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("models")).unwrap();
+        std::fs::create_dir(dir.path().join("beta-4")).unwrap();
+        let e = table(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("holds no sweep run"), "{e}");
+    }
+}
