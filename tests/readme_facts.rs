@@ -368,6 +368,7 @@ fn the_changed_verdicts_are_those_of_the_committed_claims() {
 /// table that lost its distractor column, or a sweep whose manifests all read alike, fails.
 #[test]
 fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
+    use ugl_types::learners::{CONV_BVAE, CONV_VAE};
     let doc = read("docs/neural.md");
     let start = doc
         .find("<!-- sweep-table ")
@@ -397,13 +398,13 @@ fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
     assert!(
         distractor_r2
             .iter()
-            .any(|(s, r)| s.starts_with("VAE") && *r > 0.5),
+            .any(|(s, r)| s.starts_with(&format!("{},", CONV_VAE.display)) && *r > 0.5),
         "no VAE of the sweep encodes the distractor: {distractor_r2:?}"
     );
     assert!(
         distractor_r2
             .iter()
-            .any(|(s, r)| s.starts_with("β-VAE") && *r < 0.1),
+            .any(|(s, r)| s.starts_with(&format!("{},", CONV_BVAE.display)) && *r < 0.1),
         "{distractor_r2:?}"
     );
 }

@@ -21,36 +21,34 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
                       active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | MIG | SAP |";
 
 /// A network's setting in words, from the training configuration its manifest records: the
-/// learner (`conv-vae`, `conv-bvae`), then, for a β-VAE, β, the capacity C and how it is ramped,
-/// the warm-up; then the learning rate, the iterations, and whether subnormals were flushed.
+/// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
+/// is ramped, the warm-up where there is one; then the learning rate, the iterations, and
+/// whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
+    let learner = m.learner.as_deref().map(|name| {
+        ugl_types::LEARNERS
+            .iter()
+            .find(|l| l.name == name)
+            .map_or(name, |l| l.display)
+    });
+    let mut parts = vec![learner.unwrap_or(&m.algo).to_string()];
     let Some(train) = &m.train else {
-        return m.learner.clone().unwrap_or_else(|| m.algo.clone());
+        return parts.join(", ");
     };
     let num = |k: &str| train.config_field(k).and_then(|v| v.as_f64());
     let int = |k: &str| train.config_field(k).and_then(|v| v.as_u64());
-    let mut parts = Vec::new();
-    match m.learner.as_deref() {
-        Some("conv-vae") => parts.push("VAE".to_string()),
-        other => {
-            parts.push(match other {
-                Some("conv-bvae") => "β-VAE".to_string(),
-                other => other.unwrap_or(&m.algo).to_string(),
-            });
-            if let Some(b) = num("beta") {
-                parts.push(format!("β {b}"));
-            }
-            if let Some(c) = num("capacity") {
-                parts.push(match int("capacity_iterations") {
-                    Some(1) => format!("C {c} from the start"),
-                    Some(t) => format!("C {c} reached at {t}"),
-                    None => format!("C {c} reached at the end"),
-                });
-            }
-            if let Some(w) = int("warmup") {
-                parts.push(format!("warm-up {w}"));
-            }
-        }
+    if let Some(b) = num("beta").filter(|b| *b != 1.0) {
+        parts.push(format!("β {b}"));
+    }
+    if let Some(c) = num("capacity") {
+        parts.push(match int("capacity_iterations") {
+            Some(1) => format!("C {c} from the start"),
+            Some(t) => format!("C {c} reached at {t}"),
+            None => format!("C {c} reached at the end"),
+        });
+    }
+    if let Some(w) = int("warmup").filter(|w| *w > 0) {
+        parts.push(format!("warm-up {w}"));
     }
     if let Some(lr) = num("lr") {
         parts.push(format!("lr {lr}"));
