@@ -266,7 +266,7 @@ impl ExternalLearner {
             .map_err(|e| ReprError::Io(format!("writing {}: {e}", train.display())))?;
 
         let mut cmd = Command::new("sh");
-        cmd.arg("-c")
+        cmd.args(["-c", START_GATE, "ugl-learner"])
             .arg(&self.command)
             .env("UGL_PROTOCOL", PROTOCOL_VERSION.to_string())
             .env("UGL_TRAIN", &train)
@@ -544,6 +544,14 @@ fn sweep_stale_work_dirs(base: &Path) {
     });
 }
 
+/// The learner's shell: it waits for one line on its standard input, which the harness writes
+/// once the watchdog ([`spawn_watchdog`]) runs, then becomes the learner's command (`exec`, so
+/// its process, group and `$$` stay the same). Without the gate the program could run, and a
+/// `kill -9` of `ugl` land, before the watchdog exists: a heavily loaded machine widened that
+/// window enough to leave a learner behind. If the harness dies first, the read meets the end of
+/// its input and the shell exits without starting the program.
+const START_GATE: &str = "IFS= read -r _ || exit 1; exec sh -c \"$1\"";
+
 /// A process that outlives `ugl` however it ends (Ctrl-C twice, SIGTERM, SIGKILL): every
 /// second it checks that the harness is alive; once the harness is gone it kills the learner's
 /// process group and removes its work directory. It exits by itself when the group is gone. It
@@ -669,7 +677,10 @@ impl Session {
         let watchdog = spawn_watchdog(child.id(), &workdir.path);
         #[cfg(not(unix))]
         let watchdog = None;
-        let stdin = child.stdin.take().expect("piped stdin");
+        let mut stdin = child.stdin.take().expect("piped stdin");
+        // Open the gate (START_GATE): the watchdog runs, so the program may start. A learner
+        // that is already gone shows in the READY wait, with its status and stderr.
+        let _ = stdin.write_all(b"\n").and_then(|()| stdin.flush());
         let stdout = child.stdout.take().expect("piped stdout");
         let stderr = child.stderr.take().expect("piped stderr");
         let (to_writer, writer_rx) = mpsc::channel();
