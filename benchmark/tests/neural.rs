@@ -603,6 +603,7 @@ fn host_engine_gradients_match_burn_autodiff() {
                     latents: d,
                     step,
                     warmup: cfg.code_at(model, step).warmup,
+                    kl_delay: 0,
                     beta: cfg.code_at(model, step).beta,
                     capacity: cfg.capacity_at(model, step),
                     variant,

@@ -33,23 +33,37 @@ pub const DEFAULT_BETA: f64 = 4.0;
 /// The batch's KL term: `β mean_b KL_b`, or with capacity annealing (Burgess et al. 2018, the
 /// follow-up code's `loss_function`) `β |mean_b KL_b − C|`.
 ///
-/// With a warm-up (`warmup` > 0, the follow-up code's `c` ramp), the term is multiplied by
-/// `min(1, 0.01 + step / warmup)`; without one (every dense β-VAE so far) it is left as it was.
+/// With a warm-up (`warmup` > 0, the follow-up code's `c` ramp) or a KL delay, the term is
+/// multiplied by [`warmup_factor`]; without either (every dense β-VAE so far) it is left as it
+/// was.
 fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<1> {
     let kl = kl_std_normal(mu, logvar);
     let term = match input.capacity {
         None => kl.mul_scalar(input.beta).mean(),
         Some(c) => kl.mean().sub_scalar(c).abs().mul_scalar(input.beta),
     };
-    match warmup_factor(input.step, input.warmup) {
+    match warmup_factor(input.step, input.kl_delay, input.warmup) {
         Some(f) => term.mul_scalar(f),
         None => term,
     }
 }
 
-/// The follow-up's KL warm-up factor `min(1, 0.01 + step / warmup)` (None: no warm-up).
-pub fn warmup_factor(step: usize, warmup: usize) -> Option<f64> {
-    (warmup > 0).then(|| (0.01 + step as f64 / warmup as f64).min(1.0))
+/// The KL warm-up factor at 0-based iteration `step`: `min(1, 0.01 + max(0, step − T_v) / T_a)`
+/// with T_v = `kl_delay` and T_a = `warmup`. With no delay that is the follow-up code's
+/// `c = min(1, 0.01 + step / T_a)`; a delay holds c at 0.01 for T_v iterations first (a phase in
+/// which c β < 1, so the network learns as a VAE would, before β presses), which the follow-up's
+/// form cannot give with a large β (`docs/neural.md`, "Third round"). With a delay and no ramp
+/// (T_a = 0) c jumps from 0.01 to 1 at T_v. None: neither (no factor).
+pub fn warmup_factor(step: usize, kl_delay: usize, warmup: usize) -> Option<f64> {
+    if warmup == 0 && kl_delay == 0 {
+        return None;
+    }
+    let after = step.saturating_sub(kl_delay) as f64;
+    Some(match warmup {
+        0 if step < kl_delay => 0.01,
+        0 => 1.0,
+        t_a => (0.01 + after / t_a as f64).min(1.0),
+    })
 }
 
 /// The β-VAE as a [`NeuralModel`]: TF Adam, prior N(0, I).
@@ -100,6 +114,7 @@ impl NeuralModel for Bvae {
         let number = |key: &str| knobs.get(key).and_then(serde_json::Value::as_f64);
         CodeSettings {
             warmup: 0,
+            kl_delay: 0,
             beta: number("beta").unwrap_or(DEFAULT_BETA),
             capacity: number("capacity")
                 .map(|c| c * (step as f64 / iterations.max(1) as f64).min(1.0)),
@@ -116,8 +131,12 @@ impl NeuralModel for Bvae {
         let heads = net.heads(input.x.clone());
         let (z, mu, logvar) = code(heads, &input.latent, Variant::Corrected, rng);
         let rec = bce_with_logits_sum(net.decode(z), input.x);
-        match (input.latent.capacity, input.latent.warmup) {
-            (None, 0) => (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean(),
+        match (
+            input.latent.capacity,
+            input.latent.warmup,
+            input.latent.kl_delay,
+        ) {
+            (None, 0, 0) => (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean(),
             _ => rec.mean() + kl_term(mu, logvar, &input.latent),
         }
     }

@@ -92,6 +92,8 @@ pub struct ConvSection {
     pub capacity_iterations: Option<usize>,
     /// `conv-bvae` only.
     pub warmup: Option<usize>,
+    /// `conv-bvae` only.
+    pub kl_delay: Option<usize>,
     pub flush_subnormals: Option<bool>,
 }
 
@@ -110,6 +112,7 @@ impl ConvSection {
             capacity: self.capacity.or(d.capacity),
             capacity_iterations: self.capacity_iterations.or(d.capacity_iterations),
             warmup: self.warmup.unwrap_or(d.warmup),
+            kl_delay: self.kl_delay.unwrap_or(d.kl_delay),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
         }
     }
@@ -125,6 +128,7 @@ impl ParamGuard for (ConvModel, ConvSection) {
                 ("capacity", section.capacity.is_some()),
                 ("capacity_iterations", section.capacity_iterations.is_some()),
                 ("warmup", section.warmup.is_some()),
+                ("kl_delay", section.kl_delay.is_some()),
             ] {
                 if set {
                     return Err(ParamError::at(
@@ -785,6 +789,14 @@ mod tests {
             .check()
             .unwrap_err();
         assert_eq!(e.key.as_deref(), Some("capacity_iterations"));
+        let delayed = ConvSection {
+            kl_delay: Some(100),
+            ..ConvSection::default()
+        };
+        let e = (ConvModel::ConvVae, delayed.clone()).check().unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("kl_delay"));
+        let p = (ConvModel::ConvBvae, delayed).check().unwrap();
+        assert_eq!(p.config.kl_delay, 100);
     }
 
     /// A training killed after a checkpoint and started again gives the same network, bit for

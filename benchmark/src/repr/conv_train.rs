@@ -4,7 +4,8 @@
 //! - **Loss**, as the authors' `loss_function`: the Bernoulli cross-entropy of the pixel logits,
 //!   summed over the pixels and channels and averaged over the batch, plus the model's KL term.
 //!   For the β-VAE with capacity annealing that is `c β |mean_b KL_b − C(t)|`, with `C(t)` rising
-//!   linearly to `capacity` and the warm-up factor `c = min(1, 0.01 + t / warmup)` (`bvae.rs`).
+//!   linearly to `capacity` and the warm-up factor `c = min(1, 0.01 + max(0, t − kl_delay) /
+//!   warmup)` (`bvae.rs`; the follow-up's own form has no delay).
 //! - **The middle** (heads -> code, KL) is the model's own ([`super::neural_model::NeuralModel::latent`]),
 //!   on burn's autodiff, as in the dense host engine: one implementation of each model's code.
 //! - **Optimiser**: `torch.optim.Adam` as the authors ran it (no clipping, PyTorch's placement of
@@ -58,8 +59,13 @@ pub struct ConvConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capacity_iterations: Option<usize>,
     /// The warm-up factor's length T_a: the KL term is multiplied by
-    /// `min(1, 0.01 + t / T_a)` (0: no warm-up).
+    /// `min(1, 0.01 + max(0, t − T_v) / T_a)` (0: no warm-up).
     pub warmup: usize,
+    /// The KL delay T_v: the iterations during which the warm-up factor stays at 0.01 before
+    /// its ramp starts ([`super::bvae::warmup_factor`]). 0 (the default, left out of the
+    /// configuration's identity): the follow-up's own form, whose ramp starts at once.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub kl_delay: usize,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
     /// [`ugl_kernels::flushing_pool`]): the same bits on every x86-64 CPU and path, and no
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
@@ -81,6 +87,7 @@ impl ConvConfig {
             capacity: None,
             capacity_iterations: None,
             warmup: 0,
+            kl_delay: 0,
             flush_subnormals: true,
         }
     }
@@ -108,6 +115,7 @@ impl ConvConfig {
     pub fn code_at(&self, step: usize) -> CodeSettings {
         CodeSettings {
             warmup: self.warmup,
+            kl_delay: self.kl_delay,
             beta: self.beta,
             capacity: self.capacity_at(step),
             variant: Variant::Corrected,
@@ -168,8 +176,22 @@ impl ConvConfig {
         if self.capacity_iterations == Some(0) {
             return Err(ParamError::at("capacity_iterations", "must be at least 1"));
         }
+        if self.kl_delay >= self.iterations.max(1) {
+            return Err(ParamError::at(
+                "kl_delay",
+                format!(
+                    "must be below the iterations ({}), got {}: the KL term would never get its \
+                     weight",
+                    self.iterations, self.kl_delay
+                ),
+            ));
+        }
         Ok(())
     }
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
 }
 
 /// Index of the first gradient buffer of each layer group in [`ConvNet::params`] order.
@@ -445,6 +467,7 @@ mod tests {
             latents: d,
             step,
             warmup: cfg.warmup,
+            kl_delay: cfg.kl_delay,
             beta: cfg.beta,
             capacity: cfg.capacity_at(step),
             variant: Variant::Corrected,
@@ -490,14 +513,22 @@ mod tests {
         let n = 3;
         let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
         let x = pictures(arch, n, 2);
-        let cfg = followup_config();
-        for step in [0, 3, 60] {
+        let delayed = ConvConfig {
+            kl_delay: 20,
+            ..followup_config()
+        };
+        for (cfg, step) in [0, 3, 60]
+            .map(|s| (followup_config(), s))
+            .into_iter()
+            .chain([5, 25].map(|s| (delayed.clone(), s)))
+        {
+            let cfg = &cfg;
             let mut trainer = ConvTrainer::new(net.clone());
             let loss = trainer
-                .forward_backward(&cfg, &x, n, step, &mut stream_named(3, "noise"))
+                .forward_backward(cfg, &x, n, step, &mut stream_named(3, "noise"))
                 .unwrap();
             let (want, want_grads) =
-                burn_loss_and_grads(&net, &cfg, &x, n, step, &mut stream_named(3, "noise"));
+                burn_loss_and_grads(&net, cfg, &x, n, step, &mut stream_named(3, "noise"));
             assert!(
                 (loss - want).abs() <= 1e-5 * (1.0 + want.abs()),
                 "step {step}: loss {loss} vs burn's {want}"
@@ -539,6 +570,54 @@ mod tests {
             ..followup_config()
         });
         assert_ne!(with, without);
+    }
+
+    /// The KL delay T_v holds the warm-up factor at 0.01, then the ramp starts; no delay is the
+    /// follow-up's own form, and it stays out of the configuration's identity (the hashes of the
+    /// networks trained before it existed hold).
+    #[test]
+    fn the_kl_delay_holds_the_factor_then_ramps() {
+        use crate::repr::bvae::warmup_factor;
+        assert_eq!(warmup_factor(7, 0, 0), None);
+        assert_eq!(warmup_factor(0, 0, 100), Some(0.01));
+        assert_eq!(warmup_factor(50, 0, 100), Some(0.51));
+        assert_eq!(warmup_factor(50, 300, 100), Some(0.01));
+        assert_eq!(warmup_factor(300, 300, 100), Some(0.01));
+        assert_eq!(warmup_factor(350, 300, 100), Some(0.51));
+        assert_eq!(warmup_factor(10_000, 300, 100), Some(1.0));
+        assert_eq!(warmup_factor(299, 300, 0), Some(0.01));
+        assert_eq!(warmup_factor(300, 300, 0), Some(1.0));
+
+        let plain = serde_json::to_value(followup_config()).unwrap();
+        assert!(plain.get("kl_delay").is_none(), "{plain}");
+        let delayed = ConvConfig {
+            kl_delay: 40,
+            ..followup_config()
+        };
+        assert_eq!(serde_json::to_value(&delayed).unwrap()["kl_delay"], 40);
+        let back: ConvConfig = serde_json::from_value(plain).unwrap();
+        assert_eq!(back, followup_config());
+
+        // Before the delay ends the factor is 0.01: the heads' gradients differ from the
+        // undelayed form's at the same step (factor 0.31 at step 3 of a 10-iteration ramp).
+        let arch = small();
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        let x = pictures(arch, 3, 2);
+        let run = |cfg: &ConvConfig| {
+            let mut t = ConvTrainer::new(net.clone());
+            t.forward_backward(cfg, &x, 3, 3, &mut stream_named(3, "noise"))
+                .unwrap();
+            t.gradients()[HEAD].clone()
+        };
+        assert_ne!(run(&delayed), run(&followup_config()));
+
+        let e = ConvConfig {
+            kl_delay: 100,
+            ..followup_config()
+        }
+        .check()
+        .unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("kl_delay"), "{e}");
     }
 
     /// The weights after a few steps, as bits, in a pool of `threads` that flushes subnormals

@@ -582,6 +582,7 @@ impl Middle {
             latents,
             step,
             warmup: code.warmup,
+            kl_delay: code.kl_delay,
             beta: code.beta,
             capacity: code.capacity,
             variant: code.variant,

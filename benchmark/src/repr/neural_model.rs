@@ -67,6 +67,7 @@ pub trait NeuralModel: Sync {
         let _ = (knobs, step, iterations);
         CodeSettings {
             warmup: 0,
+            kl_delay: 0,
             beta: 1.0,
             capacity: None,
             variant,
@@ -174,6 +175,9 @@ pub struct StepInput<'a> {
 pub struct CodeSettings {
     /// The warm-up length (RFVAE; the follow-up's `c` ramp of the β-VAE); 0: none.
     pub warmup: usize,
+    /// The iterations before the β-VAE's warm-up ramp starts (its factor stays at 0.01 until
+    /// then); 0 for every other model and for the follow-up's own form.
+    pub kl_delay: usize,
     /// The weight of the KL term (1 for every model but the β-VAE).
     pub beta: f64,
     /// The KL target C at this iteration (None: plain KL term).
@@ -187,8 +191,10 @@ pub struct LatentInput<'a> {
     pub latents: usize,
     /// 0-based iteration.
     pub step: usize,
-    /// RFVAE warm-up length.
+    /// RFVAE warm-up length; the β-VAE's warm-up ramp T_a.
     pub warmup: usize,
+    /// The β-VAE's KL delay T_v ([`CodeSettings::kl_delay`]).
+    pub kl_delay: usize,
     /// β-VAE: the weight of the KL term (1 for every other model).
     pub beta: f64,
     /// β-VAE with capacity annealing: the KL target C at this iteration (None: plain KL term).

@@ -353,6 +353,7 @@ impl NeuralModel for Rfvae {
                 .get("warmup")
                 .and_then(serde_json::Value::as_u64)
                 .map_or(ANNEAL_STEPS, |w| w as usize),
+            kl_delay: 0,
             beta: 1.0,
             capacity: None,
             variant,

@@ -171,6 +171,7 @@ impl<'a> Trainer<'a> {
                         latents: self.latents,
                         step: self.step,
                         warmup: code.warmup,
+                        kl_delay: code.kl_delay,
                         beta: code.beta,
                         capacity: code.capacity,
                         variant: code.variant,

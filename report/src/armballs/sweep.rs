@@ -22,7 +22,7 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
 
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
-/// is ramped, the warm-up where there is one; then the learning rate, the iterations, and
+/// is ramped, the KL delay and the warm-up where there are; then the learning rate, the iterations, and
 /// whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
     let learner = m.learner.as_deref().map(|name| {
@@ -46,6 +46,9 @@ fn setting(m: &Manifest) -> String {
             Some(t) => format!("C {c} reached at {t}"),
             None => format!("C {c} reached at the end"),
         });
+    }
+    if let Some(d) = int("kl_delay").filter(|d| *d > 0) {
+        parts.push(format!("KL delayed {d}"));
     }
     if let Some(w) = int("warmup").filter(|w| *w > 0) {
         parts.push(format!("warm-up {w}"));
