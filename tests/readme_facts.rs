@@ -387,12 +387,24 @@ fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
         generated.trim(),
         "docs/neural.md's sweep table is not `ugl sweep-table {dir}`'s output: regenerate it"
     );
+    let cells = |l: &str| -> Vec<String> { l.split('|').map(|c| c.trim().to_string()).collect() };
+    let header = cells(generated.lines().next().expect("the table has a header"));
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("the sweep table has no column '{name}': {header:?}"))
+    };
+    let (setting, distractor) = (column("setting"), column("distractor k-NN R²"));
     let distractor_r2: Vec<(String, f64)> = generated
         .lines()
         .skip(2)
         .map(|l| {
-            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
-            (cells[1].to_string(), cells[12].parse().unwrap_or(f64::NAN))
+            let row = cells(l);
+            (
+                row[setting].clone(),
+                row[distractor].parse().unwrap_or(f64::NAN),
+            )
         })
         .collect();
     assert!(
