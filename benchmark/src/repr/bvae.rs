@@ -50,9 +50,9 @@ fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<
 
 /// The KL warm-up factor at 0-based iteration `step`: `min(1, 0.01 + max(0, step − T_v) / T_a)`
 /// with T_v = `kl_delay` and T_a = `warmup`. With no delay that is the follow-up code's
-/// `c = min(1, 0.01 + step / T_a)`; a delay holds c at 0.01 for T_v iterations first (a phase in
-/// which c β < 1, so the network learns as a VAE would, before β presses), which the follow-up's
-/// form cannot give with a large β (`docs/neural.md`, "Third round"). With a delay and no ramp
+/// `c = min(1, 0.01 + step / T_a)`; a delay holds c at 0.01 for T_v iterations first (a VAE
+/// phase, with the KL target held at 0 by the configuration's `capacity_at`, before β presses),
+/// which the follow-up's form cannot give with a large β (`docs/neural.md`, "Third round"). With a delay and no ramp
 /// (T_a = 0) c jumps from 0.01 to 1 at T_v. None: neither (no factor).
 pub fn warmup_factor(step: usize, kl_delay: usize, warmup: usize) -> Option<f64> {
     if warmup == 0 && kl_delay == 0 {

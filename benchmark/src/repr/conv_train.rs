@@ -4,8 +4,9 @@
 //! - **Loss**, as the authors' `loss_function`: the Bernoulli cross-entropy of the pixel logits,
 //!   summed over the pixels and channels and averaged over the batch, plus the model's KL term.
 //!   For the β-VAE with capacity annealing that is `c β |mean_b KL_b − C(t)|`, with `C(t)` rising
-//!   linearly to `capacity` and the warm-up factor `c = min(1, 0.01 + max(0, t − kl_delay) /
-//!   warmup)` (`bvae.rs`; the follow-up's own form has no delay).
+//!   linearly to `capacity` and the warm-up factor `c = min(1, 0.01 + t / warmup)` (`bvae.rs`),
+//!   both after an optional VAE phase of `kl_delay` iterations (the follow-up's own form has
+//!   none; [`ConvConfig::kl_delay`]).
 //! - **The middle** (heads -> code, KL) is the model's own ([`super::neural_model::NeuralModel::latent`]),
 //!   on burn's autodiff, as in the dense host engine: one implementation of each model's code.
 //! - **Optimiser**: `torch.optim.Adam` as the authors ran it (no clipping, PyTorch's placement of
@@ -55,15 +56,17 @@ pub struct ConvConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capacity: Option<f64>,
     /// The iterations over which the target rises linearly from 0 to C (T_C; None: the whole
-    /// training).
+    /// training after the KL delay).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capacity_iterations: Option<usize>,
     /// The warm-up factor's length T_a: the KL term is multiplied by
     /// `min(1, 0.01 + max(0, t − T_v) / T_a)` (0: no warm-up).
     pub warmup: usize,
-    /// The KL delay T_v: the iterations during which the warm-up factor stays at 0.01 before
-    /// its ramp starts ([`super::bvae::warmup_factor`]). 0 (the default, left out of the
-    /// configuration's identity): the follow-up's own form, whose ramp starts at once.
+    /// The KL delay T_v: a VAE phase of T_v iterations before the authors' schedule, which then
+    /// runs shifted by T_v. During it the warm-up factor stays at 0.01
+    /// ([`super::bvae::warmup_factor`]) and the KL target at 0 ([`ConvConfig::capacity_at`]), so
+    /// the loss is a VAE's with the KL weighted by 0.01 β (β = 100: the VAE's loss). 0 (the
+    /// default, left out of the configuration's identity): the follow-up's own form.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub kl_delay: usize,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
@@ -103,11 +106,17 @@ impl ConvConfig {
         }
     }
 
-    /// The KL target at iteration `step`: `C min(1, step / T_C)`.
+    /// The KL target at iteration `step`: `C min(1, max(0, step − T_v) / T_C)`, T_C defaulting
+    /// to the iterations after the delay. With no delay (the authors' form) `C min(1, step /
+    /// T_C)`.
     pub fn capacity_at(&self, step: usize) -> Option<f64> {
-        let ramp = self.capacity_iterations.unwrap_or(self.iterations).max(1);
+        let ramp = self
+            .capacity_iterations
+            .unwrap_or(self.iterations.saturating_sub(self.kl_delay))
+            .max(1);
+        let after = step.saturating_sub(self.kl_delay);
         self.capacity
-            .map(|c| c * (step as f64 / ramp as f64).min(1.0))
+            .map(|c| c * (after as f64 / ramp as f64).min(1.0))
     }
 
     /// The settings of the KL term at iteration `step` (the β-VAE's code; one `eps` per
@@ -587,6 +596,25 @@ mod tests {
         assert_eq!(warmup_factor(10_000, 300, 100), Some(1.0));
         assert_eq!(warmup_factor(299, 300, 0), Some(0.01));
         assert_eq!(warmup_factor(300, 300, 0), Some(1.0));
+
+        let shifted = ConvConfig {
+            kl_delay: 40,
+            capacity_iterations: Some(20),
+            ..followup_config()
+        };
+        assert_eq!(shifted.capacity_at(39), Some(0.0));
+        assert_eq!(shifted.capacity_at(50), Some(2.5));
+        assert_eq!(shifted.capacity_at(60), Some(5.0));
+        let whole = ConvConfig {
+            kl_delay: 40,
+            ..followup_config()
+        };
+        assert_eq!(
+            whole.capacity_at(70),
+            Some(2.5),
+            "ramped over the 60 iterations left"
+        );
+        assert_eq!(followup_config().capacity_at(50), Some(2.5));
 
         let plain = serde_json::to_value(followup_config()).unwrap();
         assert!(plain.get("kl_delay").is_none(), "{plain}");
