@@ -207,6 +207,88 @@ pub fn verdict(r: &ClaimResult) -> String {
     }
 }
 
+/// The page's *Findings*: one sentence per claim that was run, generated from its verdict and
+/// comparisons (nothing written per result), the claims that decide first (not reproduced,
+/// reproduced), then the inconclusive ones, those whose premise is not met, and a list of those
+/// not run.
+pub fn findings(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
+    let mut w = String::new();
+    let _ = writeln!(
+        w,
+        "## Findings\n\n\
+         Generated from the verdicts of [the follow-up's claims](#the-follow-ups-claims) (nothing \
+         here is written by hand per result). Δ is subject − reference of the means over \
+         repetitions; an interval is the claim engine's, after its correction.\n"
+    );
+    let premise_not_met = |r: &ClaimResult| r.premise.as_ref().is_some_and(|p| !p.met);
+    let rank = |r: &ClaimResult| match (premise_not_met(r), r.verdict) {
+        (true, _) => 3,
+        (false, Verdict::NotReproduced) => 0,
+        (false, Verdict::Reproduced) => 1,
+        (false, Verdict::Inconclusive) => 2,
+    };
+    let (run, not_run): (Vec<&ClaimResult>, Vec<&ClaimResult>) =
+        results.iter().partition(|r| !r.comparisons.is_empty());
+    let mut run = run;
+    run.sort_by_key(|r| rank(r));
+    if run.is_empty() {
+        let _ = writeln!(w, "No claim could be evaluated on these results.\n");
+    }
+    for r in run {
+        let excluding = r
+            .comparisons
+            .iter()
+            .filter(|c| c.bounds().is_some_and(|(lo, hi)| lo > 0.0 || hi < 0.0))
+            .count();
+        let detail = match r.comparisons.as_slice() {
+            [c] => format!(
+                "{} − {}: Δ {} {}",
+                name(runs, &c.subject),
+                name(runs, &c.reference),
+                f3(c.diff),
+                c.bounds()
+                    .map_or("(no interval)".into(), |(lo, hi)| format!(
+                        "[{}, {}]",
+                        f3(lo),
+                        f3(hi)
+                    ))
+            ),
+            cs => {
+                let lo = cs.iter().map(|c| c.diff).fold(f64::INFINITY, f64::min);
+                let hi = cs.iter().map(|c| c.diff).fold(f64::NEG_INFINITY, f64::max);
+                format!(
+                    "Δ from {} to {} over {} comparisons, {excluding} of them with an interval \
+                     that excludes 0",
+                    f3(lo),
+                    f3(hi),
+                    cs.len()
+                )
+            }
+        };
+        let premise = match &r.premise {
+            Some(p) if !p.met => format!(" The premise is not met: {}.", p.counted),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            w,
+            "- **{}** ({}, on {}): **{}**; {detail}.{premise}",
+            r.claim.statement,
+            r.claim.id,
+            r.claim.statistic.label(),
+            verdict(r)
+        );
+    }
+    if !not_run.is_empty() {
+        let ids: Vec<&str> = not_run.iter().map(|r| r.claim.id.as_str()).collect();
+        let _ = writeln!(
+            w,
+            "- Not run (their conditions are not in these results): {}.",
+            ids.join(", ")
+        );
+    }
+    w
+}
+
 /// The claims table: claim, source, our test, what was measured, the verdict.
 pub fn table(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
     let mut t = String::new();
@@ -425,6 +507,30 @@ mod tests {
         );
         let c4 = c.iter().find(|c| c.claim.id == "C4").unwrap();
         assert_eq!(verdict(c4), "not reproduced");
+
+        // The findings state each verdict, the decided ones first, and list the claims not run.
+        let f = findings(&runs, &c);
+        let line = |id: &str| {
+            f.lines()
+                .position(|l| l.contains(&format!("({id}, on ")))
+                .unwrap_or_else(|| panic!("no finding for {id}:\n{f}"))
+        };
+        assert!(
+            f.lines()
+                .nth(line("C4"))
+                .unwrap()
+                .contains("**not reproduced**"),
+            "{f}"
+        );
+        assert!(
+            f.lines()
+                .nth(line("C6"))
+                .unwrap()
+                .contains("**reproduced**")
+        );
+        assert!(line("C4") < line("C6"), "{f}");
+        let not_run = f.lines().find(|l| l.starts_with("- Not run")).unwrap();
+        assert!(not_run.contains("C1"), "{not_run}");
     }
 
     /// Our runs in the authors' environment are compared with their published summary at their

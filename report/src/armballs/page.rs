@@ -73,6 +73,11 @@ pub(super) fn write(
         runs.len()
     );
 
+    // 0. Findings first, from the claims' verdicts.
+    if let FollowupClaims::Evaluated { results, .. } = followup_claims {
+        let _ = writeln!(p, "{}", claims::findings(runs, results));
+    }
+
     // 1. Exploration of the ball.
     let _ = writeln!(
         p,
