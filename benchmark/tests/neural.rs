@@ -602,11 +602,7 @@ fn host_engine_gradients_match_burn_autodiff() {
                     batch: rows,
                     latents: d,
                     step,
-                    warmup: cfg.code_at(model, step).warmup,
-                    kl_delay: 0,
-                    beta: cfg.code_at(model, step).beta,
-                    capacity: cfg.capacity_at(model, step),
-                    variant,
+                    code: cfg.code_at(model, step),
                     device: &device,
                 },
             };

@@ -38,11 +38,11 @@ pub const DEFAULT_BETA: f64 = 4.0;
 /// was.
 fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<1> {
     let kl = kl_std_normal(mu, logvar);
-    let term = match input.capacity {
-        None => kl.mul_scalar(input.beta).mean(),
-        Some(c) => kl.mean().sub_scalar(c).abs().mul_scalar(input.beta),
+    let term = match input.code.capacity {
+        None => kl.mul_scalar(input.code.beta).mean(),
+        Some(c) => kl.mean().sub_scalar(c).abs().mul_scalar(input.code.beta),
     };
-    match warmup_factor(input.step, input.kl_delay, input.warmup) {
+    match warmup_factor(input.step, input.code.kl_delay, input.code.warmup) {
         Some(f) => term.mul_scalar(f),
         None => term,
     }
@@ -52,8 +52,8 @@ fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<
 /// with T_v = `kl_delay` and T_a = `warmup`. With no delay that is the follow-up code's
 /// `c = min(1, 0.01 + step / T_a)`; a delay holds c at 0.01 for T_v iterations first (a VAE
 /// phase, with the KL target held at 0 by the configuration's `capacity_at`, before β presses),
-/// which the follow-up's form cannot give with a large β (`docs/neural.md`, "Third round"). With a delay and no ramp
-/// (T_a = 0) c jumps from 0.01 to 1 at T_v. None: neither (no factor).
+/// which the follow-up's form cannot give with a large β (`docs/neural.md`, "Third round").
+/// With a delay and no ramp (T_a = 0) c jumps from 0.01 to 1 at T_v. None: neither (no factor).
 pub fn warmup_factor(step: usize, kl_delay: usize, warmup: usize) -> Option<f64> {
     if warmup == 0 && kl_delay == 0 {
         return None;
@@ -132,11 +132,13 @@ impl NeuralModel for Bvae {
         let (z, mu, logvar) = code(heads, &input.latent, Variant::Corrected, rng);
         let rec = bce_with_logits_sum(net.decode(z), input.x);
         match (
-            input.latent.capacity,
-            input.latent.warmup,
-            input.latent.kl_delay,
+            input.latent.code.capacity,
+            input.latent.code.warmup,
+            input.latent.code.kl_delay,
         ) {
-            (None, 0, 0) => (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.beta)).mean(),
+            (None, 0, 0) => {
+                (rec + kl_std_normal(mu, logvar).mul_scalar(input.latent.code.beta)).mean()
+            }
             _ => rec.mean() + kl_term(mu, logvar, &input.latent),
         }
     }

@@ -475,11 +475,7 @@ mod tests {
             batch: n,
             latents: d,
             step,
-            warmup: cfg.warmup,
-            kl_delay: cfg.kl_delay,
-            beta: cfg.beta,
-            capacity: cfg.capacity_at(step),
-            variant: Variant::Corrected,
+            code: cfg.code_at(step),
             device: &device,
         };
         let latent = Model::Bvae.spec().latent(heads, &input, rng);

@@ -581,11 +581,7 @@ impl Middle {
             batch: rows,
             latents,
             step,
-            warmup: code.warmup,
-            kl_delay: code.kl_delay,
-            beta: code.beta,
-            capacity: code.capacity,
-            variant: code.variant,
+            code: *code,
             device,
         };
         let latent = model.spec().latent(heads.clone(), &input, rng);

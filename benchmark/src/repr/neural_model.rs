@@ -191,15 +191,8 @@ pub struct LatentInput<'a> {
     pub latents: usize,
     /// 0-based iteration.
     pub step: usize,
-    /// RFVAE warm-up length; the β-VAE's warm-up ramp T_a.
-    pub warmup: usize,
-    /// The β-VAE's KL delay T_v ([`CodeSettings::kl_delay`]).
-    pub kl_delay: usize,
-    /// β-VAE: the weight of the KL term (1 for every other model).
-    pub beta: f64,
-    /// β-VAE with capacity annealing: the KL target C at this iteration (None: plain KL term).
-    pub capacity: Option<f64>,
-    pub variant: Variant,
+    /// The settings of the KL term at this iteration, from the training configuration.
+    pub code: CodeSettings,
     pub device: &'a Device,
 }
 

@@ -146,12 +146,12 @@ fn code(
     let mu = heads.clone().narrow(1, 0, d);
     let logvar = heads.clone().narrow(1, d, d);
     let p = FlowParams::from_heads(&heads, d);
-    let e = eps(input.variant, input.batch, d, rng, input.device);
+    let e = eps(input.code.variant, input.batch, d, rng, input.device);
     let z0 = mu.clone() + e.mul(exp(logvar.clone().mul_scalar(0.5)));
-    let (zk, logdet) = flows(z0.clone(), &p, d, input.variant);
-    let ann = annealing(input.step, input.warmup);
+    let (zk, logdet) = flows(z0.clone(), &p, d, input.code.variant);
+    let ann = annealing(input.step, input.code.warmup);
     let kl = kl_std_normal(mu, logvar);
-    let kl = match input.variant {
+    let kl = match input.code.variant {
         Variant::Faithful => kl,
         // The prior is on z_K (Rezende & Mohamed 2015, Section 4.2): the free energy's
         // `E[log q0(z0) - log p(z_K)]` is the analytic KL of z0 plus the one-sample
@@ -170,7 +170,7 @@ fn code(
 pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
     let (zk, kl, logdet, ann) = code(net.heads(input.x.clone()), &input.latent, rng);
     let rec = bce_with_logits_sum(net.decode(zk), input.x) + kl;
-    match input.latent.variant {
+    match input.latent.code.variant {
         Variant::Corrected => (rec.mul_scalar(ann) - logdet).mean(),
         Variant::Faithful => rec.mul_scalar(ann).mean() - logdet.mean(),
     }

@@ -170,11 +170,7 @@ impl<'a> Trainer<'a> {
                         batch: k,
                         latents: self.latents,
                         step: self.step,
-                        warmup: code.warmup,
-                        kl_delay: code.kl_delay,
-                        beta: code.beta,
-                        capacity: code.capacity,
-                        variant: code.variant,
+                        code,
                         device,
                     },
                 };

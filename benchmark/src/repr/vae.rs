@@ -53,7 +53,7 @@ pub fn code(
 
 /// The training loss of one mini-batch: `mean_b (sum_pixels BCE + KL)`.
 pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1> {
-    let variant = input.latent.variant;
+    let variant = input.latent.code.variant;
     let (z, mu, logvar) = code(net.heads(input.x.clone()), &input.latent, variant, rng);
     let rec = bce_with_logits_sum(net.decode(z), input.x);
     (rec + kl_std_normal(mu, logvar)).mean()
@@ -62,7 +62,7 @@ pub fn loss(net: &DenseNet, input: StepInput<'_>, rng: &mut Stream) -> Tensor<1>
 /// The host engine's middle (same noise draws as [`loss`]): `z = mu + eps exp(logvar / 2)`,
 /// loss = the batch-mean reconstruction + the batch-mean KL.
 pub fn latent(heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
-    let (z, mu, logvar) = code(heads, input, input.variant, rng);
+    let (z, mu, logvar) = code(heads, input, input.code.variant, rng);
     Latent {
         z,
         extra: Some(kl_std_normal(mu, logvar).mean()),

@@ -227,9 +227,8 @@ pub fn findings(runs: &[FollowupRun], results: &[ClaimResult]) -> String {
         (false, Verdict::Reproduced) => 1,
         (false, Verdict::Inconclusive) => 2,
     };
-    let (run, not_run): (Vec<&ClaimResult>, Vec<&ClaimResult>) =
+    let (mut run, not_run): (Vec<&ClaimResult>, Vec<&ClaimResult>) =
         results.iter().partition(|r| !r.comparisons.is_empty());
-    let mut run = run;
     run.sort_by_key(|r| rank(r));
     if run.is_empty() {
         let _ = writeln!(w, "No claim could be evaluated on these results.\n");
