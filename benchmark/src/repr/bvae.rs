@@ -42,27 +42,34 @@ fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<
         None => kl.mul_scalar(input.code.beta).mean(),
         Some(c) => kl.mean().sub_scalar(c).abs().mul_scalar(input.code.beta),
     };
-    match warmup_factor(input.step, input.code.kl_delay, input.code.warmup) {
+    match warmup_factor(input.step, &input.code) {
         Some(f) => term.mul_scalar(f),
         None => term,
     }
 }
 
+/// The follow-up code's initial warm-up factor, the 0.01 of `c = min(1, 0.01 + t / T_a)`.
+pub const INITIAL_WARMUP_FACTOR: f64 = 0.01;
+
 /// The KL warm-up factor at 0-based iteration `step`: `min(1, 0.01 + max(0, step − T_v) / T_a)`
-/// with T_v = `kl_delay` and T_a = `warmup`. With no delay that is the follow-up code's
-/// `c = min(1, 0.01 + step / T_a)`; a delay holds c at 0.01 for T_v iterations first (a VAE
-/// phase, with the KL target held at 0 by the configuration's `capacity_at`, before β presses),
-/// which the follow-up's form cannot give with a large β (`docs/neural.md`, "Third round").
-/// With a delay and no ramp (T_a = 0) c jumps from 0.01 to 1 at T_v. None: neither (no factor).
-pub fn warmup_factor(step: usize, kl_delay: usize, warmup: usize) -> Option<f64> {
+/// after a delay of T_v = `kl_delay` iterations, with T_a = `warmup`, and the `delay_factor`
+/// (0.01 unless set) during the delay. With no delay that is the follow-up code's
+/// `c = min(1, 0.01 + step / T_a)`; a delay holds c at its factor for T_v iterations first (a
+/// VAE phase, with the KL target held at 0 by the configuration's `capacity_at`, before β
+/// presses), which the follow-up's form cannot give with a large β (`docs/neural.md`, "Third
+/// round"). With a delay and no ramp (T_a = 0) c jumps to 1 at T_v. None: neither (no factor).
+pub fn warmup_factor(step: usize, code: &CodeSettings) -> Option<f64> {
+    let (kl_delay, warmup) = (code.kl_delay, code.warmup);
     if warmup == 0 && kl_delay == 0 {
         return None;
     }
-    let after = step.saturating_sub(kl_delay) as f64;
+    if step < kl_delay {
+        return Some(code.delay_factor);
+    }
+    let after = (step - kl_delay) as f64;
     Some(match warmup {
-        0 if step < kl_delay => 0.01,
         0 => 1.0,
-        t_a => (0.01 + after / t_a as f64).min(1.0),
+        t_a => (INITIAL_WARMUP_FACTOR + after / t_a as f64).min(1.0),
     })
 }
 
@@ -115,6 +122,7 @@ impl NeuralModel for Bvae {
         CodeSettings {
             warmup: 0,
             kl_delay: 0,
+            delay_factor: INITIAL_WARMUP_FACTOR,
             beta: number("beta").unwrap_or(DEFAULT_BETA),
             capacity: number("capacity")
                 .map(|c| c * (step as f64 / iterations.max(1) as f64).min(1.0)),

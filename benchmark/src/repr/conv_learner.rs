@@ -94,6 +94,8 @@ pub struct ConvSection {
     pub warmup: Option<usize>,
     /// `conv-bvae` only.
     pub kl_delay: Option<usize>,
+    /// `conv-bvae` only.
+    pub delay_factor: Option<f64>,
     pub flush_subnormals: Option<bool>,
 }
 
@@ -113,6 +115,7 @@ impl ConvSection {
             capacity_iterations: self.capacity_iterations.or(d.capacity_iterations),
             warmup: self.warmup.unwrap_or(d.warmup),
             kl_delay: self.kl_delay.unwrap_or(d.kl_delay),
+            delay_factor: self.delay_factor.or(d.delay_factor),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
         }
     }
@@ -129,6 +132,7 @@ impl ParamGuard for (ConvModel, ConvSection) {
                 ("capacity_iterations", section.capacity_iterations.is_some()),
                 ("warmup", section.warmup.is_some()),
                 ("kl_delay", section.kl_delay.is_some()),
+                ("delay_factor", section.delay_factor.is_some()),
             ] {
                 if set {
                     return Err(ParamError::at(

@@ -69,6 +69,12 @@ pub struct ConvConfig {
     /// default, left out of the configuration's identity): the follow-up's own form.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub kl_delay: usize,
+    /// The warm-up factor during the KL delay, so that the phase's KL weight is `delay_factor β`
+    /// whatever β presses after it (None: the authors' initial 0.01,
+    /// [`super::bvae::INITIAL_WARMUP_FACTOR`]; left out of the configuration's identity). Ours:
+    /// a phase weight below the VAE's lets more networks leave the plateau with both objects.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delay_factor: Option<f64>,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
     /// [`ugl_kernels::flushing_pool`]): the same bits on every x86-64 CPU and path, and no
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
@@ -91,6 +97,7 @@ impl ConvConfig {
             capacity_iterations: None,
             warmup: 0,
             kl_delay: 0,
+            delay_factor: None,
             flush_subnormals: true,
         }
     }
@@ -125,6 +132,9 @@ impl ConvConfig {
         CodeSettings {
             warmup: self.warmup,
             kl_delay: self.kl_delay,
+            delay_factor: self
+                .delay_factor
+                .unwrap_or(super::bvae::INITIAL_WARMUP_FACTOR),
             beta: self.beta,
             capacity: self.capacity_at(step),
             variant: Variant::Corrected,
@@ -194,6 +204,20 @@ impl ConvConfig {
                     self.iterations, self.kl_delay
                 ),
             ));
+        }
+        if let Some(f) = self.delay_factor {
+            if self.kl_delay == 0 {
+                return Err(ParamError::at(
+                    "delay_factor",
+                    "sets the KL term's factor during a KL delay: set kl_delay too",
+                ));
+            }
+            if !(f.is_finite() && (0.0..=1.0).contains(&f)) {
+                return Err(ParamError::at(
+                    "delay_factor",
+                    format!("must be between 0 and 1, got {f}"),
+                ));
+            }
         }
         Ok(())
     }
@@ -522,10 +546,15 @@ mod tests {
             kl_delay: 20,
             ..followup_config()
         };
+        let own_factor = ConvConfig {
+            delay_factor: Some(0.3),
+            ..delayed.clone()
+        };
         for (cfg, step) in [0, 3, 60]
             .map(|s| (followup_config(), s))
             .into_iter()
             .chain([5, 25].map(|s| (delayed.clone(), s)))
+            .chain([(own_factor, 5)])
         {
             let cfg = &cfg;
             let mut trainer = ConvTrainer::new(net.clone());
@@ -583,15 +612,62 @@ mod tests {
     #[test]
     fn the_kl_delay_holds_the_factor_then_ramps() {
         use crate::repr::bvae::warmup_factor;
-        assert_eq!(warmup_factor(7, 0, 0), None);
-        assert_eq!(warmup_factor(0, 0, 100), Some(0.01));
-        assert_eq!(warmup_factor(50, 0, 100), Some(0.51));
-        assert_eq!(warmup_factor(50, 300, 100), Some(0.01));
-        assert_eq!(warmup_factor(300, 300, 100), Some(0.01));
-        assert_eq!(warmup_factor(350, 300, 100), Some(0.51));
-        assert_eq!(warmup_factor(10_000, 300, 100), Some(1.0));
-        assert_eq!(warmup_factor(299, 300, 0), Some(0.01));
-        assert_eq!(warmup_factor(300, 300, 0), Some(1.0));
+        let factor = |step: usize, kl_delay: usize, warmup: usize| {
+            let cfg = ConvConfig {
+                kl_delay,
+                warmup,
+                ..followup_config()
+            };
+            warmup_factor(step, &cfg.code_at(step))
+        };
+        assert_eq!(factor(7, 0, 0), None);
+        assert_eq!(factor(0, 0, 100), Some(0.01));
+        assert_eq!(factor(50, 0, 100), Some(0.51));
+        assert_eq!(factor(50, 300, 100), Some(0.01));
+        assert_eq!(factor(300, 300, 100), Some(0.01));
+        assert_eq!(factor(350, 300, 100), Some(0.51));
+        assert_eq!(factor(10_000, 300, 100), Some(1.0));
+        assert_eq!(factor(299, 300, 0), Some(0.01));
+        assert_eq!(factor(300, 300, 0), Some(1.0));
+        // A factor of its own during the delay only; the authors' ramp from 0.01 after it.
+        let own = ConvConfig {
+            kl_delay: 300,
+            warmup: 100,
+            delay_factor: Some(0.0004),
+            iterations: 1000,
+            ..followup_config()
+        };
+        assert_eq!(warmup_factor(0, &own.code_at(0)), Some(0.0004));
+        assert_eq!(warmup_factor(299, &own.code_at(299)), Some(0.0004));
+        assert_eq!(warmup_factor(300, &own.code_at(300)), Some(0.01));
+        assert_eq!(warmup_factor(350, &own.code_at(350)), Some(0.51));
+        assert!(
+            serde_json::to_value(followup_config())
+                .unwrap()
+                .get("delay_factor")
+                .is_none()
+        );
+        assert_eq!(serde_json::to_value(&own).unwrap()["delay_factor"], 0.0004);
+        for (bad, key) in [
+            (
+                ConvConfig {
+                    delay_factor: Some(0.5),
+                    ..followup_config()
+                },
+                "delay_factor",
+            ),
+            (
+                ConvConfig {
+                    delay_factor: Some(1.5),
+                    ..own.clone()
+                },
+                "delay_factor",
+            ),
+        ] {
+            let e = bad.check().unwrap_err();
+            assert_eq!(e.key.as_deref(), Some(key), "{e}");
+        }
+        own.check().unwrap();
 
         let shifted = ConvConfig {
             kl_delay: 40,

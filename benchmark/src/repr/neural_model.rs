@@ -68,6 +68,7 @@ pub trait NeuralModel: Sync {
         CodeSettings {
             warmup: 0,
             kl_delay: 0,
+            delay_factor: super::bvae::INITIAL_WARMUP_FACTOR,
             beta: 1.0,
             capacity: None,
             variant,
@@ -178,6 +179,9 @@ pub struct CodeSettings {
     /// The iterations before the β-VAE's warm-up ramp starts (its factor stays at 0.01 until
     /// then); 0 for every other model and for the follow-up's own form.
     pub kl_delay: usize,
+    /// The factor of the KL term during the delay (the follow-up's initial warm-up factor,
+    /// [`super::bvae::INITIAL_WARMUP_FACTOR`], unless the configuration sets another).
+    pub delay_factor: f64,
     /// The weight of the KL term (1 for every model but the β-VAE).
     pub beta: f64,
     /// The KL target C at this iteration (None: plain KL term).

@@ -22,7 +22,7 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
 
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
-/// is ramped, the KL delay and the warm-up where there are; then the learning rate, the iterations, and
+/// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning rate, the iterations, and
 /// whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
     let learner = m.learner.as_deref().map(|name| {
@@ -48,7 +48,13 @@ fn setting(m: &Manifest) -> String {
         });
     }
     if let Some(d) = int("kl_delay").filter(|d| *d > 0) {
-        parts.push(format!("KL delayed {d}"));
+        parts.push(match num("delay_factor") {
+            Some(f) => {
+                let weight = (f * num("beta").unwrap_or(1.0) * 1e6).round() / 1e6;
+                format!("KL delayed {d} at weight {weight}")
+            }
+            None => format!("KL delayed {d}"),
+        });
     }
     if let Some(w) = int("warmup").filter(|w| *w > 0) {
         parts.push(format!("warm-up {w}"));
@@ -175,5 +181,29 @@ mod tests {
         std::fs::create_dir(dir.path().join("beta-4")).unwrap();
         let e = table(dir.path()).unwrap_err().to_string();
         assert!(e.contains("holds no sweep run"), "{e}");
+    }
+
+    /// The setting names the KL delay, and the phase's KL weight (its factor times β) where the
+    /// configuration sets the factor.
+    #[test]
+    fn the_setting_names_the_delay_and_its_weight() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../data/sweeps/conv/beta-100_capacity-12_capacity_iterations-1_kl_delay-3000_\
+             warmup-1000_iterations-8000/armballs-corl.rge-conv-bvae.kde.l10.s1000.json"
+        );
+        let mut m = crate::load::read_manifest(std::path::Path::new(path)).unwrap();
+        assert!(
+            setting(&m).contains(", KL delayed 3000, warm-up 1000"),
+            "{}",
+            setting(&m)
+        );
+        let train = m.train.as_mut().unwrap();
+        train.config["delay_factor"] = serde_json::json!(0.0004);
+        assert!(
+            setting(&m).contains(", KL delayed 3000 at weight 0.04, warm-up"),
+            "{}",
+            setting(&m)
+        );
     }
 }
