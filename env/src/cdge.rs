@@ -592,21 +592,66 @@ pub fn write_npy(values: &[f32], path: &std::path::Path) -> Result<(), super::re
     })
 }
 
+/// Upscaling factor of [`write_png`].
+const PNG_SCALE: usize = 4;
+
 /// Write a picture as an RGB PNG a person can look at: 4x nearest-neighbour upscaling, rows
 /// flipped so that larger y is higher, as in the world (CDGE's frames put y downwards).
 pub fn write_png(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
     check_picture(values, path)?;
-    const SCALE: usize = 4;
-    let side = SIDE * SCALE;
-    let mut data = Vec::with_capacity(side * side * CHANNELS);
-    for row in 0..side {
-        let y = SIDE - 1 - row / SCALE;
-        for col in 0..side {
-            let px = &values[(y * SIDE + col / SCALE) * CHANNELS..][..CHANNELS];
-            data.extend(px.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
+    write_png_grid(&[values], 1, PNG_SCALE, path)
+}
+
+/// Gap between the cells of [`write_png_grid`], in output pixels (mid gray), as the gray grid's.
+const GRID_GAP: usize = 2;
+
+/// Write pictures ([`VALUES`] values in [0, 1] each, rows first, channels last) as one RGB PNG:
+/// `cols` per row, each upscaled `scale` times and oriented like [`write_png`], separated by a
+/// gray gap. For figures (reconstructions: inputs above outputs), as
+/// [`super::render::write_png_grid`] draws the 70 x 70 gray pictures.
+pub fn write_png_grid(
+    pictures: &[&[f32]],
+    cols: usize,
+    scale: usize,
+    path: &std::path::Path,
+) -> Result<(), super::render::RenderError> {
+    if pictures.is_empty() || cols == 0 || scale == 0 {
+        return Err(super::render::RenderError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "a PNG grid needs pictures, columns and a scale",
+            ),
+        });
+    }
+    for p in pictures {
+        check_picture(p, path)?;
+    }
+    let rows = pictures.len().div_ceil(cols);
+    let cell = SIDE * scale;
+    let (width, height) = (
+        cols * cell + (cols - 1) * GRID_GAP,
+        rows * cell + (rows - 1) * GRID_GAP,
+    );
+    let mut data = vec![128u8; width * height * CHANNELS];
+    for (k, picture) in pictures.iter().enumerate() {
+        let (r0, c0) = (
+            (k / cols) * (cell + GRID_GAP),
+            (k % cols) * (cell + GRID_GAP),
+        );
+        for row in 0..cell {
+            let y = SIDE - 1 - row / scale;
+            let start = ((r0 + row) * width + c0) * CHANNELS;
+            let line = &mut data[start..start + cell * CHANNELS];
+            for (col, px) in line.chunks_exact_mut(CHANNELS).enumerate() {
+                let src = &picture[(y * SIDE + col / scale) * CHANNELS..][..CHANNELS];
+                for (o, v) in px.iter_mut().zip(src) {
+                    *o = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+                }
+            }
         }
     }
-    super::render::write_png_bytes(path, side, side, png::ColorType::Rgb, &data)
+    super::render::write_png_bytes(path, width, height, png::ColorType::Rgb, &data)
 }
 
 fn check_picture(values: &[f32], path: &std::path::Path) -> Result<(), super::render::RenderError> {
@@ -622,6 +667,51 @@ fn check_picture(values: &[f32], path: &std::path::Path) -> Result<(), super::re
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Three pictures on a grid of two columns: each cell is its picture (rows flipped, the
+    /// channels in order), the gaps and the empty fourth cell are gray, and a picture of
+    /// another size is refused.
+    #[test]
+    fn the_png_grid_places_the_pictures_with_gaps() {
+        let picture = |seed: usize| -> Vec<f32> {
+            (0..VALUES)
+                .map(|i| ((i * 7 + seed * 13) % 256) as f32 / 255.0)
+                .collect()
+        };
+        let (a, b, c) = (picture(0), picture(1), picture(2));
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("grid.png");
+        write_png_grid(&[&a, &b, &c], 2, 1, &p).unwrap();
+        let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&p).unwrap()));
+        let mut reader = dec.read_info().unwrap();
+        let mut buf = vec![0u8; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        let w = 2 * SIDE + GRID_GAP;
+        assert_eq!((info.width as usize, info.height as usize), (w, w));
+        let px = |r: usize, col: usize| &buf[(r * w + col) * CHANNELS..][..CHANNELS];
+        assert_eq!(px(10, SIDE), [128; 3], "the gap");
+        assert_eq!(
+            px(SIDE + GRID_GAP + 5, SIDE + GRID_GAP + 5),
+            [128; 3],
+            "no fourth picture"
+        );
+        for (r0, c0, pic) in [
+            (0, 0, &a),
+            (0, SIDE + GRID_GAP, &b),
+            (SIDE + GRID_GAP, 0, &c),
+        ] {
+            for (x, y) in [(0, 0), (5, 60), (63, 63), (31, 2)] {
+                let want: Vec<u8> = pic[(y * SIDE + x) * CHANNELS..][..CHANNELS]
+                    .iter()
+                    .map(|v| (v * 255.0).round() as u8)
+                    .collect();
+                assert_eq!(px(r0 + SIDE - 1 - y, c0 + x), &want[..], "({x}, {y})");
+            }
+        }
+        assert!(write_png_grid(&[&a[..10]], 1, 1, &p).is_err());
+        assert!(write_png_grid(&[], 1, 1, &p).is_err());
+    }
 
     #[test]
     fn the_basis_peaks_at_its_centres_and_the_last_function_is_only_a_tail() {

@@ -18,8 +18,7 @@ use super::embed::grid_images;
 use super::fit::{Representation, representation_label};
 use super::plan::RunSpec;
 use super::store;
-use crate::env::make_env;
-use crate::env::render::write_png_grid;
+use crate::env::{cdge, make_env, render};
 use crate::repr::ReprError;
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::seed::{Component, run_seed, stream};
@@ -32,6 +31,9 @@ pub const RECONSTRUCTIONS: usize = 8;
 pub const DIR_NAME: &str = ugl_types::GOAL_SPACE_DIR;
 
 pub use ugl_types::GoalSpaceSample;
+
+/// A writer of a grid of pictures as one PNG (pictures, columns, upscaling, path).
+type GridWriter = fn(&[&[f32]], usize, usize, &Path) -> Result<(), render::RenderError>;
 
 /// Whether a campaign keeps figure data for this run's representation: seed 0 of learned cells.
 pub fn wanted(spec: &RunSpec) -> bool {
@@ -88,20 +90,27 @@ pub fn write(
             None => break,
         }
     }
-    // The reconstruction figure draws 70x70 gray pictures; other pictures have none yet.
-    let reconstructions = if recon.is_empty() || env.kind().spec().image != ugl_types::GRAY70 {
-        None
-    } else {
-        let name = format!("{label}.reconstructions.png");
-        let path = dir.join(&name);
-        let tmp = dir.join(format!(".{name}.tmp"));
-        let cells: Vec<&[f32]> = (0..heldout.images.n)
-            .map(|i| heldout.images.row(i))
-            .chain(recon.iter().map(|r| &r[..]))
-            .collect();
-        write_png_grid(&cells, RECONSTRUCTIONS, 2, &tmp).map_err(|e| io(&tmp, &e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| io(&path, &e))?;
-        Some(name)
+    // The reconstruction figure draws the 70x70 gray pictures and the follow-up's 64x64 RGB ones.
+    let image = env.kind().spec().image;
+    let write_grid = match image {
+        ugl_types::GRAY70 => Some(render::write_png_grid as GridWriter),
+        ugl_types::RGB64 => Some(cdge::write_png_grid as GridWriter),
+        _ => None,
+    };
+    let reconstructions = match write_grid {
+        Some(write_grid) if !recon.is_empty() => {
+            let name = format!("{label}.reconstructions.png");
+            let path = dir.join(&name);
+            let tmp = dir.join(format!(".{name}.tmp"));
+            let cells: Vec<&[f32]> = (0..heldout.images.n)
+                .map(|i| heldout.images.row(i))
+                .chain(recon.iter().map(|r| &r[..]))
+                .collect();
+            write_grid(&cells, RECONSTRUCTIONS, 2, &tmp).map_err(|e| io(&tmp, &e))?;
+            std::fs::rename(&tmp, &path).map_err(|e| io(&path, &e))?;
+            Some(name)
+        }
+        _ => None,
     };
     let sample = GoalSpaceSample {
         representation: label,
