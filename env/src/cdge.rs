@@ -602,13 +602,10 @@ pub fn write_png(values: &[f32], path: &std::path::Path) -> Result<(), super::re
     write_png_grid(&[values], 1, PNG_SCALE, path)
 }
 
-/// Gap between the cells of [`write_png_grid`], in output pixels (mid gray), as the gray grid's.
-const GRID_GAP: usize = 2;
-
 /// Write pictures ([`VALUES`] values in [0, 1] each, rows first, channels last) as one RGB PNG:
 /// `cols` per row, each upscaled `scale` times and oriented like [`write_png`], separated by a
-/// gray gap. For figures (reconstructions: inputs above outputs), as
-/// [`super::render::write_png_grid`] draws the 70 x 70 gray pictures.
+/// gray gap ([`super::render::grid_bytes`]). For figures (reconstructions: inputs above
+/// outputs), as [`super::render::write_png_grid`] draws the 70 x 70 gray pictures.
 pub fn write_png_grid(
     pictures: &[&[f32]],
     cols: usize,
@@ -627,30 +624,10 @@ pub fn write_png_grid(
     for p in pictures {
         check_picture(p, path)?;
     }
-    let rows = pictures.len().div_ceil(cols);
-    let cell = SIDE * scale;
-    let (width, height) = (
-        cols * cell + (cols - 1) * GRID_GAP,
-        rows * cell + (rows - 1) * GRID_GAP,
-    );
-    let mut data = vec![128u8; width * height * CHANNELS];
-    for (k, picture) in pictures.iter().enumerate() {
-        let (r0, c0) = (
-            (k / cols) * (cell + GRID_GAP),
-            (k % cols) * (cell + GRID_GAP),
-        );
-        for row in 0..cell {
-            let y = SIDE - 1 - row / scale;
-            let start = ((r0 + row) * width + c0) * CHANNELS;
-            let line = &mut data[start..start + cell * CHANNELS];
-            for (col, px) in line.chunks_exact_mut(CHANNELS).enumerate() {
-                let src = &picture[(y * SIDE + col / scale) * CHANNELS..][..CHANNELS];
-                for (o, v) in px.iter_mut().zip(src) {
-                    *o = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-                }
-            }
-        }
-    }
+    let (width, height, data) =
+        super::render::grid_bytes(pictures.len(), cols, scale, SIDE, CHANNELS, |k, x, y, c| {
+            pictures[k][(y * SIDE + x) * CHANNELS + c]
+        });
     super::render::write_png_bytes(path, width, height, png::ColorType::Rgb, &data)
 }
 
@@ -687,6 +664,7 @@ mod tests {
         let mut buf = vec![0u8; reader.output_buffer_size().unwrap()];
         let info = reader.next_frame(&mut buf).unwrap();
         assert_eq!(info.color_type, png::ColorType::Rgb);
+        use crate::render::GRID_GAP;
         let w = 2 * SIDE + GRID_GAP;
         assert_eq!((info.width as usize, info.height as usize), (w, w));
         let px = |r: usize, col: usize| &buf[(r * w + col) * CHANNELS..][..CHANNELS];

@@ -809,7 +809,7 @@ pub fn write_png(img: &Image70, path: &Path) -> Result<(), RenderError> {
 }
 
 /// Gap between the cells of [`write_png_grid`], in output pixels (mid gray).
-const GRID_GAP: usize = 2;
+pub(crate) const GRID_GAP: usize = 2;
 
 /// Write 70x70 images (`PIXELS` values in [0, 1] each, indexed `[x][y]`) as one grayscale PNG:
 /// `cols` per row, each upscaled `scale` times and oriented like [`write_png`], separated by a
@@ -830,28 +830,48 @@ pub fn write_png_grid(
             format!("a PNG grid needs images of {PIXELS} pixels, columns and a scale"),
         )));
     }
-    let rows = images.len().div_ceil(cols);
-    let cell = SIDE * scale;
+    let (width, height, data) = grid_bytes(images.len(), cols, scale, SIDE, 1, |k, x, y, _| {
+        images[k][x * SIDE + y]
+    });
+    write_png_bytes(path, width, height, png::ColorType::Grayscale, &data)
+}
+
+/// The 8-bit pixels of a grid of `n` square pictures of `side` x `side` pixels and `channels`
+/// values each, `cols` per row, each upscaled `scale` times, separated by a mid-gray gap of
+/// [`GRID_GAP`] pixels, with rows flipped so that larger y is higher (as in the world); `value(k,
+/// x, y, c)` is channel `c` of picture `k` at (x, y), in [0, 1]. Returns (width, height, bytes).
+pub(crate) fn grid_bytes(
+    n: usize,
+    cols: usize,
+    scale: usize,
+    side: usize,
+    channels: usize,
+    value: impl Fn(usize, usize, usize, usize) -> f32,
+) -> (usize, usize, Vec<u8>) {
+    let rows = n.div_ceil(cols);
+    let cell = side * scale;
     let (width, height) = (
         cols * cell + (cols - 1) * GRID_GAP,
         rows * cell + (rows - 1) * GRID_GAP,
     );
-    let mut data = vec![128u8; width * height];
-    for (k, img) in images.iter().enumerate() {
+    let mut data = vec![128u8; width * height * channels];
+    for k in 0..n {
         let (r0, c0) = (
             (k / cols) * (cell + GRID_GAP),
             (k % cols) * (cell + GRID_GAP),
         );
         for row in 0..cell {
-            let y = SIDE - 1 - row / scale;
-            let line = &mut data[(r0 + row) * width + c0..(r0 + row) * width + c0 + cell];
-            for (col, p) in line.iter_mut().enumerate() {
-                let v = img[(col / scale) * SIDE + y];
-                *p = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            let y = side - 1 - row / scale;
+            let start = ((r0 + row) * width + c0) * channels;
+            let line = &mut data[start..start + cell * channels];
+            for (col, px) in line.chunks_exact_mut(channels).enumerate() {
+                for (c, p) in px.iter_mut().enumerate() {
+                    *p = (value(k, col / scale, y, c).clamp(0.0, 1.0) * 255.0).round() as u8;
+                }
             }
         }
     }
-    write_png_bytes(path, width, height, png::ColorType::Grayscale, &data)
+    (width, height, data)
 }
 
 /// Encode 8-bit `data` (`height` rows of `width` pixels of `color`) as a PNG file.
