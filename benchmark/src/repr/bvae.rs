@@ -20,8 +20,8 @@ use burn::tensor::Tensor;
 
 use super::nets::{DenseNet, bce_with_logits_sum, kl_std_normal};
 use super::neural_model::{
-    CodeSettings, Knobs, Latent, LatentInput, NeuralModel, Optimiser, StepInput, Variant,
-    knob_number,
+    CodeSettings, INITIAL_WARMUP_FACTOR, Knobs, Latent, LatentInput, NeuralModel, Optimiser,
+    StepInput, Variant, knob_number,
 };
 use super::vae::{code, encoding};
 use crate::seed::Stream;
@@ -47,9 +47,6 @@ fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<
         None => term,
     }
 }
-
-/// The follow-up code's initial warm-up factor, the 0.01 of `c = min(1, 0.01 + t / T_a)`.
-pub const INITIAL_WARMUP_FACTOR: f64 = 0.01;
 
 /// The KL warm-up factor at 0-based iteration `step`: `min(1, 0.01 + max(0, step − T_v) / T_a)`
 /// after a delay of T_v = `kl_delay` iterations, with T_a = `warmup`, and the `delay_factor`

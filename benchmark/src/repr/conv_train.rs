@@ -71,7 +71,7 @@ pub struct ConvConfig {
     pub kl_delay: usize,
     /// The warm-up factor during the KL delay, so that the phase's KL weight is `delay_factor β`
     /// whatever β presses after it (None: the authors' initial 0.01,
-    /// [`super::bvae::INITIAL_WARMUP_FACTOR`]; left out of the configuration's identity). Ours:
+    /// [`super::neural_model::INITIAL_WARMUP_FACTOR`]; left out of the configuration's identity). Ours:
     /// a phase weight below the VAE's lets more networks leave the plateau with both objects.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay_factor: Option<f64>,
@@ -134,7 +134,7 @@ impl ConvConfig {
             kl_delay: self.kl_delay,
             delay_factor: self
                 .delay_factor
-                .unwrap_or(super::bvae::INITIAL_WARMUP_FACTOR),
+                .unwrap_or(super::neural_model::INITIAL_WARMUP_FACTOR),
             beta: self.beta,
             capacity: self.capacity_at(step),
             variant: Variant::Corrected,

@@ -68,7 +68,7 @@ pub trait NeuralModel: Sync {
         CodeSettings {
             warmup: 0,
             kl_delay: 0,
-            delay_factor: super::bvae::INITIAL_WARMUP_FACTOR,
+            delay_factor: INITIAL_WARMUP_FACTOR,
             beta: 1.0,
             capacity: None,
             variant,
@@ -169,6 +169,10 @@ pub struct StepInput<'a> {
     pub latent: LatentInput<'a>,
 }
 
+/// The follow-up code's initial warm-up factor, the 0.01 of `c = min(1, 0.01 + t / T_a)`
+/// (the β-VAE's `warmup_factor`).
+pub const INITIAL_WARMUP_FACTOR: f64 = 0.01;
+
 /// The settings of a model's KL term at one iteration, from its training configuration (the
 /// dense networks' [`super::neural_config::NeuralConfig::code_at`], the convolutional ones'
 /// [`super::conv_train::ConvConfig::code_at`]).
@@ -180,7 +184,7 @@ pub struct CodeSettings {
     /// then); 0 for every other model and for the follow-up's own form.
     pub kl_delay: usize,
     /// The factor of the KL term during the delay (the follow-up's initial warm-up factor,
-    /// [`super::bvae::INITIAL_WARMUP_FACTOR`], unless the configuration sets another).
+    /// [`INITIAL_WARMUP_FACTOR`], unless the configuration sets another).
     pub delay_factor: f64,
     /// The weight of the KL term (1 for every model but the β-VAE).
     pub beta: f64,

@@ -354,7 +354,7 @@ impl NeuralModel for Rfvae {
                 .and_then(serde_json::Value::as_u64)
                 .map_or(ANNEAL_STEPS, |w| w as usize),
             kl_delay: 0,
-            delay_factor: super::bvae::INITIAL_WARMUP_FACTOR,
+            delay_factor: super::neural_model::INITIAL_WARMUP_FACTOR,
             beta: 1.0,
             capacity: None,
             variant,
