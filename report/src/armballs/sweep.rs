@@ -22,8 +22,8 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
 
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
-/// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning rate, the iterations, and
-/// whether subnormals were flushed.
+/// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning
+/// rate, the iterations, and whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
     let learner = m.learner.as_deref().map(|name| {
         ugl_types::LEARNERS
