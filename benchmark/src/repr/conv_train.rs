@@ -72,8 +72,7 @@ pub struct ConvConfig {
     /// The warm-up factor during the KL delay, so that the phase's KL weight is `delay_factor β`
     /// whatever β presses after it (None: the authors' initial 0.01,
     /// [`super::neural_model::INITIAL_WARMUP_FACTOR`]; left out of the configuration's
-    /// identity). Ours: a phase weight below the VAE's, under which networks left the plateau
-    /// with both objects more often in the sweep.
+    /// identity). Ours: the phase's weight set apart from β (`docs/neural.md`, "Fifth round").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay_factor: Option<f64>,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
