@@ -168,21 +168,54 @@ pub enum Finding {
     Angle,
 }
 
-/// A condition on the results that a claim presupposes.
+/// A condition on the results that a claim presupposes, checked per network.
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Premise {
-    /// At least one network of this learner has a latent that encodes only the controllable
-    /// object and one that encodes only the distractor (ArmBalls).
+    /// The repetition's network of this learner has an active latent that encodes only the
+    /// controllable object and one that encodes only the distractor (ArmBalls): the claim is
+    /// evaluated on the repetitions whose network is disentangled.
     pub disentangled: String,
 }
 
 /// A premise checked on the results.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PremiseCheck {
+    /// Whether any repetition meets it.
     pub met: bool,
     /// What was counted, in words.
     pub counted: String,
+    /// The repetitions that meet it, as (the condition's tag, seed): a claim with this premise
+    /// compares the values of these repetitions only, in every condition. None: all of them.
+    pub repetitions: Option<BTreeSet<(Option<String>, i64)>>,
+}
+
+/// `obs` restricted to the repetitions of a premise ([`PremiseCheck::repetitions`]): a
+/// condition's values are those of its repetitions that meet it. The published summaries are
+/// kept whole (they are not ours to select from).
+struct OnRepetitions<'a> {
+    obs: &'a dyn Observations,
+    repetitions: &'a BTreeSet<(Option<String>, i64)>,
+}
+
+impl Observations for OnRepetitions<'_> {
+    fn keys(&self) -> Vec<ConditionKey> {
+        self.obs.keys()
+    }
+
+    fn values(&self, key: &ConditionKey, statistic: Statistic) -> Vec<(i64, f64)> {
+        let mut v = self.obs.values(key, statistic);
+        v.retain(|(seed, _)| self.repetitions.contains(&(key.tag.clone(), *seed)));
+        v
+    }
+
+    fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
+        self.obs.premise(premise)
+    }
+
+    fn summary(&self, key: &ConditionKey, statistic: Statistic) -> Option<stats::SampleSummary> {
+        self.obs.summary(key, statistic)
+    }
 }
 
 /// What a claims file is evaluated on: conditions and, per condition, the per-seed values of a
@@ -1182,6 +1215,24 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
         .iter()
         .map(|claim| {
             let margin = claim.margin.unwrap_or(file.settings.margin);
+            let premise = claim.premise.as_ref().map(|p| {
+                obs.premise(p).unwrap_or_else(|| PremiseCheck {
+                    met: false,
+                    counted: format!(
+                        "whether a {} network is disentangled cannot be checked on these results",
+                        p.disentangled
+                    ),
+                    repetitions: None,
+                })
+            });
+            let restricted = premise
+                .as_ref()
+                .and_then(|p| p.repetitions.as_ref())
+                .map(|repetitions| OnRepetitions { obs, repetitions });
+            let obs: &dyn Observations = match &restricted {
+                Some(r) => r,
+                None => obs,
+            };
             let mut comparisons = compare(
                 claim,
                 &keys,
@@ -1197,15 +1248,6 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
             );
             correct(&mut comparisons, claim.quantifier, alpha);
             let verdicts: Vec<Verdict> = comparisons.iter().map(|c| c.verdict).collect();
-            let premise = claim.premise.as_ref().map(|p| {
-                obs.premise(p).unwrap_or_else(|| PremiseCheck {
-                    met: false,
-                    counted: format!(
-                        "whether a {} network is disentangled cannot be checked on these results",
-                        p.disentangled
-                    ),
-                })
-            });
             let twin = file
                 .settings
                 .validated

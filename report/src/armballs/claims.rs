@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use super::authors::{self, Authors};
 use super::labels::{Condition, f3};
-use super::runs::{FollowupRun, display, role};
+use super::runs::{FollowupRun, display, is_disentangled};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
@@ -126,13 +126,26 @@ impl Observations for FollowupObservations<'_> {
     }
 
     fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
-        let (yes, n) = disentangled(self.runs, &premise.disentangled);
+        let networks = networks(self.runs, &premise.disentangled);
+        let repetitions: BTreeSet<(Option<String>, i64)> = networks
+            .iter()
+            .filter(|n| n.1)
+            .map(|n| n.0.clone())
+            .collect();
+        let (yes, n) = (repetitions.len(), networks.len());
         Some(PremiseCheck {
             met: yes > 0,
             counted: format!(
-                "{} networks with a ball-only and a distractor-only latent: {yes} of {n}",
-                learner_name(&premise.disentangled)
+                "{} networks with an active ball-only and an active distractor-only latent: \
+                 {yes} of {n}{}",
+                learner_name(&premise.disentangled),
+                if yes > 0 && yes < n {
+                    format!(", compared on those {yes} repetitions")
+                } else {
+                    String::new()
+                }
             ),
+            repetitions: Some(repetitions),
         })
     }
 }
@@ -161,26 +174,23 @@ fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
     Some(fin.get(&ball).map_or(0, |v| v.1) as f64 / total as f64)
 }
 
-/// How many of the learned networks of `learner` have a ball-only and a distractor-only latent
-/// (one network per variant campaign, seed and latent size).
-fn disentangled(runs: &[FollowupRun], learner: &str) -> (usize, usize) {
+/// The learned networks of `learner`, one per variant campaign's tag and seed (its flat and
+/// modular runs share it), each with whether it is disentangled ([`is_disentangled`]: an active
+/// ball-only and an active distractor-only latent).
+fn networks(runs: &[FollowupRun], learner: &str) -> Vec<((Option<String>, i64), bool)> {
     let mut seen = BTreeSet::new();
-    let mut n = 0;
-    let mut yes = 0;
+    let mut out = Vec::new();
     for r in runs {
         let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
             continue;
         };
-        if l != learner || !seen.insert((r.cond.tag().to_string(), r.seed, r.key.latents)) {
+        let repetition = (r.key.tag.clone(), r.seed);
+        if l != learner || !seen.insert((repetition.clone(), r.key.latents)) {
             continue;
         }
-        n += 1;
-        let roles: Vec<&str> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
-        if roles.contains(&"ball") && roles.contains(&"distractor") {
-            yes += 1;
-        }
+        out.push((repetition, is_disentangled(&r.kl_per_latent, b, d)));
     }
-    (yes, n)
+    out
 }
 
 /// A claim's verdict in words: the engine's, or "premise not met" with it.
@@ -594,6 +604,97 @@ mod tests {
             authors: Some(&authors),
         };
         assert!(evaluate_on(&claims, &obs)[0].comparisons.is_empty());
+    }
+
+    /// The premise is checked per network: a claim about a disentangled space compares the
+    /// repetitions whose β-VAE has an active ball-only and an active distractor-only latent, and
+    /// a latent that collapsed (KL below 0.5 nats) does not count even where its mean still
+    /// follows the distractor.
+    #[test]
+    fn the_premise_is_checked_per_network() {
+        let mut runs = Vec::new();
+        for s in 0..6 {
+            let disentangled = s < 4;
+            let mut b = run(
+                "mge-conv-bvae-lp",
+                s,
+                if disentangled {
+                    0.5 + 0.01 * s as f64
+                } else {
+                    0.1
+                },
+            );
+            b.learner = Some("conv-bvae".into());
+            b.per_latent = Some((vec![0.9, 0.02, 0.0], vec![0.01, 0.8, 0.0]));
+            b.kl_per_latent = vec![3.0, if disentangled { 3.0 } else { 0.01 }, 0.0];
+            runs.push(b);
+            let mut v = run(
+                "mge-conv-vae-lp",
+                s,
+                if disentangled {
+                    0.3 + 0.005 * s as f64
+                } else {
+                    0.6
+                },
+            );
+            v.learner = Some("conv-vae".into());
+            v.per_latent = Some((vec![0.5, 0.4, 0.3], vec![0.4, 0.5, 0.3]));
+            v.kl_per_latent = vec![2.0, 2.0, 2.0];
+            runs.push(v);
+        }
+        let file = committed();
+        let obs = FollowupObservations {
+            runs: &runs,
+            authors: None,
+        };
+        let c = evaluate_on(&file, &obs);
+        let c1 = c.iter().find(|c| c.claim.id == "C1").unwrap();
+        let p = c1.premise.as_ref().unwrap();
+        assert!(p.met);
+        assert!(
+            p.counted
+                .contains("4 of 6, compared on those 4 repetitions"),
+            "{}",
+            p.counted
+        );
+        assert_eq!(c1.comparisons.len(), 1);
+        assert_eq!(
+            (c1.comparisons[0].n_subject, c1.comparisons[0].n_reference),
+            (4, 4)
+        );
+        assert!(c1.comparisons[0].paired);
+        assert_eq!(verdict(c1), "reproduced");
+        // On all six repetitions the difference is not shown: the two entangled β-VAEs explore
+        // far less.
+        let all: Vec<FollowupRun> = runs
+            .iter()
+            .cloned()
+            .map(|mut r| {
+                r.kl_per_latent = Vec::new();
+                r
+            })
+            .collect();
+        let obs = FollowupObservations {
+            runs: &all,
+            authors: None,
+        };
+        let c = evaluate_on(&file, &obs);
+        let c1 = c.iter().find(|c| c.claim.id == "C1").unwrap();
+        assert!(c1.premise.as_ref().unwrap().counted.contains("6 of 6"));
+        assert_eq!(c1.comparisons[0].n_subject, 6);
+        assert_eq!(verdict(c1), "inconclusive");
+        // No network disentangled: the premise is not met.
+        for r in &mut runs {
+            r.kl_per_latent[1] = 0.0;
+        }
+        let obs = FollowupObservations {
+            runs: &runs,
+            authors: None,
+        };
+        let c = evaluate_on(&file, &obs);
+        let c1 = c.iter().find(|c| c.claim.id == "C1").unwrap();
+        assert!(!c1.premise.as_ref().unwrap().met);
+        assert!(verdict(c1).starts_with("premise not met"));
     }
 
     #[test]

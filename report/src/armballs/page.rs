@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 
 use super::labels::{Condition, f2, f3};
 use super::runs::{
-    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, algos, ball_cells, ball_grid, display, of, ratios,
-    role,
+    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, active_roles, algos, ball_cells, ball_grid,
+    display, of, ratios, role,
 };
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
@@ -259,8 +259,10 @@ pub(super) fn write(
              each object's position classifies it: **ball** (ball R² ≥ {ENCODES}, distractor \
              < {IGNORES}), **distractor** (the reverse), **both** (entangled: both ≥ {IGNORES}), \
              **none** (both below {IGNORES}; collapsed), otherwise *mostly* one. A \
-             disentangled space in the follow-up's sense has ball-only and distractor-only \
-             latents.\n"
+             disentangled space in the follow-up's sense has an *active* ball-only latent and an \
+             active distractor-only one (below: a latent above {ACTIVE_NATS} nats; the R² is \
+             blind to a latent's scale, so a collapsed latent can still follow an object), and \
+             the claims about a disentangled space compare the repetitions whose β-VAE is.\n"
         );
         // MIG, SAP and the active latents, where the networks record them.
         let measured = learned
@@ -298,13 +300,7 @@ pub(super) fn write(
                 .map(|(b, d)| format!("{b:.2}/{d:.2}"))
                 .collect();
             let extra = if measured {
-                let active: Vec<&str> = r
-                    .kl_per_latent
-                    .iter()
-                    .zip(&roles)
-                    .filter(|(kl, _)| **kl > ACTIVE_NATS)
-                    .map(|(_, role)| *role)
-                    .collect();
+                let active = active_roles(&r.kl_per_latent, b, d);
                 format!(
                     " {} | {} | {} |",
                     r.mig.map(f2).unwrap_or_else(|| "n/a".into()),

@@ -364,6 +364,29 @@ pub(super) fn role(b: f64, d: f64) -> &'static str {
     }
 }
 
+/// The kind ([`role`]) of every active latent of a network, in latent order: a latent whose
+/// posterior's mean KL from the prior is above [`ACTIVE_NATS`]. A collapsed latent is left out
+/// even where its mean still follows an object (the R² is blind to a latent's scale, so a latent
+/// of 0.00 nats can have a ball R² of 0.98). A network without the per-latent KL (`kl` empty:
+/// no posterior, e.g. an autoencoder) has every latent counted. `ball` and `distractor` are the
+/// per-latent R² of each object's position.
+pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<&'static str> {
+    ball.iter()
+        .zip(distractor)
+        .enumerate()
+        .filter(|(j, _)| kl.is_empty() || kl.get(*j).is_some_and(|k| *k > ACTIVE_NATS))
+        .map(|(_, (b, d))| role(*b, *d))
+        .collect()
+}
+
+/// Whether a network's code is disentangled in the follow-up's sense: one of its active latents
+/// ([`active_roles`]) encodes the ball alone and another the distractor alone. The premise of
+/// the follow-up's claims, checked per network.
+pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> bool {
+    let roles = active_roles(kl, ball, distractor);
+    roles.contains(&"ball") && roles.contains(&"distractor")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,6 +415,32 @@ mod tests {
         r.per_latent = Some((vec![0.1, 0.0, 0.9, 0.8], vec![0.7, 0.9, 0.0, 0.05]));
         assert_eq!(r.aligned_modules(), [1, 0]);
         assert!(r.modules_ranked());
+    }
+
+    /// Only active latents count: a collapsed latent whose mean follows the distractor does not
+    /// make a network disentangled; without the per-latent KL every latent counts.
+    #[test]
+    fn a_network_is_disentangled_by_its_active_latents() {
+        let ball = [0.9, 0.02, 0.4];
+        let distractor = [0.01, 0.8, 0.4];
+        assert_eq!(
+            active_roles(&[3.1, 3.0, 2.0], &ball, &distractor),
+            ["ball", "distractor", "both"]
+        );
+        assert!(is_disentangled(&[3.1, 3.0, 2.0], &ball, &distractor));
+        // The distractor's latent collapsed (0.01 nats): its mean still follows the distractor.
+        assert_eq!(
+            active_roles(&[3.1, 0.01, 2.0], &ball, &distractor),
+            ["ball", "both"]
+        );
+        assert!(!is_disentangled(&[3.1, 0.01, 2.0], &ball, &distractor));
+        assert!(!is_disentangled(
+            &[3.1, ACTIVE_NATS, 2.0],
+            &ball,
+            &distractor
+        ));
+        assert!(is_disentangled(&[], &ball, &distractor));
+        assert!(!is_disentangled(&[], &ball[..1], &distractor[..1]));
     }
 
     #[test]

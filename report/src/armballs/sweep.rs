@@ -4,7 +4,7 @@
 //! `docs/neural.md`, "The sweep"), and the table there is this function's output on the
 //! committed sweep (`data/sweeps/conv`), checked by a test.
 //!
-//! The columns use the ArmBalls page's rules ([`ACTIVE_NATS`], [`role`]), so that a network is
+//! The columns use the ArmBalls page's rules ([`ACTIVE_NATS`], [`active_roles`]), so that a network is
 //! called disentangled by one definition wherever it is shown.
 
 use std::fmt::Write as _;
@@ -13,7 +13,7 @@ use std::path::Path;
 use ugl_types::Manifest;
 
 use super::labels::f2;
-use super::runs::{ACTIVE_NATS, role};
+use super::runs::{ACTIVE_NATS, active_roles};
 use crate::error::ReportError;
 
 /// The header of [`table`]: what each column holds.
@@ -90,12 +90,7 @@ fn row(m: &Manifest) -> String {
             .unwrap_or_default()
     };
     let (ball, distractor) = (r2("ball"), r2("distractor"));
-    let roles: Vec<&str> = kl
-        .iter()
-        .enumerate()
-        .filter(|(_, k)| **k > ACTIVE_NATS)
-        .filter_map(|(j, _)| Some(role(*ball.get(j)?, *distractor.get(j)?)))
-        .collect();
+    let roles = active_roles(&kl, &ball, &distractor);
     let active = kl.iter().filter(|k| **k > ACTIVE_NATS).count();
     let count = |kind: &str| roles.iter().filter(|r| **r == kind).count();
     let mut sorted = kl.clone();
