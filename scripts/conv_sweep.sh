@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # The sweep that chooses the follow-up's convolutional β-VAE settings (issue 44, item 3; its
 # measurements and the choice: docs/neural.md). Each SETTING is a comma-separated list of
-# [learners.conv-bvae] keys (or `vae` for the conv-vae at its defaults); each is trained on the
+# [learners.conv-bvae] keys, or `vae` followed by [learners.conv-vae] keys (`vae`: the conv-vae at
+# its defaults; `vae,lr=0.01,batch=128`); each is trained on the
 # repetition seeds SEEDS (default 1000 1001 1002: seeds the campaigns do not use, so nothing is
 # tuned on a campaign's own repetitions) with `ugl run` on armballs-corl, 10 latents, and
 # `ugl sweep-table OUT` tabulates what each network's manifest records: its loss fraction, the
 # per-latent KL, the latents active and which object each encodes, MIG and SAP.
 #
 #   scripts/conv_sweep.sh OUT SETTING...
-#   e.g. scripts/conv_sweep.sh /tmp/sweep beta=100,capacity=12,iterations=5000 vae
+#   e.g. scripts/conv_sweep.sh /tmp/sweep beta=100,capacity=12,iterations=5000 vae vae,lr=0.01
 #
 # Resumable: a (setting, seed) whose manifest exists is skipped. Environment: UGL (the binary;
 # default target/debug/ugl, built first), SEEDS, IMAGES (training pictures, default 10000),
@@ -28,18 +29,18 @@ for setting in "$@"; do
   tag="$(echo "$setting" | tr ',=' '_-')"
   dir="$out/$tag"
   mkdir -p "$dir"
-  if [ "$setting" = vae ]; then
-    algo=rge-conv-vae table="[learners.conv-vae]"
-  else
-    algo=rge-conv-bvae table="[learners.conv-bvae]"
-  fi
+  case "$setting" in
+    vae | vae,*) algo=rge-conv-vae table="[learners.conv-vae]" keys="${setting#vae}" ;;
+    *) algo=rge-conv-bvae table="[learners.conv-bvae]" keys="$setting" ;;
+  esac
+  keys="${keys#,}"
   {
     printf '[campaign]\nname = "conv-sweep"\nseed = 0\nreps = 1\n'
     printf '[matrix]\nenvs = ["armballs-corl"]\nalgos = ["%s"]\nlatents = [10]\n' "$algo"
     printf '[ugl]\nimages = %s\n[explore]\nepochs = %s\neval_every = %s\n' "$images" "$epochs" "$epochs"
     printf '%s\n' "$table"
-    if [ "$setting" != vae ]; then
-      echo "$setting" | tr ',' '\n' | sed 's/=/ = /'
+    if [ -n "$keys" ]; then
+      echo "$keys" | tr ',' '\n' | sed 's/=/ = /'
     fi
   } > "$dir/profile.toml"
   for seed in $seeds; do

@@ -60,6 +60,11 @@ pub struct LearnerInfo {
     /// moves no other; the slots of all strategies and learners are distinct and run from 0
     /// without a gap (`Algo::styled`).
     pub style: usize,
+    /// The learner whose random stream this one draws (None: its own). A learner that differs
+    /// from another only in its objective draws the other's stream, so that a repetition's two
+    /// networks start from the same weights and draw the same batches and noise: a paired
+    /// comparison of the objectives (the follow-up's VAE draws its β-VAE's).
+    pub shares_stream_with: Option<&'static LearnerInfo>,
 }
 
 const fn dense(iterations: usize, optimiser: &'static str, warmup: usize) -> PaperTraining {
@@ -84,6 +89,7 @@ pub static PCA: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: None,
     style: 2,
+    shares_stream_with: None,
 };
 pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     name: "pca-centred",
@@ -96,6 +102,7 @@ pub static PCA_CENTRED: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: None,
     style: 9,
+    shares_stream_with: None,
 };
 pub static ISOMAP: LearnerInfo = LearnerInfo {
     name: "isomap",
@@ -108,6 +115,7 @@ pub static ISOMAP: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: None,
     style: 3,
+    shares_stream_with: None,
 };
 pub static AE: LearnerInfo = LearnerInfo {
     name: "ae",
@@ -120,6 +128,7 @@ pub static AE: LearnerInfo = LearnerInfo {
     paper_training: Some(dense(200_000, "Adagrad", 0)),
     image: None,
     style: 4,
+    shares_stream_with: None,
 };
 pub static VAE: LearnerInfo = LearnerInfo {
     name: "vae",
@@ -132,6 +141,7 @@ pub static VAE: LearnerInfo = LearnerInfo {
     paper_training: Some(dense(100_000, "Adam", 0)),
     image: None,
     style: 5,
+    shares_stream_with: None,
 };
 pub static RFVAE: LearnerInfo = LearnerInfo {
     name: "rfvae",
@@ -144,6 +154,7 @@ pub static RFVAE: LearnerInfo = LearnerInfo {
     paper_training: Some(dense(50_000, "Adam", 10_000)),
     image: None,
     style: 6,
+    shares_stream_with: None,
 };
 pub static BVAE: LearnerInfo = LearnerInfo {
     name: "bvae",
@@ -156,6 +167,7 @@ pub static BVAE: LearnerInfo = LearnerInfo {
     paper_training: Some(dense(100_000, "Adam", 0)),
     image: None,
     style: 10,
+    shares_stream_with: None,
 };
 pub static CONV_VAE: LearnerInfo = LearnerInfo {
     name: "conv-vae",
@@ -168,6 +180,7 @@ pub static CONV_VAE: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: Some(RGB64),
     style: 11,
+    shares_stream_with: Some(&CONV_BVAE),
 };
 pub static CONV_BVAE: LearnerInfo = LearnerInfo {
     name: "conv-bvae",
@@ -180,6 +193,7 @@ pub static CONV_BVAE: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: Some(RGB64),
     style: 12,
+    shares_stream_with: None,
 };
 pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     name: "gaussian-projection",
@@ -192,6 +206,7 @@ pub static GAUSSIAN_PROJECTION: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: None,
     style: 13,
+    shares_stream_with: None,
 };
 pub static EXTERNAL: LearnerInfo = LearnerInfo {
     name: "external",
@@ -204,6 +219,7 @@ pub static EXTERNAL: LearnerInfo = LearnerInfo {
     paper_training: None,
     image: None,
     style: 14,
+    shares_stream_with: None,
 };
 
 /// Every learner, in the report's order.
@@ -222,6 +238,11 @@ pub static LEARNERS: [&LearnerInfo; 11] = [
 ];
 
 impl LearnerInfo {
+    /// The name the learner's random stream derives from ([`Self::shares_stream_with`]).
+    pub fn stream_name(&self) -> &'static str {
+        self.shares_stream_with.map_or(self.name, |l| l.name)
+    }
+
     /// Every learner, in the registry's order.
     pub fn all() -> impl Iterator<Item = &'static LearnerInfo> {
         LEARNERS.iter().copied()

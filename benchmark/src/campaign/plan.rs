@@ -172,26 +172,31 @@ impl RunSpec {
     /// the same env, learner, variant, latent size, data-set size and repetition); None for
     /// baselines. It groups runs, shards and names the model cache entry.
     pub fn representation_identity(&self, images: usize) -> Option<String> {
-        self.learner_seed_identity(images)
-            .map(|id| match self.variant {
+        self.algo.learner().map(|l| {
+            let id = self.learner_identity(l.name(), images);
+            match self.variant {
                 Some(v) => format!("{id}/variant={v}"),
                 None => id,
-            })
+            }
+        })
     }
 
     /// The identity the learner's random stream derives from: the representation identity
     /// without the variant, so the faithful and corrected variants of a cell start from the
-    /// same weights and draw the same batches (a paired comparison).
+    /// same weights and draw the same batches (a paired comparison), and under the name of the
+    /// learner whose stream it shares (`LearnerInfo::shares_stream_with`: the follow-up's VAE
+    /// draws its β-VAE's, so a repetition's two start from the same weights too).
     pub fn learner_seed_identity(&self, images: usize) -> Option<String> {
-        self.algo.learner().map(|l| {
-            format!(
-                "repr/env={}/learner={}/latents={}/images={images}/seed={}",
-                self.env,
-                l.name(),
-                self.latents,
-                self.seed
-            )
-        })
+        self.algo
+            .learner()
+            .map(|l| self.learner_identity(l.entry().info.stream_name(), images))
+    }
+
+    fn learner_identity(&self, learner: &str, images: usize) -> String {
+        format!(
+            "repr/env={}/learner={learner}/latents={}/images={images}/seed={}",
+            self.env, self.latents, self.seed
+        )
     }
 }
 
@@ -396,6 +401,54 @@ mod tests {
             .run_id(),
             "armball.rge-ae.kde.l2.s0"
         );
+    }
+
+    /// The follow-up's VAE draws its β-VAE's stream (a repetition's two networks start from the
+    /// same weights and batches) but keeps its own model; every other learner draws its own,
+    /// under the identity its committed runs were drawn with.
+    #[test]
+    fn the_convolutional_vae_draws_the_beta_vaes_stream() {
+        let spec = |learner: &str, env| {
+            RunSpec::learned(
+                env,
+                Algo::rge(Learner::by_name(learner).unwrap()),
+                SamplerKind::GAUSSIAN,
+                10,
+                Variant::Faithful,
+                3,
+            )
+        };
+        // (learner, its β twin, environment, the learner's stream and model identities).
+        for (learner, twin, env, stream, model) in [
+            (
+                "conv-vae",
+                "conv-bvae",
+                EnvKind::ARMBALLS_CORL,
+                "repr/env=armballs-corl/learner=conv-bvae/latents=10/images=100/seed=3",
+                "repr/env=armballs-corl/learner=conv-vae/latents=10/images=100/seed=3",
+            ),
+            (
+                "vae",
+                "bvae",
+                EnvKind::ARMBALL,
+                "repr/env=armball/learner=vae/latents=10/images=100/seed=3",
+                "repr/env=armball/learner=vae/latents=10/images=100/seed=3/variant=faithful",
+            ),
+        ] {
+            let (a, b) = (spec(learner, env), spec(twin, env));
+            assert_eq!(a.learner_seed_identity(100).as_deref(), Some(stream));
+            assert_eq!(a.representation_identity(100).as_deref(), Some(model));
+            assert_ne!(
+                a.representation_identity(100),
+                b.representation_identity(100)
+            );
+            let shared = learner.starts_with("conv");
+            assert_eq!(
+                a.learner_seed_identity(100) == b.learner_seed_identity(100),
+                shared,
+                "{learner} and {twin}"
+            );
+        }
     }
 
     /// The position-only engineered goal space is a condition only where the outcome has an

@@ -23,7 +23,7 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
 /// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning
-/// rate, the iterations, and whether subnormals were flushed.
+/// rate, the batch, the iterations, and whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
     let learner = m.learner.as_deref().map(|name| {
         ugl_types::LEARNERS
@@ -61,6 +61,9 @@ fn setting(m: &Manifest) -> String {
     }
     if let Some(lr) = num("lr") {
         parts.push(format!("lr {lr}"));
+    }
+    if let Some(batch) = int("batch") {
+        parts.push(format!("batch {batch}"));
     }
     parts.push(format!(
         "{} it",
@@ -178,8 +181,8 @@ mod tests {
         assert!(e.contains("holds no sweep run"), "{e}");
     }
 
-    /// The setting names the KL delay, and the phase's KL weight (its factor times β) where the
-    /// configuration sets the factor.
+    /// The setting names the KL delay, the phase's KL weight (its factor times β) where the
+    /// configuration sets the factor, the learning rate and the batch.
     #[test]
     fn the_setting_names_the_delay_and_its_weight() {
         let path = concat!(
@@ -189,7 +192,7 @@ mod tests {
         );
         let mut m = crate::load::read_manifest(std::path::Path::new(path)).unwrap();
         assert!(
-            setting(&m).contains(", KL delayed 3000, warm-up 1000"),
+            setting(&m).contains(", KL delayed 3000, warm-up 1000, lr 0.001, batch 64, 8000 it"),
             "{}",
             setting(&m)
         );
