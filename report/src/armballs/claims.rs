@@ -145,7 +145,8 @@ impl Observations for FollowupObservations<'_> {
                     String::new()
                 }
             ),
-            repetitions: Some(repetitions),
+            // None meets it: the difference on every repetition is still shown, marked.
+            repetitions: (yes > 0).then_some(repetitions),
         })
     }
 }
@@ -669,8 +670,11 @@ mod tests {
         assert_eq!(c.comparisons[0].n_subject, 6);
         assert_eq!(verdict(&c), "inconclusive");
         // No network disentangled: the premise is not met.
+        // No network disentangled: the premise is not met, and the difference on all six
+        // repetitions is shown beside it.
         let c = c1(&networks(&|_| Some(0.0)));
         assert!(!c.premise.as_ref().unwrap().met);
+        assert_eq!(c.comparisons[0].n_subject, 6);
         assert!(verdict(&c).starts_with("premise not met"));
     }
 
