@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use super::authors::{self, Authors};
 use super::labels::{Condition, f3};
-use super::runs::{FollowupRun, display, is_disentangled};
+use super::runs::{FollowupRun, display, is_disentangled, one_run_per_network};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
@@ -179,19 +179,17 @@ fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
 /// modular runs share it), each with whether it is disentangled ([`is_disentangled`]: an active
 /// ball-only and an active distractor-only latent).
 fn networks(runs: &[FollowupRun], learner: &str) -> Vec<((Option<String>, i64), bool)> {
-    let mut seen = BTreeSet::new();
-    let mut out = Vec::new();
-    for r in runs {
-        let (Some(l), Some((b, d))) = (&r.learner, &r.per_latent) else {
-            continue;
-        };
-        let repetition = (r.key.tag.clone(), r.seed);
-        if l != learner || !seen.insert((repetition.clone(), r.key.latents)) {
-            continue;
-        }
-        out.push((repetition, is_disentangled(&r.kl_per_latent, b, d)));
-    }
-    out
+    one_run_per_network(runs)
+        .into_iter()
+        .filter(|r| r.learner.as_deref() == Some(learner))
+        .filter_map(|r| {
+            let (b, d) = r.per_latent.as_ref()?;
+            Some((
+                (r.key.tag.clone(), r.seed),
+                is_disentangled(&r.kl_per_latent, b, d),
+            ))
+        })
+        .collect()
 }
 
 /// A claim's verdict in words: the engine's, or "premise not met" with it.

@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 
 use super::labels::{Condition, f2, f3};
 use super::runs::{
-    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, active_roles, algos, ball_cells, ball_grid,
-    display, of, ratios, role,
+    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, LatentRole, active_roles, algos, ball_cells,
+    ball_grid, count_role, display, of, one_run_per_network, ratios, role,
 };
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
@@ -234,20 +234,7 @@ pub(super) fn write(
     }
 
     // 3. Disentanglement.
-    let learned: Vec<&FollowupRun> = {
-        let mut seen = std::collections::BTreeSet::new();
-        runs.iter()
-            .filter(|r| r.per_latent.is_some())
-            .filter(|r| {
-                seen.insert((
-                    r.cond.tag().to_string(),
-                    r.learner.clone(),
-                    r.seed,
-                    r.key.latents,
-                ))
-            })
-            .collect()
-    };
+    let learned = one_run_per_network(runs);
     if !learned.is_empty() {
         let _ = writeln!(
             p,
@@ -292,8 +279,8 @@ pub(super) fn write(
         p.push_str("---|\n");
         for r in &learned {
             let (b, d) = r.per_latent.as_ref().expect("filtered");
-            let roles: Vec<&str> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
-            let count = |x: &str| roles.iter().filter(|r| **r == x).count();
+            let roles: Vec<LatentRole> = b.iter().zip(d).map(|(b, d)| role(*b, *d)).collect();
+            let count = |kind| count_role(&roles, kind);
             let per: Vec<String> = b
                 .iter()
                 .zip(d)
@@ -308,7 +295,15 @@ pub(super) fn write(
                     if r.kl_per_latent.is_empty() {
                         "n/a".to_string()
                     } else {
-                        format!("{} ({})", active.len(), active.join(", "))
+                        format!(
+                            "{} ({})",
+                            active.len(),
+                            active
+                                .iter()
+                                .map(|r| r.label())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
                     }
                 )
             } else {
@@ -330,10 +325,10 @@ pub(super) fn write(
                 r.loss_fraction.map(f2).unwrap_or_else(|| "n/a".into()),
                 r.knn_ball.map(f2).unwrap_or_else(|| "n/a".into()),
                 r.knn_distractor.map(f2).unwrap_or_else(|| "n/a".into()),
-                count("ball"),
-                count("distractor"),
-                count("both"),
-                count("none"),
+                count(LatentRole::Ball),
+                count(LatentRole::Distractor),
+                count(LatentRole::Both),
+                count(LatentRole::Neither),
                 per.join(" "),
             );
         }

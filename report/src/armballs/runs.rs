@@ -352,16 +352,68 @@ pub(super) fn ratios(runs: &[FollowupRun], cond: &Condition) -> Vec<f64> {
     of(runs, cond).iter().map(|r| r.final_ratio()).collect()
 }
 
-/// A latent's role from its two R²: `ball`, `distractor`, `both` (entangled) or `none`.
-pub(super) fn role(b: f64, d: f64) -> &'static str {
-    match (b >= ENCODES && d < IGNORES, d >= ENCODES && b < IGNORES) {
-        (true, _) => "ball",
-        (_, true) => "distractor",
-        _ if b >= IGNORES && d >= IGNORES => "both",
-        _ if b < IGNORES && d < IGNORES => "none",
-        _ if b > d => "mostly ball",
-        _ => "mostly distractor",
+/// What one latent encodes, from the k-NN R² of each object's position ([`role`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum LatentRole {
+    /// The ball alone (its R² at least [`ENCODES`], the distractor's below [`IGNORES`]).
+    Ball,
+    /// The distractor alone.
+    Distractor,
+    /// Both objects (entangled: both R² at least [`IGNORES`]).
+    Both,
+    /// Neither (both below [`IGNORES`]; collapsed).
+    Neither,
+    MostlyBall,
+    MostlyDistractor,
+}
+
+impl LatentRole {
+    /// The word the page and the sweep table print.
+    pub(super) fn label(self) -> &'static str {
+        match self {
+            LatentRole::Ball => "ball",
+            LatentRole::Distractor => "distractor",
+            LatentRole::Both => "both",
+            LatentRole::Neither => "none",
+            LatentRole::MostlyBall => "mostly ball",
+            LatentRole::MostlyDistractor => "mostly distractor",
+        }
     }
+}
+
+impl std::fmt::Display for LatentRole {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.label())
+    }
+}
+
+/// A latent's role from its two R² (`b` the ball's, `d` the distractor's).
+pub(super) fn role(b: f64, d: f64) -> LatentRole {
+    match (b >= ENCODES && d < IGNORES, d >= ENCODES && b < IGNORES) {
+        (true, _) => LatentRole::Ball,
+        (_, true) => LatentRole::Distractor,
+        _ if b >= IGNORES && d >= IGNORES => LatentRole::Both,
+        _ if b < IGNORES && d < IGNORES => LatentRole::Neither,
+        _ if b > d => LatentRole::MostlyBall,
+        _ => LatentRole::MostlyDistractor,
+    }
+}
+
+/// How many of `roles` are `role`.
+pub(super) fn count_role(roles: &[LatentRole], role: LatentRole) -> usize {
+    roles.iter().filter(|r| **r == role).count()
+}
+
+/// One run per learned network: the first of each (variant campaign's tag, learner, seed,
+/// latent count), since a network's flat and modular runs share it. Runs without a learned
+/// goal space (no per-latent measure) are left out. The page's disentanglement table and the
+/// claims' premise both count networks through it.
+pub(super) fn one_run_per_network(runs: &[FollowupRun]) -> Vec<&FollowupRun> {
+    let mut seen = BTreeSet::new();
+    runs.iter()
+        .filter(|r| r.per_latent.is_some())
+        .filter(|r| seen.insert((r.key.tag.clone(), r.learner.clone(), r.seed, r.key.latents)))
+        .collect()
 }
 
 /// The kind ([`role`]) of every active latent of a network, in latent order: a latent whose
@@ -370,7 +422,7 @@ pub(super) fn role(b: f64, d: f64) -> &'static str {
 /// of 0.00 nats can have a ball R² of 0.98). A network without the per-latent KL (`kl` empty:
 /// no posterior, e.g. an autoencoder) has every latent counted. `ball` and `distractor` are the
 /// per-latent R² of each object's position.
-pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<&'static str> {
+pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<LatentRole> {
     ball.iter()
         .zip(distractor)
         .enumerate()
@@ -384,7 +436,7 @@ pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<
 /// the follow-up's claims, checked per network.
 pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> bool {
     let roles = active_roles(kl, ball, distractor);
-    roles.contains(&"ball") && roles.contains(&"distractor")
+    roles.contains(&LatentRole::Ball) && roles.contains(&LatentRole::Distractor)
 }
 
 #[cfg(test)]
@@ -425,13 +477,13 @@ mod tests {
         let distractor = [0.01, 0.8, 0.4];
         assert_eq!(
             active_roles(&[3.1, 3.0, 2.0], &ball, &distractor),
-            ["ball", "distractor", "both"]
+            [LatentRole::Ball, LatentRole::Distractor, LatentRole::Both]
         );
         assert!(is_disentangled(&[3.1, 3.0, 2.0], &ball, &distractor));
         // The distractor's latent collapsed (0.01 nats): its mean still follows the distractor.
         assert_eq!(
             active_roles(&[3.1, 0.01, 2.0], &ball, &distractor),
-            ["ball", "both"]
+            [LatentRole::Ball, LatentRole::Both]
         );
         assert!(!is_disentangled(&[3.1, 0.01, 2.0], &ball, &distractor));
         assert!(!is_disentangled(
@@ -445,10 +497,12 @@ mod tests {
 
     #[test]
     fn latent_roles() {
-        assert_eq!(role(0.9, 0.01), "ball");
-        assert_eq!(role(0.02, 0.8), "distractor");
-        assert_eq!(role(0.5, 0.2), "both");
-        assert_eq!(role(0.01, 0.05), "none");
-        assert_eq!(role(0.3, 0.05), "mostly ball");
+        assert_eq!(role(0.9, 0.01), LatentRole::Ball);
+        assert_eq!(role(0.02, 0.8), LatentRole::Distractor);
+        assert_eq!(role(0.5, 0.2), LatentRole::Both);
+        assert_eq!(role(0.01, 0.05), LatentRole::Neither);
+        assert_eq!(role(0.3, 0.05), LatentRole::MostlyBall);
+        assert_eq!(role(0.05, 0.3), LatentRole::MostlyDistractor);
+        assert_eq!(LatentRole::Neither.to_string(), "none");
     }
 }

@@ -13,7 +13,7 @@ use std::path::Path;
 use ugl_types::Manifest;
 
 use super::labels::f2;
-use super::runs::{ACTIVE_NATS, active_roles};
+use super::runs::{ACTIVE_NATS, LatentRole, active_roles, count_role};
 use crate::error::ReportError;
 
 /// The header of [`table`]: what each column holds.
@@ -95,7 +95,7 @@ fn row(m: &Manifest) -> String {
     let (ball, distractor) = (r2("ball"), r2("distractor"));
     let roles = active_roles(&kl, &ball, &distractor);
     let active = kl.iter().filter(|k| **k > ACTIVE_NATS).count();
-    let count = |kind: &str| roles.iter().filter(|r| **r == kind).count();
+    let count = |kind| count_role(&roles, kind);
     let mut sorted = kl.clone();
     sorted.sort_by(|a, b| b.total_cmp(a));
     let knn = |group: &str| {
@@ -123,9 +123,9 @@ fn row(m: &Manifest) -> String {
             .map(|k| format!("{k:.2}"))
             .collect::<Vec<_>>()
             .join(" "),
-        count("ball"),
-        count("distractor"),
-        count("both"),
+        count(LatentRole::Ball),
+        count(LatentRole::Distractor),
+        count(LatentRole::Both),
         knn("position"),
         knn("distractor"),
         dis.map_or("n/a".into(), |d| format!("{:.3}", d.mig)),

@@ -271,7 +271,8 @@ impl Section for Illustrations {
     }
     fn render(&self, _: &Context<'_>, out: &mut Output) -> Result<String, ReportError> {
         let dir = out.figures_dir();
-        let mut figs = Vec::new();
+        // Room for all three, so the build without the environment figures pushes fewer.
+        let mut figs = Vec::with_capacity(3);
         #[cfg(feature = "environment-figures")]
         figs.push(figures::environment::draw_environments(&dir)?);
         figs.push(figures::radial_flow::draw(&dir)?);
