@@ -1149,3 +1149,46 @@ fn truncate(s: &str, max: usize) -> String {
         None => s.to_string(),
     }
 }
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::START_GATE;
+    use std::io::Write;
+    use std::path::Path;
+    use std::process::{Command, ExitStatus, Stdio};
+
+    /// The learner's shell as `Session::spawn` starts it, with a command that leaves `marker`;
+    /// `open`: the harness writes the gate's line, otherwise it closes the shell's input unwritten
+    /// (the harness died before its watchdog ran).
+    fn gated(marker: &Path, open: bool) -> ExitStatus {
+        let mut child = Command::new("sh")
+            .args(["-c", START_GATE, "ugl-learner"])
+            .arg(format!("touch '{}'", marker.display()))
+            .stdin(Stdio::piped())
+            .spawn()
+            .expect("sh starts");
+        let mut stdin = child.stdin.take().expect("piped stdin");
+        if open {
+            stdin.write_all(b"\n").expect("the gate's line");
+        }
+        drop(stdin);
+        child.wait().expect("sh ends")
+    }
+
+    /// The program starts only once the harness opens the gate: a harness gone before it (its
+    /// input closed) leaves nothing running. Without the gate the program would run at once.
+    #[test]
+    fn the_learner_starts_only_once_the_gate_opens() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let marker = dir.path().join("started");
+        let status = gated(&marker, false);
+        assert!(!status.success(), "the shell exits with an error");
+        assert!(!marker.exists(), "the program ran without the gate's line");
+        let status = gated(&marker, true);
+        assert!(status.success());
+        assert!(
+            marker.exists(),
+            "the program did not run once the gate opened"
+        );
+    }
+}
