@@ -667,7 +667,6 @@ mod tests {
         assert!(c.premise.as_ref().unwrap().counted.contains("6 of 6"));
         assert_eq!(c.comparisons[0].n_subject, 6);
         assert_eq!(verdict(&c), "inconclusive");
-        // No network disentangled: the premise is not met.
         // No network disentangled: the premise is not met, and the difference on all six
         // repetitions is shown beside it.
         let c = c1(&networks(&|_| Some(0.0)));
