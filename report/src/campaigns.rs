@@ -100,6 +100,18 @@ pub struct Campaigns {
 }
 
 impl Campaigns {
+    /// The campaigns of a role that the report reads (the main campaign alone for `Main`).
+    pub fn of_role(&self, role: CampaignRole) -> &[Campaign] {
+        match role {
+            CampaignRole::Main => std::slice::from_ref(&self.main),
+            CampaignRole::Budget => &self.budget,
+            CampaignRole::Compare => &self.compare,
+            CampaignRole::Recipe => &self.recipe,
+            CampaignRole::Followup => &self.followup,
+            CampaignRole::Validation => &self.validation,
+        }
+    }
+
     /// Every campaign the report reads: the main one first, then by role.
     pub fn used(&self) -> impl Iterator<Item = &Campaign> {
         std::iter::once(&self.main)

@@ -861,6 +861,15 @@ fn a_validation_campaign_is_what_the_validity_check_reads() {
         "{md}"
     );
     assert!(!md.contains("**the same runs carry the claims**"));
+    // It is listed among the campaigns read, and under *How to reproduce*.
+    assert!(
+        md.contains("the validity check's held-out repetitions `paper-validation` ("),
+        "{md}"
+    );
+    assert!(
+        md.contains("make campaign PROFILE=paper-validation\n"),
+        "{md}"
+    );
     // Only the validation campaign's runs are checked: the main campaign's copies give the same
     // lines, without the recipe and compare campaigns' runs.
     let after = std::fs::read_to_string(out2.join("data/validity.csv")).unwrap();

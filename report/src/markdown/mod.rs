@@ -12,6 +12,7 @@ use crate::figures::FigureFile;
 use crate::load::{Run, campaign_display};
 use crate::names::{algo_name, describe_key, env_name};
 use crate::options::ReportOptions;
+use ugl_types::CampaignRole;
 
 pub mod claims;
 pub mod compare;
@@ -1106,14 +1107,14 @@ pub fn reproduce(w: &mut String, inp: &Context<'_>) {
         }
     };
     let _ = writeln!(w, "{}", profile(&inp.campaigns.main.name));
-    for c in inp
-        .campaigns
-        .budget
-        .iter()
-        .chain(&inp.campaigns.recipe)
-        .chain(&inp.campaigns.followup)
-    {
-        let _ = writeln!(w, "{}", profile(&c.name));
+    // Every other role's campaigns by their profile, but the `ugl compare` ones (below).
+    for role in CampaignRole::ALL {
+        if matches!(role, CampaignRole::Main | CampaignRole::Compare) {
+            continue;
+        }
+        for c in inp.campaigns.of_role(role) {
+            let _ = writeln!(w, "{}", profile(&c.name));
+        }
     }
     for c in &inp.campaigns.compare {
         // The learner its runs recorded (`ugl compare --learner NAME` wrote them).

@@ -16,6 +16,7 @@ use crate::load::campaign_display;
 use crate::names::{algo_name, env_name, learner_name, sampler_name};
 use crate::neural::{self, BudgetPoint, paper_training};
 use crate::stats::{self, Summary};
+use ugl_types::CampaignRole;
 
 /// What faithful and corrected mean, for the report's readers.
 pub const VARIANT_NOTE: &str = "*Faithful* reproduces the original code's behaviour, defects \
@@ -32,8 +33,20 @@ fn campaign(name: &str) -> String {
     format!("`{}`", campaign_display(name))
 }
 
-/// `- **Campaigns:** ...`: the main one, the budget and training-recipe ones, and those present
-/// but not used.
+/// What the campaigns of a role are, in the campaigns line.
+fn role_words(role: CampaignRole) -> &'static str {
+    match role {
+        CampaignRole::Main => "main",
+        CampaignRole::Budget => "training-budget sensitivity",
+        CampaignRole::Compare => "new learners (`ugl compare`)",
+        CampaignRole::Recipe => "training recipes",
+        CampaignRole::Followup => "the follow-up paper's setting",
+        CampaignRole::Validation => "the validity check's held-out repetitions",
+    }
+}
+
+/// `- **Campaigns:** ...`: the main one, those of every other role the report reads, and those
+/// present but not used.
 pub fn campaigns_line(w: &mut String, inp: &Context<'_>) {
     let c = inp.campaigns;
     let n = c.main.store.runs.len();
@@ -53,23 +66,11 @@ pub fn campaigns_line(w: &mut String, inp: &Context<'_>) {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    if !c.budget.is_empty() {
-        parts.push(format!("training-budget sensitivity {}", listed(&c.budget)));
-    }
-    if !c.recipe.is_empty() {
-        parts.push(format!("training recipes {}", listed(&c.recipe)));
-    }
-    if !c.compare.is_empty() {
-        parts.push(format!(
-            "new learners (`ugl compare`) {}",
-            listed(&c.compare)
-        ));
-    }
-    if !c.followup.is_empty() {
-        parts.push(format!(
-            "the follow-up paper's setting {}",
-            listed(&c.followup)
-        ));
+    for role in CampaignRole::ALL {
+        let group = c.of_role(role);
+        if role != CampaignRole::Main && !group.is_empty() {
+            parts.push(format!("{} {}", role_words(role), listed(group)));
+        }
     }
     if !c.unused.is_empty() {
         let u: Vec<String> = c
