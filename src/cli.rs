@@ -156,7 +156,9 @@ pub(crate) enum Command {
     Compare(CompareArgs),
     /// Write a Slurm job for a campaign into a job directory: an array job (one task per
     /// shard), a report step that runs once every task succeeded, and `submit.sh`, which builds
-    /// ugl once and submits both. Nothing is written into the checkout unless told.
+    /// ugl once and submits both. Everything goes under OUT (default data/results/<name>, in
+    /// the checkout, where git ignores the job directory and the report) unless --scripts and
+    /// --report-out say otherwise.
     Slurm(SlurmArgs),
     /// How far a campaign's results directory is: runs complete, missing, damaged or of
     /// another configuration, overall and per shard (what a resumed campaign would compute).
@@ -178,6 +180,10 @@ pub(crate) enum Command {
     /// rerun a sample of its runs (stratified over the conditions, at least one trained
     /// network) from the campaign's profile into a scratch directory, fitting afresh, and
     /// compare their bytes with the committed ones. Exits with an error on any difference.
+    /// Each sampled run is recomputed whole: a trained network is retrained from scratch, with
+    /// its progress on stderr (a `paper-long` network takes hours). The first Ctrl-C stops after
+    /// the rerun in flight and reports the ones done. Stores written by `ugl compare` have no
+    /// profile of their own and are not checked yet.
     Verify {
         /// A campaign's results directory (holding its campaign.toml).
         #[arg(long)]
@@ -186,7 +192,8 @@ pub(crate) enum Command {
         /// configuration hash must be the record's.
         #[arg(long)]
         config: Option<PathBuf>,
-        /// How many runs to rerun.
+        /// How many runs to rerun: at most one per condition, so at most the number of
+        /// conditions.
         #[arg(long, default_value_t = 4)]
         sample: usize,
     },
@@ -218,9 +225,9 @@ pub(crate) enum Command {
         /// The paper's reference values.
         #[arg(long, default_value = "data/paper")]
         paper: PathBuf,
-        /// The campaign (sub-directory of --results) the figures and tables are drawn from;
-        /// `budget-*` campaigns feed the training-budget section. `(top level)` or `.`: the
-        /// runs directly in --results.
+        /// The campaign (sub-directory of --results) the figures and tables are drawn from; the
+        /// campaigns whose recorded role ties them to it (budget, recipe, compare, follow-up,
+        /// validation) feed their sections. `(top level)` or `.`: the runs directly in --results.
         #[arg(long = "main", default_value = "paper")]
         main_campaign: String,
     },

@@ -1000,6 +1000,14 @@ fn shards_merge_into_the_whole_campaign() {
         )),
         "--shard",
     );
+    // More shards than groups of runs sharing a fit: refused, as `status` and `slurm` do.
+    assert_one_line_error(
+        &ugl(&argv(
+            "campaign --config {} --out {} --shard 0/1000",
+            &[p(&cfg), p(&whole)],
+        )),
+        "groups of runs that share a fit",
+    );
 }
 
 /// `ugl status` says what a resumed campaign would compute: complete, missing and damaged runs,
@@ -2046,6 +2054,32 @@ fn a_failing_external_fit_is_started_once_per_cell() {
     );
     let n = std::fs::read_to_string(&starts).unwrap().lines().count();
     assert_eq!(n, 1, "started once for 6 runs in 3 groups");
+}
+
+/// Several failed fits (one per cell) are counted in the campaign's one-line error, with the
+/// first, not dropped.
+#[test]
+fn several_failures_are_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("ext.toml");
+    std::fs::write(
+        &cfg,
+        "[campaign]\nname = \"ext-fail2\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\n\
+         algos = [\"rpe\", \"rge-external\"]\nsamplers = [\"kde\"]\nlatents = [2, 3]\n\
+         [ugl]\nimages = 50\n[explore]\nbootstrap_epochs = 10\nepochs = 20\n\
+         [learners.external]\nname = \"broken\"\ncommand = \"sh -c 'exit 3'\"\n",
+    )
+    .unwrap();
+    let o = ugl(&argv(
+        "campaign --config {} --out {} --jobs 1 --quiet",
+        &[p(&cfg), p(&dir.path().join("res"))],
+    ));
+    assert_one_line_error(&o, "2 runs failed (0 more not run");
+    assert!(
+        stderr(&o).contains("1 finished and stored"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// A run whose data file was truncated after its manifest was written is not complete: `ugl

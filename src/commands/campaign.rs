@@ -95,6 +95,14 @@ pub(crate) fn refresh_config(
     Ok(())
 }
 
+/// The number of groups of runs that share a fit: the most non-empty shards of a campaign.
+fn fit_groups(cfg: &CampaignConfig) -> usize {
+    shard_groups(&plan(cfg), cfg.ugl.images)
+        .into_iter()
+        .max()
+        .map_or(1, |g| g + 1)
+}
+
 /// The checked `--shard`, `--out` (default `data/results/<campaign>`) and `--jobs` (default: the
 /// number of cores) of a campaign command.
 pub(crate) fn campaign_args(
@@ -107,6 +115,16 @@ pub(crate) fn campaign_args(
         .map(parse_shard)
         .transpose()
         .map_err(|e| anyhow::anyhow!(e))?;
+    if let Some((_, n)) = shard {
+        // As `ugl status` and `ugl slurm`: a shard beyond the groups would run nothing.
+        let groups = fit_groups(cfg);
+        if n > groups {
+            bail!(
+                "--shard: {n} shards, but the campaign has {groups} groups of runs that share a \
+                 fit (more shards would be empty)"
+            );
+        }
+    }
     let out = out.unwrap_or_else(|| PathBuf::from("data/results").join(&cfg.campaign.name));
     let jobs = jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
@@ -163,6 +181,12 @@ pub(crate) fn run_config(cfg: &CampaignConfig, profile: &str, opts: RunOptions<'
         Progress::Finished(s) => {
             bar.inc(1);
             bar.set_message(format!("{} klc={:.3}", s.run, s.final_klc));
+        }
+        Progress::Failed { error, .. } => {
+            // On a terminal each failure is shown as it happens; the campaign's error at the end
+            // counts them all and gives the first (one line in a log).
+            bar.inc(1);
+            bar.println(format!("failed: {error}"));
         }
     };
     let opts = CampaignOptions {
@@ -259,10 +283,7 @@ pub(crate) fn status(
     let cfg = CampaignConfig::load(config)?;
     // At most one shard per group of runs that share a fit, as `ugl slurm` writes them (a huge
     // count would only allocate empty shards).
-    let n_groups = shard_groups(&plan(&cfg), cfg.ugl.images)
-        .into_iter()
-        .max()
-        .map_or(1, |g| g + 1);
+    let n_groups = fit_groups(&cfg);
     if shards == 0 || shards > n_groups {
         bail!(
             "--shards {shards}: must be between 1 and {n_groups}, the campaign's groups of runs \

@@ -2,6 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -13,6 +14,7 @@ use ugl_bench::campaign::{Harness, RunContext};
 use ugl_types::{CampaignRecord, Manifest, RESULTS_VERSION, verify_files};
 
 use crate::output::outln;
+use crate::progress::{learner_lines, progress_area, stop_on_ctrl_c, training_bars};
 
 /// One committed run chosen for a rerun.
 struct Pick {
@@ -152,6 +154,14 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
         }
     }
     let checked = runs.len() + older;
+    if checked == 0 {
+        bail!(
+            "{}: no run of the plan of {} is in it (a store written by `ugl compare` has no \
+             profile of its own and cannot be checked yet)",
+            results.display(),
+            path.display()
+        );
+    }
     if runs.is_empty() {
         bail!(
             "{}: none of its {checked} runs is of this code's results version ({RESULTS_VERSION}): \
@@ -159,27 +169,36 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
             results.display()
         );
     }
+    let of_version = runs.len();
+    let picks = sample(runs, n);
     outln!(
         "{}: {checked} runs match their recorded digests ({older} of an older results version); \
-         rerunning {} of the {} of version {RESULTS_VERSION}",
+         rerunning {} of the {of_version} of version {RESULTS_VERSION} (at most one per condition)",
         results.display(),
-        n.min(runs.len()),
-        runs.len()
+        picks.len(),
     )?;
-    let picks = sample(runs, n);
-    let scratch = std::env::temp_dir().join(format!("ugl-verify-{}", std::process::id()));
+    let scratch = Scratch(std::env::temp_dir().join(format!("ugl-verify-{}", std::process::id())));
     let profile_name = path.display().to_string();
+    let stop = stop_on_ctrl_c("the rerun in flight")?;
+    let mp = progress_area();
     let ctx = RunContext::new(
         &cfg,
         rayon::current_num_threads(),
         Harness {
             profile: &profile_name,
+            train_progress: Some(training_bars(&mp, None)),
+            learner_messages: Some(learner_lines(&mp, None)),
             ..Harness::default()
         },
     );
     let mut failed = 0;
+    let mut done = 0;
     for p in &picks {
-        let dir = scratch.join(p.spec.run_id());
+        if stop.load(Ordering::SeqCst) {
+            break;
+        }
+        done += 1;
+        let dir = scratch.0.join(p.spec.run_id());
         std::fs::create_dir_all(&dir)
             .with_context(|| format!("cannot create {}", dir.display()))?;
         let t0 = Instant::now();
@@ -203,12 +222,25 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
         // Best effort: a scratch copy left behind is harmless.
         let _ = std::fs::remove_dir_all(&dir);
     }
-    let _ = std::fs::remove_dir_all(&scratch);
     if failed > 0 {
+        bail!("{failed} of {done} rerun runs differ from the committed ones");
+    }
+    if done < picks.len() {
         bail!(
-            "{failed} of {} rerun runs differ from the committed ones",
+            "interrupted: {done} of the {} sampled runs rerun, all with the same bytes",
             picks.len()
         );
     }
     Ok(())
+}
+
+/// The scratch directory of the reruns, removed however `verify` ends (an error, an interrupt)
+/// but a second Ctrl-C, which exits at once.
+struct Scratch(PathBuf);
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        // Best effort: a scratch copy left behind is harmless.
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }

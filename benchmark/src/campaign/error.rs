@@ -26,4 +26,16 @@ pub enum RunError {
         "interrupted: {done} of {total} runs finished and stored; rerun the same command to resume"
     )]
     Interrupted { done: usize, total: usize },
+    /// Several runs failed (each reported as it failed, `Progress::Failed`); the others
+    /// finished and are stored.
+    #[error(
+        "{failed} runs failed ({not_run} more not run: the fit they share failed; {stored} \
+         finished and stored); the first failure: {first}"
+    )]
+    Failed {
+        failed: usize,
+        not_run: usize,
+        stored: usize,
+        first: Box<RunError>,
+    },
 }

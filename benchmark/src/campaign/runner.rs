@@ -28,6 +28,10 @@ pub enum Progress {
     Planned { total: usize, skipped: usize },
     /// A run finished.
     Finished(Summary),
+    /// A run failed (its fit or its exploration; not the runs skipped because a fit they share
+    /// failed before); the campaign goes on with the other groups and returns an error at the
+    /// end.
+    Failed { run: String, error: String },
 }
 
 /// The outcome of each run of a group (None: skipped after a stop request).
@@ -320,6 +324,18 @@ pub fn run_campaign(
             .is_some_and(Learner::is_external)
             .then(|| format!("{}/{}", spec.env.name(), spec.latents))
     };
+    let failed_event = |e: &RunError| {
+        let run = match e {
+            RunError::Repr { run, .. }
+            | RunError::Explore { run, .. }
+            | RunError::FitFailedBefore { run, .. } => run.clone(),
+            _ => String::new(),
+        };
+        on_progress(Progress::Failed {
+            run,
+            error: e.to_string(),
+        });
+    };
     let run_group = |key: &Option<String>, specs: &[&RunSpec]| -> GroupResult {
         let mut out_v = Vec::with_capacity(specs.len());
         let mut repr = None;
@@ -363,17 +379,20 @@ pub fn run_campaign(
                                 .entry(c)
                                 .or_insert_with(|| spec.run_id());
                         }
-                        out_v.push(Some(Err(RunError::Repr {
+                        let e = RunError::Repr {
                             run: spec.run_id(),
                             source,
-                        })));
+                        };
+                        failed_event(&e);
+                        out_v.push(Some(Err(e)));
                         continue;
                     }
                 }
             }
             let r = execute(spec, &ctx, out, repr.as_mut());
-            if let Ok(s) = &r {
-                on_progress(Progress::Finished(s.clone()));
+            match &r {
+                Ok(s) => on_progress(Progress::Finished(s.clone())),
+                Err(e) => failed_event(e),
             }
             out_v.push(Some(r));
         }
@@ -386,22 +405,37 @@ pub fn run_campaign(
     let mut done = Vec::new();
     let mut skipped_now = 0;
     let mut first_err: Option<RunError> = None;
+    let (mut failed, mut not_run) = (0, 0);
     for r in results.into_iter().flatten() {
         match r {
             Some(Ok(r)) => done.push(r),
             // The error to report: the first real one (a run skipped because of an earlier
             // failed fit only points to it).
-            Some(Err(e)) => match (&first_err, &e) {
-                (None, _) | (Some(RunError::FitFailedBefore { .. }), RunError::Repr { .. }) => {
-                    first_err = Some(e)
+            Some(Err(e)) => {
+                match e {
+                    RunError::FitFailedBefore { .. } => not_run += 1,
+                    _ => failed += 1,
                 }
-                _ => {}
-            },
+                match (&first_err, &e) {
+                    (None, _) | (Some(RunError::FitFailedBefore { .. }), RunError::Repr { .. }) => {
+                        first_err = Some(e)
+                    }
+                    _ => {}
+                }
+            }
             None => skipped_now += 1,
         }
     }
     if let Some(e) = first_err {
-        return Err(e);
+        if failed <= 1 {
+            return Err(e);
+        }
+        return Err(RunError::Failed {
+            failed,
+            not_run,
+            stored: done.len(),
+            first: Box::new(e),
+        });
     }
     if skipped_now > 0 {
         return Err(RunError::Interrupted {

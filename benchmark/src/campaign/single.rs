@@ -210,6 +210,15 @@ pub fn set_images(cfg: &mut CampaignConfig, images: Option<usize>) -> Result<(),
 
 /// `--latents` of a learned goal space fitted on `images` images.
 pub fn check_latents(latents: usize, images: usize) -> Result<(), InvalidValue> {
+    if images < 2 {
+        return Err(InvalidValue::new(
+            "--images",
+            format!(
+                "a learned goal space needs at least 2 training images ([ugl] images or \
+                 --images), got {images}"
+            ),
+        ));
+    }
     if latents == 0 || latents >= images {
         return Err(InvalidValue::new(
             "--latents",
@@ -380,6 +389,22 @@ mod tests {
 
     fn cfg() -> CampaignConfig {
         CampaignConfig::from_toml(PROFILE, Path::new("base.toml")).unwrap()
+    }
+
+    /// Fewer than 2 images (a profile without learned algorithms may say 0) is a clear error,
+    /// not an overflow.
+    #[test]
+    fn too_few_images_for_a_learned_space_is_an_error() {
+        for images in [0, 1] {
+            let e = check_latents(1, images).unwrap_err().to_string();
+            assert!(e.contains("at least 2 training images"), "{e}");
+        }
+        assert!(check_latents(1, 2).is_ok());
+        let e = check_latents(2, 2).unwrap_err().to_string();
+        assert!(
+            e.contains("between 1 and the number of images - 1 (1)"),
+            "{e}"
+        );
     }
 
     fn request(algo: &str) -> RunRequest {
