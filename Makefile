@@ -76,11 +76,15 @@ test-slurm: check-toolchain
 # The committed results themselves, not only the smoke campaign: `ugl verify` checks every run's
 # files against its manifest, then reruns VERIFY_SAMPLE runs (stratified over the conditions, a
 # trained network among them) from the campaign's profile and compares their bytes. The main
-# store, of the current results version (a rerun fills data/results-pending/ first).
-VERIFY_STORES ?= data/results/paper
+# store, of the current results version (a rerun fills data/results-pending/ first), and the
+# `ugl compare` example of a Rust learner (its runs all trained networks: one is rerun). Each
+# entry is DIR or DIR:N (N runs instead of VERIFY_SAMPLE). Not `compare-random-projection`: its
+# learner is a Python program whose numpy products depend on the machine's BLAS.
+VERIFY_STORES ?= data/results/paper data/results/compare-bvae:1
 VERIFY_SAMPLE ?= 3
 verify-store: check-toolchain
-	@for d in $(VERIFY_STORES); do $(UGL) verify --results $$d --sample $(VERIFY_SAMPLE) || exit 1; done
+	@for e in $(VERIFY_STORES); do d=$${e%%:*}; n=$${e#*:}; [ "$$n" = "$$e" ] && n=$(VERIFY_SAMPLE); \
+	  $(UGL) verify --results $$d --sample $$n || exit 1; done
 
 campaign: check-toolchain
 	$(UGL) campaign --config data/campaigns/$(PROFILE).toml --out $(RESULTS)/$(PROFILE) $(if $(JOBS),--jobs $(JOBS))

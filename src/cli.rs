@@ -182,14 +182,15 @@ pub(crate) enum Command {
     /// compare their bytes with the committed ones. Exits with an error on any difference.
     /// Each sampled run is recomputed whole: a trained network is retrained from scratch, with
     /// its progress on stderr (a `paper-long` network takes hours). The first Ctrl-C stops after
-    /// the rerun in flight and reports the ones done. Stores written by `ugl compare` have no
-    /// profile of their own and are not checked yet.
+    /// the rerun in flight and reports the ones done. A store of `ugl compare` is rerun as
+    /// `ugl compare` built it, from its base campaign's profile.
     Verify {
         /// A campaign's results directory (holding its campaign.toml).
         #[arg(long)]
         results: PathBuf,
-        /// The campaign's profile (default: data/campaigns/<the record's name>.toml); its
-        /// configuration hash must be the record's.
+        /// The campaign's profile (default: data/campaigns/<the record's name>.toml, or for a
+        /// `ugl compare` store the campaign built on its base's); its configuration hash must
+        /// be the record's.
         #[arg(long)]
         config: Option<PathBuf>,
         /// How many runs to rerun: at most one per condition, so at most the number of

@@ -124,3 +124,35 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
     let (ok, t) = verify(out_s, other_cfg.to_str().unwrap(), "4");
     assert!(!ok && t.contains("configuration hash"), "{t}");
 }
+
+/// A store of `ugl compare` has no profile of its own: `ugl verify` rebuilds the campaign that
+/// `ugl compare` ran from its record (the base campaign it varies, the learner of its name) and
+/// reruns it to the same bytes.
+#[test]
+fn verify_reruns_a_compare_store_from_its_base_profile() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("compare-pca-centred");
+    let out_s = out.to_str().unwrap();
+    let o = ugl(&[
+        "compare",
+        "--learner",
+        "pca-centred",
+        "--config",
+        "data/campaigns/smoke.toml",
+        "--out",
+        out_s,
+        "--quiet",
+        "--jobs",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = ugl(&["verify", "--results", out_s, "--sample", "2"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert_eq!(
+        t.lines().filter(|l| l.starts_with("same bytes")).count(),
+        2,
+        "{t}"
+    );
+    assert!(t.contains(".rge-pca-centred."), "{t}");
+}

@@ -9,9 +9,11 @@ use anyhow::{Context, Result, bail};
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
 use ugl_bench::campaign::plan::{RunSpec, plan};
+use ugl_bench::campaign::single::compare_campaign;
 use ugl_bench::campaign::store::read_manifest;
 use ugl_bench::campaign::{Harness, RunContext};
-use ugl_types::{CampaignRecord, Manifest, RESULTS_VERSION, verify_files};
+use ugl_bench::goals::SamplerKind;
+use ugl_types::{CampaignRecord, CampaignRole, Manifest, RESULTS_VERSION, verify_files};
 
 use crate::output::outln;
 use crate::progress::{learner_lines, progress_area, stop_on_ctrl_c, training_bars};
@@ -110,6 +112,68 @@ fn differences(committed: &Manifest, rerun: &Manifest) -> Vec<String> {
     out
 }
 
+/// The campaign a store was run with, and the profile it comes from: `--config`, or the
+/// profile of the record's name; for a store of `ugl compare` (role `compare`, no `--config`),
+/// the campaign `ugl compare` built on its base profile (`variant_of`), with the learner of its
+/// name (`compare-NAME`), and an external program's command and whether it drew Gaussian goals
+/// as its runs' manifests recorded them.
+fn campaign_of(
+    record: &CampaignRecord,
+    results: &Path,
+    profile: Option<&Path>,
+) -> Result<(CampaignConfig, PathBuf)> {
+    if let Some(p) = profile {
+        return Ok((CampaignConfig::load(p)?, p.to_path_buf()));
+    }
+    if record.decl.role != CampaignRole::Compare {
+        let path = resolve_profile(&record.name)?;
+        return Ok((CampaignConfig::load(&path)?, path));
+    }
+    let base = record.decl.variant_of.as_deref().with_context(|| {
+        format!(
+            "{}: a compare campaign's record without the campaign it varies",
+            results.display()
+        )
+    })?;
+    let learner = record.name.strip_prefix("compare-").with_context(|| {
+        format!(
+            "{}: a compare campaign not named compare-<learner> ({}); pass its profile with \
+             --config",
+            results.display(),
+            record.name
+        )
+    })?;
+    let mut command = None;
+    let mut gaussian = false;
+    let entries =
+        std::fs::read_dir(results).with_context(|| format!("cannot read {}", results.display()))?;
+    for e in entries {
+        let file = e
+            .with_context(|| format!("cannot read {}", results.display()))?
+            .path();
+        if file.extension().is_none_or(|x| x != "json") {
+            continue;
+        }
+        let m = read_manifest(&file)?;
+        if command.is_none() {
+            command = m.external_command().map(str::to_string);
+        }
+        gaussian |= m
+            .sampler
+            .parse::<SamplerKind>()
+            .is_ok_and(SamplerKind::needs_prior);
+    }
+    let path = resolve_profile(base)?;
+    let (cfg, _) = compare_campaign(
+        CampaignConfig::load(&path)?,
+        learner,
+        command.as_deref(),
+        gaussian,
+    )
+    .map_err(anyhow::Error::msg)?;
+    Ok((cfg, path))
+}
+
 pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result<()> {
     if n == 0 {
         bail!("--sample must be at least 1");
@@ -122,11 +186,7 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
                 results.display()
             )
         })?;
-    let path: PathBuf = match profile {
-        Some(p) => p.to_path_buf(),
-        None => resolve_profile(&record.name)?,
-    };
-    let cfg = CampaignConfig::load(&path)?;
+    let (cfg, path) = campaign_of(&record, results, profile)?;
     let hash = cfg.configuration_hash();
     if record.configuration.as_deref() != Some(hash.as_str()) {
         bail!(
@@ -156,8 +216,7 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
     let checked = runs.len() + older;
     if checked == 0 {
         bail!(
-            "{}: no run of the plan of {} is in it (a store written by `ugl compare` has no \
-             profile of its own and cannot be checked yet)",
+            "{}: no run of the plan of {} is in it",
             results.display(),
             path.display()
         );
@@ -178,7 +237,11 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
         picks.len(),
     )?;
     let scratch = Scratch(std::env::temp_dir().join(format!("ugl-verify-{}", std::process::id())));
-    let profile_name = path.display().to_string();
+    // What `ugl campaign` and `ugl compare` record as the profile.
+    let profile_name = match record.decl.role {
+        CampaignRole::Compare if profile.is_none() => cfg.campaign.name.clone(),
+        _ => path.display().to_string(),
+    };
     let stop = stop_on_ctrl_c("the rerun in flight")?;
     let mp = progress_area();
     let ctx = RunContext::new(
