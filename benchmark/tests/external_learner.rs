@@ -259,13 +259,12 @@ fn garbage_instead_of_ready_is_fast_and_kills_the_group() {
         "sleep 30 & echo $! > '{}'; echo 'epoch 1 loss 0.3'; sleep 30",
         pidfile.display()
     );
-    let t = Instant::now();
-    let m = external_msg(sh("chatty", &cmd).fit(&images(3), 2, &mut stream_named(0, "learner")));
-    assert!(
-        t.elapsed() < Duration::from_secs(5),
-        "took {:?}",
-        t.elapsed()
-    );
+    // Fast without a clock: with a ready timeout of an hour, only the garbage line can end the
+    // wait before the program's own end (after 30 s, whose message says it exited, not that it
+    // was killed).
+    let mut l = sh("chatty", &cmd);
+    l.ready_timeout = Duration::from_secs(3600);
+    let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
     assert!(m.contains("epoch 1 loss 0.3") && m.contains("READY"), "{m}");
     assert!(m.contains("killed"), "{m}");
     let bg: u32 = std::fs::read_to_string(&pidfile)
@@ -273,7 +272,8 @@ fn garbage_instead_of_ready_is_fast_and_kills_the_group() {
         .trim()
         .parse()
         .unwrap();
-    let until = Instant::now() + Duration::from_secs(2);
+    // A guard against a hang, not a speed check.
+    let until = Instant::now() + Duration::from_secs(60);
     while !gone(bg) && Instant::now() < until {
         std::thread::sleep(Duration::from_millis(10));
     }
@@ -301,9 +301,9 @@ fn zero_latents_is_invalid_input_and_starts_nothing() {
 fn ready_timeout() {
     let mut l = sh("slow", "sleep 30");
     l.ready_timeout = Duration::from_millis(200);
-    let t = Instant::now();
+    // The message is the timeout's (the program would exit after 30 s without READY, which is
+    // another message): no clock is read.
     let m = external_msg(l.fit(&images(3), 2, &mut stream_named(0, "learner")));
-    assert!(t.elapsed() < Duration::from_secs(5));
     assert!(m.contains("ready timeout"), "{m}");
 }
 
@@ -408,9 +408,7 @@ fn answer_timeout() {
     let (mut enc, _) = l
         .fit_external(&images(3), 2, &mut stream_named(0, "learner"))
         .unwrap();
-    let t = Instant::now();
     let m = external_msg(enc.encode_one(images(1).row(0), &mut [0.0; 2]));
-    assert!(t.elapsed() < Duration::from_secs(5));
     assert!(m.contains("answer timeout"), "{m}");
 }
 
@@ -490,9 +488,8 @@ fn a_bad_end_on_drop_is_a_warning() {
         "{w}"
     );
 
-    let t = Instant::now();
+    // Killed, not waited for (the warning says so; no clock is read).
     let w = warnings_of(|| drop(fitted("deaf", "sleep 30", None)));
-    assert!(t.elapsed() < Duration::from_secs(15), "{:?}", t.elapsed());
     assert!(w.contains("learner 'deaf'") && w.contains("killed"), "{w}");
 
     let w = warnings_of(|| drop(fitted("clean", "cat > /dev/null", None)));

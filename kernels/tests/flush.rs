@@ -110,18 +110,36 @@ fn flushed_convolutions_agree_on_every_path() {
     let x = tiny(n * c.in_len(), 3);
     let w = tiny(c.weight_len(), 4);
     let g = tiny(n * c.out_len(), 5);
-    let run = |path: SimdPath, threads: usize| {
-        flushing_pool(threads).unwrap().install(|| {
-            let mut y = vec![0.0; n * c.out_len()];
-            c.forward_on(path, n, &x, &w, None, &mut y);
-            let mut dx = vec![0.0; n * c.in_len()];
-            c.backward_input_on(path, n, &g, &w, &mut dx);
-            let mut dw = vec![0.0; c.weight_len()];
-            c.backward_weight_on(path, n, &x, &g, &mut dw, None);
-            [bits(&y), bits(&dx), bits(&dw)]
-        })
+    let compute = |path: SimdPath| {
+        let mut y = vec![0.0; n * c.out_len()];
+        c.forward_on(path, n, &x, &w, None, &mut y);
+        let mut dx = vec![0.0; n * c.in_len()];
+        c.backward_input_on(path, n, &g, &w, &mut dx);
+        let mut dw = vec![0.0; c.weight_len()];
+        c.backward_weight_on(path, n, &x, &g, &mut dw, None);
+        [bits(&y), bits(&dx), bits(&dw)]
     };
+    let run =
+        |path: SimdPath, threads: usize| flushing_pool(threads).unwrap().install(|| compute(path));
     let reference = run(SimdPath::Scalar, 1);
+    // Not a comparison of zeros: each output has non-zero values, none subnormal, and IEEE
+    // arithmetic gives other bits for each (so a path that ignored the flush would show).
+    let plain = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| compute(SimdPath::Scalar));
+    for (k, (flushed, ieee)) in reference.iter().zip(&plain).enumerate() {
+        assert!(
+            flushed.iter().any(|&u| f32::from_bits(u) != 0.0),
+            "output {k}: all zero"
+        );
+        assert!(
+            flushed.iter().all(|&u| !f32::from_bits(u).is_subnormal()),
+            "output {k}"
+        );
+        assert_ne!(flushed, ieee, "output {k}: the flush changed nothing");
+    }
     for path in paths() {
         for threads in [1, 2] {
             assert!(
