@@ -163,9 +163,11 @@ pub(crate) enum Command {
     /// How far a campaign's results directory is: runs complete, missing, damaged or of
     /// another configuration, overall and per shard (what a resumed campaign would compute).
     Status {
-        /// Campaign file (data/campaigns/NAME.toml).
+        /// Campaign file (data/campaigns/NAME.toml). Without it, the campaign `--out`'s record
+        /// (campaign.toml) names: its profile, or for a store of `ugl compare` the campaign
+        /// `ugl compare` built.
         #[arg(long)]
-        config: PathBuf,
+        config: Option<PathBuf>,
         /// Results directory (default: data/results/<campaign name>).
         #[arg(long)]
         out: Option<PathBuf>,

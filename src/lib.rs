@@ -183,7 +183,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             out,
             shards,
             require_complete,
-        } => status(&config, out, shards, require_complete),
+        } => status(config.as_deref(), out, shards, require_complete),
         Command::Merge { into, sources } => merge(&into, &sources),
         Command::Verify {
             results,

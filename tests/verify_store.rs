@@ -155,4 +155,9 @@ fn verify_reruns_a_compare_store_from_its_base_profile() {
         "{t}"
     );
     assert!(t.contains(".rge-pca-centred."), "{t}");
+    // `ugl status` counts it from its record alone, as the compare campaign it was.
+    let o = ugl(&["status", "--out", out_s, "--require-complete"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("campaign compare-pca-centred"), "{t}");
 }

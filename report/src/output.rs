@@ -42,6 +42,7 @@ impl Output {
                 source,
             })?;
         }
+        remove_abandoned_staging(root);
         create_dir(&staging.join(crate::figures::DIR))?;
         let list = root.join(FILE_LIST);
         let previous = match std::fs::read_to_string(&list) {
@@ -163,6 +164,34 @@ impl Drop for Output {
 /// The staging directory's name, before the process id.
 pub const STAGING_PREFIX: &str = ".rendering-";
 
+/// Removes the staging directories of renders whose process is gone (killed, or stopped by
+/// Ctrl-C, so that [`Output`]'s drop never ran). A render still running keeps its own. Where
+/// the system has no `/proc` to ask, nothing is removed. Best effort: a failure here only
+/// leaves an old directory behind. (Processes are this machine's: two machines rendering into
+/// one shared directory at once are not supported, as they would also overwrite each other.)
+fn remove_abandoned_staging(root: &Path) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(root) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(STAGING_PREFIX))
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !proc.join(pid.to_string()).exists() {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// The entries of a list: comment lines skipped, and only plain relative paths (no `..`, no
 /// absolute path), so that a damaged list can never reach outside the output directory.
 fn parse_list(text: &str) -> BTreeSet<PathBuf> {
@@ -216,6 +245,28 @@ mod tests {
         );
         let list = std::fs::read_to_string(root.join(FILE_LIST)).unwrap();
         assert!(list.ends_with("\na.md\n"), "{list}");
+    }
+
+    #[test]
+    fn an_interrupted_render_is_cleaned_by_the_next() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path();
+        // A pid above the kernel's limit (2^22) belongs to no process; this one does.
+        let gone = root.join(format!("{STAGING_PREFIX}4194305"));
+        let alive = root.join(format!("{STAGING_PREFIX}1"));
+        let mine = root.join(format!("{STAGING_PREFIX}notapid"));
+        for d in [&gone, &alive, &mine] {
+            std::fs::create_dir_all(d.join("figures")).unwrap();
+        }
+        Output::open(root).unwrap().finish().unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!gone.exists(), "a dead render's staging was kept");
+        }
+        assert!(alive.exists(), "a running process's staging was removed");
+        assert!(
+            mine.exists(),
+            "a directory that is not a staging one was removed"
+        );
     }
 
     #[test]

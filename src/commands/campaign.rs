@@ -274,13 +274,17 @@ pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
 
 /// `ugl status`: the state of a campaign's results directory, overall and per shard.
 pub(crate) fn status(
-    config: &Path,
+    config: Option<&Path>,
     out: Option<PathBuf>,
     shards: usize,
     require_complete: bool,
 ) -> Result<()> {
     use ugl_bench::campaign::status::{RunState, store_status};
-    let cfg = CampaignConfig::load(config)?;
+    let cfg = match (config, &out) {
+        (Some(config), _) => CampaignConfig::load(config)?,
+        (None, Some(out)) => super::verify::recorded_campaign(out)?,
+        (None, None) => bail!("give --config, or --out of a store that holds its campaign.toml"),
+    };
     // At most one shard per group of runs that share a fit, as `ugl slurm` writes them (a huge
     // count would only allocate empty shards).
     let n_groups = fit_groups(&cfg);

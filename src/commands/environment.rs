@@ -56,8 +56,10 @@ pub(crate) fn rollout(kind: EnvKind, params: &Path, seed: u64) -> Result<()> {
 
 pub(crate) fn klc(kind: EnvKind, path: &Path) -> Result<()> {
     // Measured on the controllable object (armballs: the ball's x, y).
-    let dim = kind.metric_dims().len();
-    let pts = read_outcomes_csv(path, dim)?;
+    let spec = kind.spec();
+    let columns = &spec.outcome_columns[spec.metric_dims()];
+    let dim = columns.len();
+    let pts = read_outcomes_csv(path, columns)?;
     let k = KlCoverage::new(dim)?;
     let v = k.evaluate(pts.iter().map(|p| &p[..]))?;
     if v.is_infinite() {

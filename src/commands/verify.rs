@@ -174,6 +174,20 @@ fn campaign_of(
     Ok((cfg, path))
 }
 
+/// The campaign a store's record (campaign.toml) names, as [`campaign_of`] rebuilds it without
+/// `--config` (`ugl status --out DIR`).
+pub(crate) fn recorded_campaign(results: &Path) -> Result<CampaignConfig> {
+    let record = CampaignRecord::read(results)
+        .with_context(|| format!("--out {}", results.display()))?
+        .with_context(|| {
+            format!(
+                "--out {}: no campaign.toml (not a campaign's results directory); pass --config",
+                results.display()
+            )
+        })?;
+    Ok(campaign_of(&record, results, None)?.0)
+}
+
 pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result<()> {
     if n == 0 {
         bail!("--sample must be at least 1");

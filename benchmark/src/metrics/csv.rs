@@ -1,5 +1,6 @@
-//! Reading engineered outcomes from CSV (`ugl klc --outcomes FILE`): a header `x,y` (ArmBall) or
-//! `x,y,angle` (ArmArrow), then one outcome per line.
+//! Reading engineered outcomes from CSV (`ugl klc --outcomes FILE`): a header naming the
+//! environment's measured coordinates (`x,y` for ArmBall, `x,y,angle` for ArmArrow: the
+//! registry's `outcome_columns` of its controllable objects), then one outcome per line.
 
 use std::path::{Path, PathBuf};
 
@@ -36,13 +37,14 @@ pub enum CsvError {
     Empty { path: PathBuf },
 }
 
-/// Read outcomes of dimension `dim` (2 or 3) from `path`.
-pub fn read_outcomes_csv(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>, CsvError> {
+/// Read outcomes from `path`, whose header must be `columns` in that order.
+pub fn read_outcomes_csv(path: &Path, columns: &[&str]) -> Result<Vec<Vec<f64>>, CsvError> {
+    let dim = columns.len();
     let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io {
         path: path.into(),
         source,
     })?;
-    let expected = ["x", "y", "angle"][..dim].join(",");
+    let expected = columns.join(",");
     let mut lines = text
         .lines()
         .enumerate()
@@ -93,39 +95,51 @@ pub fn read_outcomes_csv(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>, CsvEr
 mod tests {
     use super::*;
 
+    const XY: &[&str] = &["x", "y"];
+
     #[test]
     fn reads_and_rejects() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("o.csv");
         std::fs::write(&p, "x,y\n0.1,0.2\n\n-0.5, 0.25\n").unwrap();
         assert_eq!(
-            read_outcomes_csv(&p, 2).unwrap(),
+            read_outcomes_csv(&p, XY).unwrap(),
             vec![vec![0.1, 0.2], vec![-0.5, 0.25]]
         );
         assert!(matches!(
-            read_outcomes_csv(&p, 3),
+            read_outcomes_csv(&p, &["x", "y", "angle"]),
             Err(CsvError::Header { .. })
         ));
         std::fs::write(&p, "x,y\n0.1\n").unwrap();
         assert!(
-            read_outcomes_csv(&p, 2)
+            read_outcomes_csv(&p, XY)
                 .unwrap_err()
                 .to_string()
                 .contains(":2:")
         );
         std::fs::write(&p, "x,y\n0.1,abc\n").unwrap();
         assert!(matches!(
-            read_outcomes_csv(&p, 2),
+            read_outcomes_csv(&p, XY),
             Err(CsvError::Number { .. })
         ));
         std::fs::write(&p, "x,y\n0.1,nan\n").unwrap();
         assert!(matches!(
-            read_outcomes_csv(&p, 2),
+            read_outcomes_csv(&p, XY),
             Err(CsvError::Number { .. })
+        ));
+        // Another environment's coordinates are its own header, not `x,y`.
+        std::fs::write(&p, "a,b\n0.1,0.2\n").unwrap();
+        assert_eq!(
+            read_outcomes_csv(&p, &["a", "b"]).unwrap(),
+            vec![vec![0.1, 0.2]]
+        );
+        assert!(matches!(
+            read_outcomes_csv(&p, XY),
+            Err(CsvError::Header { .. })
         ));
         std::fs::write(&p, "x,y\n").unwrap();
         assert!(matches!(
-            read_outcomes_csv(&p, 2),
+            read_outcomes_csv(&p, XY),
             Err(CsvError::Empty { .. })
         ));
     }
