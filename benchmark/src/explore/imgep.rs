@@ -24,6 +24,13 @@ pub trait OutcomeSpace {
     fn dim(&self) -> usize;
     /// Encode the engineered outcome `state` into `out` (length `dim`).
     fn encode(&mut self, state: &[f64], out: &mut [f64]);
+    /// A distance of this space in the units of the follow-up's code, whose competence caps
+    /// distances at 2 (`explore::interest`): the engineered features there are the state in
+    /// [-1, 1], while [`EngineeredSpace`] holds `(s + 1) / 2` and so halves distances (2); a
+    /// learned space's latents and the mixed features are in the same units as theirs (1).
+    fn competence_scale(&self) -> f64 {
+        1.0
+    }
 }
 
 /// The engineered goal space of RGE-EFR: z = (s + 1) / 2 in [0,1]^d, over every outcome
@@ -49,6 +56,9 @@ impl EngineeredSpace {
 impl OutcomeSpace for EngineeredSpace {
     fn dim(&self) -> usize {
         self.dims.len()
+    }
+    fn competence_scale(&self) -> f64 {
+        2.0
     }
     fn encode(&mut self, state: &[f64], out: &mut [f64]) {
         for (o, &k) in out.iter_mut().zip(&self.dims) {

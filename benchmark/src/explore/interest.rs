@@ -4,8 +4,9 @@
 //! `update_interest`; module choice: explauto's `prop_choice`), written out with its sources in
 //! `docs/learning-progress.md`:
 //!
-//! - competence of reaching `s` for goal `g`: `c(g, s) = -||g - s|| / 2` (explauto's
-//!   `competence_dist` with `dist_max = 2`);
+//! - competence of reaching `s` for goal `g`: `c(g, s) = -min(||g - s||, 2)` (explauto's
+//!   `competence_dist` with `dist_min = 0` and `dist_max = 2`, as explauto has had it since
+//!   June 2016; distances in the units of their code: [`ModuleInterest::new`]'s `scale`);
 //! - progress of one (exploitation) episode with goal `g` and outcome `s`:
 //!   `p = c(g, s) - c(g, s')`, where `s'` is the outcome reached for the module's earlier goal
 //!   nearest to `g` (0 for the module's first episode);
@@ -24,7 +25,7 @@ use crate::seed::Stream;
 /// The interest before any episode (the original's initial value).
 pub const INITIAL_PROGRESS: f64 = 1e-5;
 
-/// The distance that scales competence (the original's `dist_max`).
+/// The distance beyond which competence stays at its floor (the original's `dist_max`).
 pub const DIST_MAX: f64 = 2.0;
 
 /// The interest of one goal module: its goals, the outcomes reached for them and the smoothed
@@ -33,6 +34,8 @@ pub const DIST_MAX: f64 = 2.0;
 pub struct ModuleInterest {
     dim: usize,
     window: f64,
+    /// A distance of the module's space in the original's units.
+    scale: f64,
     /// Goals, row-major `n x dim`.
     goals: Vec<f64>,
     /// Outcomes reached for them (the module's dimensions), row-major `n x dim`.
@@ -42,26 +45,33 @@ pub struct ModuleInterest {
 
 impl ModuleInterest {
     /// A module of `dim` goal dimensions whose progress is averaged with rate `1 / window`
-    /// (the original: 1000). `Err` for `dim = 0` or a window below 1 or not finite.
-    pub fn new(dim: usize, window: f64) -> Result<Self, ExploreError> {
+    /// (the original: 1000), in a space whose distances are `scale` times the original's units
+    /// ([`super::imgep::OutcomeSpace::competence_scale`]). `Err` for `dim = 0`, a window below 1
+    /// or not finite, or a scale not positive and finite.
+    pub fn new(dim: usize, window: f64, scale: f64) -> Result<Self, ExploreError> {
         if dim == 0 {
             return Err(ExploreError::EmptyModule);
         }
         if !(window.is_finite() && window >= 1.0) {
             return Err(ExploreError::InterestWindow(window));
         }
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(ExploreError::CompetenceScale(scale));
+        }
         Ok(ModuleInterest {
             dim,
             window,
+            scale,
             goals: Vec::new(),
             reached: Vec::new(),
             progress: INITIAL_PROGRESS,
         })
     }
 
-    /// The competence of reaching `reached` for `goal`: `-||goal - reached|| / 2`.
-    pub fn competence(goal: &[f64], reached: &[f64]) -> f64 {
-        -distance(goal, reached) / DIST_MAX
+    /// The competence of reaching `reached` for `goal`: `-min(||goal - reached||, 2)`, the
+    /// distance in the original's units.
+    pub fn competence(&self, goal: &[f64], reached: &[f64]) -> f64 {
+        -(self.scale * distance(goal, reached)).min(DIST_MAX)
     }
 
     /// Record one episode with `goal` and its outcome `reached` (the module's dimensions) and
@@ -78,10 +88,10 @@ impl ModuleInterest {
         if goal.iter().chain(reached).any(|v| !v.is_finite()) {
             return Err(ExploreError::NonFinite);
         }
-        let c = Self::competence(goal, reached);
+        let c = self.competence(goal, reached);
         let p = match self.nearest_goal(goal) {
             None => 0.0,
-            Some(i) => c - Self::competence(goal, &self.reached[i * self.dim..(i + 1) * self.dim]),
+            Some(i) => c - self.competence(goal, &self.reached[i * self.dim..(i + 1) * self.dim]),
         };
         self.goals.extend_from_slice(goal);
         self.reached.extend_from_slice(reached);
@@ -161,41 +171,55 @@ mod tests {
     use crate::seed::stream_named;
 
     #[test]
-    fn competence_is_minus_half_the_distance() {
-        assert_eq!(ModuleInterest::competence(&[0.0, 0.0], &[0.6, 0.8]), -0.5);
-        assert_eq!(ModuleInterest::competence(&[0.3, -0.2], &[0.3, -0.2]), 0.0);
+    fn competence_is_minus_the_distance_capped_at_two() {
+        let m = ModuleInterest::new(2, 10.0, 1.0).unwrap();
+        assert_eq!(m.competence(&[0.0, 0.0], &[0.6, 0.8]), -1.0);
+        assert_eq!(m.competence(&[0.3, -0.2], &[0.3, -0.2]), 0.0);
+        assert_eq!(m.competence(&[0.0, 0.0], &[3.0, 4.0]), -2.0);
+        // The engineered space's (s + 1) / 2 halves distances: 2 in the original's units.
+        let e = ModuleInterest::new(2, 10.0, 2.0).unwrap();
+        assert_eq!(e.competence(&[0.0, 0.0], &[0.3, 0.4]), -1.0);
+        assert_eq!(e.competence(&[0.0, 0.0], &[0.6, 0.8]), -2.0);
+        assert_eq!(e.competence(&[0.0, 0.0], &[1.0, 1.0]), -2.0);
     }
 
     /// A case computed by hand, window 2.
     #[test]
     fn progress_and_interest_by_hand() {
-        let mut m = ModuleInterest::new(2, 2.0).unwrap();
+        let mut m = ModuleInterest::new(2, 2.0, 1.0).unwrap();
         assert_eq!(m.interest(), INITIAL_PROGRESS);
         // First episode: no earlier goal, progress 0; q = 1e-5 + (0 - 1e-5) / 2.
         assert_eq!(m.update(&[0.0, 0.0], &[1.0, 0.0]).unwrap(), 0.0);
         assert!((m.interest() - 5e-6).abs() < 1e-20);
         // Goal (0.1, 0) reached exactly: c = 0. Nearest earlier goal (0, 0), whose outcome
-        // (1, 0) is 0.9 from this goal: c_old = -0.45, progress 0.45; q = 5e-6 + (0.45 - 5e-6) / 2.
+        // (1, 0) is 0.9 from this goal: c_old = -0.9, progress 0.9; q = 5e-6 + (0.9 - 5e-6) / 2.
         let p = m.update(&[0.1, 0.0], &[0.1, 0.0]).unwrap();
-        assert!((p - 0.45).abs() < 1e-15, "{p}");
-        assert!((m.interest() - (5e-6 + (0.45 - 5e-6) / 2.0)).abs() < 1e-15);
+        assert!((p - 0.9).abs() < 1e-15, "{p}");
+        assert!((m.interest() - (5e-6 + (0.9 - 5e-6) / 2.0)).abs() < 1e-15);
         // Worse than the neighbour's outcome: negative progress, and the interest is |q|.
-        let p = m.update(&[0.1, 0.01], &[-1.0, 0.0]).unwrap();
-        // Nearest earlier goal (0.1, 0), reached (0.1, 0): c_old = -0.005, c = -0.55002...
-        let c = -((1.1f64).powi(2) + 0.0001).sqrt() / 2.0;
-        assert!((p - (c + 0.005)).abs() < 1e-15, "{p}");
-        assert_eq!(m.len(), 3);
-        let mut q = 5e-6 + (0.45 - 5e-6) / 2.0;
+        let p3 = m.update(&[0.1, 0.01], &[-1.0, 0.0]).unwrap();
+        // Nearest earlier goal (0.1, 0), reached (0.1, 0): c_old = -0.01, c = -1.10004...
+        let c = -((1.1f64).powi(2) + 0.0001).sqrt();
+        assert!((p3 - (c + 0.01)).abs() < 1e-15, "{p3}");
+        // Beyond the cap: an outcome 3 away from its goal counts as 2 away.
+        let p = m.update(&[0.1, 0.02], &[3.1, 0.02]).unwrap();
+        // Nearest earlier goal (0.1, 0.01), reached (-1, 0): c_old = -1.10004..., c = -2.
+        let c_old = -((1.1f64).powi(2) + 0.0004).sqrt();
+        assert!((p - (-2.0 - c_old)).abs() < 1e-15, "{p}");
+        assert_eq!(m.len(), 4);
+        let mut q = 5e-6 + (0.9 - 5e-6) / 2.0;
+        q += (p3 - q) / 2.0;
         q += (p - q) / 2.0;
         assert!((m.interest() - q.abs()).abs() < 1e-15);
     }
 
     #[test]
     fn bad_input_is_an_error() {
-        assert!(ModuleInterest::new(0, 10.0).is_err());
-        assert!(ModuleInterest::new(2, 0.5).is_err());
-        assert!(ModuleInterest::new(2, f64::NAN).is_err());
-        let mut m = ModuleInterest::new(2, 10.0).unwrap();
+        assert!(ModuleInterest::new(0, 10.0, 1.0).is_err());
+        assert!(ModuleInterest::new(2, 0.5, 1.0).is_err());
+        assert!(ModuleInterest::new(2, f64::NAN, 1.0).is_err());
+        assert!(ModuleInterest::new(2, 10.0, 0.0).is_err());
+        let mut m = ModuleInterest::new(2, 10.0, 1.0).unwrap();
         assert!(m.update(&[0.0], &[0.0, 0.0]).is_err());
         assert!(m.update(&[0.0, f64::NAN], &[0.0, 0.0]).is_err());
         assert!(m.is_empty(), "a refused episode is not recorded");

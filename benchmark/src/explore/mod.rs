@@ -64,6 +64,8 @@ pub enum ExploreError {
     EmptyModule,
     #[error("the interest window must be at least 1, got {0}")]
     InterestWindow(f64),
+    #[error("a goal space's competence scale must be positive and finite, got {0}")]
+    CompetenceScale(f64),
     #[error("goal and outcome must have {dim} values, got {goal} and {reached}")]
     GoalLength {
         dim: usize,
