@@ -16,11 +16,12 @@
 //! Every product runs on [`ugl_kernels`]' deterministic kernels, so a forward pass has the same
 //! bits on every SIMD path and for every thread count.
 //!
-//! Initialisation: PyTorch's defaults, which the authors' code kept: every weight and bias
-//! uniform in `±1/sqrt(fan_in)` (`kaiming_uniform(a = sqrt(5))` for the weights), with
-//! PyTorch's fan-in (`in x k x k` for a convolution, `out x k x k` for a transposed one: its
-//! weight's second dimension). The draws come from the learner's stream, layer by layer in the
-//! order above, weight then bias.
+//! Initialisation: today's PyTorch defaults: every weight and bias uniform in `±1/sqrt(fan_in)`
+//! (`kaiming_uniform(a = sqrt(5))` for the weights), with PyTorch's fan-in (`in x k x k` for a
+//! convolution, `out x k x k` for a transposed one: its weight's second dimension). The
+//! authors' PyTorch (0.4.0) took `in x k x k` for a transposed convolution too, which differs
+//! only for the last one (32 -> 3: 3.3 times smaller there; `docs/neural.md`). The draws come
+//! from the learner's stream, layer by layer in the order above, weight then bias.
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
