@@ -160,8 +160,8 @@ mod tests {
         }
         let text = svg(&rs);
         assert!(
-            text.contains("the authors&apos; mean, n=30")
-                || text.contains("the authors' mean, n=30"),
+            text.contains("the authors&apos; mean, n=15")
+                || text.contains("the authors' mean, n=15"),
             "no authors' curve"
         );
         assert!(text.contains("Thin lines: the authors"));
