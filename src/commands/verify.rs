@@ -177,29 +177,28 @@ fn campaign_of(
 /// The campaign a store's record (campaign.toml) names, as [`campaign_of`] rebuilds it without
 /// `--config` (`ugl status --out DIR`).
 pub(crate) fn recorded_campaign(results: &Path) -> Result<CampaignConfig> {
-    let record = CampaignRecord::read(results)
-        .with_context(|| format!("--out {}", results.display()))?
+    let record = read_record(results, "--out", "; pass --config")?;
+    Ok(campaign_of(&record, results, None)?.0)
+}
+
+/// The record (campaign.toml) of the results directory given by `flag`; an error, ending with
+/// `hint`, where there is none.
+fn read_record(results: &Path, flag: &str, hint: &str) -> Result<CampaignRecord> {
+    CampaignRecord::read(results)
+        .with_context(|| format!("{flag} {}", results.display()))?
         .with_context(|| {
             format!(
-                "--out {}: no campaign.toml (not a campaign's results directory); pass --config",
+                "{flag} {}: no campaign.toml (not a campaign's results directory){hint}",
                 results.display()
             )
-        })?;
-    Ok(campaign_of(&record, results, None)?.0)
+        })
 }
 
 pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result<()> {
     if n == 0 {
         bail!("--sample must be at least 1");
     }
-    let record = CampaignRecord::read(results)
-        .with_context(|| format!("--results {}", results.display()))?
-        .with_context(|| {
-            format!(
-                "--results {}: no campaign.toml (not a campaign's results directory)",
-                results.display()
-            )
-        })?;
+    let record = read_record(results, "--results", "")?;
     let (cfg, path) = campaign_of(&record, results, profile)?;
     let hash = cfg.configuration_hash();
     if record.configuration.as_deref() != Some(hash.as_str()) {

@@ -486,6 +486,18 @@ mod tests {
     }
 
     fn efr_run_with(env: EnvKind, choice: Modules, seed: u64, mge: &MgeConfig) -> ExplorationLog {
+        efr_run_for(env, choice, seed, mge, 600, 50)
+    }
+
+    /// An engineered-feature run of `epochs` episodes, the first `bootstrap` random.
+    fn efr_run_for(
+        env: EnvKind,
+        choice: Modules,
+        seed: u64,
+        mge: &MgeConfig,
+        epochs: usize,
+        bootstrap: usize,
+    ) -> ExplorationLog {
         let env = make_env(env, &EnvConfig::default());
         let d = env.state_dim();
         let objects = env.kind().objects();
@@ -495,8 +507,8 @@ mod tests {
             .map(|m| Box::new(UniformGoals::unit(m.dims.len())) as Box<dyn GoalSampler>)
             .collect();
         let cfg = ExploreConfig {
-            epochs: 600,
-            bootstrap_epochs: 50,
+            epochs,
+            bootstrap_epochs: bootstrap,
             ..ExploreConfig::default()
         };
         run_mge(
@@ -602,30 +614,14 @@ mod tests {
         for env in [EnvKind::ARMBALLS, EnvKind::ARMBALLS_CORL] {
             let (mut ball, mut distractor) = (0, 0);
             for seed in 0..4 {
-                let e = make_env(env, &EnvConfig::default());
-                let d = e.state_dim();
-                let objects = e.kind().objects();
-                let modules = goal_modules(Modules::Progress, d, Some(&objects), &[], 2).unwrap();
-                let mut samplers: Vec<Box<dyn GoalSampler>> = modules
-                    .iter()
-                    .map(|m| Box::new(UniformGoals::unit(m.dims.len())) as Box<dyn GoalSampler>)
-                    .collect();
-                let cfg = ExploreConfig {
-                    epochs: 2000,
-                    bootstrap_epochs: 100,
-                    ..ExploreConfig::default()
-                };
-                let log = run_mge(
-                    e.as_ref(),
-                    &mut EngineeredSpace::new(d),
-                    &modules,
-                    &mut samplers,
+                let log = efr_run_for(
+                    env,
                     Modules::Progress,
-                    &cfg,
-                    &MgeConfig::default(),
                     seed,
-                )
-                .unwrap();
+                    &MgeConfig::default(),
+                    2000,
+                    100,
+                );
                 let n = log.interest.len();
                 assert_eq!(log.interest[n - 2].module, 0);
                 ball += log.interest[n - 2].n_chosen;
