@@ -420,3 +420,31 @@ fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
         "{distractor_r2:?}"
     );
 }
+
+/// The README's count of the version-5 `paper-long` networks and runs collected so far is the
+/// pending store's.
+#[test]
+fn the_paper_long_rerun_so_far_is_the_pending_stores() {
+    let text = readme();
+    let c = captures(
+        &text,
+        "`paper-long` (the paper's own training budget, 100,000 iterations) is being rerun at \
+         version 5, one network per working session, from the same revision ({} of its five \
+         networks and their {} runs are in `data/results-pending/paper-long`)",
+    );
+    let word = |w: &str| match w {
+        "one" => 1,
+        "two" => 2,
+        "three" => 3,
+        "four" => 4,
+        "five" => 5,
+        w => number(w),
+    };
+    let runs = manifests("data/results-pending/paper-long");
+    assert_eq!(runs.len(), number(&c[1]), "runs");
+    let networks: BTreeSet<String> = runs.iter().map(|m| m["seed"].to_string()).collect();
+    assert_eq!(networks.len(), word(&c[0]), "networks");
+    for m in &runs {
+        assert_eq!(m["crate_versions"]["results_version"].as_u64(), Some(5));
+    }
+}
