@@ -50,6 +50,14 @@ pub struct Campaign {
     pub configurations: usize,
 }
 
+impl Campaign {
+    /// The name its conditions go by beside the campaign it varies (`rge-vae@untrained`): its
+    /// declared tag, else its name.
+    pub fn tag(&self) -> String {
+        self.decl.tag.clone().unwrap_or_else(|| self.name.clone())
+    }
+}
+
 /// The configurations of a campaign's runs: distinct (campaign seed, `[explore]`, `[env]`) of
 /// its runs, and distinct `[ugl]` of those in a learned goal space; the larger count. The
 /// runner refuses to mix configurations in one store; a store assembled by hand (or by an

@@ -1283,6 +1283,93 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
         .collect()
 }
 
+/// A claim of the paper evaluated twice on one cell, on the repetitions both ran: with the main
+/// campaign's networks and with a recipe campaign's (its conditions tagged `tag`). It answers
+/// whether the training recipe changes the claim's verdict there.
+#[derive(Debug, Clone)]
+pub struct CellVerdict {
+    /// The recipe campaign's tag.
+    pub tag: String,
+    /// The cell: the main campaign's condition (untagged).
+    pub cell: ConditionKey,
+    /// The repetitions both ran, the only ones either side is evaluated on.
+    pub repetitions: Vec<i64>,
+    /// The claim, its subject narrowed to the main campaign's cell.
+    pub main: ClaimResult,
+    /// The same claim with the recipe's condition as its subject.
+    pub recipe: ClaimResult,
+}
+
+/// The claims of the paper (not ours, without a premise) whose subject covers a cell of
+/// `cells` (main-campaign keys), each evaluated on that cell alone with the main campaign's
+/// networks and with those of the recipe campaign tagged `tag` ([`CellVerdict`]). Both sides
+/// are restricted to the repetitions both ran, so the two verdicts rest on the same data sets,
+/// exploration streams and references; a claim none of whose comparisons can be made on both
+/// sides (a reference that must agree with the subject on its campaign) is left out.
+pub fn cell_verdicts(
+    file: &ClaimsFile,
+    obs: &dyn Observations,
+    tag: &str,
+    cells: &[ConditionKey],
+) -> Vec<CellVerdict> {
+    let exact = |k: &ConditionKey| Selector {
+        env: Some(vec![k.env.to_string()]),
+        algo: Some(vec![k.tagged_algo()]),
+        sampler: Some(vec![k.sampler.to_string()]),
+        variant: Some(vec![k.variant.to_string()]),
+        latents: Some(LatentsSelector::Size(k.latents)),
+    };
+    let mut out = Vec::new();
+    for cell in cells {
+        let tagged = cell.tagged(Some(tag));
+        let seeds = |k: &ConditionKey| -> BTreeSet<i64> {
+            obs.values(k, Statistic::FinalKlc)
+                .into_iter()
+                .map(|v| v.0)
+                .collect()
+        };
+        let repetitions: Vec<i64> = seeds(cell).intersection(&seeds(&tagged)).copied().collect();
+        if repetitions.len() < 2 {
+            continue;
+        }
+        let allowed: BTreeSet<(Option<String>, i64)> = repetitions
+            .iter()
+            .flat_map(|&s| [(None, s), (Some(tag.to_string()), s)])
+            .collect();
+        let restricted = OnRepetitions {
+            obs,
+            repetitions: &allowed,
+        };
+        for claim in file.claims.iter().filter(|c| {
+            !c.ours && c.premise.is_none() && c.subject.matches(cell) && !c.reference.matches(cell)
+        }) {
+            let narrowed = |k: &ConditionKey| Claim {
+                subject: exact(k),
+                ..claim.clone()
+            };
+            let both = ClaimsFile {
+                settings: file.settings.clone(),
+                claims: vec![narrowed(cell), narrowed(&tagged)],
+            };
+            let mut results = evaluate_on(&both, &restricted).into_iter();
+            let (Some(main), Some(recipe)) = (results.next(), results.next()) else {
+                continue;
+            };
+            if main.comparisons.is_empty() || recipe.comparisons.is_empty() {
+                continue;
+            }
+            out.push(CellVerdict {
+                tag: tag.to_string(),
+                cell: cell.clone(),
+                repetitions: repetitions.clone(),
+                main,
+                recipe,
+            });
+        }
+    }
+    out
+}
+
 /// The comparisons of `claim` on `statistic` (uncorrected): the claim's relation, mirrored
 /// where `statistic` is better in the other direction than the claim's own statistic. `margin`
 /// gives a comparison's margin from its subject condition and its reference mean (None: the
@@ -2105,6 +2192,58 @@ pair_on = ["env"]
             .unwrap();
         assert_eq!(goal.verdict, Verdict::NotReproduced);
         assert_eq!(t.verdict, Verdict::NotReproduced);
+    }
+
+    /// A paper claim evaluated on one cell with the main campaign's networks and with a recipe
+    /// campaign's: both on the repetitions both ran (paired with the reference's), each with its
+    /// own verdicts; a claim of ours is not evaluated there.
+    #[test]
+    fn a_claim_on_one_cell_with_either_network() {
+        let file = twin_file("final_klc", "at_most", false);
+        // The main networks are worse than EFR on the validated measures, the recipe's as good.
+        let mut given = pca_vs_efr([0.10, 0.05], [0.30, 0.55]).0;
+        let pca = key("armball", "rge-pca", "kde", 10, "none");
+        let long = pca.tagged(Some("long"));
+        let near = |m: f64| vec![m, m + 0.003, m - 0.002, m + 0.001];
+        given.push((long.clone(), Statistic::FinalKlc, near(4.0)));
+        given.push((long.clone(), Statistic::GoalError, near(0.05)));
+        given.push((long, Statistic::Coverage, near(0.55)));
+        let obs = Given(given);
+        let v = cell_verdicts(&file, &obs, "long", std::slice::from_ref(&pca));
+        assert_eq!(v.len(), 1, "one claim on one cell");
+        let v = &v[0];
+        assert_eq!(v.repetitions, vec![0, 1, 2, 3], "the recipe ran 4 of the 6");
+        assert_eq!((v.tag.as_str(), &v.cell), ("long", &pca));
+        for r in [&v.main, &v.recipe] {
+            let t = r.twin.as_ref().unwrap();
+            for c in r.comparisons.iter().chain(&t.comparisons) {
+                assert_eq!(
+                    (c.n_subject, c.n_reference, c.paired),
+                    (4, 4, true),
+                    "{c:?}"
+                );
+                assert_eq!(c.subject.env, "armball");
+                assert_eq!(c.reference.algo, "rge-efr");
+            }
+        }
+        assert_eq!(v.main.comparisons[0].subject.tag, None);
+        assert_eq!(v.recipe.comparisons[0].subject.tag.as_deref(), Some("long"));
+        assert_eq!(
+            v.main.twin.as_ref().unwrap().verdict,
+            Verdict::NotReproduced
+        );
+        assert_eq!(v.recipe.twin.as_ref().unwrap().verdict, Verdict::Reproduced);
+        // A claim of ours is left out; so is a cell the recipe did not run twice.
+        assert!(
+            cell_verdicts(
+                &twin_file("final_klc", "at_most", true),
+                &obs,
+                "long",
+                std::slice::from_ref(&pca)
+            )
+            .is_empty()
+        );
+        assert!(cell_verdicts(&file, &obs, "other", &[pca]).is_empty());
     }
 
     /// Which claims get a twin: the paper's, on final KLC or episodes moved; not ours, not the

@@ -29,6 +29,9 @@ pub struct Context<'a> {
     pub losses: &'a [LossCurve],
     /// The paper's claims, evaluated on the main campaign.
     pub claims: &'a ClaimsInput<'a>,
+    /// The paper's claims on the cells of the recipe campaigns, with the main campaign's
+    /// networks and the recipe's ([`crate::claims::cell_verdicts`]).
+    pub recipe_verdicts: &'a [crate::claims::CellVerdict],
     /// Main and `compare` campaigns, ranked.
     pub leaderboard: &'a Leaderboard,
     /// Every run the report reads, with its discovery measures at the final epoch.

@@ -151,10 +151,7 @@ fn render_report_on_pool(opts: &ReportOptions) -> Result<ReportSummary, ReportEr
     let recipe_conditions: Vec<(String, Vec<aggregate::ConditionSummary>)> = camps
         .recipe
         .iter()
-        .map(|c| {
-            let tag = c.decl.tag.clone().unwrap_or_else(|| c.name.clone());
-            (tag, aggregate::aggregate(&c.store, &paper))
-        })
+        .map(|c| (c.tag(), aggregate::aggregate(&c.store, &paper)))
         .collect();
     let mut parts = vec![(None, conditions.as_slice(), store)];
     for ((tag, conds), c) in recipe_conditions.iter().zip(&camps.recipe) {
@@ -164,6 +161,19 @@ fn render_report_on_pool(opts: &ReportOptions) -> Result<ReportSummary, ReportEr
     let mut claim_results = claims_file
         .as_ref()
         .map(|f| claims::evaluate_on(f, &observations))
+        .unwrap_or_default();
+    // The paper's claims on each recipe cell, with the main campaign's networks and the recipe's.
+    let recipe_verdicts: Vec<claims::CellVerdict> = claims_file
+        .as_ref()
+        .map(|f| {
+            recipe_conditions
+                .iter()
+                .flat_map(|(tag, conds)| {
+                    let cells: Vec<_> = conds.iter().map(|c| c.key.clone()).collect();
+                    claims::cell_verdicts(f, &observations, tag, &cells)
+                })
+                .collect()
+        })
         .unwrap_or_default();
     let keys: Vec<_> = conditions.iter().map(|c| c.key.clone()).collect();
     claims::attach_paper_checks(&mut claim_results, &keys, &paper);
@@ -204,6 +214,7 @@ fn render_report_on_pool(opts: &ReportOptions) -> Result<ReportSummary, ReportEr
         budget: &budget,
         losses: &losses,
         claims: &claims_input,
+        recipe_verdicts: &recipe_verdicts,
         leaderboard: &board,
         discovery: &measured,
         validity: &validity,

@@ -191,10 +191,13 @@ fn our_claims(w: &mut String, title: &str, rs: &[&ClaimResult], checks: &[Check]
 }
 
 /// The training-budget sentence: each budget series' goal-reaching error per budget, against
-/// RGE-EFR's on the same environment (Welch's interval at the largest budget).
+/// RGE-EFR's on the same environment (Welch's interval at the largest budget); then, where a
+/// recipe campaign trained the series' cell longer than every budget (`paper-long`, the paper's
+/// own budget), its error beside the main campaign's on the same repetitions and the verdict of
+/// the main claim on that cell with either network ([`recipe_budget`]).
 fn budget(w: &mut String, inp: &Context<'_>) {
     for s in &inp.budget.series {
-        let goal = |campaign: &str, algo: &str| -> Vec<f64> {
+        let goal_by_seed = |campaign: &str, algo: &str| -> Vec<(i64, f64)> {
             let values: Vec<(i64, f64)> = inp
                 .discovery
                 .iter()
@@ -207,6 +210,9 @@ fn budget(w: &mut String, inp: &Context<'_>) {
                 .filter_map(|r| Some((r.run.seed, r.discovery.as_ref()?.goal_error_mean)))
                 .collect();
             crate::aggregate::seed_means(&values)
+        };
+        let goal = |campaign: &str, algo: &str| -> Vec<f64> {
+            goal_by_seed(campaign, algo)
                 .into_iter()
                 .map(|v| v.1)
                 .collect()
@@ -241,16 +247,87 @@ fn budget(w: &mut String, inp: &Context<'_>) {
             ),
             Err(_) => String::new(),
         };
+        let longer = recipe_budget(inp, &s.key, last.0, &goal_by_seed);
         let _ = writeln!(
             w,
             "- **The training budget** ([budget]({BUDGET})): {}, {}: goal-reaching error {}{vs_efr} \
-             ({:.0}% Welch interval).",
+             ({:.0}% Welch interval){longer}.",
             env_name(&s.key.env),
             crate::names::describe_key(&s.key),
             listed.join(", "),
             stats::CONFIDENCE * 100.0
         );
     }
+}
+
+/// The clause on a recipe campaign that trained `cell` for more iterations than `beyond`: its
+/// goal-reaching error beside the main campaign's on the repetitions both ran, and the verdict
+/// of the main claim on this cell ([`Finding::LearnedVsEfr`]) on the validated measures with the
+/// main campaign's networks and with the recipe's ([`crate::claims::cell_verdicts`]). Empty
+/// where there is none.
+fn recipe_budget(
+    inp: &Context<'_>,
+    cell: &crate::load::ConditionKey,
+    beyond: i64,
+    goal_by_seed: &dyn Fn(&str, &str) -> Vec<(i64, f64)>,
+) -> String {
+    let validated = match inp.claims {
+        ClaimsInput::Evaluated { validated, .. } => *validated,
+        ClaimsInput::Missing(_) => None,
+    };
+    let mut out = String::new();
+    for v in inp
+        .recipe_verdicts
+        .iter()
+        .filter(|v| &v.cell == cell && v.main.claim.finding == Some(Finding::LearnedVsEfr))
+    {
+        let Some(camp) = inp.campaigns.recipe.iter().find(|c| c.tag() == v.tag) else {
+            continue;
+        };
+        let iterations: Option<i64> = camp
+            .store
+            .runs
+            .iter()
+            .filter(|r| &r.key == cell)
+            .filter_map(|r| crate::neural::training(&r.manifest)?.iterations)
+            .max();
+        let Some(iterations) = iterations.filter(|&i| i > beyond) else {
+            continue;
+        };
+        let on_reps = |campaign: &str| -> Vec<f64> {
+            goal_by_seed(campaign, &cell.algo)
+                .into_iter()
+                .filter(|(seed, _)| v.repetitions.contains(seed))
+                .map(|v| v.1)
+                .collect()
+        };
+        let (long, short) = (on_reps(&camp.name), on_reps(&inp.campaigns.main.name));
+        let (Some((a, _)), Some((b, _))) =
+            (v.main.validated(validated), v.recipe.validated(validated))
+        else {
+            continue;
+        };
+        if long.is_empty() || short.is_empty() {
+            continue;
+        }
+        let reps = v.repetitions.len();
+        let _ = write!(
+            out,
+            "; trained {iterations} iterations (`{}`, the same {reps} repetitions) it reaches \
+             {:.3} against {:.3} with `{}`'s networks, and the main claim ([`{}`]({CLAIMS})) on \
+             this cell is **{}** on the validated measures with the longer training, **{}** with \
+             `{}`'s ([recipes](#training-recipes))",
+            camp.name,
+            stats::mean(&long),
+            stats::mean(&short),
+            inp.campaigns.main.name,
+            v.main.claim.id,
+            b.label(),
+            a.label(),
+            inp.campaigns.main.name,
+        );
+    }
+    out
 }
 
 /// The validity sentence: per environment, the final KLC's and the goal error's P(better)

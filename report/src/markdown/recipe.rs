@@ -14,9 +14,10 @@ use std::fmt::Write as _;
 use super::quality::{evidence, group_r2, median};
 use super::{fmt_klc, plural};
 use crate::campaigns::Campaign;
+use crate::claims::{CellVerdict, ClaimResult, Comparison, Verdict};
 use crate::context::Context;
 use crate::load::{ConditionKey, Run};
-use crate::names::{algo_name, env_name};
+use crate::names::{algo_name, describe_key, env_name};
 use crate::neural::{learner, training};
 
 /// The first logged iteration whose training loss is below `fraction` of the plateau, skipping
@@ -111,6 +112,11 @@ struct Side {
     never_left: usize,
     position_knn: Vec<f64>,
     klc: Vec<f64>,
+    /// The validated measures ([`crate::discovery`]): goal-reaching error (mean), the fraction
+    /// of the achievable cells reached, KLC of the episodes that moved the object.
+    goal_error: Vec<f64>,
+    coverage: Vec<f64>,
+    moved_klc: Vec<f64>,
 }
 
 impl Side {
@@ -129,6 +135,11 @@ impl Side {
             self.position_knn.push(k);
         }
         self.klc.push(r.final_point().klc);
+        self.coverage.push(r.final_point().coverage);
+        if let Ok(Some(d)) = crate::discovery::measure_run(r) {
+            self.goal_error.push(d.goal_error_mean);
+            self.moved_klc.extend(d.moved_klc);
+        }
     }
 
     fn untrained_cell(&self) -> String {
@@ -154,23 +165,26 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
-/// A cell of the table: its key, and the pairs (recipe run, main run) of the same seed.
+/// A cell of the table: its key, and the pairs (recipe run, main run) of the same repetition and
+/// exploration replicate.
 struct Cell<'a> {
     key: ConditionKey,
     pairs: Vec<(&'a Run, &'a Run)>,
 }
 
 fn cells<'a>(camp: &'a Campaign, main: &'a Campaign) -> (Vec<Cell<'a>>, usize) {
-    let by_id: BTreeMap<(&ConditionKey, i64), &Run> = main
+    // A run's identity in its cell: repetition and exploration replicate (the replicates of a
+    // repetition share its data set and fit, not their exploration streams).
+    let by_id: BTreeMap<(&ConditionKey, i64, u32), &Run> = main
         .store
         .runs
         .iter()
-        .map(|r| ((&r.key, r.seed), r))
+        .map(|r| ((&r.key, r.seed, r.manifest.exploration), r))
         .collect();
     let mut cells: BTreeMap<_, Cell<'a>> = BTreeMap::new();
     let mut unpaired = 0;
     for r in &camp.store.runs {
-        let Some(m) = by_id.get(&(&r.key, r.seed)) else {
+        let Some(m) = by_id.get(&(&r.key, r.seed, r.manifest.exploration)) else {
             unpaired += 1;
             continue;
         };
@@ -197,8 +211,8 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
         w,
         "Campaigns named `{m}-*` rerun cells of `{m}` with another training recipe for the \
          neural learners. Their runs have `{m}`'s run seeds (the same data set and the same \
-         exploration streams), so each pairs with the `{m}` run of its cell and seed, and only \
-         the network differs. In the tables each entry is *recipe / `{m}`*: **untrained** counts \
+         exploration streams), so each pairs with the `{m}` run of its cell, repetition and \
+         exploration replicate, and only the network differs. In the tables each entry is *recipe / `{m}`*: **untrained** counts \
          the runs whose reconstruction loss is not below 0.8 of the mean-image plateau (the \
          quality section); **loss / plateau** is its median; **left the plateau** is the median \
          first logged iteration whose *training* loss is below 0.8 of the plateau (after the \
@@ -208,8 +222,11 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
          over the pairs, **Δ** the mean paired difference (recipe − `{m}`) with the range of the per-pair \
          differences (*min to max*: a range, not a confidence interval), and \
          **recipe better** the pairs where the recipe's run ends with the lower (better) \
-         KL-coverage. n ≤ 5 pairs: read the \
-         differences as indications, not tests.\n",
+         KL-coverage; **goal error**, **cells reached** and **moved KLC** are the means of the \
+         validated measures (the goal-reaching error, the fraction of the achievable cells \
+         reached, the KLC of the episodes that moved the object: the validity check's). n ≤ 5 \
+         pairs: read the differences as indications, not tests; the paper's claims on each cell \
+         are then evaluated with either network, with their intervals.\n",
         m = main.name
     );
     for camp in &inp.campaigns.recipe {
@@ -279,11 +296,12 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
         let _ = writeln!(
             w,
             "| env | algorithm | goals | variant | latents | pairs | untrained | loss / plateau | \
-             left the plateau | position R² | final KLC | Δ | recipe better |"
+             left the plateau | position R² | final KLC | Δ | recipe better | goal error | \
+             cells reached | moved KLC |"
         );
         let _ = writeln!(
             w,
-            "|---|---|---|---|---:|---:|---|---|---|---|---|---|---:|"
+            "|---|---|---|---|---:|---:|---|---|---|---|---|---|---:|---|---|---|"
         );
         let mut all_delta: Vec<f64> = Vec::new();
         let mut untrained = [0usize; 2];
@@ -317,7 +335,7 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
             let pair = |a: String, b: String| format!("{a} / {b}");
             let _ = writeln!(
                 w,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} | {} | {} | {} |",
                 env_name(&c.key.env),
                 algo_name(&c.key.algo),
                 c.key.sampler,
@@ -340,7 +358,19 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
                 ),
                 delta,
                 better,
-                deltas.len()
+                deltas.len(),
+                pair(
+                    fmt_opt(mean(&ours.goal_error), 3),
+                    fmt_opt(mean(&theirs.goal_error), 3)
+                ),
+                pair(
+                    fmt_opt(mean(&ours.coverage), 3),
+                    fmt_opt(mean(&theirs.coverage), 3)
+                ),
+                pair(
+                    fmt_opt(mean(&ours.moved_klc), 2),
+                    fmt_opt(mean(&theirs.moved_klc), 2)
+                ),
             );
         }
         let n = all_delta.len();
@@ -364,6 +394,158 @@ pub fn section(w: &mut String, inp: &Context<'_>) {
         } else {
             let _ = writeln!(w);
         }
+        let tag = camp.tag();
+        let verdicts: Vec<&CellVerdict> = inp
+            .recipe_verdicts
+            .iter()
+            .filter(|v| v.tag == tag)
+            .collect();
+        cell_verdicts(w, &verdicts, &camp.name, &main.name, cells.len());
+    }
+}
+
+/// At most this many cells get the table of the paper's claims on each; a campaign with more
+/// (the untrained twins of every cell) gets the count of changed verdicts only.
+const CELLS_WITH_CLAIM_TABLES: usize = 4;
+
+/// Whether the recipe changes the verdicts of the paper's claims on its cells: a table of every
+/// claim's comparisons with either network (few cells), and the verdicts that changed.
+fn cell_verdicts(
+    w: &mut String,
+    verdicts: &[&CellVerdict],
+    recipe: &str,
+    main: &str,
+    n_cells: usize,
+) {
+    if verdicts.is_empty() {
+        return;
+    }
+    let validated = |r: &ClaimResult| -> (Verdict, Vec<Comparison>) {
+        match &r.twin {
+            Some(t) => (t.verdict, t.comparisons.clone()),
+            None => (r.verdict, Vec::new()),
+        }
+    };
+    let reps = |v: &CellVerdict| {
+        let r = &v.repetitions;
+        match (r.first(), r.last()) {
+            (Some(a), Some(b)) if (b - a) as usize + 1 == r.len() => format!("{a}-{b}"),
+            _ => r.iter().map(i64::to_string).collect::<Vec<_>>().join(", "),
+        }
+    };
+    let _ = writeln!(
+        w,
+        "**The paper's claims on {}**, evaluated on each cell with `{main}`'s networks and with \
+         `{recipe}`'s, on the repetitions both ran (the references are `{main}`'s runs of those \
+         repetitions; intervals and corrections as in the claims section). A claim on the final \
+         KLC or the episodes moved is also judged on the validated measures.\n",
+        if n_cells == 1 {
+            "this cell"
+        } else {
+            "these cells"
+        }
+    );
+    if n_cells <= CELLS_WITH_CLAIM_TABLES {
+        let _ = writeln!(
+            w,
+            "| cell | repetitions | claim | measure | reference | `{main}`: Δ (interval) → verdict | \
+             `{recipe}`: Δ (interval) → verdict |"
+        );
+        let _ = writeln!(w, "|---|---|---|---|---|---|---|");
+        for v in verdicts {
+            let (_, main_twin) = validated(&v.main);
+            let (_, recipe_twin) = validated(&v.recipe);
+            // Each comparison with `main`'s networks, beside the recipe's of the same reference
+            // and measure.
+            let theirs: Vec<&Comparison> =
+                v.recipe.comparisons.iter().chain(&recipe_twin).collect();
+            let rows = v.main.comparisons.iter().chain(&main_twin).filter_map(|m| {
+                let r = theirs
+                    .iter()
+                    .find(|r| r.reference == m.reference && r.statistic == m.statistic)?;
+                Some((m, *r))
+            });
+            for (m, r) in rows {
+                let cmp = |c: &Comparison| {
+                    let i = c.bounds().map_or("no interval".into(), |(lo, hi)| {
+                        format!("{lo:+.3} to {hi:+.3}")
+                    });
+                    format!("{:+.3} ({i}) → {}", c.diff, c.verdict.label())
+                };
+                let _ = writeln!(
+                    w,
+                    "| {} | {} | `{}` | {} | {} | {} | {} |",
+                    describe_key(&v.cell),
+                    reps(v),
+                    v.main.claim.id,
+                    m.statistic.label(),
+                    describe_key(&m.reference),
+                    cmp(m),
+                    cmp(r)
+                );
+            }
+        }
+        let _ = writeln!(w);
+    }
+    // What changes: the claim's verdict on its own statistic and on the validated measures.
+    let mut changed = Vec::new();
+    let mut same = 0;
+    for v in verdicts {
+        let pairs = [
+            ("its own statistic", v.main.verdict, v.recipe.verdict, true),
+            (
+                "the validated measures",
+                validated(&v.main).0,
+                validated(&v.recipe).0,
+                v.main.twin.is_some(),
+            ),
+        ];
+        for (on, a, b, present) in pairs {
+            if !present {
+                continue;
+            }
+            if a == b {
+                same += 1;
+            } else {
+                changed.push(format!(
+                    "`{}` on {} ({}), {on}: {} with `{main}`'s networks, {} with `{recipe}`'s",
+                    v.main.claim.id,
+                    describe_key(&v.cell),
+                    reps(v),
+                    a.label(),
+                    b.label()
+                ));
+            }
+        }
+    }
+    let total = same + changed.len();
+    if changed.is_empty() {
+        let _ = writeln!(
+            w,
+            "**The recipe changes none of the {total} verdicts** (claim x cell, on the claim's own \
+             statistic and on the validated measures): each is the same with `{main}`'s networks \
+             and with `{recipe}`'s.\n"
+        );
+    } else {
+        let _ = writeln!(
+            w,
+            "**The recipe changes {} of the {total} verdicts** (claim x cell, on the claim's own \
+             statistic and on the validated measures){}\n",
+            changed.len(),
+            if n_cells <= CELLS_WITH_CLAIM_TABLES {
+                ":"
+            } else {
+                ". Which:\n\n<details><summary>the changed verdicts</summary>"
+            }
+        );
+        for (i, c) in changed.iter().enumerate() {
+            let end = if i + 1 == changed.len() { '.' } else { ';' };
+            let _ = writeln!(w, "- {c}{end}");
+        }
+        if n_cells > CELLS_WITH_CLAIM_TABLES {
+            let _ = writeln!(w, "\n</details>");
+        }
+        let _ = writeln!(w);
     }
 }
 
@@ -408,6 +590,60 @@ mod tests {
             manifest_path: PathBuf::new(),
             measured: Default::default(),
         }
+    }
+
+    /// With exploration replicates, a recipe run pairs with the main run of its repetition *and*
+    /// replicate (the replicates' exploration streams differ), never with another replicate.
+    #[test]
+    fn recipe_runs_pair_by_repetition_and_replicate() {
+        let with = |campaign: &str, seed: i64, exploration: u32| {
+            let mut r = run(&[], 0);
+            r.campaign = campaign.into();
+            r.seed = seed;
+            r.manifest.exploration = exploration;
+            r.run_id = format!("{campaign}.s{seed}.e{exploration}");
+            r
+        };
+        let campaign = |name: &str, runs: Vec<Run>| Campaign {
+            name: name.into(),
+            path: PathBuf::new(),
+            decl: Default::default(),
+            store: crate::load::Store {
+                runs,
+                incomplete: Vec::new(),
+            },
+            configurations: 1,
+        };
+        let main = campaign(
+            "paper",
+            (0..2)
+                .flat_map(|s| (0..3).map(move |e| (s, e)))
+                .map(|(s, e)| with("paper", s, e))
+                .collect(),
+        );
+        let recipe = campaign(
+            "paper-long",
+            vec![
+                with("paper-long", 1, 2),
+                with("paper-long", 1, 0),
+                with("paper-long", 4, 0),
+            ],
+        );
+        let (cells, unpaired) = cells(&recipe, &main);
+        assert_eq!(unpaired, 1, "repetition 4 has no main run");
+        assert_eq!(cells.len(), 1);
+        let ids: Vec<(&str, &str)> = cells[0]
+            .pairs
+            .iter()
+            .map(|(a, b)| (a.run_id.as_str(), b.run_id.as_str()))
+            .collect();
+        assert_eq!(
+            ids,
+            [
+                ("paper-long.s1.e2", "paper.s1.e2"),
+                ("paper-long.s1.e0", "paper.s1.e0")
+            ]
+        );
     }
 
     #[test]
