@@ -21,6 +21,11 @@ pub mod curve {
     /// coverage over the whole square.
     pub const CONTROL_KLC: &str = "control_klc";
     pub const CONTROL_COVERAGE: &str = "control_coverage";
+    /// The same scenes: the follow-up's exploration ratios of the controlled object, the
+    /// fraction of the cells of a 30 x 30 and of a 50 x 50 grid over the whole square that
+    /// hold an outcome.
+    pub const RATIO_30: &str = "ratio_30";
+    pub const RATIO_50: &str = "ratio_50";
 }
 
 /// `<run_id>.outcomes.parquet`: every outcome, in history order.

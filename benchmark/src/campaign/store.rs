@@ -37,7 +37,8 @@ pub enum StoreError {
 }
 
 /// The curve table of a run. Where the scene has an object the agent cannot control
-/// (ArmBalls), its KL-coverage and cell coverage follow as `control_klc`, `control_coverage`.
+/// (ArmBalls), its KL-coverage and cell coverage follow as `control_klc`, `control_coverage`,
+/// then the follow-up's exploration ratios of the controlled object, `ratio_30`, `ratio_50`.
 pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
     let n = log.checkpoints.len();
     let c = &log.checkpoints;
@@ -66,6 +67,15 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
             curve::CONTROL_COVERAGE.into(),
             control(|v| v.1),
         ))?;
+    }
+    if c.iter().any(|p| p.ratios.is_some()) {
+        let ratio = |f: fn((f64, f64)) -> f64| {
+            c.iter()
+                .map(|p| p.ratios.map(f))
+                .collect::<Vec<Option<f64>>>()
+        };
+        df.with_column(Column::new(curve::RATIO_30.into(), ratio(|v| v.0)))?;
+        df.with_column(Column::new(curve::RATIO_50.into(), ratio(|v| v.1)))?;
     }
     Ok(df)
 }

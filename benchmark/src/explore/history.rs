@@ -49,6 +49,54 @@ pub struct Checkpoint {
     /// KL-coverage and cell coverage of the uncontrollable object's outcomes (ArmBalls'
     /// distractor), a control; None where the scene has none.
     pub control: Option<(f64, f64)>,
+    /// The follow-up's exploration ratios of the controlled object ([`FollowupRatios`]): the
+    /// fraction of the cells of a 30 x 30 and of a 50 x 50 grid over the whole square [-1, 1]²
+    /// that hold an outcome. Scenes with an uncontrollable object (ArmBalls) only; None
+    /// elsewhere.
+    pub ratios: Option<(f64, f64)>,
+}
+
+/// The follow-up paper's measure of exploration (Laversanne-Finot et al., CoRL 2018; its
+/// `exploration_30`, and the 50-bin one beside it): the fraction of the cells of a `G x G` grid
+/// over the whole square [-1, 1]² that hold at least one final position of the controlled
+/// object, its cell `min(floor((v + 1) / 2 * G), G - 1)` per coordinate (clipped at 0). Unlike
+/// [`Checkpoint::coverage`], every cell counts, also those outside the arm's disk that a pushed
+/// ball reaches.
+#[derive(Clone, Debug)]
+pub(crate) struct FollowupRatios {
+    grids: [(usize, Vec<bool>, usize); 2],
+}
+
+impl FollowupRatios {
+    /// The grid sizes: 30 (the follow-up's figures) and 50.
+    pub const BINS: [usize; 2] = [30, 50];
+
+    pub fn new() -> Self {
+        FollowupRatios {
+            grids: Self::BINS.map(|g| (g, vec![false; g * g], 0)),
+        }
+    }
+
+    /// The cell of `v` on a grid of `g` bins over [-1, 1].
+    fn bin(v: f64, g: usize) -> usize {
+        (((v + 1.0) / 2.0 * g as f64).floor().max(0.0) as usize).min(g - 1)
+    }
+
+    pub fn add(&mut self, x: f64, y: f64) {
+        for (g, seen, n) in &mut self.grids {
+            let cell = Self::bin(x, *g) * *g + Self::bin(y, *g);
+            if !seen[cell] {
+                seen[cell] = true;
+                *n += 1;
+            }
+        }
+    }
+
+    /// The two ratios, 30 then 50 bins.
+    pub fn ratios(&self) -> (f64, f64) {
+        let r = |(g, _, n): &(usize, Vec<bool>, usize)| *n as f64 / (g * g) as f64;
+        (r(&self.grids[0]), r(&self.grids[1]))
+    }
 }
 
 /// The interest of one module at one point of a modular exploration (`explore::mge`).
@@ -91,6 +139,7 @@ pub(crate) struct Recorder<'k> {
     hist: CoverageHistogram<'k>,
     dims: Range<usize>,
     control: Option<(CoverageHistogram<'k>, Range<usize>)>,
+    ratios: Option<FollowupRatios>,
     initial: Vec<f64>,
     log: ExplorationLog,
     n_moved: usize,
@@ -112,6 +161,7 @@ impl<'k> Recorder<'k> {
                 .control
                 .as_ref()
                 .map(|(k, d)| (k.histogram(), d.clone())),
+            ratios: metrics.control.as_ref().map(|_| FollowupRatios::new()),
             initial: initial.to_vec(),
             log: ExplorationLog {
                 dim: initial.len(),
@@ -140,6 +190,9 @@ impl<'k> Recorder<'k> {
         if let Some((h, d)) = &mut self.control {
             h.add(&r.outcome()[d.clone()])
                 .expect("rollout outcome is finite and of the environment's dimension");
+        }
+        if let Some(f) = &mut self.ratios {
+            f.add(s[0], s[1]);
         }
         let m = moved(s, &self.initial[self.dims.clone()]);
         self.n_moved += m as usize;
@@ -174,6 +227,7 @@ impl<'k> Recorder<'k> {
                         h.coverage(),
                     )
                 }),
+                ratios: self.ratios.as_ref().map(FollowupRatios::ratios),
             });
             self.next_eval += 1;
         }
@@ -197,5 +251,34 @@ impl<'k> Recorder<'k> {
     /// The log.
     pub fn finish(self) -> ExplorationLog {
         self.log
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FollowupRatios;
+
+    /// The follow-up's ratios count the cells of the whole square, each once, with the edges
+    /// clipped into the grid: the same cells as `scripts/exploration_ratio.py`, which reproduces
+    /// the authors' RPE ratio.
+    #[test]
+    fn followup_ratios_count_each_cell_of_the_whole_square_once() {
+        let mut f = FollowupRatios::new();
+        assert_eq!(f.ratios(), (0.0, 0.0));
+        // The corners (outside the arm's disk, still cells of the square), twice each.
+        for _ in 0..2 {
+            f.add(-1.0, -1.0);
+            f.add(1.0, 1.0);
+            f.add(-1.2, 1.3);
+        }
+        assert_eq!(f.ratios(), (3.0 / 900.0, 3.0 / 2500.0));
+        // 0.0 and 0.05 share a 30-bin cell ([0, 1/15)) but not a 50-bin one ([0, 0.04)).
+        f.add(0.0, 0.0);
+        f.add(0.05, 0.0);
+        assert_eq!(f.ratios(), (4.0 / 900.0, 5.0 / 2500.0));
+        assert_eq!(FollowupRatios::bin(-1.0, 30), 0);
+        assert_eq!(FollowupRatios::bin(1.0, 30), 29);
+        assert_eq!(FollowupRatios::bin(0.0, 30), 15);
+        assert_eq!(FollowupRatios::bin(-0.01, 50), 24);
     }
 }

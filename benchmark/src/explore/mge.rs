@@ -601,8 +601,9 @@ mod tests {
         let n_goals: usize = last.iter().map(|p| p.n_chosen).sum();
         // 550 goal episodes in cycles of 5 (the last cycle may be cut).
         assert_eq!(n_goals, a.n_goal.div_ceil(5));
-        // The distractor is measured as a control.
+        // The distractor is measured as a control, the ball by the follow-up's ratios too.
         assert!(a.checkpoints.iter().all(|c| c.control.is_some()));
+        assert!(a.checkpoints.iter().all(|c| c.ratios.is_some()));
     }
 
     #[test]
