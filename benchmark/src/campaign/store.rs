@@ -12,7 +12,7 @@ use polars::prelude::*;
 use thiserror::Error;
 
 use super::plan::RunSpec;
-use crate::explore::ExplorationLog;
+use crate::explore::{Checkpoint, ExplorationLog};
 use ugl_types::columns::{curve, interest, outcomes};
 pub use ugl_types::{
     Diagnostics, DigestError, FileDigest, Manifest, Outcome, RunPaths, Summary, run_paths,
@@ -56,26 +56,21 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         curve::N_MOVED => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
         curve::COVERAGE => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
     )?;
-    if c.iter().any(|p| p.control.is_some()) {
-        let control = |f: fn((f64, f64)) -> f64| {
-            c.iter()
-                .map(|p| p.control.map(f))
-                .collect::<Vec<Option<f64>>>()
-        };
-        df.with_column(Column::new(curve::CONTROL_KLC.into(), control(|v| v.0)))?;
-        df.with_column(Column::new(
-            curve::CONTROL_COVERAGE.into(),
-            control(|v| v.1),
-        ))?;
-    }
-    if c.iter().any(|p| p.ratios.is_some()) {
-        let ratio = |f: fn((f64, f64)) -> f64| {
-            c.iter()
-                .map(|p| p.ratios.map(f))
-                .collect::<Vec<Option<f64>>>()
-        };
-        df.with_column(Column::new(curve::RATIO_30.into(), ratio(|v| v.0)))?;
-        df.with_column(Column::new(curve::RATIO_50.into(), ratio(|v| v.1)))?;
+    // The optional pairs of columns, each written where some checkpoint has it.
+    let pairs: [(fn(&Checkpoint) -> Option<(f64, f64)>, [&str; 2]); 2] = [
+        (|p| p.control, [curve::CONTROL_KLC, curve::CONTROL_COVERAGE]),
+        (|p| p.ratios, [curve::RATIO_30, curve::RATIO_50]),
+    ];
+    for (get, names) in pairs {
+        if c.iter().any(|p| get(p).is_some()) {
+            for (k, name) in names.into_iter().enumerate() {
+                let v: Vec<Option<f64>> = c
+                    .iter()
+                    .map(|p| get(p).map(|(a, b)| if k == 0 { a } else { b }))
+                    .collect();
+                df.with_column(Column::new(name.into(), v))?;
+            }
+        }
     }
     Ok(df)
 }
