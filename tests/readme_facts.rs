@@ -421,16 +421,16 @@ fn the_docs_sweep_table_is_that_of_the_committed_sweep() {
     );
 }
 
-/// The README's count of the version-5 `paper-long` networks and runs collected so far is the
-/// pending store's.
+/// The README's account of `paper-long` is the committed store's: its networks and runs, all
+/// results version 5 from the `paper` store's one revision, every network trained the paper's
+/// 100,000 iterations.
 #[test]
-fn the_paper_long_rerun_so_far_is_the_pending_stores() {
+fn the_paper_long_store_is_the_papers_budget() {
     let text = readme();
     let c = captures(
         &text,
-        "`paper-long` (the paper's own training budget, 100,000 iterations) is being rerun at \
-         version 5, one network per working session, from the same revision ({} of its five \
-         networks and their {} runs are in `data/results-pending/paper-long`)",
+        "10 latents, the paper's init and 100,000 iterations, where `paper` trains 600): {} \
+         networks and their {} runs, results version 5 from the same revision",
     );
     let word = |w: &str| match w {
         "one" => 1,
@@ -440,11 +440,27 @@ fn the_paper_long_rerun_so_far_is_the_pending_stores() {
         "five" => 5,
         w => number(w),
     };
-    let runs = manifests("data/results-pending/paper-long");
+    let runs = manifests("data/results/paper-long");
     assert_eq!(runs.len(), number(&c[1]), "runs");
     let networks: BTreeSet<String> = runs.iter().map(|m| m["seed"].to_string()).collect();
     assert_eq!(networks.len(), word(&c[0]), "networks");
+    let paper: BTreeSet<String> = manifests("data/results/paper")
+        .iter()
+        .map(|m| m["git_revision"].to_string())
+        .collect();
+    assert_eq!(paper.len(), 1, "`paper` comes from one revision");
     for m in &runs {
         assert_eq!(m["crate_versions"]["results_version"].as_u64(), Some(5));
+        assert!(
+            paper.contains(&m["git_revision"].to_string()),
+            "{}",
+            m["run_id"]
+        );
+        assert_eq!(
+            m["train"]["iterations"].as_u64(),
+            Some(100_000),
+            "{}",
+            m["run_id"]
+        );
     }
 }

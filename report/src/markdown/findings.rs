@@ -294,14 +294,33 @@ fn recipe_budget(
         let Some(iterations) = iterations.filter(|&i| i > beyond) else {
             continue;
         };
-        let on_reps = |campaign: &str| -> Vec<f64> {
+        let on_reps = |campaign: &str| -> Vec<(i64, f64)> {
             goal_by_seed(campaign, &cell.algo)
                 .into_iter()
                 .filter(|(seed, _)| v.repetitions.contains(seed))
-                .map(|v| v.1)
                 .collect()
         };
         let (long, short) = (on_reps(&camp.name), on_reps(&inp.campaigns.main.name));
+        // The difference paired by repetition (each pair shares its data set and streams).
+        let paired =
+            if long.len() == short.len() && long.iter().zip(&short).all(|(a, b)| a.0 == b.0) {
+                let d: Vec<f64> = long.iter().zip(&short).map(|(a, b)| a.1 - b.1).collect();
+                stats::t_interval(&d, stats::CONFIDENCE)
+                    .map(|i| {
+                        format!(
+                            " (Δ {:+.3} [{:+.3}, {:+.3}], {:.0}% t interval paired by repetition)",
+                            i.estimate,
+                            i.lo,
+                            i.hi,
+                            stats::CONFIDENCE * 100.0
+                        )
+                    })
+                    .unwrap_or_default()
+            } else {
+                String::new()
+            };
+        let long: Vec<f64> = long.into_iter().map(|v| v.1).collect();
+        let short: Vec<f64> = short.into_iter().map(|v| v.1).collect();
         let (Some((a, _)), Some((b, _))) =
             (v.main.validated(validated), v.recipe.validated(validated))
         else {
@@ -314,7 +333,7 @@ fn recipe_budget(
         let _ = write!(
             out,
             "; trained {iterations} iterations (`{}`, the same {reps} repetitions) it reaches \
-             {:.3} against {:.3} with `{}`'s networks, and the main claim ([`{}`]({CLAIMS})) on \
+             {:.3} against {:.3} with `{}`'s networks{paired}, and the main claim ([`{}`]({CLAIMS})) on \
              this cell is **{}** on the validated measures with the longer training, **{}** with \
              `{}`'s ([recipes](#training-recipes))",
             camp.name,

@@ -437,8 +437,9 @@ fn cell_verdicts(
         w,
         "**The paper's claims on {}**, evaluated on each cell with `{main}`'s networks and with \
          `{recipe}`'s, on the repetitions both ran (the references are `{main}`'s runs of those \
-         repetitions; intervals and corrections as in the claims section). A claim on the final \
-         KLC or the episodes moved is also judged on the validated measures.\n",
+         repetitions, paired by repetition; intervals as in the claims section, Holm's \
+         correction over the claim's comparisons on the cell). A claim on the final KLC or the \
+         episodes moved is also judged on the validated measures.\n",
         if n_cells == 1 {
             "this cell"
         } else {
