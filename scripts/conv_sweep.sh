@@ -40,7 +40,12 @@ for setting in "$@"; do
     printf '[ugl]\nimages = %s\n[explore]\nepochs = %s\neval_every = %s\n' "$images" "$epochs" "$epochs"
     printf '%s\n' "$table"
     if [ -n "$keys" ]; then
-      echo "$keys" | tr ',' '\n' | sed 's/=/ = /'
+      # Numbers and booleans as they are, anything else (init=torch) as a TOML string.
+      echo "$keys" | tr ',' '\n' | awk -F= '{
+        v = $2
+        if (v !~ /^(true|false|[-+0-9.eE]+)$/) v = "\"" v "\""
+        print $1 " = " v
+      }'
     fi
   } > "$dir/profile.toml"
   for seed in $seeds; do

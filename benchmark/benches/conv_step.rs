@@ -11,7 +11,7 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use ugl_bench::env::cdge::{VALUES, normalise, render_rgb};
-use ugl_bench::repr::conv_net::{ConvArch, ConvNet};
+use ugl_bench::repr::conv_net::{ConvArch, ConvInit, ConvNet};
 use ugl_bench::repr::conv_train::{ConvConfig, ConvTrainer};
 use ugl_bench::seed::stream_named;
 
@@ -51,7 +51,11 @@ fn bench(c: &mut Criterion) {
     g.warm_up_time(Duration::from_secs(2));
     g.measurement_time(Duration::from_secs(8));
     let mut rng = stream_named(1, "learner");
-    let mut trainer = ConvTrainer::new(ConvNet::init(&mut rng, ConvArch::followup(10)));
+    let mut trainer = ConvTrainer::new(ConvNet::init(
+        &mut rng,
+        ConvArch::followup(10),
+        ConvInit::default(),
+    ));
     let mut step = 0;
     g.bench_function("followup-bvae/batch64", |b| {
         b.iter(|| {

@@ -26,6 +26,10 @@ pub mod curve {
     /// hold an outcome.
     pub const RATIO_30: &str = "ratio_30";
     pub const RATIO_50: &str = "ratio_50";
+    /// The same scenes: the goal-reaching error of the controlled object's outcomes so far (the
+    /// mean distance from a test goal to its nearest outcome; the manifest's
+    /// `discovery.final.goal_error_mean` at the last epoch).
+    pub const GOAL_ERROR: &str = "goal_error";
 }
 
 /// `<run_id>.outcomes.parquet`: every outcome, in history order.

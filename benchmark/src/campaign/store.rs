@@ -38,7 +38,8 @@ pub enum StoreError {
 
 /// The curve table of a run. Where the scene has an object the agent cannot control
 /// (ArmBalls), its KL-coverage and cell coverage follow as `control_klc`, `control_coverage`,
-/// then the follow-up's exploration ratios of the controlled object, `ratio_30`, `ratio_50`.
+/// then the follow-up's exploration ratios of the controlled object, `ratio_30`, `ratio_50`,
+/// and its goal-reaching error, `goal_error`.
 pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFrame> {
     let n = log.checkpoints.len();
     let c = &log.checkpoints;
@@ -71,6 +72,10 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
                 df.with_column(Column::new(name.into(), v))?;
             }
         }
+    }
+    if c.iter().any(|p| p.goal_error.is_some()) {
+        let v: Vec<Option<f64>> = c.iter().map(|p| p.goal_error).collect();
+        df.with_column(Column::new(curve::GOAL_ERROR.into(), v))?;
     }
     Ok(df)
 }

@@ -54,6 +54,52 @@ pub struct Checkpoint {
     /// that hold an outcome. Scenes with an uncontrollable object (ArmBalls) only; None
     /// elsewhere.
     pub ratios: Option<(f64, f64)>,
+    /// The goal-reaching error of the controlled object's outcomes so far ([`GoalReach`]), the
+    /// validated measure the report ranks by; scenes with an uncontrollable object (ArmBalls)
+    /// only, None elsewhere.
+    pub goal_error: Option<f64>,
+}
+
+/// The goal-reaching error along the curve: per test goal of [`ugl_types::GoalGrid`] (the
+/// controlled object's position), the least squared distance to an outcome so far, updated
+/// outcome by outcome. [`GoalReach::error`] is then the mean distance from a goal to its nearest
+/// outcome, with the same arithmetic as `ugl_types::EnvMeasures::measure` (squared distances
+/// summed coordinate by coordinate, the distances sorted before they are summed), so that it
+/// equals the discovery measure of the outcomes up to that epoch bit for bit.
+#[derive(Clone, Debug)]
+pub(crate) struct GoalReach {
+    goals: Vec<[f64; 2]>,
+    best: Vec<f64>,
+}
+
+impl GoalReach {
+    pub fn new() -> Self {
+        let goals: Vec<[f64; 2]> = ugl_types::GoalGrid::new(2)
+            .goals()
+            .map(|g| [g[0], g[1]])
+            .collect();
+        GoalReach {
+            best: vec![f64::INFINITY; goals.len()],
+            goals,
+        }
+    }
+
+    pub fn add(&mut self, x: f64, y: f64) {
+        for (g, best) in self.goals.iter().zip(&mut self.best) {
+            let (dx, dy) = (x - g[0], y - g[1]);
+            let d2 = dx * dx + dy * dy;
+            if d2 < *best {
+                *best = d2;
+            }
+        }
+    }
+
+    /// The mean distance from a test goal to its nearest outcome (infinite before any).
+    pub fn error(&self) -> f64 {
+        let mut d: Vec<f64> = self.best.iter().map(|b| b.sqrt()).collect();
+        d.sort_by(f64::total_cmp);
+        d.iter().sum::<f64>() / d.len().max(1) as f64
+    }
 }
 
 /// The follow-up paper's measure of exploration (Laversanne-Finot et al., CoRL 2018; its
@@ -140,6 +186,7 @@ pub(crate) struct Recorder<'k> {
     dims: Range<usize>,
     control: Option<(CoverageHistogram<'k>, Range<usize>)>,
     ratios: Option<FollowupRatios>,
+    reach: Option<GoalReach>,
     initial: Vec<f64>,
     log: ExplorationLog,
     n_moved: usize,
@@ -162,6 +209,7 @@ impl<'k> Recorder<'k> {
                 .as_ref()
                 .map(|(k, d)| (k.histogram(), d.clone())),
             ratios: metrics.control.as_ref().map(|_| FollowupRatios::new()),
+            reach: metrics.control.as_ref().map(|_| GoalReach::new()),
             initial: initial.to_vec(),
             log: ExplorationLog {
                 dim: initial.len(),
@@ -193,6 +241,9 @@ impl<'k> Recorder<'k> {
         }
         if let Some(f) = &mut self.ratios {
             f.add(s[0], s[1]);
+        }
+        if let Some(g) = &mut self.reach {
+            g.add(s[0], s[1]);
         }
         let m = moved(s, &self.initial[self.dims.clone()]);
         self.n_moved += m as usize;
@@ -228,6 +279,7 @@ impl<'k> Recorder<'k> {
                     )
                 }),
                 ratios: self.ratios.as_ref().map(FollowupRatios::ratios),
+                goal_error: self.reach.as_ref().map(GoalReach::error),
             });
             self.next_eval += 1;
         }
@@ -256,7 +308,44 @@ impl<'k> Recorder<'k> {
 
 #[cfg(test)]
 mod tests {
-    use super::FollowupRatios;
+    use super::{FollowupRatios, GoalReach};
+
+    /// The error along the curve is the discovery measure of the outcomes so far, bit for bit:
+    /// after each outcome of a spread, uneven set (pushed balls outside the disk included).
+    #[test]
+    fn the_goal_error_along_the_curve_is_the_discovery_measure() {
+        let env = ugl_types::EnvMeasures::by_name("armballs-corl").unwrap();
+        let mut reach = GoalReach::new();
+        assert_eq!(reach.error(), f64::INFINITY);
+        let mut outcomes = Vec::new();
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.4 - 1.2
+        };
+        for index in 0..300 {
+            let (x, y) = (next(), 0.5 * next());
+            reach.add(x, y);
+            outcomes.push(ugl_types::Outcome {
+                index,
+                epoch: index,
+                x,
+                y,
+                angle: None,
+                moved: true,
+            });
+            if index % 37 == 0 || index == 299 {
+                let d = env.measure(&outcomes, None).unwrap().unwrap();
+                assert_eq!(
+                    reach.error().to_bits(),
+                    d.goal_error_mean.to_bits(),
+                    "{index}"
+                );
+            }
+        }
+    }
 
     /// The follow-up's ratios count the cells of the whole square, each once, with the edges
     /// clipped into the grid: the same cells as `scripts/exploration_ratio.py`, which reproduces

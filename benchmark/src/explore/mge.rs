@@ -604,6 +604,30 @@ mod tests {
         // The distractor is measured as a control, the ball by the follow-up's ratios too.
         assert!(a.checkpoints.iter().all(|c| c.control.is_some()));
         assert!(a.checkpoints.iter().all(|c| c.ratios.is_some()));
+        // The goal-reaching error along the curve ends at the run's own measure of the ball.
+        let last = a.checkpoints.last().unwrap();
+        assert_eq!(last.n_outcomes, a.outcomes.len());
+        let outcomes: Vec<ugl_types::Outcome> = a
+            .outcomes
+            .iter()
+            .enumerate()
+            .map(|(i, s)| ugl_types::Outcome {
+                index: i as i64,
+                epoch: a.epochs[i] as i64,
+                x: s[0],
+                y: s[1],
+                angle: None,
+                moved: a.moved[i],
+            })
+            .collect();
+        let d = ugl_types::EnvMeasures::by_name("armballs")
+            .unwrap()
+            .measure(&outcomes, None)
+            .unwrap()
+            .unwrap();
+        assert_eq!(last.goal_error, Some(d.goal_error_mean));
+        let errors: Vec<f64> = a.checkpoints.iter().filter_map(|c| c.goal_error).collect();
+        assert!(errors.windows(2).all(|w| w[1] <= w[0]), "{errors:?}");
     }
 
     #[test]

@@ -20,7 +20,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::checkpoint::{self, CheckpointSpec, Restored, Snapshot};
-use super::conv_net::{ConvArch, ConvNet, channels_first};
+use super::conv_net::{ConvArch, ConvInit, ConvNet, channels_first};
 use super::conv_train::{ConvConfig, ConvTrainer};
 use super::evidence::{EVIDENCE_IMAGES, TrainingEvidence, bce_of_logit, mean_image_loss};
 use super::host_train::HostOptimizer;
@@ -97,6 +97,7 @@ pub struct ConvSection {
     /// `conv-bvae` only.
     pub delay_factor: Option<f64>,
     pub flush_subnormals: Option<bool>,
+    pub init: Option<ConvInit>,
 }
 
 impl ConvSection {
@@ -117,6 +118,7 @@ impl ConvSection {
             kl_delay: self.kl_delay.unwrap_or(d.kl_delay),
             delay_factor: self.delay_factor.or(d.delay_factor),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
+            init: self.init.unwrap_or(d.init),
         }
     }
 }
@@ -191,6 +193,15 @@ impl LearnerParams for ConvParams {
                 )
             },
         ]
+        .into_iter()
+        .chain((self.config.init == ConvInit::Torch).then(|| {
+            format!(
+                "{}: today's PyTorch initialisation (init = \"torch\"): the last transposed \
+                 convolution drawn 3.3 times wider than by the authors' PyTorch 0.4.0",
+                self.model.name()
+            )
+        }))
+        .collect()
     }
     fn build(&self, _variant: Option<Variant>) -> Box<dyn RepresentationLearner> {
         Box::new(ConvLearner::new(self.model, self.config.clone()))
@@ -458,7 +469,7 @@ pub fn train(
         Some(r) => r,
         None => {
             *rng = start;
-            let net = ConvNet::init(rng, arch);
+            let net = ConvNet::init(rng, arch, cfg.init);
             let training = ConvTraining::new(
                 ConvTrainer::new(net),
                 cfg,
@@ -838,7 +849,7 @@ mod tests {
         let mut rng = stream_named(5, "learner");
         let arch = arch_for(&cfg, &images, 2).unwrap();
         let mut t = ConvTraining::new(
-            ConvTrainer::new(ConvNet::init(&mut rng, arch)),
+            ConvTrainer::new(ConvNet::init(&mut rng, arch, cfg.init)),
             &short,
             &images,
             (0..images.n).collect(),
@@ -880,7 +891,7 @@ mod tests {
         // A damaged checkpoint: the optimiser file changed after its hash was taken.
         let mut rng = stream_named(5, "learner");
         let mut t = ConvTraining::new(
-            ConvTrainer::new(ConvNet::init(&mut rng, arch)),
+            ConvTrainer::new(ConvNet::init(&mut rng, arch, cfg.init)),
             &short,
             &images,
             (0..images.n).collect(),

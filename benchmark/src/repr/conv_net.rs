@@ -16,12 +16,14 @@
 //! Every product runs on [`ugl_kernels`]' deterministic kernels, so a forward pass has the same
 //! bits on every SIMD path and for every thread count.
 //!
-//! Initialisation: today's PyTorch defaults: every weight and bias uniform in `±1/sqrt(fan_in)`
-//! (`kaiming_uniform(a = sqrt(5))` for the weights), with PyTorch's fan-in (`in x k x k` for a
-//! convolution, `out x k x k` for a transposed one: its weight's second dimension). The
-//! authors' PyTorch (0.4.0) took `in x k x k` for a transposed convolution too, which differs
-//! only for the last one (32 -> 3: 3.3 times smaller there; `docs/neural.md`). The draws come
-//! from the learner's stream, layer by layer in the order above, weight then bias.
+//! Initialisation ([`ConvInit`]): PyTorch's defaults, every weight and bias uniform in
+//! `±1/sqrt(fan_in)`. The authors' PyTorch (0.4.0, [`ConvInit::Torch04`], the default) took the
+//! fan-in as `in x k x k` for every convolution, transposed or not; today's
+//! (`kaiming_uniform(a = sqrt(5))`, [`ConvInit::Torch`]) takes a transposed convolution's
+//! weight's second dimension, `out x k x k`. The two differ only for the last transposed
+//! convolution (32 -> 3), which the authors' draws 3.3 times smaller (`docs/neural.md`). The
+//! draws come from the learner's stream, layer by layer in the order above, weight then bias,
+//! the same draws for both (only that layer's bound differs).
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
@@ -40,6 +42,38 @@ pub const STRIDE: usize = 2;
 pub const PADDING: usize = 1;
 /// Stride-2 convolutions in the encoder (and transposed ones in the decoder).
 pub const CONV_LAYERS: usize = 4;
+
+/// Which PyTorch's default initialisation [`ConvNet::init`] draws (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ConvInit {
+    /// The authors' PyTorch 0.4.0: a transposed convolution's fan-in is `in x k x k`.
+    #[default]
+    #[serde(rename = "torch-0.4")]
+    Torch04,
+    /// Today's PyTorch: a transposed convolution's fan-in is `out x k x k` (ours before the
+    /// `init` key; the sweep's first networks).
+    #[serde(rename = "torch")]
+    Torch,
+}
+
+impl ConvInit {
+    /// The key's value in configuration files and manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            ConvInit::Torch04 => "torch-0.4",
+            ConvInit::Torch => "torch",
+        }
+    }
+
+    /// The fan-in of a transposed convolution of this shape.
+    fn deconv_fan_in(self, shape: &ConvTranspose2d) -> usize {
+        let k2 = shape.kernel * shape.kernel;
+        match self {
+            ConvInit::Torch04 => shape.channels_in * k2,
+            ConvInit::Torch => shape.channels_out * k2,
+        }
+    }
+}
 
 /// The sizes of a convolutional VAE. [`ConvArch::followup`] is the authors'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -191,11 +225,12 @@ fn dense(rng: &mut Stream, inp: usize, out: usize) -> HostLayer {
 }
 
 impl ConvNet {
-    /// Fresh weights from `rng` (PyTorch's default initialisation; module docs).
+    /// Fresh weights from `rng` (PyTorch's default initialisation of version `init`; module
+    /// docs).
     ///
     /// # Panics
     /// If `arch` does not pass [`ConvArch::check`] (the learner checks it first).
-    pub fn init(rng: &mut Stream, arch: ConvArch) -> ConvNet {
+    pub fn init(rng: &mut Stream, arch: ConvArch, init: ConvInit) -> ConvNet {
         if let Err(e) = arch.check() {
             panic!("ConvNet::init: {e}");
         }
@@ -223,7 +258,7 @@ impl ConvNet {
         let dec_conv = (0..CONV_LAYERS)
             .map(|i| {
                 let shape = arch.deconv(i);
-                let fan_in = shape.channels_out * k2;
+                let fan_in = init.deconv_fan_in(&shape);
                 DeconvLayer {
                     shape,
                     w: torch_uniform(rng, shape.weight_len(), fan_in),
@@ -400,7 +435,11 @@ impl ConvNet {
     pub fn from_payload(arch: ConvArch, payload: &[u8]) -> Result<ConvNet, ModelFileError> {
         arch.check().map_err(ModelFileError::Content)?;
         // Shapes from the architecture; values from the payload.
-        let mut net = ConvNet::init(&mut crate::seed::stream_named(0, "shapes"), arch);
+        let mut net = ConvNet::init(
+            &mut crate::seed::stream_named(0, "shapes"),
+            arch,
+            ConvInit::Torch04,
+        );
         let want: usize = net.num_params() * 4;
         if payload.len() != want {
             return Err(ModelFileError::Content(format!(
@@ -463,7 +502,7 @@ mod tests {
         let arch = ConvArch::followup(10);
         arch.check().unwrap();
         assert_eq!(arch.flat(), 512);
-        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
         // The tensor sizes of the authors' released weights: 4 convolutions (3->32, 3 x 32->32,
         // 4x4), 512-256-256-20 and 10-256-512 dense layers, 4 transposed convolutions.
         let conv = 32 * 3 * 16 + 32 + 3 * (32 * 32 * 16 + 32);
@@ -485,6 +524,34 @@ mod tests {
     }
 
     #[test]
+    fn the_authors_initialisation_draws_only_the_last_layer_smaller() {
+        let arch = ConvArch::followup(10);
+        let theirs = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
+        let today = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch);
+        // The same draws: every layer but the last transposed convolution is identical.
+        assert_eq!(theirs.enc_conv, today.enc_conv);
+        assert_eq!(theirs.dec_conv[..3], today.dec_conv[..3]);
+        assert_eq!(theirs.dec_fc, today.dec_fc);
+        // The last one (32 -> 3): bound 1/sqrt(32 x 16) against 1/sqrt(3 x 16), draw by draw.
+        let (a, b) = (&theirs.dec_conv[3], &today.dec_conv[3]);
+        let ratio = (48f64 / 512.0).sqrt();
+        for (x, y) in a.w.iter().chain(&a.b).zip(b.w.iter().chain(&b.b)) {
+            assert!(
+                (f64::from(*x) - ratio * f64::from(*y)).abs() < 1e-6,
+                "{x} {y}"
+            );
+        }
+        let bound = 1.0 / 512f32.sqrt();
+        assert!(a.w.iter().all(|w| w.abs() <= bound));
+        assert!(a.w.iter().any(|w| w.abs() > 0.9 * bound));
+        assert_eq!(ConvInit::default(), ConvInit::Torch04);
+        assert_eq!(
+            serde_json::to_value(ConvInit::Torch04).unwrap(),
+            "torch-0.4"
+        );
+    }
+
+    #[test]
     fn sizes_that_make_no_network_are_refused() {
         let arch = ConvArch::followup(10);
         assert!(ConvArch { side: 60, ..arch }.check().is_err());
@@ -502,7 +569,7 @@ mod tests {
             hidden: 5,
             latents: 2,
         };
-        let net = ConvNet::init(&mut stream_named(4, "conv"), arch);
+        let net = ConvNet::init(&mut stream_named(4, "conv"), arch, ConvInit::Torch04);
         let bytes = net.to_model_bytes();
         assert_eq!(ConvNet::from_model_bytes(&bytes).unwrap(), net);
         let mut damaged = bytes.clone();
@@ -513,7 +580,11 @@ mod tests {
             ModelFileError::Checksum
         );
         // A sound file of another payload length (a network of other sizes, same header).
-        let other = ConvNet::init(&mut stream_named(4, "conv"), ConvArch { hidden: 6, ..arch });
+        let other = ConvNet::init(
+            &mut stream_named(4, "conv"),
+            ConvArch { hidden: 6, ..arch },
+            ConvInit::Torch04,
+        );
         let (_, payload) = super::super::model_file::unseal(&other.to_model_bytes())
             .map(|(h, p)| (h.to_vec(), p.to_vec()))
             .unwrap();

@@ -21,7 +21,7 @@ use burn::tensor::Device;
 use serde::{Deserialize, Serialize};
 
 use super::ReprError;
-use super::conv_net::{CONV_LAYERS, ConvNet, DecoderActivations, EncoderActivations};
+use super::conv_net::{CONV_LAYERS, ConvInit, ConvNet, DecoderActivations, EncoderActivations};
 use super::host_train::{
     HostOptimizer, Middle, bce_and_grad, dense_backward, relu_backward, sized,
 };
@@ -80,6 +80,15 @@ pub struct ConvConfig {
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
     /// 6 times slower. `false`: IEEE subnormals, as PyTorch's CPU default (other bits).
     pub flush_subnormals: bool,
+    /// Which PyTorch's default initialisation draws the weights ([`ConvInit`]; the authors'
+    /// 0.4.0 by default). A configuration recorded before the key existed was today's PyTorch.
+    #[serde(default = "init_before_the_key")]
+    pub init: ConvInit,
+}
+
+/// The initialisation of a configuration recorded before `init` existed.
+fn init_before_the_key() -> ConvInit {
+    ConvInit::Torch
 }
 
 impl ConvConfig {
@@ -99,6 +108,7 @@ impl ConvConfig {
             kl_delay: 0,
             delay_factor: None,
             flush_subnormals: true,
+            init: ConvInit::Torch04,
         }
     }
 
@@ -540,7 +550,7 @@ mod tests {
     fn the_host_gradients_are_burns() {
         let arch = small();
         let n = 3;
-        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
         let x = pictures(arch, n, 2);
         let delayed = ConvConfig {
             kl_delay: 20,
@@ -590,7 +600,7 @@ mod tests {
     #[test]
     fn the_warm_up_changes_the_gradients() {
         let arch = small();
-        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
         let x = pictures(arch, 3, 2);
         let run = |cfg: &ConvConfig| {
             let mut t = ConvTrainer::new(net.clone());
@@ -701,7 +711,7 @@ mod tests {
         // Before the delay ends the factor is 0.01: the heads' gradients differ from the
         // undelayed form's at the same step (factor 0.31 at step 3 of a 10-iteration ramp).
         let arch = small();
-        let net = ConvNet::init(&mut stream_named(1, "conv"), arch);
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
         let x = pictures(arch, 3, 2);
         let run = |cfg: &ConvConfig| {
             let mut t = ConvTrainer::new(net.clone());
@@ -733,7 +743,11 @@ mod tests {
                 .unwrap()
         };
         pool.install(|| {
-            let mut t = ConvTrainer::new(ConvNet::init(&mut stream_named(1, "conv"), arch));
+            let mut t = ConvTrainer::new(ConvNet::init(
+                &mut stream_named(1, "conv"),
+                arch,
+                ConvInit::Torch04,
+            ));
             let cfg = followup_config();
             let mut rng = stream_named(4, "noise");
             for step in 0..3 {
@@ -811,8 +825,14 @@ mod tests {
             ..followup_config()
         };
         let mut finals = vec![];
+        // Today's PyTorch initialisation: with the authors' (the last layer drawn smaller)
+        // only 1 of these 4 seeds leaves the plateau in 1500 iterations (`docs/neural.md`).
         for seed in 1..=4 {
-            let mut t = ConvTrainer::new(ConvNet::init(&mut stream_named(seed, "conv"), arch));
+            let mut t = ConvTrainer::new(ConvNet::init(
+                &mut stream_named(seed, "conv"),
+                arch,
+                ConvInit::Torch,
+            ));
             let mut rng = stream_named(seed, "noise");
             let mut losses = vec![];
             for step in 0..cfg.iterations {
@@ -838,7 +858,11 @@ mod tests {
     #[test]
     fn a_batch_of_the_wrong_size_is_an_error() {
         let arch = small();
-        let mut t = ConvTrainer::new(ConvNet::init(&mut stream_named(1, "conv"), arch));
+        let mut t = ConvTrainer::new(ConvNet::init(
+            &mut stream_named(1, "conv"),
+            arch,
+            ConvInit::Torch04,
+        ));
         let x = pictures(arch, 2, 1);
         let err = t
             .forward_backward(&followup_config(), &x, 3, 0, &mut stream_named(3, "n"))

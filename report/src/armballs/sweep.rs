@@ -42,6 +42,8 @@ fn setting(m: &Manifest) -> String {
     }
     if let Some(c) = num("capacity") {
         parts.push(match int("capacity_iterations") {
+            // |KL − 0| is the KL: the plain β-VAE objective.
+            _ if c == 0.0 => "C 0 (the plain β-VAE)".to_string(),
             Some(1) => format!("C {c} from the start"),
             Some(t) => format!("C {c} reached at {t}"),
             None => format!("C {c} reached at the end"),
@@ -78,6 +80,10 @@ fn setting(m: &Manifest) -> String {
         != Some(true)
     {
         parts.push("subnormals kept".into());
+    }
+    // Recorded before the key existed: today's PyTorch initialisation.
+    if train.config_field("init").and_then(|v| v.as_str()) != Some("torch-0.4") {
+        parts.push("init of today's PyTorch".into());
     }
     parts.join(", ")
 }
@@ -200,6 +206,24 @@ mod tests {
         train.config["delay_factor"] = serde_json::json!(0.0004);
         assert!(
             setting(&m).contains(", KL delayed 3000 at weight 0.04, warm-up"),
+            "{}",
+            setting(&m)
+        );
+        // Trained before the `init` key: today's PyTorch initialisation, said; the authors'
+        // (the default since) is not.
+        assert!(
+            setting(&m).ends_with(", init of today's PyTorch"),
+            "{}",
+            setting(&m)
+        );
+        let train = m.train.as_mut().unwrap();
+        train.config["init"] = serde_json::json!("torch-0.4");
+        assert!(setting(&m).ends_with(", 8000 it"), "{}", setting(&m));
+        // A capacity of 0 is the plain β-VAE objective, and says so.
+        let train = m.train.as_mut().unwrap();
+        train.config["capacity"] = serde_json::json!(0.0);
+        assert!(
+            setting(&m).contains(", β 100, C 0 (the plain β-VAE), KL delayed"),
             "{}",
             setting(&m)
         );

@@ -302,23 +302,22 @@ fn recipe_budget(
         };
         let (long, short) = (on_reps(&camp.name), on_reps(&inp.campaigns.main.name));
         // The difference paired by repetition (each pair shares its data set and streams).
-        let paired =
-            if long.len() == short.len() && long.iter().zip(&short).all(|(a, b)| a.0 == b.0) {
-                let d: Vec<f64> = long.iter().zip(&short).map(|(a, b)| a.1 - b.1).collect();
-                stats::t_interval(&d, stats::CONFIDENCE)
-                    .map(|i| {
-                        format!(
-                            " (Δ {:+.3} [{:+.3}, {:+.3}], {:.0}% t interval paired by repetition)",
-                            i.estimate,
-                            i.lo,
-                            i.hi,
-                            stats::CONFIDENCE * 100.0
-                        )
-                    })
-                    .unwrap_or_default()
-            } else {
-                String::new()
-            };
+        let paired = if crate::claims::is_paired(&long, &short) {
+            let d: Vec<f64> = long.iter().zip(&short).map(|(a, b)| a.1 - b.1).collect();
+            stats::t_interval(&d, stats::CONFIDENCE)
+                .map(|i| {
+                    format!(
+                        " (Δ {:+.3} [{:+.3}, {:+.3}], {:.0}% t interval paired by repetition)",
+                        i.estimate,
+                        i.lo,
+                        i.hi,
+                        stats::CONFIDENCE * 100.0
+                    )
+                })
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
         let long: Vec<f64> = long.into_iter().map(|v| v.1).collect();
         let short: Vec<f64> = short.into_iter().map(|v| v.1).collect();
         let (Some((a, _)), Some((b, _))) =
