@@ -57,25 +57,19 @@ pub fn curve_frame(spec: &RunSpec, log: &ExplorationLog) -> PolarsResult<DataFra
         curve::N_MOVED => c.iter().map(|p| p.n_moved as i64).collect::<Vec<_>>(),
         curve::COVERAGE => c.iter().map(|p| p.coverage).collect::<Vec<_>>(),
     )?;
-    // The optional pairs of columns, each written where some checkpoint has it.
-    let pairs: [(fn(&Checkpoint) -> Option<(f64, f64)>, [&str; 2]); 2] = [
-        (|p| p.control, [curve::CONTROL_KLC, curve::CONTROL_COVERAGE]),
-        (|p| p.ratios, [curve::RATIO_30, curve::RATIO_50]),
+    // The optional columns, each written where some checkpoint has it.
+    let optional: [(&str, fn(&Checkpoint) -> Option<f64>); 5] = [
+        (curve::CONTROL_KLC, |p| p.control.map(|c| c.0)),
+        (curve::CONTROL_COVERAGE, |p| p.control.map(|c| c.1)),
+        (curve::RATIO_30, |p| p.ratios.map(|r| r.0)),
+        (curve::RATIO_50, |p| p.ratios.map(|r| r.1)),
+        (curve::GOAL_ERROR, |p| p.goal_error),
     ];
-    for (get, names) in pairs {
+    for (name, get) in optional {
         if c.iter().any(|p| get(p).is_some()) {
-            for (k, name) in names.into_iter().enumerate() {
-                let v: Vec<Option<f64>> = c
-                    .iter()
-                    .map(|p| get(p).map(|(a, b)| if k == 0 { a } else { b }))
-                    .collect();
-                df.with_column(Column::new(name.into(), v))?;
-            }
+            let v: Vec<Option<f64>> = c.iter().map(get).collect();
+            df.with_column(Column::new(name.into(), v))?;
         }
-    }
-    if c.iter().any(|p| p.goal_error.is_some()) {
-        let v: Vec<Option<f64>> = c.iter().map(|p| p.goal_error).collect();
-        df.with_column(Column::new(curve::GOAL_ERROR.into(), v))?;
     }
     Ok(df)
 }
@@ -282,5 +276,75 @@ pub fn is_complete(dir: &Path, run_id: &str, config_hash: &str) -> bool {
             }
         },
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::EnvKind;
+    use crate::explore::Algo;
+
+    fn log(checkpoints: Vec<Checkpoint>) -> ExplorationLog {
+        ExplorationLog {
+            dim: 4,
+            outcomes: Vec::new(),
+            epochs: Vec::new(),
+            moved: Vec::new(),
+            checkpoints,
+            n_random: 0,
+            n_goal: 0,
+            modules: Vec::new(),
+            interest: Vec::new(),
+        }
+    }
+
+    /// The optional columns come after the fixed ones, in their order, each only where some
+    /// checkpoint has it: none for a scene without an uncontrollable object, all five for
+    /// ArmBalls, with each value in its own column.
+    #[test]
+    fn the_curve_writes_the_optional_columns_where_the_scene_has_them() {
+        let point = Checkpoint {
+            epoch: 10,
+            n_outcomes: 11,
+            klc: 3.0,
+            n_moved: 4,
+            coverage: 0.1,
+            control: None,
+            ratios: None,
+            goal_error: None,
+        };
+        let plain = curve_frame(
+            &RunSpec::baseline(EnvKind::ARMBALL, Algo::RPE, 0),
+            &log(vec![point]),
+        )
+        .unwrap();
+        assert_eq!(
+            plain.get_column_names().last().unwrap().as_str(),
+            curve::COVERAGE
+        );
+        let balls = Checkpoint {
+            control: Some((1.0, 0.2)),
+            ratios: Some((0.3, 0.4)),
+            goal_error: Some(0.5),
+            ..point
+        };
+        let df = curve_frame(
+            &RunSpec::baseline(EnvKind::ARMBALLS, Algo::RPE, 0),
+            &log(vec![balls]),
+        )
+        .unwrap();
+        let names: Vec<&str> = df.get_column_names().iter().map(|n| n.as_str()).collect();
+        let optional = [
+            (curve::CONTROL_KLC, 1.0),
+            (curve::CONTROL_COVERAGE, 0.2),
+            (curve::RATIO_30, 0.3),
+            (curve::RATIO_50, 0.4),
+            (curve::GOAL_ERROR, 0.5),
+        ];
+        assert_eq!(names[names.len() - 5..], optional.map(|o| o.0));
+        for (name, v) in optional {
+            assert_eq!(df.column(name).unwrap().f64().unwrap().get(0), Some(v));
+        }
     }
 }

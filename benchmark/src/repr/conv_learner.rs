@@ -196,9 +196,10 @@ impl LearnerParams for ConvParams {
         .into_iter()
         .chain((self.config.init == ConvInit::Torch).then(|| {
             format!(
-                "{}: today's PyTorch initialisation (init = \"torch\"): the last transposed \
+                "{}: today's PyTorch initialisation (init = \"{}\"): the last transposed \
                  convolution drawn 3.3 times wider than by the authors' PyTorch 0.4.0",
-                self.model.name()
+                self.model.name(),
+                ConvInit::Torch.name()
             )
         }))
         .collect()

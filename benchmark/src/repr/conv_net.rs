@@ -545,10 +545,11 @@ mod tests {
         assert!(a.w.iter().all(|w| w.abs() <= bound));
         assert!(a.w.iter().any(|w| w.abs() > 0.9 * bound));
         assert_eq!(ConvInit::default(), ConvInit::Torch04);
-        assert_eq!(
-            serde_json::to_value(ConvInit::Torch04).unwrap(),
-            "torch-0.4"
-        );
+        assert_eq!(ConvInit::Torch04.name(), "torch-0.4");
+        // The key's value in files is its name.
+        for init in [ConvInit::Torch04, ConvInit::Torch] {
+            assert_eq!(serde_json::to_value(init).unwrap(), init.name());
+        }
     }
 
     #[test]
