@@ -18,6 +18,7 @@
 //!   from its [`Outcome`]s by [`EnvMeasures`], recorded in its manifest;
 //! - [`GoalSpaceSample`]: the goal-space figure data a campaign writes beside its runs;
 //! - [`TrainingRecord`]: how a run's trained network was obtained (its manifest's `train`).
+//! - [`ConvInit`]: which PyTorch initialisation drew a convolutional network.
 //!
 //! ```
 //! let ball = ugl_types::EnvSpec::by_name("armball").unwrap();
@@ -28,6 +29,7 @@
 mod campaign;
 pub mod columns;
 mod condition;
+mod conv_init;
 mod diagnostics;
 mod discovery;
 mod env;
@@ -45,6 +47,7 @@ mod training;
 
 pub use campaign::{CampaignDecl, CampaignRecord, CampaignRole, RECORD_FILE, RecordError};
 pub use condition::{Algo, AlgoInfo, ConditionKey, Sampler, Variant};
+pub use conv_init::ConvInit;
 pub use diagnostics::{DIAGNOSTICS_DIR, Diagnostics};
 pub use discovery::{
     Discovery, DiscoveryError, EnvMeasures, GOAL_OTHER_BINS, GOAL_POSITION_BINS, GoalGrid, Outcome,

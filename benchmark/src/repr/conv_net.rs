@@ -43,35 +43,14 @@ pub const PADDING: usize = 1;
 /// Stride-2 convolutions in the encoder (and transposed ones in the decoder).
 pub const CONV_LAYERS: usize = 4;
 
-/// Which PyTorch's default initialisation [`ConvNet::init`] draws (module docs).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum ConvInit {
-    /// The authors' PyTorch 0.4.0: a transposed convolution's fan-in is `in x k x k`.
-    #[default]
-    #[serde(rename = "torch-0.4")]
-    Torch04,
-    /// Today's PyTorch: a transposed convolution's fan-in is `out x k x k` (ours before the
-    /// `init` key; the sweep's first networks).
-    #[serde(rename = "torch")]
-    Torch,
-}
+pub use ugl_types::ConvInit;
 
-impl ConvInit {
-    /// The key's value in configuration files and manifests.
-    pub fn name(self) -> &'static str {
-        match self {
-            ConvInit::Torch04 => "torch-0.4",
-            ConvInit::Torch => "torch",
-        }
-    }
-
-    /// The fan-in of a transposed convolution of this shape.
-    fn deconv_fan_in(self, shape: &ConvTranspose2d) -> usize {
-        let k2 = shape.kernel * shape.kernel;
-        match self {
-            ConvInit::Torch04 => shape.channels_in * k2,
-            ConvInit::Torch => shape.channels_out * k2,
-        }
+/// The fan-in of a transposed convolution of this shape under `init`.
+fn deconv_fan_in(init: ConvInit, shape: &ConvTranspose2d) -> usize {
+    let k2 = shape.kernel * shape.kernel;
+    match init {
+        ConvInit::Torch04 => shape.channels_in * k2,
+        ConvInit::Torch => shape.channels_out * k2,
     }
 }
 
@@ -258,7 +237,7 @@ impl ConvNet {
         let dec_conv = (0..CONV_LAYERS)
             .map(|i| {
                 let shape = arch.deconv(i);
-                let fan_in = init.deconv_fan_in(&shape);
+                let fan_in = deconv_fan_in(init, &shape);
                 DeconvLayer {
                     shape,
                     w: torch_uniform(rng, shape.weight_len(), fan_in),
@@ -545,11 +524,6 @@ mod tests {
         assert!(a.w.iter().all(|w| w.abs() <= bound));
         assert!(a.w.iter().any(|w| w.abs() > 0.9 * bound));
         assert_eq!(ConvInit::default(), ConvInit::Torch04);
-        assert_eq!(ConvInit::Torch04.name(), "torch-0.4");
-        // The key's value in files is its name.
-        for init in [ConvInit::Torch04, ConvInit::Torch] {
-            assert_eq!(serde_json::to_value(init).unwrap(), init.name());
-        }
     }
 
     #[test]

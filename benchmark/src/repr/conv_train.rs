@@ -88,7 +88,7 @@ pub struct ConvConfig {
 
 /// The initialisation of a configuration recorded before `init` existed.
 fn init_before_the_key() -> ConvInit {
-    ConvInit::Torch
+    ConvInit::BEFORE_THE_KEY
 }
 
 impl ConvConfig {

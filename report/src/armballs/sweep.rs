@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use ugl_types::Manifest;
+use ugl_types::{ConvInit, Manifest};
 
 use super::labels::f2;
 use super::runs::{ACTIVE_NATS, LatentRole, active_roles, count_role};
@@ -82,14 +82,16 @@ fn setting(m: &Manifest) -> String {
         parts.push("subnormals kept".into());
     }
     // Recorded before the key existed: today's PyTorch initialisation.
-    if train.config_field("init").and_then(|v| v.as_str()) != Some("torch-0.4") {
-        parts.push("init of today's PyTorch".into());
+    match ConvInit::of_record(train.config_field("init")) {
+        Ok(ConvInit::Torch04) => {}
+        Ok(ConvInit::Torch) => parts.push("init of today's PyTorch".into()),
+        Err(_) => parts.push("an init this build does not know".into()),
     }
     parts.join(", ")
 }
 
-/// One row of [`table`].
-fn row(m: &Manifest) -> String {
+/// One row of [`table`], as its setting ([`setting`]) and the cells after it (from the seed on).
+fn row(m: &Manifest) -> (String, String) {
     let evidence = m.training_evidence();
     let q = m.latent_quality.as_ref();
     let kl: Vec<f64> = q.map(|q| q.kl_per_latent.clone()).unwrap_or_default();
@@ -109,9 +111,8 @@ fn row(m: &Manifest) -> String {
             .map_or("n/a".into(), |g| f2(g.knn_r2))
     };
     let dis = q.and_then(|q| q.disentanglement.as_ref());
-    format!(
-        "| {} | {} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} |",
-        setting(m),
+    let cells = format!(
+        "{} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} |",
         m.seed,
         match evidence.map(|e| e.trained) {
             Some(true) => "yes",
@@ -136,12 +137,14 @@ fn row(m: &Manifest) -> String {
         knn("distractor"),
         dis.map_or("n/a".into(), |d| format!("{:.3}", d.mig)),
         dis.map_or("n/a".into(), |d| format!("{:.3}", d.sap)),
-    )
+    );
+    (setting(m), cells)
 }
 
 /// The markdown table of the sweep under `dir`: one row per run manifest in each setting's
 /// sub-directory (the model cache, `models/`, is skipped), settings in directory order and runs
-/// in file order. Each manifest is read as the report reads a run's (its data files checked
+/// in file order; a row whose setting is the row above's leaves its setting cell empty, so that
+/// each setting is written once above its seeds. Each manifest is read as the report reads a run's (its data files checked
 /// against their recorded hashes). An error if `dir` holds no run.
 pub fn table(dir: &Path) -> Result<String, ReportError> {
     let mut settings = crate::load::sorted_entries(dir)?;
@@ -151,13 +154,21 @@ pub fn table(dir: &Path) -> Result<String, ReportError> {
         "---|".repeat(HEADER.matches(" | ").count() + 1)
     );
     let mut rows = 0;
+    let mut above = None;
     for s in settings {
         let manifests = crate::load::sorted_entries(&s)?;
         for path in manifests
             .iter()
             .filter(|p| p.extension().is_some_and(|e| e == "json"))
         {
-            let _ = writeln!(out, "{}", row(&crate::load::read_manifest(path)?));
+            let (setting, cells) = row(&crate::load::read_manifest(path)?);
+            let shown = if above.as_ref() == Some(&setting) {
+                ""
+            } else {
+                &setting
+            };
+            let _ = writeln!(out, "| {shown} | {cells}");
+            above = Some(setting);
             rows += 1;
         }
     }
@@ -185,6 +196,44 @@ mod tests {
         std::fs::create_dir(dir.path().join("beta-4")).unwrap();
         let e = table(dir.path()).unwrap_err().to_string();
         assert!(e.contains("holds no sweep run"), "{e}");
+    }
+
+    /// A setting trained on three seeds is written once, above its three rows, and the next
+    /// setting again: the table copies two committed settings and counts.
+    #[test]
+    fn each_setting_is_written_once_above_its_seeds() {
+        let sweep = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/sweeps/conv");
+        let dir = tempfile::tempdir().unwrap();
+        let three = "beta-10_capacity-12_capacity_iterations-5000_iterations-20000_init-torch";
+        let one = "beta-16_capacity-0_kl_delay-2000_delay_factor-0.0625_warmup-0_iterations-\
+                   6000_init-torch";
+        for name in [three, one] {
+            let to = dir.path().join(name);
+            std::fs::create_dir(&to).unwrap();
+            for f in std::fs::read_dir(Path::new(sweep).join(name)).unwrap() {
+                let f = f.unwrap().path();
+                std::fs::copy(&f, to.join(f.file_name().unwrap())).unwrap();
+            }
+        }
+        let out = table(dir.path()).unwrap();
+        let rows: Vec<&str> = out.lines().skip(2).collect();
+        assert_eq!(rows.len(), 4, "{out}");
+        let first_cell = |r: &str| {
+            r.split(" | ")
+                .next()
+                .unwrap()
+                .trim_start_matches("| ")
+                .to_string()
+        };
+        assert!(
+            first_cell(rows[0]).starts_with("conv β-VAE, β 10, C 12"),
+            "{out}"
+        );
+        assert!(
+            rows[1].starts_with("|  | 1001 |") && rows[2].starts_with("|  | 1002 |"),
+            "{out}"
+        );
+        assert!(first_cell(rows[3]).starts_with("conv β-VAE, β 16"), "{out}");
     }
 
     /// The setting names the KL delay, the phase's KL weight (its factor times β) where the
@@ -217,8 +266,18 @@ mod tests {
             setting(&m)
         );
         let train = m.train.as_mut().unwrap();
-        train.config["init"] = serde_json::json!("torch-0.4");
+        train.config["init"] = serde_json::json!(ConvInit::Torch04.name());
         assert!(setting(&m).ends_with(", 8000 it"), "{}", setting(&m));
+        // A value no build of ours wrote is said, not read as one of ours.
+        let train = m.train.as_mut().unwrap();
+        train.config["init"] = serde_json::json!("torch-2");
+        assert!(
+            setting(&m).ends_with(", an init this build does not know"),
+            "{}",
+            setting(&m)
+        );
+        let train = m.train.as_mut().unwrap();
+        train.config["init"] = serde_json::json!(ConvInit::Torch04.name());
         // A capacity of 0 is the plain β-VAE objective, and says so.
         let train = m.train.as_mut().unwrap();
         train.config["capacity"] = serde_json::json!(0.0);
