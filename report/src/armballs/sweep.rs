@@ -265,19 +265,14 @@ mod tests {
             "{}",
             setting(&m)
         );
-        let train = m.train.as_mut().unwrap();
-        train.config["init"] = serde_json::json!(ConvInit::Torch04.name());
-        assert!(setting(&m).ends_with(", 8000 it"), "{}", setting(&m));
-        // A value no build of ours wrote is said, not read as one of ours.
-        let train = m.train.as_mut().unwrap();
-        train.config["init"] = serde_json::json!("torch-2");
-        assert!(
-            setting(&m).ends_with(", an init this build does not know"),
-            "{}",
-            setting(&m)
-        );
-        let train = m.train.as_mut().unwrap();
-        train.config["init"] = serde_json::json!(ConvInit::Torch04.name());
+        // The authors' is not said; a value no build of ours wrote is said, not read as ours.
+        for (init, end) in [
+            ("torch-2", ", an init this build does not know"),
+            (ConvInit::Torch04.name(), ", 8000 it"),
+        ] {
+            m.train.as_mut().unwrap().config["init"] = serde_json::json!(init);
+            assert!(setting(&m).ends_with(end), "{}", setting(&m));
+        }
         // A capacity of 0 is the plain β-VAE objective, and says so.
         let train = m.train.as_mut().unwrap();
         train.config["capacity"] = serde_json::json!(0.0);
