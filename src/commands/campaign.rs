@@ -282,7 +282,7 @@ pub(crate) fn status(
     use ugl_bench::campaign::status::{RunState, store_status};
     let cfg = match (config, &out) {
         (Some(config), _) => CampaignConfig::load(config)?,
-        (None, Some(out)) => super::verify::recorded_campaign(out)?,
+        (None, Some(out)) => super::record::recorded_campaign(out)?,
         (None, None) => bail!("give --config, or --out of a store that holds its campaign.toml"),
     };
     // At most one shard per group of runs that share a fit, as `ugl slurm` writes them (a huge
