@@ -11,13 +11,20 @@
 #   scripts/conv_sweep.sh OUT SETTING...
 #   e.g. scripts/conv_sweep.sh /tmp/sweep beta=100,capacity=12,iterations=5000 vae vae,lr=0.01
 #
-# Resumable: a (setting, seed) whose manifest exists is skipped. Environment: UGL (the binary;
-# default target/debug/ugl, built first), SEEDS, IMAGES (training pictures, default 10000),
+# Resumable: a (setting, seed) whose manifest exists is skipped. Environment: UGL (the binary,
+# a path from the caller's directory or a command on PATH; default target/debug/ugl, built first), SEEDS, IMAGES (training pictures, default 10000),
 # EPOCHS (exploration epochs of each run, default 200: the exploration is not what is measured).
 set -euo pipefail
 out="${1:?usage: scripts/conv_sweep.sh OUT SETTING...}"
 shift
 [ $# -gt 0 ] || { echo "error: give at least one SETTING (e.g. beta=100,capacity=12)" >&2; exit 2; }
+# OUT and a UGL given as a path are read from the caller's directory, before the script moves to
+# the repository's root.
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
+case "${UGL:-}" in
+  */*) UGL="$(cd "$(dirname "$UGL")" && pwd)/$(basename "$UGL")" ;;
+esac
 cd "$(dirname "$0")/.."
 ugl="${UGL:-target/debug/ugl}"
 if [ -z "${UGL:-}" ]; then cargo build --quiet --bin ugl; fi
