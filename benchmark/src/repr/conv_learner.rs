@@ -96,6 +96,12 @@ pub struct ConvSection {
     pub kl_delay: Option<usize>,
     /// `conv-bvae` only.
     pub delay_factor: Option<f64>,
+    /// `conv-bvae` only.
+    pub beta_final: Option<f64>,
+    /// `conv-bvae` only.
+    pub beta_from: Option<usize>,
+    /// `conv-bvae` only.
+    pub beta_until: Option<usize>,
     pub flush_subnormals: Option<bool>,
     pub init: Option<ConvInit>,
 }
@@ -117,6 +123,9 @@ impl ConvSection {
             warmup: self.warmup.unwrap_or(d.warmup),
             kl_delay: self.kl_delay.unwrap_or(d.kl_delay),
             delay_factor: self.delay_factor.or(d.delay_factor),
+            beta_final: self.beta_final.or(d.beta_final),
+            beta_from: self.beta_from.or(d.beta_from),
+            beta_until: self.beta_until.or(d.beta_until),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
             init: self.init.unwrap_or(d.init),
         }
@@ -135,6 +144,9 @@ impl ParamGuard for (ConvModel, ConvSection) {
                 ("warmup", section.warmup.is_some()),
                 ("kl_delay", section.kl_delay.is_some()),
                 ("delay_factor", section.delay_factor.is_some()),
+                ("beta_final", section.beta_final.is_some()),
+                ("beta_from", section.beta_from.is_some()),
+                ("beta_until", section.beta_until.is_some()),
             ] {
                 if set {
                     return Err(ParamError::at(
@@ -169,7 +181,7 @@ impl LearnerParams for ConvParams {
         vec![
             format!(
                 "{}: training settings of ours (the authors' are not public): {} iterations, batch {}, \
-             lr {}{}",
+             lr {}{}{}",
                 self.model.name(),
                 self.config.iterations,
                 self.config.batch,
@@ -177,6 +189,13 @@ impl LearnerParams for ConvParams {
                 match self.config.capacity {
                     Some(c) => format!(", β {} and capacity {c} nats", self.config.beta),
                     None => String::new(),
+                },
+                match (self.config.beta_final, self.config.beta_from) {
+                    (Some(last), Some(from)) => format!(
+                        ", β moving to {last} from iteration {from} to {}",
+                        self.config.beta_until.unwrap_or(from)
+                    ),
+                    _ => String::new(),
                 },
             ),
             if self.config.flush_subnormals {
@@ -813,6 +832,24 @@ mod tests {
         assert_eq!(e.key.as_deref(), Some("kl_delay"));
         let p = (ConvModel::ConvBvae, delayed).check().unwrap();
         assert_eq!(p.config.kl_delay, 100);
+        // A later β: the β-VAE's, said among its deviations.
+        let later = ConvSection {
+            beta_final: Some(40.0),
+            beta_from: Some(1000),
+            beta_until: Some(2000),
+            ..ConvSection::default()
+        };
+        let e = (ConvModel::ConvVae, later.clone()).check().unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("beta_final"));
+        let p = (ConvModel::ConvBvae, later).check().unwrap();
+        assert_eq!(p.config.beta_at(1500), 22.0);
+        assert!(
+            p.deviations(None)
+                .iter()
+                .any(|d| d.contains(", β moving to 40 from iteration 1000 to 2000")),
+            "{:?}",
+            p.deviations(None)
+        );
     }
 
     /// A training killed after a checkpoint and started again gives the same network, bit for

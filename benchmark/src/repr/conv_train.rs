@@ -75,6 +75,19 @@ pub struct ConvConfig {
     /// identity). Ours: the phase's weight set apart from β (`docs/neural.md`, "Fifth round").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay_factor: Option<f64>,
+    /// A later KL weight: β moves linearly to `beta_final` between the iterations `beta_from`
+    /// and `beta_until` (a jump at `beta_from` when they are equal), and stays there ([`ConvConfig::beta_at`]).
+    /// Ours: a β that lets the network leave the plateau and learn both objects, then one that
+    /// holds the KL at the target (`docs/neural.md`, "Eighth round"). None (the default, left
+    /// out of the configuration's identity): β throughout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_final: Option<f64>,
+    /// The iteration at which β starts moving to `beta_final` (with `beta_final` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_from: Option<usize>,
+    /// The iteration at which β reaches `beta_final` (default: `beta_from`, a jump).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_until: Option<usize>,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
     /// [`ugl_kernels::flushing_pool`]): the same bits on every x86-64 CPU and path, and no
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
@@ -107,6 +120,9 @@ impl ConvConfig {
             warmup: 0,
             kl_delay: 0,
             delay_factor: None,
+            beta_final: None,
+            beta_from: None,
+            beta_until: None,
             flush_subnormals: true,
             init: ConvInit::Torch04,
         }
@@ -136,6 +152,23 @@ impl ConvConfig {
             .map(|c| c * (after as f64 / ramp as f64).min(1.0))
     }
 
+    /// The KL weight at iteration `step`: β, moving linearly to `beta_final` between
+    /// `beta_from` and `beta_until` where the configuration sets them.
+    pub fn beta_at(&self, step: usize) -> f64 {
+        let (Some(last), Some(from)) = (self.beta_final, self.beta_from) else {
+            return self.beta;
+        };
+        let until = self.beta_until.unwrap_or(from);
+        if step < from {
+            self.beta
+        } else if step >= until {
+            last
+        } else {
+            let t = (step - from) as f64 / (until - from) as f64;
+            self.beta + (last - self.beta) * t
+        }
+    }
+
     /// The settings of the KL term at iteration `step` (the β-VAE's code; one `eps` per
     /// picture).
     pub fn code_at(&self, step: usize) -> CodeSettings {
@@ -145,7 +178,7 @@ impl ConvConfig {
             delay_factor: self
                 .delay_factor
                 .unwrap_or(super::neural_model::INITIAL_WARMUP_FACTOR),
-            beta: self.beta,
+            beta: self.beta_at(step),
             capacity: self.capacity_at(step),
             variant: Variant::Corrected,
         }
@@ -227,6 +260,56 @@ impl ConvConfig {
                     "delay_factor",
                     format!("must be between 0 and 1, got {f}"),
                 ));
+            }
+        }
+        match (self.beta_final, self.beta_from) {
+            (None, None) if self.beta_until.is_some() => {
+                return Err(ParamError::at(
+                    "beta_until",
+                    "ends the move to beta_final: set beta_final and beta_from too",
+                ));
+            }
+            (None, None) => {}
+            (Some(_), None) => {
+                return Err(ParamError::at(
+                    "beta_from",
+                    "must be set with beta_final: the iteration at which β starts moving to it",
+                ));
+            }
+            (None, Some(_)) => {
+                return Err(ParamError::at(
+                    "beta_final",
+                    "must be set with beta_from: the KL weight β moves to",
+                ));
+            }
+            (Some(last), Some(from)) => {
+                if !(last.is_finite() && last > 0.0 && last <= 1e6) {
+                    return Err(ParamError::at(
+                        "beta_final",
+                        format!("must be positive and at most 1e6, got {last}"),
+                    ));
+                }
+                let until = self.beta_until.unwrap_or(from);
+                if until < from {
+                    return Err(ParamError::at(
+                        "beta_until",
+                        format!("must not be below beta_from ({from}), got {until}"),
+                    ));
+                }
+                if until >= self.iterations.max(1) {
+                    return Err(ParamError::at(
+                        if self.beta_until.is_some() {
+                            "beta_until"
+                        } else {
+                            "beta_from"
+                        },
+                        format!(
+                            "must be below the iterations ({}), got {until}: β would never reach \
+                             beta_final",
+                            self.iterations
+                        ),
+                    ));
+                }
             }
         }
         Ok(())
@@ -619,6 +702,72 @@ mod tests {
     /// The KL delay T_v holds the warm-up factor at 0.01, then the ramp starts; no delay is the
     /// follow-up's own form, and it stays out of the configuration's identity (the hashes of the
     /// networks trained before it existed hold).
+    /// β moves linearly to `beta_final` between `beta_from` and `beta_until` (a jump when they
+    /// are equal) and the KL term's weight follows it; the keys stay out of the identity when
+    /// unset, and a schedule that never reaches its value, or half of one, is refused by key.
+    #[test]
+    fn beta_moves_to_its_final_value_on_its_schedule() {
+        let ramp = ConvConfig {
+            beta_final: Some(24.0),
+            beta_from: Some(40),
+            beta_until: Some(60),
+            ..followup_config()
+        };
+        assert!(ramp.check().is_ok());
+        let betas: Vec<f64> = [0, 39, 40, 50, 59, 60, 99]
+            .iter()
+            .map(|s| ramp.beta_at(*s))
+            .collect();
+        assert_eq!(betas, [4.0, 4.0, 4.0, 14.0, 23.0, 24.0, 24.0]);
+        assert_eq!(ramp.code_at(50).beta, 14.0);
+        let jump = ConvConfig {
+            beta_until: None,
+            ..ramp.clone()
+        };
+        assert_eq!((jump.beta_at(39), jump.beta_at(40)), (4.0, 24.0));
+        assert_eq!(followup_config().beta_at(99), 4.0);
+
+        let plain = serde_json::to_value(followup_config()).unwrap();
+        assert!(plain.get("beta_final").is_none() && plain.get("beta_from").is_none());
+        assert_eq!(serde_json::to_value(&ramp).unwrap()["beta_final"], 24.0);
+
+        let key = |cfg: ConvConfig| cfg.check().unwrap_err().key;
+        let only = |final_: Option<f64>, from: Option<usize>, until: Option<usize>| ConvConfig {
+            beta_final: final_,
+            beta_from: from,
+            beta_until: until,
+            ..followup_config()
+        };
+        assert_eq!(
+            key(only(Some(24.0), None, None)).as_deref(),
+            Some("beta_from")
+        );
+        assert_eq!(
+            key(only(None, Some(40), None)).as_deref(),
+            Some("beta_final")
+        );
+        assert_eq!(
+            key(only(None, None, Some(60))).as_deref(),
+            Some("beta_until")
+        );
+        assert_eq!(
+            key(only(Some(24.0), Some(40), Some(30))).as_deref(),
+            Some("beta_until")
+        );
+        assert_eq!(
+            key(only(Some(24.0), Some(100), None)).as_deref(),
+            Some("beta_from")
+        );
+        assert_eq!(
+            key(only(Some(24.0), Some(40), Some(100))).as_deref(),
+            Some("beta_until")
+        );
+        assert_eq!(
+            key(only(Some(0.0), Some(40), None)).as_deref(),
+            Some("beta_final")
+        );
+    }
+
     #[test]
     fn the_kl_delay_holds_the_factor_then_ramps() {
         use crate::repr::bvae::warmup_factor;

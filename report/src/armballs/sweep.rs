@@ -40,6 +40,12 @@ fn setting(m: &Manifest) -> String {
     if let Some(b) = num("beta").filter(|b| *b != 1.0) {
         parts.push(format!("β {b}"));
     }
+    if let (Some(last), Some(from)) = (num("beta_final"), int("beta_from")) {
+        parts.push(match int("beta_until").filter(|u| *u > from) {
+            Some(until) => format!("then β {last} reached from {from} to {until}"),
+            None => format!("then β {last} from {from}"),
+        });
+    }
     if let Some(c) = num("capacity") {
         parts.push(match int("capacity_iterations") {
             // |KL − 0| is the KL: the plain β-VAE objective.
@@ -272,6 +278,25 @@ mod tests {
         ] {
             m.train.as_mut().unwrap().config["init"] = serde_json::json!(init);
             assert!(setting(&m).ends_with(end), "{}", setting(&m));
+        }
+        // A later β is said after β, with its schedule.
+        let config = &mut m.train.as_mut().unwrap().config;
+        config["beta_final"] = serde_json::json!(400.0);
+        config["beta_from"] = serde_json::json!(5000);
+        assert!(
+            setting(&m).contains(", β 100, then β 400 from 5000, C 12"),
+            "{}",
+            setting(&m)
+        );
+        m.train.as_mut().unwrap().config["beta_until"] = serde_json::json!(6000);
+        assert!(
+            setting(&m).contains(", β 100, then β 400 reached from 5000 to 6000, C 12"),
+            "{}",
+            setting(&m)
+        );
+        let config = m.train.as_mut().unwrap().config.as_object_mut().unwrap();
+        for key in ["beta_final", "beta_from", "beta_until"] {
+            config.remove(key);
         }
         // A capacity of 0 is the plain β-VAE objective, and says so.
         let train = m.train.as_mut().unwrap();
