@@ -21,7 +21,8 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
                       active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | MIG | SAP |";
 
 /// A network's setting in words, from the training configuration its manifest records: the
-/// learner's display name (the registry's), then β where it is not 1, the capacity C and how it
+/// learner's display name (the registry's), then β where it is not 1 (and the later β it moves
+/// to, with its iterations, where the configuration sets one), the capacity C and how it
 /// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning
 /// rate, the batch, the iterations, and whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
@@ -150,8 +151,8 @@ fn row(m: &Manifest) -> (String, String) {
 /// The markdown table of the sweep under `dir`: one row per run manifest in each setting's
 /// sub-directory (the model cache, `models/`, is skipped), settings in directory order and runs
 /// in file order; a row whose setting is the row above's leaves its setting cell empty, so that
-/// each setting is written once above its seeds. Each manifest is read as the report reads a run's (its data files checked
-/// against their recorded hashes). An error if `dir` holds no run.
+/// each setting is written once above its seeds. Each manifest is read as the report reads a
+/// run's (its data files checked against their recorded hashes). An error if `dir` holds no run.
 pub fn table(dir: &Path) -> Result<String, ReportError> {
     let mut settings = crate::load::sorted_entries(dir)?;
     settings.retain(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "models"));
