@@ -76,7 +76,8 @@ pub struct ConvConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay_factor: Option<f64>,
     /// A later KL weight: β moves linearly to `beta_final` between the iterations `beta_from`
-    /// and `beta_until` (a jump at `beta_from` when they are equal), and stays there ([`ConvConfig::beta_at`]).
+    /// and `beta_until` (a jump at `beta_from` when they are equal), and stays there
+    /// ([`ConvConfig::beta_at`]).
     /// Ours: a β that lets the network leave the plateau and learn both objects, then one that
     /// holds the KL at the target (`docs/neural.md`, "Eighth round"). None (the default, left
     /// out of the configuration's identity): β throughout.
@@ -215,12 +216,7 @@ impl ConvConfig {
                 ugl_kernels::FlushError::Unsupported(std::env::consts::ARCH).to_string(),
             ));
         }
-        if !(self.beta.is_finite() && self.beta > 0.0 && self.beta <= 1e6) {
-            return Err(ParamError::at(
-                "beta",
-                format!("must be positive and at most 1e6, got {}", self.beta),
-            ));
-        }
+        check_beta("beta", self.beta)?;
         if let Some(c) = self.capacity
             && !(c.is_finite() && (0.0..=1e4).contains(&c))
         {
@@ -283,12 +279,7 @@ impl ConvConfig {
                 ));
             }
             (Some(last), Some(from)) => {
-                if !(last.is_finite() && last > 0.0 && last <= 1e6) {
-                    return Err(ParamError::at(
-                        "beta_final",
-                        format!("must be positive and at most 1e6, got {last}"),
-                    ));
-                }
+                check_beta("beta_final", last)?;
                 let until = self.beta_until.unwrap_or(from);
                 if until < from {
                     return Err(ParamError::at(
@@ -313,6 +304,18 @@ impl ConvConfig {
             }
         }
         Ok(())
+    }
+}
+
+/// A KL weight (`beta`, `beta_final`): positive, finite and at most 1e6.
+fn check_beta(key: &str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v > 0.0 && v <= 1e6 {
+        Ok(())
+    } else {
+        Err(ParamError::at(
+            key,
+            format!("must be positive and at most 1e6, got {v}"),
+        ))
     }
 }
 
@@ -699,9 +702,6 @@ mod tests {
         assert_ne!(with, without);
     }
 
-    /// The KL delay T_v holds the warm-up factor at 0.01, then the ramp starts; no delay is the
-    /// follow-up's own form, and it stays out of the configuration's identity (the hashes of the
-    /// networks trained before it existed hold).
     /// β moves linearly to `beta_final` between `beta_from` and `beta_until` (a jump when they
     /// are equal) and the KL term's weight follows it; the keys stay out of the identity when
     /// unset, and a schedule that never reaches its value, or half of one, is refused by key.
@@ -768,6 +768,9 @@ mod tests {
         );
     }
 
+    /// The KL delay T_v holds the warm-up factor at 0.01, then the ramp starts; no delay is the
+    /// follow-up's own form, and it stays out of the configuration's identity (the hashes of the
+    /// networks trained before it existed hold).
     #[test]
     fn the_kl_delay_holds_the_factor_then_ramps() {
         use crate::repr::bvae::warmup_factor;
