@@ -13,7 +13,8 @@
 #
 # Resumable: a (setting, seed) whose manifest exists is skipped. Environment: UGL (the binary,
 # a path from the caller's directory or a command on PATH; default target/debug/ugl, built first), SEEDS, IMAGES (training pictures, default 10000),
-# EPOCHS (exploration epochs of each run, default 200: the exploration is not what is measured).
+# EPOCHS (exploration epochs of each run, default 200: the exploration is not what is measured),
+# KEEP_CHECKPOINTS (default 1: keep every checkpoint, for `ugl embed --checkpoint`; 0: not).
 set -euo pipefail
 out="${1:?usage: scripts/conv_sweep.sh OUT SETTING...}"
 shift
@@ -31,6 +32,10 @@ if [ -z "${UGL:-}" ]; then cargo build --quiet --bin ugl; fi
 seeds="${SEEDS:-1000 1001 1002}"
 images="${IMAGES:-10000}"
 epochs="${EPOCHS:-200}"
+# Every checkpoint of each training is kept in OUT/models (5 MB per 1000 iterations) for
+# `ugl embed --checkpoint N`: the network part-way (docs/running.md, "Checkpoints").
+keep="--keep-checkpoints"
+[ "${KEEP_CHECKPOINTS:-1}" = 0 ] && keep=""
 mkdir -p "$out"
 for setting in "$@"; do
   tag="$(echo "$setting" | tr ',=' '_-')"
@@ -62,7 +67,7 @@ for setting in "$@"; do
     fi
     echo "$tag seed $seed: training ($(date +%H:%M))"
     "$ugl" run --env armballs-corl --algo "$algo" --latents 10 --seed "$seed" \
-      --profile "$dir/profile.toml" --out "$dir" --cache "$out/models" > "$dir/s$seed.log"
+      --profile "$dir/profile.toml" --out "$dir" --cache "$out/models" $keep > "$dir/s$seed.log"
   done
 done
 "$ugl" sweep-table "$out"

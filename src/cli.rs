@@ -311,6 +311,11 @@ pub(crate) struct EmbedArgs {
     /// (n, state dim), OUT-stem.grid.npy (GRID^2, latents) and OUT-stem.grid_states.npy.
     #[arg(long)]
     pub(crate) out: PathBuf,
+    /// Encode with the weights of the network's checkpoint after this many iterations, read from
+    /// the model cache, instead of the finished network: the network part-way through its
+    /// training (kept by a run with --keep-checkpoints). Nothing is trained.
+    #[arg(long, value_name = "ITERATIONS", conflicts_with = "no_cache")]
+    pub(crate) checkpoint: Option<usize>,
     #[command(flatten)]
     pub(crate) cache: CacheArgs,
 }
@@ -365,6 +370,11 @@ pub(crate) struct CacheArgs {
     /// bit-identical to an uninterrupted one.
     #[arg(long, default_value_t = 1000)]
     pub(crate) checkpoint_every: usize,
+    /// Keep every checkpoint, also after the training finished (a few MB each), to look at the
+    /// network part-way with `ugl embed --checkpoint`; by default a checkpoint replaces the older
+    /// ones and the finished training removes the last.
+    #[arg(long)]
+    pub(crate) keep_checkpoints: bool,
 }
 
 impl CacheArgs {

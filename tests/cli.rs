@@ -1647,6 +1647,77 @@ fn a_training_killed_mid_way_resumes_from_its_checkpoint() {
     );
 }
 
+/// `--keep-checkpoints` keeps every checkpoint after the training, and `ugl embed --checkpoint
+/// N` reads the network after N iterations without training: its latents differ from the
+/// finished network's, its training record says N; a checkpoint not there, a learner that saves
+/// none and a run without a model cache are refused in one line.
+#[test]
+fn embed_reads_a_kept_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = common::write_file(
+        dir.path(),
+        "keep.toml",
+        "[campaign]\nname = \"keep\"\nreps = 1\n[matrix]\nenvs = [\"armball\"]\nalgos = [\"rge-vae\"]\n\
+         [ugl]\nimages = 300\n[explore]\nbootstrap_epochs = 10\nepochs = 100\n\
+         [learners.vae]\niterations = 300\nhidden = [32, 16]\ninit = \"he\"\n",
+    );
+    let out = dir.path().join("run");
+    let o = ugl(&argv(
+        "run --env armball --algo rge-vae --latents 2 --profile {} --out {} --checkpoint-every 100 --keep-checkpoints",
+        &[p(&cfg), p(&out)],
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let models = out.join("models");
+    let kept = std::fs::read_dir(&models)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains(".ckpt."))
+        .count();
+    assert_eq!(
+        kept, 2,
+        "the checkpoints after 100 and 200 iterations are kept"
+    );
+    let embed = |extra: &str, name: &str| {
+        let npy = dir.path().join(name);
+        ugl(&argv(
+            &format!(
+                "embed --env armball --learner vae --latents 2 --profile {{}} --cache {{}} --out {{}} --grid 3 {extra}"
+            ),
+            &[p(&cfg), p(&models), p(&npy)],
+        ))
+    };
+    let summary = |o: &std::process::Output| -> serde_json::Value {
+        assert!(o.status.success(), "{}", stderr(o));
+        serde_json::from_str(stdout(o).lines().last().unwrap()).unwrap()
+    };
+    let end = summary(&embed("", "end.npy"));
+    assert_eq!(end["training"]["iterations"], 300);
+    let part = summary(&embed("--checkpoint 100", "part.npy"));
+    assert_eq!(part["checkpoint"], 100);
+    assert_eq!(part["training"]["iterations"], 100);
+    assert!(part["latent_quality"]["knn_r2"].is_array(), "{part}");
+    assert_ne!(
+        std::fs::read(dir.path().join("part.npy")).unwrap(),
+        std::fs::read(dir.path().join("end.npy")).unwrap(),
+        "the network after 100 iterations is not the finished one"
+    );
+    assert_one_line_error(
+        &embed("--checkpoint 150", "x.npy"),
+        "after 100, 200 iterations",
+    );
+    let o = ugl(&argv(
+        "embed --env armball --learner pca --latents 2 --profile {} --cache {} --out {} --checkpoint 100",
+        &[p(&cfg), p(&models), p(&dir.path().join("pca.npy"))],
+    ));
+    assert_one_line_error(&o, "pca trainings save no checkpoints");
+    let o = ugl(&argv(
+        "embed --env armball --learner vae --latents 2 --profile {} --no-cache --out {} --checkpoint 100",
+        &[p(&cfg), p(&dir.path().join("none.npy"))],
+    ));
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--no-cache"), "{}", stderr(&o));
+}
+
 /// Arguments are checked before anything touches the disk; seeds the store cannot hold are
 /// refused (they were stored as -1).
 #[test]

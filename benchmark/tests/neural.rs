@@ -748,6 +748,7 @@ fn a_killed_training_resumes_from_its_checkpoint_to_the_same_bits() {
             dir: dir.path().to_path_buf(),
             key: format!("test-{}", model.name()),
             every: 20,
+            keep: false,
         };
         let killer: ugl_bench::repr::neural::ProgressFn = Arc::new(|p| {
             if p.iteration == 47 {
@@ -869,6 +870,7 @@ fn a_damaged_or_inconsistent_checkpoint_state_is_ignored() {
         dir: dir.path().to_path_buf(),
         key: "state-test".into(),
         every: 20,
+        keep: false,
     };
     let ckpt = |step: usize| dir.path().join(format!("state-test.ckpt.{step}"));
     // Train, killed after iteration `at`; returns the first iteration it ran (1-based).
@@ -1182,6 +1184,7 @@ fn the_plateau_rule_trains_on_until_the_network_leaves_the_plateau() {
         dir: dir.path().to_path_buf(),
         key: "plateau".into(),
         every: 10,
+        keep: false,
     };
     let kill_at = done - 5;
     let killer: ugl_bench::repr::neural::ProgressFn = Arc::new(move |p| {

@@ -73,6 +73,7 @@ pub(crate) fn refresh_config(
             profile,
             cache: model_cache.as_ref(),
             checkpoint_every: cache.checkpoint_every,
+            keep_checkpoints: cache.keep_checkpoints,
             ..Harness::default()
         },
     };
@@ -158,7 +159,7 @@ pub(crate) fn run_config(cfg: &CampaignConfig, profile: &str, opts: RunOptions<'
         mp.set_draw_target(ProgressDrawTarget::hidden());
     }
     let bar = mp.add(ProgressBar::new(0));
-    let checkpoint_every = cache.checkpoint_every;
+    let (checkpoint_every, keep_checkpoints) = (cache.checkpoint_every, cache.keep_checkpoints);
     let cache = cache.resolve(&out);
     bar.set_style(
         ProgressStyle::with_template(
@@ -197,6 +198,7 @@ pub(crate) fn run_config(cfg: &CampaignConfig, profile: &str, opts: RunOptions<'
             profile,
             cache: cache.as_ref(),
             checkpoint_every,
+            keep_checkpoints,
             train_progress: Some(training_bars(&mp, Some(&bar))),
             learner_messages: Some(learner_lines(&mp, Some(&bar))),
             ..Harness::default()

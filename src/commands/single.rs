@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::MultiProgress;
 
 use ugl_bench::campaign::config::{CampaignConfig, resolve_profile};
+use ugl_bench::campaign::fit::Source;
 use ugl_bench::campaign::single::{self, RunRequest};
 use ugl_bench::campaign::{Harness, RunContext, RunSpec};
 use ugl_bench::explore::{Algo, SamplerKind};
@@ -52,6 +53,7 @@ pub(crate) fn single_context<'a>(
         profile,
         cache: model_cache,
         checkpoint_every: cache.checkpoint_every,
+        keep_checkpoints: cache.keep_checkpoints,
         train_progress: Some(training_bars(mp, None)),
         learner_messages: Some(learner_lines(mp, None)),
         log_dir: Some(out),
@@ -131,7 +133,8 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
     let model_cache = a.cache.resolve(dir);
     let mp = progress_area();
     let ctx = single_context(&cfg, &a.profile, model_cache.as_ref(), &a.cache, dir, &mp);
-    let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid)?;
+    let source = a.checkpoint.map_or(Source::Fit, Source::Checkpoint);
+    let e = ugl_bench::campaign::embed::embed(&spec, &ctx, a.grid, source)?;
     let stem = a.out.with_extension("");
     let sibling = |suffix: &str| PathBuf::from(format!("{}.{suffix}.npy", stem.display()));
     let files = [
@@ -158,6 +161,11 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
             "representation": ugl_bench::campaign::fit::representation_label(&spec),
             "files": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
             "latent_quality": e.quality,
+            "checkpoint": a.checkpoint,
+            "training": e.training.as_ref().map(|t| serde_json::json!({
+                "iterations": t.iterations,
+                "evidence": t.evidence,
+            })),
         })
     )?;
     Ok(())

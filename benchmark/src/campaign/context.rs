@@ -57,6 +57,8 @@ pub struct Harness<'a> {
     /// Neural trainings save a checkpoint in the model cache every this many iterations
     /// (0: never); a killed training resumes from its latest one, bit-identically.
     pub checkpoint_every: usize,
+    /// Keep every checkpoint ([`neural::CheckpointSpec::keep`]).
+    pub keep_checkpoints: bool,
     /// Training progress of neural representations.
     pub train_progress: Option<Arc<TrainSink>>,
     /// External learners' stderr lines, as they come.
@@ -94,6 +96,7 @@ impl Harness<'_> {
                     dir: c.dir.clone(),
                     key: key.to_string(),
                     every: self.checkpoint_every,
+                    keep: self.keep_checkpoints,
                 }),
             threads: self.train_threads,
             log_file: self.log_dir.map(|d| d.join(format!("{label}.learner.log"))),

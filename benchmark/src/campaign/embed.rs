@@ -10,12 +10,13 @@
 use std::path::Path;
 
 use super::context::RunContext;
-use super::fit::fit_with_data;
+use super::fit::{Source, fit_with_data};
 use super::plan::RunSpec;
 use crate::env::{Environment, make_env};
 use crate::repr::quality::LatentQuality;
 use crate::repr::{ImageSet, Latents, ReprError};
 use crate::seed::{Component, stream};
+use ugl_types::TrainingRecord;
 
 /// What `ugl embed` writes.
 pub struct Embedding {
@@ -28,12 +29,19 @@ pub struct Embedding {
     pub grid_states: Vec<f64>,
     /// The representation's held-out latent quality, if measured.
     pub quality: Option<LatentQuality>,
+    /// A neural network's training: its iterations, loss curve and evidence.
+    pub training: Option<TrainingRecord>,
 }
 
-/// Fit (or load) the representation of `spec` and encode its training images and a grid of
-/// `grid x grid` object positions. A stochastic encoder draws its noise from the data set's
-/// encoding stream.
-pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding, ReprError> {
+/// Fit (or load) the representation of `spec`, or read it from `source`'s checkpoint, and
+/// encode its training images and a grid of `grid x grid` object positions. A stochastic
+/// encoder draws its noise from the data set's encoding stream.
+pub fn embed(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    grid: usize,
+    source: Source,
+) -> Result<Embedding, ReprError> {
     if grid < 2 {
         return Err(ReprError::InvalidInput(format!(
             "the grid needs at least 2 x 2 positions, got {grid}"
@@ -41,7 +49,7 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
     }
     crate::limits::check_grid(grid, ctx.ugl.images, spec.env.spec().image.len())
         .map_err(|e| ReprError::InvalidInput(e.to_string()))?;
-    let (mut repr, data, ds_seed) = fit_with_data(spec, ctx)?;
+    let (mut repr, data, ds_seed) = fit_with_data(spec, ctx, source)?;
     let env = make_env(spec.env, ctx.env);
     let d = env.state_dim();
     repr.encoder.begin_run(stream(ds_seed, Component::Encoding));
@@ -55,6 +63,7 @@ pub fn embed(spec: &RunSpec, ctx: &RunContext, grid: usize) -> Result<Embedding,
         grid: grid_latents,
         grid_states,
         quality: repr.quality,
+        training: repr.training,
     })
 }
 

@@ -7,7 +7,7 @@ use super::config::LearnersConfig;
 use super::plan::RunSpec;
 use crate::env::{Environment, make_env};
 use crate::explore::Learner;
-use crate::repr::cache::CacheEntry;
+use crate::repr::cache::{CacheEntry, ModelFileError};
 use crate::repr::dataset::{dataset_identity, generate};
 use crate::repr::neural::{self, Variant};
 use crate::repr::quality::{self, LatentQuality};
@@ -157,6 +157,16 @@ pub fn model_key(spec: &RunSpec, ctx: &RunContext, identity: &serde_json::Value)
     blake3::hash(&json).to_hex().to_string()
 }
 
+/// Where a representation comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// Fitted, or loaded from the model cache: what a run uses.
+    Fit,
+    /// The weights of a neural training's checkpoint after this many iterations, in the model
+    /// cache (`ugl embed --checkpoint`): the network part-way through its training.
+    Checkpoint(usize),
+}
+
 /// Fit `spec`'s representation on `images`, or load it from the model cache (learners whose
 /// encoders persist): the one fit path of every learner. Returns the encoder, the training
 /// latents, for a trained network how it was obtained, and the learner's name in results (an
@@ -167,6 +177,7 @@ fn fit_or_load(
     learner: Learner,
     images: &ImageSet,
     rng: &mut crate::seed::Stream,
+    source: Source,
 ) -> Result<(Box<dyn Encoder>, Latents, Option<TrainingRecord>, String), ReprError> {
     let params = ctx
         .learners
@@ -175,6 +186,36 @@ fn fit_or_load(
     let identity = params.identity(spec.variant);
     let fitter = params.build(spec.variant);
     let key = model_key(spec, ctx, &identity);
+    if let Source::Checkpoint(step) = source {
+        if !fitter.saves_checkpoints() {
+            return Err(ReprError::InvalidInput(format!(
+                "{}: {}",
+                fitter.name(),
+                ModelFileError::NoCheckpoints {
+                    learner: fitter.name().to_string()
+                }
+            )));
+        }
+        let cache = ctx.harness.cache.ok_or_else(|| {
+            ReprError::InvalidInput(
+                "a checkpoint is read from the model cache, and there is none".into(),
+            )
+        })?;
+        let checkpoint = crate::repr::checkpoint::inspect(&cache.dir, &key, step, images.n)?;
+        let mut encoder = fitter
+            .load_checkpoint(&key, &checkpoint)
+            .map_err(|e| ReprError::InvalidInput(format!("{}: {e}", fitter.name())))?;
+        let z = encoder.training_latents(images)?;
+        let info = encoder.training_outcome(images).map(|r| TrainingRecord {
+            cache: None,
+            config: identity,
+            evidence: Some(r.evidence),
+            iterations: Some(checkpoint.step),
+            key,
+            losses: r.losses,
+        });
+        return Ok((encoder, z, info, fitter.name().to_string()));
+    }
     let cache = ctx.harness.cache.filter(|_| fitter.persists());
     let mut status = CacheStatus::Off;
     let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
@@ -242,13 +283,15 @@ pub fn representation_label(spec: &RunSpec) -> String {
 
 /// Generate the UGL data set of the spec's repetition and fit its learner.
 pub fn fit_representation(spec: &RunSpec, ctx: &RunContext) -> Result<Representation, ReprError> {
-    fit_with_data(spec, ctx).map(|(r, _, _)| r)
+    fit_with_data(spec, ctx, Source::Fit).map(|(r, _, _)| r)
 }
 
-/// [`fit_representation`], also returning the UGL data set it was fitted on and its seed.
+/// [`fit_representation`] from `source`, also returning the UGL data set it was fitted on and
+/// its seed.
 pub fn fit_with_data(
     spec: &RunSpec,
     ctx: &RunContext,
+    source: Source,
 ) -> Result<(Representation, crate::repr::dataset::UglDataset, u64), ReprError> {
     let learner = spec.algo.learner().ok_or_else(|| {
         ReprError::InvalidInput(format!("{} learns no representation", spec.algo))
@@ -269,7 +312,7 @@ pub fn fit_with_data(
         .expect("learned algorithm");
     let mut rng = stream(run_seed(ctx.campaign_seed, &seed_id), Component::Learner);
     let (mut encoder, train, info, learner_name) =
-        fit_or_load(spec, ctx, learner, &data.images, &mut rng)?;
+        fit_or_load(spec, ctx, learner, &data.images, &mut rng, source)?;
     let quality = match measure_quality(encoder.as_mut(), env.as_ref(), &data, ds_seed) {
         Ok(q) => Some(q),
         Err(e) => {

@@ -35,6 +35,10 @@ pub struct CheckpointSpec {
     pub key: String,
     /// Save every this many iterations (and never at the end: the model cache keeps that).
     pub every: usize,
+    /// Keep every checkpoint, also after the training finished, to look at the network part-way
+    /// (`ugl embed --checkpoint`); otherwise a checkpoint replaces the older ones and the
+    /// finished training removes the last.
+    pub keep: bool,
 }
 
 /// `state.json`: the state and the BLAKE3 digest of its JSON ([`digest`]).
@@ -222,16 +226,79 @@ pub(crate) fn save_snapshot(
     let json = serde_json::to_vec(&sealed).expect("state serialises");
     let state_path = dir.join("state.json");
     crate::fsio::write_atomic(&state_path, &json).map_err(|e| io("write", &state_path, e))?;
-    for (step, old) in existing(c) {
-        if step < snapshot.step {
-            let _ = std::fs::remove_dir_all(old);
+    if !c.keep {
+        for (step, old) in existing(c) {
+            if step < snapshot.step {
+                let _ = std::fs::remove_dir_all(old);
+            }
         }
     }
     Ok(())
 }
 
-/// Remove every checkpoint of `c.key` (the training finished).
+/// A checkpoint read back to be looked at, not resumed (`ugl embed --checkpoint`).
+#[derive(Debug)]
+pub struct Inspected {
+    /// Iterations done.
+    pub step: usize,
+    /// The loss curve so far.
+    pub losses: Vec<(usize, f64)>,
+    /// The weights, as the trainer sealed them (the learner reads them:
+    /// [`super::RepresentationLearner::load_checkpoint`]).
+    pub net: Vec<u8>,
+}
+
+/// The checkpoint of the training keyed `key` after `step` iterations, in the model cache
+/// `dir`, with the checks of a resume (its seal, its key, a batch permutation of `images`
+/// images, the weights' hash); `Err` says what is missing, with the iterations of the
+/// checkpoints `dir` holds of that training, or why the checkpoint cannot be trusted.
+pub fn inspect(dir: &Path, key: &str, step: usize, images: usize) -> Result<Inspected, ReprError> {
+    let c = CheckpointSpec {
+        dir: dir.to_path_buf(),
+        key: key.to_string(),
+        every: 0,
+        keep: true,
+    };
+    let at = dir_of(&c, step);
+    let state_path = at.join("state.json");
+    if !state_path.is_file() {
+        let mut held: Vec<usize> = existing(&c).into_iter().map(|(s, _)| s).collect();
+        held.sort_unstable();
+        let held = if held.is_empty() {
+            "none of this network".to_string()
+        } else {
+            let list: Vec<String> = held.iter().map(|s| s.to_string()).collect();
+            format!("this network's after {} iterations", list.join(", "))
+        };
+        return Err(ReprError::InvalidInput(format!(
+            "no checkpoint after {step} iterations in {} (it holds {held}; a finished training \
+             removes its checkpoints unless they are kept: --keep-checkpoints)",
+            dir.display()
+        )));
+    }
+    let untrusted = |why: String| ReprError::Cache(format!("checkpoint {}: {why}", at.display()));
+    let text = std::fs::read(&state_path).map_err(|e| io("read", &state_path, e))?;
+    let state = verify(&text, usize::MAX, images).map_err(untrusted)?;
+    if state.key != key || state.step != step {
+        return Err(untrusted("written for another training".into()));
+    }
+    let net_path = at.join("net.model");
+    let net = std::fs::read(&net_path).map_err(|e| io("read", &net_path, e))?;
+    if blake3::hash(&net).to_hex().as_str() != state.net_blake3 {
+        return Err(untrusted("net.model does not match its hash".into()));
+    }
+    Ok(Inspected {
+        step,
+        losses: state.losses,
+        net,
+    })
+}
+
+/// Remove every checkpoint of `c.key` (the training finished), unless they are kept.
 pub fn remove_all(c: &CheckpointSpec) {
+    if c.keep {
+        return;
+    }
     for (_, d) in existing(c) {
         let _ = std::fs::remove_dir_all(d);
     }

@@ -19,7 +19,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use super::checkpoint::{self, CheckpointSpec, Restored, Snapshot};
+use super::checkpoint::{self, CheckpointSpec, Inspected, Restored, Snapshot};
 use super::conv_net::{ConvArch, ConvInit, ConvNet, channels_first};
 use super::conv_train::{ConvConfig, ConvTrainer};
 use super::evidence::{EVIDENCE_IMAGES, TrainingEvidence, bce_of_logit, mean_image_loss};
@@ -321,6 +321,23 @@ impl RepresentationLearner for ConvLearner {
             )));
         }
         Ok(Box::new(enc))
+    }
+
+    fn saves_checkpoints(&self) -> bool {
+        true
+    }
+
+    fn load_checkpoint(
+        &self,
+        _key: &str,
+        checkpoint: &Inspected,
+    ) -> Result<Box<dyn Encoder>, ModelFileError> {
+        Ok(Box::new(ConvEncoder {
+            model: self.model,
+            net: ConvNet::from_model_bytes(&checkpoint.net)?,
+            losses: checkpoint.losses.clone(),
+            iterations: checkpoint.step,
+        }))
     }
 }
 
@@ -878,6 +895,7 @@ mod tests {
             dir: dir.path().to_path_buf(),
             key: "k".into(),
             every: 5,
+            keep: false,
         };
         // The "killed" run: stopped after 7 iterations, with the checkpoint of iteration 5.
         let short = ConvConfig {
@@ -954,6 +972,72 @@ mod tests {
             12,
             "started over"
         );
+    }
+
+    /// Kept checkpoints outlive the training, and a checkpoint read back as an encoder
+    /// (`ugl embed --checkpoint`) is the network of a training stopped there: the weights and
+    /// loss curve of a 4-iteration training, part-way through a 12-iteration one whose schedule
+    /// does not depend on its length. A checkpoint not kept is refused with the ones there are.
+    #[test]
+    fn a_kept_checkpoint_is_the_network_part_way() {
+        let images = pictures(10);
+        let cfg = ConvConfig {
+            capacity_iterations: Some(6),
+            ..small()
+        };
+        let fit = |cfg: &ConvConfig, ckpt: Option<&CheckpointSpec>| {
+            let mut rng = stream_named(5, "learner");
+            train(ConvModel::ConvBvae, cfg, &images, 2, &mut rng, None, ckpt).unwrap()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let spec = CheckpointSpec {
+            dir: dir.path().to_path_buf(),
+            key: "k".into(),
+            every: 4,
+            keep: true,
+        };
+        fit(&cfg, Some(&spec));
+        for step in [4, 8] {
+            assert!(
+                dir.path()
+                    .join(format!("k.ckpt.{step}/state.json"))
+                    .exists()
+            );
+        }
+        let four = fit(
+            &ConvConfig {
+                iterations: 4,
+                ..cfg.clone()
+            },
+            None,
+        );
+        let learner = ConvLearner::new(ConvModel::ConvBvae, cfg.clone());
+        let seen = checkpoint::inspect(dir.path(), "k", 4, images.n).unwrap();
+        let mut enc = learner.load_checkpoint("k", &seen).unwrap();
+        assert_eq!(
+            enc.encode(&images).unwrap(),
+            four.clone().encode(&images).unwrap()
+        );
+        // Its loss curve so far: the 4-iteration training's without the last iteration, which
+        // a finished training always logs.
+        let outcome = enc.training_outcome(&images).unwrap();
+        assert_eq!(outcome.iterations, 4);
+        assert_eq!(outcome.losses[..], four.losses[..four.losses.len() - 1]);
+        // Part-way is not the end: the 8-iteration network encodes otherwise.
+        let seen = checkpoint::inspect(dir.path(), "k", 8, images.n).unwrap();
+        let mut eight = learner.load_checkpoint("k", &seen).unwrap();
+        assert_ne!(
+            eight.encode(&images).unwrap(),
+            four.clone().encode(&images).unwrap()
+        );
+        let e = checkpoint::inspect(dir.path(), "k", 6, images.n)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("after 4, 8 iterations"), "{e}");
+        let e = checkpoint::inspect(dir.path(), "other", 4, images.n)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("none of this network"), "{e}");
     }
 
     /// The per-latent KL is the closed form of the heads, and a latent the network ignores

@@ -321,6 +321,24 @@ pub trait RepresentationLearner: Send + Sync {
             learner: self.name().to_string(),
         })
     }
+    /// Whether its trainings save mid-training checkpoints ([`FitContext::checkpoint`]) that
+    /// [`RepresentationLearner::load_checkpoint`] reads.
+    fn saves_checkpoints(&self) -> bool {
+        false
+    }
+    /// An encoder of a mid-training checkpoint's weights (`ugl embed --checkpoint`), with the
+    /// loss curve so far; `Err` says why the weights cannot be read. The default: the learner's
+    /// trainings save no checkpoints.
+    fn load_checkpoint(
+        &self,
+        key: &str,
+        checkpoint: &checkpoint::Inspected,
+    ) -> Result<Box<dyn Encoder>, model_file::ModelFileError> {
+        let _ = (key, checkpoint);
+        Err(model_file::ModelFileError::NoCheckpoints {
+            learner: self.name().to_string(),
+        })
+    }
 }
 
 /// Check the common preconditions of a fit.

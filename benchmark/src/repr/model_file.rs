@@ -28,6 +28,9 @@ pub enum ModelFileError {
     /// The learner keeps no encoder in the model cache.
     #[error("{learner} encoders are not kept in the model cache")]
     NotKept { learner: String },
+    /// The learner's trainings save no mid-training checkpoints.
+    #[error("{learner} trainings save no checkpoints")]
+    NoCheckpoints { learner: String },
 }
 
 /// Frame a header and a payload: magic, version, header length, header, payload, BLAKE3.

@@ -287,6 +287,19 @@ impl super::RepresentationLearner for NeuralLearner {
         }
         Ok(Box::new(enc))
     }
+
+    fn saves_checkpoints(&self) -> bool {
+        true
+    }
+
+    /// A dense checkpoint's weights are an encoder's model file, with the loss curve so far.
+    fn load_checkpoint(
+        &self,
+        key: &str,
+        checkpoint: &super::checkpoint::Inspected,
+    ) -> Result<Box<dyn Encoder>, ModelFileError> {
+        self.load(key, &checkpoint.net)
+    }
 }
 
 /// Train `model` on `images` and return the encoder. The stream is used for: the initial
