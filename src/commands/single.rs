@@ -163,6 +163,7 @@ pub(crate) fn embed(a: EmbedArgs) -> Result<()> {
             "latent_quality": e.quality,
             "checkpoint": a.checkpoint,
             "training": e.training.as_ref().map(|t| serde_json::json!({
+                "key": t.key,
                 "iterations": t.iterations,
                 "evidence": t.evidence,
             })),

@@ -188,13 +188,12 @@ fn fit_or_load(
     let key = model_key(spec, ctx, &identity);
     if let Source::Checkpoint(step) = source {
         if !fitter.saves_checkpoints() {
-            return Err(ReprError::InvalidInput(format!(
-                "{}: {}",
-                fitter.name(),
+            return Err(ReprError::InvalidInput(
                 ModelFileError::NoCheckpoints {
-                    learner: fitter.name().to_string()
+                    learner: fitter.name().to_string(),
                 }
-            )));
+                .to_string(),
+            ));
         }
         let cache = ctx.harness.cache.ok_or_else(|| {
             ReprError::InvalidInput(
