@@ -23,12 +23,8 @@ shift
 # the repository's root.
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
-case "${UGL:-}" in
-  */*) UGL="$(cd "$(dirname "$UGL")" && pwd)/$(basename "$UGL")" ;;
-esac
-cd "$(dirname "$0")/.."
-ugl="${UGL:-target/debug/ugl}"
-if [ -z "${UGL:-}" ]; then cargo build --quiet --bin ugl; fi
+. "$(dirname "$0")/enter_repository.sh"
+enter_repository
 seeds="${SEEDS:-1000 1001 1002}"
 images="${IMAGES:-10000}"
 epochs="${EPOCHS:-200}"

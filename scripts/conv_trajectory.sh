@@ -17,12 +17,8 @@ seed="${3:?give the SEED}"
 out="$(cd "$out" && pwd)"
 cache="${CACHE:-$out/models}"
 cache="$(cd "$cache" && pwd)"
-case "${UGL:-}" in
-  */*) UGL="$(cd "$(dirname "$UGL")" && pwd)/$(basename "$UGL")" ;;
-esac
-cd "$(dirname "$0")/.."
-ugl="${UGL:-target/debug/ugl}"
-if [ -z "${UGL:-}" ]; then cargo build --quiet --bin ugl; fi
+. "$(dirname "$0")/enter_repository.sh"
+enter_repository
 tag="$(echo "$setting" | tr ',=' '_-')"
 dir="$out/$tag"
 [ -f "$dir/profile.toml" ] || { echo "error: $dir/profile.toml: train the setting first (scripts/conv_sweep.sh)" >&2; exit 2; }
@@ -37,10 +33,10 @@ embed() {
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 # The run's manifest names its network's model-cache key, and with it the checkpoints.
-manifest="$(ls "$dir"/*.s"$seed".json 2>/dev/null | head -n 1)"
+manifest="$(ls "$dir"/*.s"$seed".json 2>/dev/null | head -n 1 || true)"
 [ -n "$manifest" ] || { echo "error: no manifest of seed $seed in $dir: train it first (scripts/conv_sweep.sh)" >&2; exit 2; }
 key="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["train"]["key"])' "$manifest")"
-held="$(ls -d "$cache/$key".ckpt.* 2>/dev/null | sed 's/.*\.ckpt\.//' | sort -n)"
+held="$(ls -d "$cache/$key".ckpt.* 2>/dev/null | sed 's/.*\.ckpt\.//' | sort -n || true)"
 [ -n "$held" ] || { echo "error: no checkpoint of $tag seed $seed in $cache" >&2; exit 2; }
 file="$dir/checkpoints.s$seed.jsonl"
 : > "$tmp/lines"
