@@ -186,38 +186,41 @@ fn fit_or_load(
     let identity = params.identity(spec.variant);
     let fitter = params.build(spec.variant);
     let key = model_key(spec, ctx, &identity);
-    if let Source::Checkpoint(step) = source {
-        if !fitter.saves_checkpoints() {
-            return Err(ReprError::InvalidInput(
-                ModelFileError::NoCheckpoints {
-                    learner: fitter.name().to_string(),
-                }
-                .to_string(),
-            ));
+    let (encoder, z, status, iterations) = match source {
+        Source::Fit => {
+            let (encoder, z, status) =
+                fit_or_cached(spec, ctx, fitter.as_ref(), &key, images, rng)?;
+            (encoder, z, Some(status), None)
         }
-        let cache = ctx.harness.cache.ok_or_else(|| {
-            ReprError::InvalidInput(
-                "a checkpoint is read from the model cache, and there is none".into(),
-            )
-        })?;
-        let checkpoint = crate::repr::checkpoint::inspect(&cache.dir, &key, step, images.n)?;
-        let mut encoder = fitter
-            .load_checkpoint(&key, &checkpoint)
-            .map_err(|e| ReprError::InvalidInput(format!("{}: {e}", fitter.name())))?;
-        let z = encoder.training_latents(images)?;
-        let info = encoder.training_outcome(images).map(|r| TrainingRecord {
-            cache: None,
-            config: identity,
-            evidence: Some(r.evidence),
-            iterations: Some(checkpoint.step),
-            key,
-            losses: r.losses,
-        });
-        return Ok((encoder, z, info, fitter.name().to_string()));
-    }
+        Source::Checkpoint(step) => {
+            let (encoder, z) = read_checkpoint(ctx, fitter.as_ref(), &key, step, images)?;
+            (encoder, z, None, Some(step))
+        }
+    };
+    let info = encoder.training_outcome(images).map(|r| TrainingRecord {
+        cache: status,
+        config: identity,
+        evidence: Some(r.evidence),
+        iterations: Some(iterations.unwrap_or(r.iterations)),
+        key,
+        losses: r.losses,
+    });
+    Ok((encoder, z, info, fitter.name().to_string()))
+}
+
+/// The encoder of `key` from the model cache, or fitted (and stored there), with the training
+/// latents and what the cache held.
+fn fit_or_cached(
+    spec: &RunSpec,
+    ctx: &RunContext,
+    fitter: &dyn RepresentationLearner,
+    key: &str,
+    images: &ImageSet,
+    rng: &mut crate::seed::Stream,
+) -> Result<(Box<dyn Encoder>, Latents, CacheStatus), ReprError> {
     let cache = ctx.harness.cache.filter(|_| fitter.persists());
     let mut status = CacheStatus::Off;
-    let cached = match cache.map(|c| c.load(&key, |bytes| fitter.load(&key, bytes))) {
+    let cached = match cache.map(|c| c.load(key, |bytes| fitter.load(key, bytes))) {
         Some(CacheEntry::Hit(enc)) => {
             status = CacheStatus::Hit;
             Some(enc)
@@ -245,29 +248,51 @@ fn fit_or_load(
             let label = representation_label(spec);
             let fit_ctx =
                 ctx.harness
-                    .fit_context(&label, &key, cache.is_some(), spec.env.spec().image);
+                    .fit_context(&label, key, cache.is_some(), spec.env.spec().image);
             let fitted = fitter.fit_in(images, spec.latents, rng, &fit_ctx);
             if let Some(sink) = &ctx.harness.learner_messages {
                 sink(&label, None);
             }
             let (enc, z) = fitted?;
             if let Some(c) = cache
-                && let Some(bytes) = enc.save(&key)
+                && let Some(bytes) = enc.save(key)
             {
-                c.store(&key, &bytes)?;
+                c.store(key, &bytes)?;
             }
             (enc, z)
         }
     };
-    let info = encoder.training_outcome(images).map(|r| TrainingRecord {
-        cache: Some(status),
-        config: identity,
-        evidence: Some(r.evidence),
-        iterations: Some(r.iterations),
-        key,
-        losses: r.losses,
-    });
-    Ok((encoder, z, info, fitter.name().to_string()))
+    Ok((encoder, z, status))
+}
+
+/// The encoder of the checkpoint of `key` after `step` iterations, in the model cache
+/// (`ugl embed --checkpoint`), with the training latents; nothing is trained.
+fn read_checkpoint(
+    ctx: &RunContext,
+    fitter: &dyn RepresentationLearner,
+    key: &str,
+    step: usize,
+    images: &ImageSet,
+) -> Result<(Box<dyn Encoder>, Latents), ReprError> {
+    if !fitter.saves_checkpoints() {
+        return Err(ReprError::InvalidInput(
+            ModelFileError::NoCheckpoints {
+                learner: fitter.name().to_string(),
+            }
+            .to_string(),
+        ));
+    }
+    let cache = ctx.harness.cache.ok_or_else(|| {
+        ReprError::InvalidInput(
+            "a checkpoint is read from the model cache, and there is none".into(),
+        )
+    })?;
+    let checkpoint = crate::repr::checkpoint::inspect(&cache.dir, key, step, images.n)?;
+    let mut encoder = fitter
+        .load_checkpoint(key, &checkpoint)
+        .map_err(|e| ReprError::InvalidInput(format!("{}: {e}", fitter.name())))?;
+    let z = encoder.training_latents(images)?;
+    Ok((encoder, z))
 }
 
 /// A short label of a run's representation, for progress bars and messages:
