@@ -23,6 +23,7 @@ use super::neural_model::{
     CodeSettings, INITIAL_WARMUP_FACTOR, Knobs, Latent, LatentInput, NeuralModel, Optimiser,
     StepInput, Variant, knob_number,
 };
+use super::total_correlation::total_correlation;
 use super::vae::{code, encoding};
 use crate::seed::Stream;
 
@@ -46,6 +47,20 @@ fn kl_term(mu: Tensor<2>, logvar: Tensor<2>, input: &LatentInput<'_>) -> Tensor<
         Some(f) => term.mul_scalar(f),
         None => term,
     }
+}
+
+/// The added total-correlation term (the convolutional β-VAE's `tc`, ours): `weight` times the
+/// batch's total correlation ([`total_correlation`]), under the same warm-up factor as the KL
+/// term, since it is a part of the KL that the term weighs again.
+fn tc_term(
+    z: Tensor<2>,
+    mu: Tensor<2>,
+    logvar: Tensor<2>,
+    weight: f64,
+    input: &LatentInput<'_>,
+) -> Tensor<1> {
+    let factor = warmup_factor(input.step, &input.code).unwrap_or(1.0);
+    total_correlation(z, mu, logvar).mul_scalar(weight * factor)
 }
 
 /// The KL warm-up factor at 0-based iteration `step`: `min(1, 0.01 + max(0, step − T_v) / T_a)`
@@ -123,6 +138,7 @@ impl NeuralModel for Bvae {
             beta: number("beta").unwrap_or(DEFAULT_BETA),
             capacity: number("capacity")
                 .map(|c| c * (step as f64 / iterations.max(1) as f64).min(1.0)),
+            tc: None,
             variant,
         }
     }
@@ -149,9 +165,16 @@ impl NeuralModel for Bvae {
     }
     fn latent(&self, heads: Tensor<2>, input: &LatentInput<'_>, rng: &mut Stream) -> Latent {
         let (z, mu, logvar) = code(heads, input, Variant::Corrected, rng);
+        let extra = match input.code.tc {
+            None => kl_term(mu, logvar, input),
+            Some(weight) => {
+                let tc = tc_term(z.clone(), mu.clone(), logvar.clone(), weight, input);
+                kl_term(mu, logvar, input) + tc
+            }
+        };
         Latent {
             z,
-            extra: Some(kl_term(mu, logvar, input)),
+            extra: Some(extra),
             rec_scale: 1.0,
         }
     }

@@ -102,6 +102,8 @@ pub struct ConvSection {
     pub beta_from: Option<usize>,
     /// `conv-bvae` only.
     pub beta_until: Option<usize>,
+    /// `conv-bvae` only.
+    pub tc: Option<f64>,
     pub flush_subnormals: Option<bool>,
     pub init: Option<ConvInit>,
 }
@@ -126,6 +128,7 @@ impl ConvSection {
             beta_final: self.beta_final.or(d.beta_final),
             beta_from: self.beta_from.or(d.beta_from),
             beta_until: self.beta_until.or(d.beta_until),
+            tc: self.tc.or(d.tc),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
             init: self.init.unwrap_or(d.init),
         }
@@ -147,6 +150,7 @@ impl ParamGuard for (ConvModel, ConvSection) {
                 ("beta_final", section.beta_final.is_some()),
                 ("beta_from", section.beta_from.is_some()),
                 ("beta_until", section.beta_until.is_some()),
+                ("tc", section.tc.is_some()),
             ] {
                 if set {
                     return Err(ParamError::at(
@@ -181,7 +185,7 @@ impl LearnerParams for ConvParams {
         vec![
             format!(
                 "{}: training settings of ours (the authors' are not public): {} iterations, batch {}, \
-             lr {}{}{}",
+             lr {}{}{}{}",
                 self.model.name(),
                 self.config.iterations,
                 self.config.batch,
@@ -196,6 +200,10 @@ impl LearnerParams for ConvParams {
                         self.config.beta_until.unwrap_or(from)
                     ),
                     _ => String::new(),
+                },
+                match self.config.tc {
+                    Some(w) => format!(", a total-correlation term weighted {w} (β-TCVAE's)"),
+                    None => String::new(),
                 },
             ),
             if self.config.flush_subnormals {
@@ -867,6 +875,35 @@ mod tests {
             "{:?}",
             p.deviations(None)
         );
+        // A total-correlation weight: the β-VAE's, checked, said among its deviations, and
+        // out of the identity when unset.
+        let weighted = ConvSection {
+            tc: Some(10.0),
+            ..ConvSection::default()
+        };
+        let e = (ConvModel::ConvVae, weighted.clone()).check().unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("tc"));
+        let p = (ConvModel::ConvBvae, weighted).check().unwrap();
+        assert!(
+            p.deviations(None)
+                .iter()
+                .any(|d| d.contains(", a total-correlation term weighted 10")),
+            "{:?}",
+            p.deviations(None)
+        );
+        assert_eq!(p.identity(None)["tc"], 10.0);
+        let plain = (ConvModel::ConvBvae, ConvSection::default())
+            .check()
+            .unwrap();
+        assert!(plain.identity(None).get("tc").is_none());
+        for bad in [0.0, -1.0, f64::NAN, 2e6] {
+            let section = ConvSection {
+                tc: Some(bad),
+                ..ConvSection::default()
+            };
+            let e = (ConvModel::ConvBvae, section).check().unwrap_err();
+            assert_eq!(e.key.as_deref(), Some("tc"), "{bad}: {e}");
+        }
     }
 
     /// A training killed after a checkpoint and started again gives the same network, bit for

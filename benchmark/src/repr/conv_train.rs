@@ -89,6 +89,13 @@ pub struct ConvConfig {
     /// The iteration at which β reaches `beta_final` (default: `beta_from`, a jump).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta_until: Option<usize>,
+    /// A total-correlation weight λ: the loss gains `λ TC`, the batch's total correlation
+    /// (β-TCVAE, Chen et al. 2018; [`super::total_correlation`]), under the KL term's warm-up
+    /// factor. Ours: it presses the dependence between latents alone, which the β-VAE's KL term
+    /// leaves free inside its capacity (`docs/neural.md`, "Tenth round"). None (the default,
+    /// left out of the configuration's identity): no such term.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tc: Option<f64>,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
     /// [`ugl_kernels::flushing_pool`]): the same bits on every x86-64 CPU and path, and no
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
@@ -124,6 +131,7 @@ impl ConvConfig {
             beta_final: None,
             beta_from: None,
             beta_until: None,
+            tc: None,
             flush_subnormals: true,
             init: ConvInit::Torch04,
         }
@@ -181,6 +189,7 @@ impl ConvConfig {
                 .unwrap_or(super::neural_model::INITIAL_WARMUP_FACTOR),
             beta: self.beta_at(step),
             capacity: self.capacity_at(step),
+            tc: self.tc,
             variant: Variant::Corrected,
         }
     }
@@ -217,6 +226,9 @@ impl ConvConfig {
             ));
         }
         check_beta("beta", self.beta)?;
+        if let Some(w) = self.tc {
+            check_beta("tc", w)?;
+        }
         if let Some(c) = self.capacity
             && !(c.is_finite() && (0.0..=1e4).contains(&c))
         {
@@ -307,7 +319,7 @@ impl ConvConfig {
     }
 }
 
-/// A KL weight (`beta`, `beta_final`): positive, finite and at most 1e6.
+/// A KL weight (`beta`, `beta_final`, `tc`): positive, finite and at most 1e6.
 fn check_beta(key: &str, v: f64) -> Result<(), ParamError> {
     if v.is_finite() && v > 0.0 && v <= 1e6 {
         Ok(())
@@ -646,11 +658,16 @@ mod tests {
             delay_factor: Some(0.3),
             ..delayed.clone()
         };
+        let with_tc = ConvConfig {
+            tc: Some(7.0),
+            ..followup_config()
+        };
         for (cfg, step) in [0, 3, 60]
             .map(|s| (followup_config(), s))
             .into_iter()
             .chain([5, 25].map(|s| (delayed.clone(), s)))
             .chain([(own_factor, 5)])
+            .chain([3, 60].map(|s| (with_tc.clone(), s)))
         {
             let cfg = &cfg;
             let mut trainer = ConvTrainer::new(net.clone());
@@ -700,6 +717,13 @@ mod tests {
             ..followup_config()
         });
         assert_ne!(with, without);
+        // And a total-correlation weight changes them too (its own gradients are checked
+        // against its definition in `total_correlation.rs`).
+        let with_tc = run(&ConvConfig {
+            tc: Some(7.0),
+            ..followup_config()
+        });
+        assert_ne!(with, with_tc);
     }
 
     /// β moves linearly to `beta_final` between `beta_from` and `beta_until` (a jump when they

@@ -71,6 +71,7 @@ pub trait NeuralModel: Sync {
             delay_factor: INITIAL_WARMUP_FACTOR,
             beta: 1.0,
             capacity: None,
+            tc: None,
             variant,
         }
     }
@@ -190,6 +191,9 @@ pub struct CodeSettings {
     pub beta: f64,
     /// The KL target C at this iteration (None: plain KL term).
     pub capacity: Option<f64>,
+    /// The weight of an added total-correlation term (the convolutional β-VAE's `tc`,
+    /// [`super::total_correlation`]; None: none, every other model).
+    pub tc: Option<f64>,
     pub variant: Variant,
 }
 

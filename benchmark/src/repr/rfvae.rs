@@ -357,6 +357,7 @@ impl NeuralModel for Rfvae {
             delay_factor: super::neural_model::INITIAL_WARMUP_FACTOR,
             beta: 1.0,
             capacity: None,
+            tc: None,
             variant,
         }
     }

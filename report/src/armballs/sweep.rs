@@ -47,6 +47,9 @@ fn setting(m: &Manifest) -> String {
             None => format!("then β {last} from {from}"),
         });
     }
+    if let Some(w) = num("tc") {
+        parts.push(format!("TC weight {w}"));
+    }
     if let Some(c) = num("capacity") {
         parts.push(match int("capacity_iterations") {
             // |KL − 0| is the KL: the plain β-VAE objective.
@@ -295,8 +298,15 @@ mod tests {
             "{}",
             setting(&m)
         );
+        // A total-correlation weight is said before the capacity.
+        m.train.as_mut().unwrap().config["tc"] = serde_json::json!(10.0);
+        assert!(
+            setting(&m).contains(" to 6000, TC weight 10, C 12"),
+            "{}",
+            setting(&m)
+        );
         let config = m.train.as_mut().unwrap().config.as_object_mut().unwrap();
-        for key in ["beta_final", "beta_from", "beta_until"] {
+        for key in ["beta_final", "beta_from", "beta_until", "tc"] {
             config.remove(key);
         }
         // A capacity of 0 is the plain β-VAE objective, and says so.
