@@ -18,7 +18,8 @@ use crate::error::ReportError;
 
 /// The header of [`table`]: what each column holds.
 const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | per-latent KL, sorted | \
-                      active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | MIG | SAP |";
+                      active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | \
+                      ball linear R² | distractor linear R² | MIG | SAP |";
 
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1 (and the later β it moves
@@ -120,9 +121,15 @@ fn row(m: &Manifest) -> (String, String) {
         q.and_then(|q| q.group(group))
             .map_or("n/a".into(), |g| f2(g.knn_r2))
     };
+    // The linear R² beside the k-NN one: a code that holds an object's position folded (each
+    // latent non-monotone in it) has the second near 1 and the first well below.
+    let linear = |group: &str| {
+        q.and_then(|q| q.group(group))
+            .map_or("n/a".into(), |g| f2(g.linear_r2))
+    };
     let dis = q.and_then(|q| q.disentanglement.as_ref());
     let cells = format!(
-        "{} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} |",
+        "{} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
         m.seed,
         match evidence.map(|e| e.trained) {
             Some(true) => "yes",
@@ -145,6 +152,8 @@ fn row(m: &Manifest) -> (String, String) {
         count(LatentRole::Both),
         knn("position"),
         knn("distractor"),
+        linear("position"),
+        linear("distractor"),
         dis.map_or("n/a".into(), |d| format!("{:.3}", d.mig)),
         dis.map_or("n/a".into(), |d| format!("{:.3}", d.sap)),
     );
