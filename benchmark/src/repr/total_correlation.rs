@@ -67,6 +67,7 @@ pub fn estimate(z: &[f32], mu: &[f32], logvar: &[f32], m: usize, d: usize) -> Tc
     let mut joint = vec![0.0; m];
     let mut p = vec![0.0; m];
     let mut column = vec![0.0; m];
+    let mut weights = vec![0.0; m];
     let mut r = vec![0.0; m * d];
     let mut est = TcEstimate {
         value: 0.0,
@@ -91,7 +92,6 @@ pub fn estimate(z: &[f32], mu: &[f32], logvar: &[f32], m: usize, d: usize) -> Tc
             for j in 0..m {
                 column[j] = l[j * d + k];
             }
-            let mut weights = vec![0.0; m];
             term -= logsumexp(&column, &mut weights) - log_m;
             for j in 0..m {
                 r[j * d + k] = weights[j];
