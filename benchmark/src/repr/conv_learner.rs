@@ -104,6 +104,8 @@ pub struct ConvSection {
     pub beta_until: Option<usize>,
     /// `conv-bvae` only.
     pub tc: Option<f64>,
+    pub blur: Option<f64>,
+    pub blur_until: Option<usize>,
     pub flush_subnormals: Option<bool>,
     pub init: Option<ConvInit>,
 }
@@ -129,6 +131,8 @@ impl ConvSection {
             beta_from: self.beta_from.or(d.beta_from),
             beta_until: self.beta_until.or(d.beta_until),
             tc: self.tc.or(d.tc),
+            blur: self.blur.or(d.blur),
+            blur_until: self.blur_until.or(d.blur_until),
             flush_subnormals: self.flush_subnormals.unwrap_or(d.flush_subnormals),
             init: self.init.unwrap_or(d.init),
         }
@@ -185,7 +189,7 @@ impl LearnerParams for ConvParams {
         vec![
             format!(
                 "{}: training settings of ours (the authors' are not public): {} iterations, batch {}, \
-             lr {}{}{}{}",
+             lr {}{}{}{}{}",
                 self.model.name(),
                 self.config.iterations,
                 self.config.batch,
@@ -204,6 +208,13 @@ impl LearnerParams for ConvParams {
                 match self.config.tc {
                     Some(w) => format!(", a total-correlation term weighted {w} (β-TCVAE's)"),
                     None => String::new(),
+                },
+                match (self.config.blur, self.config.blur_until) {
+                    (Some(s), Some(until)) => format!(
+                        ", the reconstruction target blurred by a Gaussian of {s} pixels falling \
+                         to none at iteration {until}"
+                    ),
+                    _ => String::new(),
                 },
             ),
             if self.config.flush_subnormals {
@@ -903,6 +914,43 @@ mod tests {
             };
             let e = (ConvModel::ConvBvae, section).check().unwrap_err();
             assert_eq!(e.key.as_deref(), Some("tc"), "{bad}: {e}");
+        }
+        // A blurred target: either network's, checked, said among the deviations, out of the
+        // identity when unset.
+        let blurred = ConvSection {
+            blur: Some(16.0),
+            blur_until: Some(3000),
+            ..ConvSection::default()
+        };
+        for model in [ConvModel::ConvVae, ConvModel::ConvBvae] {
+            let p = (model, blurred.clone()).check().unwrap();
+            assert!(
+                p.deviations(None).iter().any(|d| d.contains(
+                    ", the reconstruction target blurred by a Gaussian of 16 pixels falling to \
+                     none at iteration 3000"
+                )),
+                "{:?}",
+                p.deviations(None)
+            );
+            assert_eq!(p.identity(None)["blur_until"], 3000);
+        }
+        assert!(plain.identity(None).get("blur").is_none());
+        for (blur, until, key) in [
+            (Some(16.0), None, "blur_until"),
+            (None, Some(3000), "blur_until"),
+            (Some(0.0), Some(3000), "blur"),
+            (Some(65.0), Some(3000), "blur"),
+            (Some(f64::NAN), Some(3000), "blur"),
+            (Some(16.0), Some(0), "blur_until"),
+            (Some(16.0), Some(5001), "blur_until"),
+        ] {
+            let section = ConvSection {
+                blur,
+                blur_until: until,
+                ..ConvSection::default()
+            };
+            let e = (ConvModel::ConvBvae, section).check().unwrap_err();
+            assert_eq!(e.key.as_deref(), Some(key), "{blur:?} {until:?}: {e}");
         }
     }
 

@@ -29,6 +29,7 @@ use super::nets::TfAdam;
 use super::neural_config::Model;
 use super::neural_model::{CodeSettings, Variant};
 use super::params::ParamError;
+use super::target_blur;
 use crate::seed::Stream;
 
 /// The training recipe of a convolutional network (`[learners.conv-vae]`,
@@ -96,6 +97,17 @@ pub struct ConvConfig {
     /// left out of the configuration's identity): no such term.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tc: Option<f64>,
+    /// A blurred reconstruction target: the loss compares the decoder's picture with the
+    /// picture blurred by a Gaussian of σ pixels, σ falling linearly from `blur` at iteration
+    /// 0 to 0 at `blur_until` ([`super::target_blur`]); the encoder sees the picture itself.
+    /// Ours: the reconstruction then orders places farther apart than an object's diameter,
+    /// which sharp pictures leave equal (`docs/neural.md`, "Eleventh round"). None (the
+    /// default, left out of the configuration's identity): the picture itself throughout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blur: Option<f64>,
+    /// The iteration at which the blur's σ reaches 0 (with `blur` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blur_until: Option<usize>,
     /// Train with subnormal numbers flushed to zero (x86-64's FTZ and DAZ,
     /// [`ugl_kernels::flushing_pool`]): the same bits on every x86-64 CPU and path, and no
     /// microcode assists on Intel CPUs, where a trained VAE's tiny gradients made each iteration
@@ -132,6 +144,8 @@ impl ConvConfig {
             beta_from: None,
             beta_until: None,
             tc: None,
+            blur: None,
+            blur_until: None,
             flush_subnormals: true,
             init: ConvInit::Torch04,
         }
@@ -194,6 +208,15 @@ impl ConvConfig {
         }
     }
 
+    /// The σ, in pixels, of the blur of the reconstruction target at iteration `step` (None:
+    /// the picture itself).
+    pub fn blur_at(&self, step: usize) -> Option<f64> {
+        match (self.blur, self.blur_until) {
+            (Some(s), Some(until)) => super::target_blur::sigma_at(s, until, step),
+            _ => None,
+        }
+    }
+
     /// Validate every value; the error names the key.
     pub fn check(&self) -> Result<(), ParamError> {
         for (key, v, most) in [
@@ -228,6 +251,38 @@ impl ConvConfig {
         check_beta("beta", self.beta)?;
         if let Some(w) = self.tc {
             check_beta("tc", w)?;
+        }
+        match (self.blur, self.blur_until) {
+            (None, None) => {}
+            (None, Some(_)) => {
+                return Err(ParamError::at(
+                    "blur_until",
+                    "ends the blur of the reconstruction target: set blur too",
+                ));
+            }
+            (Some(_), None) => {
+                return Err(ParamError::at(
+                    "blur_until",
+                    "must be set with blur: the iteration at which the blur reaches 0",
+                ));
+            }
+            (Some(s), Some(until)) => {
+                if !(s.is_finite() && s > 0.0 && s <= 64.0) {
+                    return Err(ParamError::at(
+                        "blur",
+                        format!("must be a σ in pixels above 0 and at most 64, got {s}"),
+                    ));
+                }
+                if until == 0 || until > self.iterations {
+                    return Err(ParamError::at(
+                        "blur_until",
+                        format!(
+                            "must be between 1 and the iterations ({}), got {until}",
+                            self.iterations
+                        ),
+                    ));
+                }
+            }
         }
         if let Some(c) = self.capacity
             && !(c.is_finite() && (0.0..=1e4).contains(&c))
@@ -351,6 +406,8 @@ struct Workspace {
     grad: Vec<f32>,
     grad_next: Vec<f32>,
     dz: Vec<f32>,
+    /// The blurred reconstruction target, when the recipe blurs it.
+    target: Vec<f32>,
     /// Gradients of the parameters, [`ConvNet::params`] order.
     grads: Vec<Vec<f32>>,
 }
@@ -441,10 +498,17 @@ impl ConvTrainer {
         ws.z.clone_from(&middle.z);
 
         net.decoder_forward(&ws.z, n, &mut ws.dec);
+        let target: &[f32] = match cfg.blur_at(step) {
+            Some(sigma) => {
+                target_blur::blur(x, n, arch.channels, arch.side, sigma, &mut ws.target);
+                &ws.target
+            }
+            None => x,
+        };
         let scale = middle.rec_scale() / n as f64;
         let per_image = bce_and_grad(
             &ws.dec.logits,
-            x,
+            target,
             arch.image_len(),
             scale as f32,
             sized(&mut ws.grad, ws.dec.logits.len()),
@@ -724,6 +788,33 @@ mod tests {
             ..followup_config()
         });
         assert_ne!(with, with_tc);
+    }
+
+    /// A blurred reconstruction target changes the loss and the gradients until `blur_until`,
+    /// and nothing from it on (the blur itself is tested in `target_blur.rs`).
+    #[test]
+    fn the_blur_changes_the_target_until_its_end() {
+        let arch = small();
+        let net = ConvNet::init(&mut stream_named(1, "conv"), arch, ConvInit::Torch04);
+        let x = pictures(arch, 3, 2);
+        let run = |cfg: &ConvConfig, step: usize| {
+            let mut t = ConvTrainer::new(net.clone());
+            let loss = t
+                .forward_backward(cfg, &x, 3, step, &mut stream_named(3, "noise"))
+                .unwrap();
+            (loss, t.gradients().to_vec())
+        };
+        let blurred = ConvConfig {
+            blur: Some(3.0),
+            blur_until: Some(5),
+            ..followup_config()
+        };
+        assert_eq!(blurred.check(), Ok(()));
+        let (sharp_loss, sharp_grads) = run(&followup_config(), 2);
+        let (loss, grads) = run(&blurred, 2);
+        assert_ne!(loss, sharp_loss);
+        assert_ne!(grads[DEC_CONV + 6], sharp_grads[DEC_CONV + 6]);
+        assert_eq!(run(&blurred, 5), run(&followup_config(), 5));
     }
 
     /// β moves linearly to `beta_final` between `beta_from` and `beta_until` (a jump when they

@@ -33,6 +33,7 @@ pub mod quality;
 pub mod registry;
 pub mod rfvae;
 pub mod sparse;
+pub mod target_blur;
 pub mod total_correlation;
 pub mod trainer;
 pub mod training_loop;

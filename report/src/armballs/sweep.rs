@@ -24,7 +24,8 @@ const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | pe
 /// A network's setting in words, from the training configuration its manifest records: the
 /// learner's display name (the registry's), then β where it is not 1 (and the later β it moves
 /// to, with its iterations, where the configuration sets one), the capacity C and how it
-/// is ramped, the KL delay (and its weight) and the warm-up where there are; then the learning
+/// is ramped, the KL delay (and its weight), the warm-up and a blurred reconstruction target
+/// where there are; then the learning
 /// rate, the batch, the iterations, and whether subnormals were flushed.
 fn setting(m: &Manifest) -> String {
     let learner = m.learner.as_deref().map(|name| {
@@ -71,6 +72,9 @@ fn setting(m: &Manifest) -> String {
     }
     if let Some(w) = int("warmup").filter(|w| *w > 0) {
         parts.push(format!("warm-up {w}"));
+    }
+    if let (Some(s), Some(until)) = (num("blur"), int("blur_until")) {
+        parts.push(format!("target blurred σ {s} px to 0 at {until}"));
     }
     if let Some(lr) = num("lr") {
         parts.push(format!("lr {lr}"));
@@ -314,8 +318,23 @@ mod tests {
             "{}",
             setting(&m)
         );
+        // A blurred target is said after the warm-up.
+        m.train.as_mut().unwrap().config["blur"] = serde_json::json!(16.0);
+        m.train.as_mut().unwrap().config["blur_until"] = serde_json::json!(6000);
+        assert!(
+            setting(&m).contains("target blurred σ 16 px to 0 at 6000, lr"),
+            "{}",
+            setting(&m)
+        );
         let config = m.train.as_mut().unwrap().config.as_object_mut().unwrap();
-        for key in ["beta_final", "beta_from", "beta_until", "tc"] {
+        for key in [
+            "beta_final",
+            "beta_from",
+            "beta_until",
+            "tc",
+            "blur",
+            "blur_until",
+        ] {
             config.remove(key);
         }
         // A capacity of 0 is the plain β-VAE objective, and says so.
