@@ -282,7 +282,8 @@ pub fn trustworthiness_continuity(
     )
 }
 
-/// Per-column mean and standard deviation (1 where the column is constant).
+/// Per-column mean and standard deviation (infinite where the column is constant up to
+/// rounding, [`CONSTANT_SPREAD`], so that its standardised values are 0).
 fn standardiser(z: &Latents) -> (Vec<f64>, Vec<f64>) {
     let (n, d) = (z.n as f64, z.latents);
     let mut mean = vec![0.0; d];
@@ -299,10 +300,27 @@ fn standardiser(z: &Latents) -> (Vec<f64>, Vec<f64>) {
     }
     let sd = sd
         .into_iter()
-        .map(|v| if v.sqrt() > 0.0 { v.sqrt() } else { 1.0 })
+        .zip(&mean)
+        .map(|(v, m)| {
+            let sd = v.sqrt();
+            // Constant up to rounding: an infinite scale makes its standardised column 0.
+            if sd > CONSTANT_SPREAD * m.abs().max(1.0) {
+                sd
+            } else {
+                f64::INFINITY
+            }
+        })
         .collect();
     (mean, sd)
 }
+
+/// A latent whose spread over the training codes is at most this fraction of its size (or of 1,
+/// the prior's scale, where it is smaller) is constant up to rounding: an `f32` code's rounding
+/// is about 6e-8 of its size, and a dead encoder's codes differ by that alone (seen: a spread of
+/// 3e-10 on codes of 0.01). Standardised, its rounding would be read as signal, and codes 1e-6
+/// away from it extrapolated without bound (a linear R² of -6e7), so it is left out of the
+/// linear map.
+const CONSTANT_SPREAD: f64 = 1e-6;
 
 fn linear_predictions(
     train: &Latents,
@@ -486,13 +504,34 @@ mod tests {
             &y_tr,
             &map(&s_te, &flat, 2),
             &y_te,
-            names,
+            names.clone(),
         )
         .unwrap();
         assert!(
             q.linear_r2_mean.abs() < 0.02 && q.knn_r2_mean.abs() < 0.05,
             "{q:?}"
         );
+        // Collapsed up to rounding (a dead encoder: every training code the same but for a
+        // few one or two rounding steps away, the held-out codes 1e-6 away): nothing either,
+        // never the rounding noise read as signal (a network of the sweep had a linear R² of
+        // -6e7; this case gave -1.3e6).
+        let dead = |n: usize, shift: f64, bumps: &[(usize, usize, f64)]| {
+            let mut data: Vec<f64> = (0..n).flat_map(|_| [0.01 + shift, -0.02 + shift]).collect();
+            for &(row, col, by) in bumps {
+                data[row * 2 + col] += by;
+            }
+            latents(n, 2, data)
+        };
+        let n_tr = y_tr.len() / 2;
+        let q = latent_quality(
+            &dead(n_tr, 0.0, &[(7, 0, 1e-9), (50, 1, -1e-9), (30, 0, 2e-9)]),
+            &y_tr,
+            &dead(y_te.len() / 2, 1e-6, &[]),
+            &y_te,
+            names,
+        )
+        .unwrap();
+        assert!(q.linear_r2_mean.abs() < 0.02, "{q:?}");
     }
 
     /// Trustworthiness and continuity on known answers: an isometry keeps every neighbourhood
