@@ -212,7 +212,7 @@ impl ConvConfig {
     /// the picture itself).
     pub fn blur_at(&self, step: usize) -> Option<f64> {
         match (self.blur, self.blur_until) {
-            (Some(s), Some(until)) => super::target_blur::sigma_at(s, until, step),
+            (Some(s), Some(until)) => target_blur::sigma_at(s, until, step),
             _ => None,
         }
     }
