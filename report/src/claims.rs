@@ -168,14 +168,40 @@ pub enum Finding {
     Angle,
 }
 
-/// A condition on the results that a claim presupposes, checked per network.
+/// A condition on the results that a claim presupposes, checked per network: the claim is
+/// evaluated on the repetitions that meet every part given (at least one).
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Premise {
-    /// The repetition's network of this learner has an active latent that encodes only the
-    /// controllable object and one that encodes only the distractor (ArmBalls): the claim is
-    /// evaluated on the repetitions whose network is disentangled.
-    pub disentangled: String,
+    /// The repetition's network of this learner is disentangled: it has an active latent that
+    /// encodes only the controllable object and one that encodes only the distractor
+    /// (ArmBalls).
+    #[serde(default)]
+    pub disentangled: Option<String>,
+    /// The repetition's network of this learner is the entangled control: its code holds both
+    /// objects (the held-out k-NN R² of each object's position from the whole code), and it is
+    /// not disentangled. A network that holds one object only is blind to the other, not
+    /// entangled.
+    #[serde(default)]
+    pub entangled: Option<String>,
+}
+
+impl Premise {
+    /// The premise in words, for a verdict that cannot check it.
+    pub fn describe(&self) -> String {
+        let parts: Vec<String> = [
+            self.disentangled
+                .as_ref()
+                .map(|l| format!("a {l} network is disentangled")),
+            self.entangled
+                .as_ref()
+                .map(|l| format!("a {l} network holds both objects, entangled")),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        parts.join(" and ")
+    }
 }
 
 /// A premise checked on the results.
@@ -664,6 +690,20 @@ pub fn parse_claims(text: &str, path: &Path) -> Result<ClaimsFile, ReportError> 
         }
         if let Some(m) = c.margin {
             check_margin(m).map_err(|m| invalid(format!("claim `{}`: margin {m}", c.id)))?;
+        }
+        if let Some(p) = &c.premise {
+            if p.disentangled.is_none() && p.entangled.is_none() {
+                return Err(invalid(format!(
+                    "claim `{}`: a premise names `disentangled` or `entangled` (a learner)",
+                    c.id
+                )));
+            }
+            if p.disentangled.is_some() && p.disentangled == p.entangled {
+                return Err(invalid(format!(
+                    "claim `{}`: the premise names one learner both disentangled and entangled",
+                    c.id
+                )));
+            }
         }
         if let Some(m) = c.relative_margin {
             check_margin(m)
@@ -1219,8 +1259,8 @@ pub fn evaluate_on(file: &ClaimsFile, obs: &dyn Observations) -> Vec<ClaimResult
                 obs.premise(p).unwrap_or_else(|| PremiseCheck {
                     met: false,
                     counted: format!(
-                        "whether a {} network is disentangled cannot be checked on these results",
-                        p.disentangled
+                        "whether {} cannot be checked on these results",
+                        p.describe()
                     ),
                     repetitions: None,
                 })

@@ -7,7 +7,9 @@ use std::fmt::Write as _;
 
 use super::authors::{self, Authors};
 use super::labels::{Condition, f3};
-use super::runs::{FollowupRun, display, is_disentangled, one_run_per_network};
+use super::runs::{
+    ENCODES, FollowupRun, display, holds_both, is_disentangled, one_run_per_network,
+};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
@@ -126,25 +128,64 @@ impl Observations for FollowupObservations<'_> {
     }
 
     fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
-        let networks = networks(self.runs, &premise.disentangled);
-        let repetitions: BTreeSet<(Option<String>, i64)> = networks
+        // Each part of the premise: the repetitions whose network meets it, and its count.
+        let mut parts: Vec<(BTreeSet<(Option<String>, i64)>, String)> = Vec::new();
+        if let Some(learner) = &premise.disentangled {
+            let networks = networks(self.runs, learner);
+            let yes: BTreeSet<_> = networks
+                .iter()
+                .filter(|n| n.disentangled)
+                .map(|n| n.repetition.clone())
+                .collect();
+            parts.push((
+                yes.clone(),
+                format!(
+                    "{} networks with an active ball-only and an active distractor-only latent: \
+                     {} of {}",
+                    learner_name(learner),
+                    yes.len(),
+                    networks.len()
+                ),
+            ));
+        }
+        if let Some(learner) = &premise.entangled {
+            let networks = networks(self.runs, learner);
+            let yes: BTreeSet<_> = networks
+                .iter()
+                .filter(|n| n.holds_both && !n.disentangled)
+                .map(|n| n.repetition.clone())
+                .collect();
+            parts.push((
+                yes.clone(),
+                format!(
+                    "{} networks holding both objects (k-NN R² of each position at least {ENCODES}), \
+                     not disentangled: {} of {}",
+                    learner_name(learner),
+                    yes.len(),
+                    networks.len()
+                ),
+            ));
+        }
+        let (first, _) = parts.first()?;
+        let repetitions: BTreeSet<(Option<String>, i64)> = first
             .iter()
-            .filter(|n| n.1)
-            .map(|n| n.0.clone())
+            .filter(|r| parts.iter().all(|(p, _)| p.contains(r)))
+            .cloned()
             .collect();
-        let (yes, n) = (repetitions.len(), networks.len());
+        // Every network counted, whichever part: the repetitions that could be compared.
+        let all: BTreeSet<(Option<String>, i64)> = [&premise.disentangled, &premise.entangled]
+            .into_iter()
+            .flatten()
+            .flat_map(|l| networks(self.runs, l).into_iter().map(|n| n.repetition))
+            .collect();
+        let yes = repetitions.len();
+        let mut counted: Vec<String> = parts.into_iter().map(|(_, c)| c).collect();
+        if yes > 0 && yes < all.len() {
+            counted.push(format!("compared on the {yes} repetitions that meet it"));
+        }
         Some(PremiseCheck {
             met: yes > 0,
-            counted: format!(
-                "{} networks with an active ball-only and an active distractor-only latent: \
-                 {yes} of {n}{}",
-                learner_name(&premise.disentangled),
-                if yes > 0 && yes < n {
-                    format!(", compared on those {yes} repetitions")
-                } else {
-                    String::new()
-                }
-            ),
+            counted: counted.join("; "),
             // None meets it: the difference on every repetition is still shown, marked.
             repetitions: (yes > 0).then_some(repetitions),
         })
@@ -175,19 +216,30 @@ fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
     Some(fin.get(&ball).map_or(0, |v| v.1) as f64 / total as f64)
 }
 
+/// A learned network as the claims' premise sees it.
+struct Network {
+    /// Its repetition: the variant campaign's tag and the seed.
+    repetition: (Option<String>, i64),
+    /// An active ball-only and an active distractor-only latent ([`is_disentangled`]).
+    disentangled: bool,
+    /// Its code holds both objects: the held-out k-NN R² of each object's position at least
+    /// [`ENCODES`] ([`holds_both`]).
+    holds_both: bool,
+}
+
 /// The learned networks of `learner`, one per variant campaign's tag and seed (its flat and
-/// modular runs share it), each with whether it is disentangled ([`is_disentangled`]: an active
-/// ball-only and an active distractor-only latent).
-fn networks(runs: &[FollowupRun], learner: &str) -> Vec<((Option<String>, i64), bool)> {
+/// modular runs share it).
+fn networks(runs: &[FollowupRun], learner: &str) -> Vec<Network> {
     one_run_per_network(runs)
         .into_iter()
         .filter(|r| r.learner.as_deref() == Some(learner))
         .filter_map(|r| {
             let (b, d) = r.per_latent.as_ref()?;
-            Some((
-                (r.key.tag.clone(), r.seed),
-                is_disentangled(&r.kl_per_latent, b, d),
-            ))
+            Some(Network {
+                repetition: (r.key.tag.clone(), r.seed),
+                disentangled: is_disentangled(&r.kl_per_latent, b, d),
+                holds_both: holds_both(r.knn_ball, r.knn_distractor),
+            })
         })
         .collect()
 }
@@ -632,6 +684,7 @@ mod tests {
                 );
                 v.learner = Some("conv-vae".into());
                 v.per_latent = Some((vec![0.5, 0.4, 0.3], vec![0.4, 0.5, 0.3]));
+                (v.knn_ball, v.knn_distractor) = (Some(0.95), Some(0.7));
                 runs.extend([b, v]);
             }
             runs
@@ -649,8 +702,10 @@ mod tests {
         let p = c.premise.as_ref().unwrap();
         assert!(p.met);
         assert!(
-            p.counted
-                .contains("4 of 6, compared on those 4 repetitions"),
+            p.counted.contains("latent: 4 of 6; ")
+                && p.counted.contains("not disentangled: 6 of 6; ")
+                && p.counted
+                    .ends_with("compared on the 4 repetitions that meet it"),
             "{}",
             p.counted
         );
@@ -673,6 +728,105 @@ mod tests {
         assert!(!c.premise.as_ref().unwrap().met);
         assert_eq!(c.comparisons[0].n_subject, 6);
         assert!(verdict(&c).starts_with("premise not met"));
+    }
+
+    /// The entangled control is checked per network too: a VAE whose code holds one object
+    /// only (distractor-blind) or that happens to be disentangled is not the control, so its
+    /// repetition is left out of the claims that compare with it (C1 with the β-VAE's part, C7
+    /// alone).
+    #[test]
+    fn the_entangled_control_is_checked_per_network() {
+        let mut runs = Vec::new();
+        for s in 0..6 {
+            let mut b = run("mge-conv-bvae-lp", s, 0.5 + 0.01 * s as f64);
+            b.learner = Some("conv-bvae".into());
+            b.per_latent = Some((vec![0.9, 0.02, 0.0], vec![0.01, 0.8, 0.0]));
+            b.kl_per_latent = vec![3.0, 3.0, 0.0];
+            // Seeds 0-3 the control; seed 4 blind to the distractor; seed 5 disentangled.
+            let mut v = run("mge-conv-vae-lp", s, 0.3 + 0.005 * s as f64);
+            v.learner = Some("conv-vae".into());
+            v.per_latent = Some(if s == 5 {
+                (vec![0.9, 0.0, 0.3], vec![0.0, 0.9, 0.3])
+            } else {
+                (vec![0.5, 0.4, 0.3], vec![0.4, 0.5, 0.3])
+            });
+            (v.knn_ball, v.knn_distractor) = (Some(0.95), Some(if s == 4 { -0.1 } else { 0.7 }));
+            let mut f = run("mge-conv-vae-flat", s, 0.4 + 0.005 * s as f64);
+            f.learner = v.learner.clone();
+            (f.per_latent, f.knn_ball, f.knn_distractor) =
+                (v.per_latent.clone(), v.knn_ball, v.knn_distractor);
+            runs.extend([b, v, f]);
+        }
+        let file = committed();
+        let obs = FollowupObservations {
+            runs: &runs,
+            authors: None,
+        };
+        let results = evaluate_on(&file, &obs);
+        let get = |id: &str| results.iter().find(|c| c.claim.id == id).unwrap();
+        for id in ["C1", "C7"] {
+            let c = get(id);
+            let p = c.premise.as_ref().unwrap();
+            assert!(p.met, "{id}");
+            assert!(
+                p.counted.contains("not disentangled: 4 of 6"),
+                "{id}: {}",
+                p.counted
+            );
+            assert!(
+                p.counted
+                    .ends_with("compared on the 4 repetitions that meet it"),
+                "{id}: {}",
+                p.counted
+            );
+            assert_eq!(
+                (c.comparisons[0].n_subject, c.comparisons[0].n_reference),
+                (4, 4),
+                "{id}"
+            );
+            assert_eq!(verdict(c), "reproduced", "{id}");
+        }
+        // Every control blind to the distractor: C7's premise is not met.
+        for r in runs
+            .iter_mut()
+            .filter(|r| r.learner.as_deref() == Some("conv-vae"))
+        {
+            r.knn_distractor = Some(0.05);
+        }
+        let obs = FollowupObservations {
+            runs: &runs,
+            authors: None,
+        };
+        let c7 = evaluate_on(&file, &obs)
+            .into_iter()
+            .find(|c| c.claim.id == "C7")
+            .unwrap();
+        assert!(!c7.premise.as_ref().unwrap().met);
+        assert!(verdict(&c7).starts_with("premise not met"));
+    }
+
+    /// A premise names at least one part, and never one learner as both.
+    #[test]
+    fn a_premise_is_checked_when_the_file_is_read() {
+        let file = |premise: &str| {
+            parse_claims(
+                &format!(
+                    "[settings]\nconfidence = 0.95\nmargin = 0.0\n[[claim]]\nid = \"A\"\n\
+                     source = \"s\"\nquote = \"q\"\nstatement = \"s\"\n\
+                     statistic = \"ball_ratio\"\nrelation = \"greater\"\n\
+                     subject = {{ algo = [\"a\"] }}\nreference = {{ algo = [\"b\"] }}\n\
+                     premise = {premise}\n"
+                ),
+                std::path::Path::new("t.toml"),
+            )
+        };
+        assert!(file("{ entangled = \"conv-vae\" }").is_ok());
+        let e = file("{}").unwrap_err().to_string();
+        assert!(e.contains("names `disentangled` or `entangled`"), "{e}");
+        let e = file("{ disentangled = \"x\", entangled = \"x\" }")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("both disentangled and entangled"), "{e}");
     }
 
     #[test]

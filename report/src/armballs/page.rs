@@ -354,7 +354,8 @@ pub(super) fn write(
                      (`docs/followup-paper-sources.md` section 5), so each claim is formalised \
                      here (our choice, `{}`, explained in `docs/armballs.md`) and evaluated by \
                      the same engine as the paper's claims. {} **Premise not met** when the \
-                     claim is about a disentangled space and no network here is one. Of {} \
+                     claim is about a disentangled space (or the entangled control) and no \
+                     repetition's network here is one. Of {} \
                      claims: {yes} reproduced, {no} not reproduced, {open} inconclusive, \
                      {premise} with the premise not met{not_run}.",
                     path.display(),

@@ -439,6 +439,14 @@ pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> b
     roles.contains(&LatentRole::Ball) && roles.contains(&LatentRole::Distractor)
 }
 
+/// Whether a network's whole code holds both objects: the held-out k-NN R² of each object's
+/// position at least [`ENCODES`] (None: not measured, so not). The premise of the follow-up's
+/// claims about its entangled control: a code that ignores the distractor is blind to it, not
+/// entangled.
+pub(super) fn holds_both(knn_ball: Option<f64>, knn_distractor: Option<f64>) -> bool {
+    knn_ball.is_some_and(|b| b >= ENCODES) && knn_distractor.is_some_and(|d| d >= ENCODES)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
