@@ -7,9 +7,7 @@ use std::fmt::Write as _;
 
 use super::authors::{self, Authors};
 use super::labels::{Condition, f3};
-use super::runs::{
-    ENCODES, FollowupRun, display, holds_both, is_disentangled, one_run_per_network,
-};
+use super::runs::{CodeKind, ENCODES, FollowupRun, display, one_run_per_network};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
@@ -134,14 +132,14 @@ impl Observations for FollowupObservations<'_> {
             let networks = networks(self.runs, learner);
             let yes: BTreeSet<_> = networks
                 .iter()
-                .filter(|n| n.disentangled)
-                .map(|n| n.repetition.clone())
+                .filter(|n| n.1 == CodeKind::Disentangled)
+                .map(|n| n.0.clone())
                 .collect();
             parts.push((
                 yes.clone(),
                 format!(
-                    "{} networks with an active ball-only and an active distractor-only latent: \
-                     {} of {}",
+                    "{} networks with an active ball-only and an active distractor-only latent \
+                     and none of both: {} of {}",
                     learner_name(learner),
                     yes.len(),
                     networks.len()
@@ -152,8 +150,8 @@ impl Observations for FollowupObservations<'_> {
             let networks = networks(self.runs, learner);
             let yes: BTreeSet<_> = networks
                 .iter()
-                .filter(|n| n.holds_both && !n.disentangled)
-                .map(|n| n.repetition.clone())
+                .filter(|n| n.1 == CodeKind::Entangled)
+                .map(|n| n.0.clone())
                 .collect();
             parts.push((
                 yes.clone(),
@@ -176,7 +174,7 @@ impl Observations for FollowupObservations<'_> {
         let all: BTreeSet<(Option<String>, i64)> = [&premise.disentangled, &premise.entangled]
             .into_iter()
             .flatten()
-            .flat_map(|l| networks(self.runs, l).into_iter().map(|n| n.repetition))
+            .flat_map(|l| networks(self.runs, l).into_iter().map(|n| n.0))
             .collect();
         let yes = repetitions.len();
         let mut counted: Vec<String> = parts.into_iter().map(|(_, c)| c).collect();
@@ -216,31 +214,13 @@ fn ball_module_goals(r: &FollowupRun) -> Option<f64> {
     Some(fin.get(&ball).map_or(0, |v| v.1) as f64 / total as f64)
 }
 
-/// A learned network as the claims' premise sees it.
-struct Network {
-    /// Its repetition: the variant campaign's tag and the seed.
-    repetition: (Option<String>, i64),
-    /// An active ball-only and an active distractor-only latent ([`is_disentangled`]).
-    disentangled: bool,
-    /// Its code holds both objects: the held-out k-NN R² of each object's position at least
-    /// [`ENCODES`] ([`holds_both`]).
-    holds_both: bool,
-}
-
 /// The learned networks of `learner`, one per variant campaign's tag and seed (its flat and
-/// modular runs share it).
-fn networks(runs: &[FollowupRun], learner: &str) -> Vec<Network> {
+/// modular runs share it): its repetition and what its code is ([`CodeKind`]).
+fn networks(runs: &[FollowupRun], learner: &str) -> Vec<((Option<String>, i64), CodeKind)> {
     one_run_per_network(runs)
         .into_iter()
         .filter(|r| r.learner.as_deref() == Some(learner))
-        .filter_map(|r| {
-            let (b, d) = r.per_latent.as_ref()?;
-            Some(Network {
-                repetition: (r.key.tag.clone(), r.seed),
-                disentangled: is_disentangled(&r.kl_per_latent, b, d),
-                holds_both: holds_both(r.knn_ball, r.knn_distractor),
-            })
-        })
+        .filter_map(|r| Some(((r.key.tag.clone(), r.seed), CodeKind::of(r)?)))
         .collect()
 }
 
@@ -702,7 +682,7 @@ mod tests {
         let p = c.premise.as_ref().unwrap();
         assert!(p.met);
         assert!(
-            p.counted.contains("latent: 4 of 6; ")
+            p.counted.contains("none of both: 4 of 6; ")
                 && p.counted.contains("not disentangled: 6 of 6; ")
                 && p.counted
                     .ends_with("compared on the 4 repetitions that meet it"),
@@ -746,7 +726,7 @@ mod tests {
             let mut v = run("mge-conv-vae-lp", s, 0.3 + 0.005 * s as f64);
             v.learner = Some("conv-vae".into());
             v.per_latent = Some(if s == 5 {
-                (vec![0.9, 0.0, 0.3], vec![0.0, 0.9, 0.3])
+                (vec![0.9, 0.0, 0.0], vec![0.0, 0.9, 0.0])
             } else {
                 (vec![0.5, 0.4, 0.3], vec![0.4, 0.5, 0.3])
             });

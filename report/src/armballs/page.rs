@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 
 use super::labels::{Condition, f2, f3};
 use super::runs::{
-    ACTIVE_NATS, ENCODES, FollowupRun, IGNORES, LatentRole, active_roles, algos, ball_cells,
-    ball_grid, count_role, display, of, one_run_per_network, ratios, role,
+    ACTIVE_NATS, CodeKind, ENCODES, FollowupRun, IGNORES, LatentRole, active_roles, algos,
+    ball_cells, ball_grid, count_role, display, of, one_run_per_network, ratios, role,
 };
 use super::{COVERAGE_FIGURE, FollowupClaims, INTEREST_FIGURE, PAGE, claims};
 use crate::campaigns::Campaign;
@@ -245,11 +245,16 @@ pub(super) fn write(
              read off the latents (held-out images). Per latent, the k-NN R² of the latent from \
              each object's position classifies it: **ball** (ball R² ≥ {ENCODES}, distractor \
              < {IGNORES}), **distractor** (the reverse), **both** (entangled: both ≥ {IGNORES}), \
-             **none** (both below {IGNORES}; collapsed), otherwise *mostly* one. A \
-             disentangled space in the follow-up's sense has an *active* ball-only latent and an \
-             active distractor-only one (below: a latent above {ACTIVE_NATS} nats; the R² is \
-             blind to a latent's scale, so a collapsed latent can still follow an object), and \
-             the claims about a disentangled space compare the repetitions whose β-VAE is.\n"
+             **none** (both below {IGNORES}; collapsed), otherwise *mostly* one. *Code*: \
+             **disentangled** in the follow-up's sense (\"each latent variable is sensitive to a \
+             single degree of freedom\") when an *active* latent encodes the ball alone, another \
+             the distractor alone, and none encodes both (active: above {ACTIVE_NATS} nats; the \
+             R² is blind to a latent's scale, so a collapsed latent can still follow an object); \
+             **entangled** when the code holds both objects (k-NN R² of each at least \
+             {ENCODES}) and is not disentangled; **not both objects** otherwise (blind to one). \
+             The claims about a disentangled space compare the repetitions whose β-VAE is \
+             disentangled, those about the entangled control the repetitions whose VAE is \
+             entangled.\n"
         );
         // MIG, SAP and the active latents, where the networks record them.
         let measured = learned
@@ -267,14 +272,16 @@ pub(super) fn write(
             );
         }
         p.push_str(
-            "| learner | seed | loss / plateau | ball k-NN R² | distractor k-NN R² | ball-only latents | distractor-only | both | none |",
+            "| learner | seed | loss / plateau | ball k-NN R² | distractor k-NN R² | ball-only latents | distractor-only | both | none | code |",
         );
         p.push_str(if measured {
             " MIG | SAP | active latents |"
         } else {
             ""
         });
-        p.push_str(" per latent: ball R² / distractor R² |\n|---|---|---|---|---|---|---|---|---|");
+        p.push_str(
+            " per latent: ball R² / distractor R² |\n|---|---|---|---|---|---|---|---|---|---|",
+        );
         p.push_str(if measured { "---|---|---|" } else { "" });
         p.push_str("---|\n");
         for r in &learned {
@@ -311,7 +318,7 @@ pub(super) fn write(
             };
             let _ = writeln!(
                 p,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |{extra} {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |{extra} {} |",
                 match (r.learner.as_deref().map(learner_name), r.cond.tag()) {
                     (Some(l), "") => l,
                     (Some(l), t) => format!("{l}, {t}"),
@@ -329,6 +336,7 @@ pub(super) fn write(
                 count(LatentRole::Distractor),
                 count(LatentRole::Both),
                 count(LatentRole::Neither),
+                CodeKind::of(r).map_or("n/a", CodeKind::label),
                 per.join(" "),
             );
         }

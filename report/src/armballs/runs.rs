@@ -431,20 +431,56 @@ pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<
         .collect()
 }
 
-/// Whether a network's code is disentangled in the follow-up's sense: one of its active latents
-/// ([`active_roles`]) encodes the ball alone and another the distractor alone. The premise of
-/// the follow-up's claims, checked per network.
+/// Whether a network's code is disentangled in the follow-up's sense, "a representation where
+/// each latent variable is sensitive to a single degree of freedom" (its abstract): one of its
+/// active latents ([`active_roles`]) encodes the ball alone, another the distractor alone, and
+/// none encodes both. An active latent of both objects entangles the modules that hold it (a
+/// plain VAE can have a ball-only and a distractor-only latent beside six of both).
 pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> bool {
     let roles = active_roles(kl, ball, distractor);
-    roles.contains(&LatentRole::Ball) && roles.contains(&LatentRole::Distractor)
+    roles.contains(&LatentRole::Ball)
+        && roles.contains(&LatentRole::Distractor)
+        && !roles.contains(&LatentRole::Both)
 }
 
 /// Whether a network's whole code holds both objects: the held-out k-NN R² of each object's
-/// position at least [`ENCODES`] (None: not measured, so not). The premise of the follow-up's
-/// claims about its entangled control: a code that ignores the distractor is blind to it, not
-/// entangled.
+/// position at least [`ENCODES`] (None: not measured, so not).
 pub(super) fn holds_both(knn_ball: Option<f64>, knn_distractor: Option<f64>) -> bool {
     knn_ball.is_some_and(|b| b >= ENCODES) && knn_distractor.is_some_and(|d| d >= ENCODES)
+}
+
+/// What a learned network's code is, for the follow-up's claims (their premises) and page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum CodeKind {
+    /// [`is_disentangled`].
+    Disentangled,
+    /// Holds both objects ([`holds_both`]) and is not disentangled: the entangled control.
+    Entangled,
+    /// Holds one object or neither: blind to the other, neither of the follow-up's spaces.
+    Partial,
+}
+
+impl CodeKind {
+    /// The network of run `r`, where its per-latent measure is recorded.
+    pub(super) fn of(r: &FollowupRun) -> Option<CodeKind> {
+        let (b, d) = r.per_latent.as_ref()?;
+        Some(if is_disentangled(&r.kl_per_latent, b, d) {
+            CodeKind::Disentangled
+        } else if holds_both(r.knn_ball, r.knn_distractor) {
+            CodeKind::Entangled
+        } else {
+            CodeKind::Partial
+        })
+    }
+
+    /// The word the page prints.
+    pub(super) fn label(self) -> &'static str {
+        match self {
+            CodeKind::Disentangled => "disentangled",
+            CodeKind::Entangled => "entangled",
+            CodeKind::Partial => "not both objects",
+        }
+    }
 }
 
 #[cfg(test)]
@@ -487,20 +523,51 @@ mod tests {
             active_roles(&[3.1, 3.0, 2.0], &ball, &distractor),
             [LatentRole::Ball, LatentRole::Distractor, LatentRole::Both]
         );
-        assert!(is_disentangled(&[3.1, 3.0, 2.0], &ball, &distractor));
+        // An active latent of both objects: entangled, whatever else the code holds.
+        assert!(!is_disentangled(&[3.1, 3.0, 2.0], &ball, &distractor));
+        assert!(is_disentangled(&[3.1, 3.0, 0.2], &ball, &distractor));
         // The distractor's latent collapsed (0.01 nats): its mean still follows the distractor.
         assert_eq!(
             active_roles(&[3.1, 0.01, 2.0], &ball, &distractor),
             [LatentRole::Ball, LatentRole::Both]
         );
-        assert!(!is_disentangled(&[3.1, 0.01, 2.0], &ball, &distractor));
+        assert!(!is_disentangled(&[3.1, 0.01, 0.2], &ball, &distractor));
         assert!(!is_disentangled(
-            &[3.1, ACTIVE_NATS, 2.0],
+            &[3.1, ACTIVE_NATS, 0.2],
             &ball,
             &distractor
         ));
-        assert!(is_disentangled(&[], &ball, &distractor));
+        assert!(is_disentangled(&[], &ball[..2], &distractor[..2]));
+        assert!(!is_disentangled(&[], &ball, &distractor));
         assert!(!is_disentangled(&[], &ball[..1], &distractor[..1]));
+    }
+
+    /// A network's code is disentangled, the entangled control (both objects, some latent of
+    /// both), or neither of the follow-up's spaces (one object only).
+    #[test]
+    fn code_kinds() {
+        let key = ConditionKey {
+            env: "armballs-corl".into(),
+            algo: "mge-conv-vae-lp".into(),
+            sampler: "gaussian".into(),
+            latents: 3,
+            variant: "none".into(),
+            tag: None,
+        };
+        let mut r = FollowupRun::test_run(key, 0, 0.3);
+        assert_eq!(CodeKind::of(&r), None);
+        r.kl_per_latent = vec![3.0, 3.0, 2.0];
+        r.per_latent = Some((vec![0.9, 0.02, 0.4], vec![0.01, 0.8, 0.4]));
+        (r.knn_ball, r.knn_distractor) = (Some(0.99), Some(0.97));
+        assert_eq!(CodeKind::of(&r), Some(CodeKind::Entangled));
+        r.kl_per_latent[2] = 0.1;
+        assert_eq!(CodeKind::of(&r), Some(CodeKind::Disentangled));
+        // The ball alone: blind to the distractor.
+        r.per_latent = Some((vec![0.9, 0.8, 0.4], vec![0.01, 0.0, 0.05]));
+        r.knn_distractor = Some(-0.1);
+        assert_eq!(CodeKind::of(&r), Some(CodeKind::Partial));
+        r.knn_distractor = None;
+        assert_eq!(CodeKind::of(&r), Some(CodeKind::Partial));
     }
 
     #[test]
