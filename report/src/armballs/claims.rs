@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use super::authors::{self, Authors};
 use super::labels::{Condition, f3};
-use super::runs::{CodeKind, ENCODES, FollowupRun, display, one_run_per_network};
+use super::runs::{CodeKind, FollowupRun, display, one_run_per_network};
 use crate::claims::{ClaimResult, Observations, Premise, PremiseCheck, Statistic, Verdict};
 use crate::load::ConditionKey;
 use crate::names::learner_name;
@@ -126,55 +126,38 @@ impl Observations for FollowupObservations<'_> {
     }
 
     fn premise(&self, premise: &Premise) -> Option<PremiseCheck> {
-        // Each part of the premise: the repetitions whose network meets it, and its count.
+        // Each part of the premise: its learner and the kind of code its network must have.
+        let wanted = [
+            (&premise.disentangled, CodeKind::Disentangled),
+            (&premise.entangled, CodeKind::Entangled),
+        ];
+        // Per part, the repetitions whose network meets it, and the count in words; and every
+        // repetition with a network of a part's learner (those that could be compared).
         let mut parts: Vec<(BTreeSet<(Option<String>, i64)>, String)> = Vec::new();
-        if let Some(learner) = &premise.disentangled {
+        let mut all: BTreeSet<(Option<String>, i64)> = BTreeSet::new();
+        for (learner, kind) in wanted {
+            let Some(learner) = learner else { continue };
             let networks = networks(self.runs, learner);
             let yes: BTreeSet<_> = networks
                 .iter()
-                .filter(|n| n.1 == CodeKind::Disentangled)
+                .filter(|n| n.1 == kind)
                 .map(|n| n.0.clone())
                 .collect();
-            parts.push((
-                yes.clone(),
-                format!(
-                    "{} networks with an active ball-only and an active distractor-only latent \
-                     and none of both: {} of {}",
-                    learner_name(learner),
-                    yes.len(),
-                    networks.len()
-                ),
-            ));
-        }
-        if let Some(learner) = &premise.entangled {
-            let networks = networks(self.runs, learner);
-            let yes: BTreeSet<_> = networks
-                .iter()
-                .filter(|n| n.1 == CodeKind::Entangled)
-                .map(|n| n.0.clone())
-                .collect();
-            parts.push((
-                yes.clone(),
-                format!(
-                    "{} networks holding both objects (k-NN R² of each position at least {ENCODES}), \
-                     not disentangled: {} of {}",
-                    learner_name(learner),
-                    yes.len(),
-                    networks.len()
-                ),
-            ));
+            let counted = format!(
+                "{} networks {}: {} of {}",
+                learner_name(learner),
+                kind.criterion(),
+                yes.len(),
+                networks.len()
+            );
+            all.extend(networks.into_iter().map(|n| n.0));
+            parts.push((yes, counted));
         }
         let (first, _) = parts.first()?;
         let repetitions: BTreeSet<(Option<String>, i64)> = first
             .iter()
             .filter(|r| parts.iter().all(|(p, _)| p.contains(r)))
             .cloned()
-            .collect();
-        // Every network counted, whichever part: the repetitions that could be compared.
-        let all: BTreeSet<(Option<String>, i64)> = [&premise.disentangled, &premise.entangled]
-            .into_iter()
-            .flatten()
-            .flat_map(|l| networks(self.runs, l).into_iter().map(|n| n.0))
             .collect();
         let yes = repetitions.len();
         let mut counted: Vec<String> = parts.into_iter().map(|(_, c)| c).collect();

@@ -473,6 +473,20 @@ impl CodeKind {
         })
     }
 
+    /// What a network of this kind has, in words (the claims' premise counts them).
+    pub(super) fn criterion(self) -> String {
+        match self {
+            CodeKind::Disentangled => "with an active ball-only and an active distractor-only \
+                                       latent and none of both"
+                .into(),
+            CodeKind::Entangled => format!(
+                "holding both objects (k-NN R² of each position at least {ENCODES}), not \
+                 disentangled"
+            ),
+            CodeKind::Partial => "holding one object or neither".into(),
+        }
+    }
+
     /// The word the page prints.
     pub(super) fn label(self) -> &'static str {
         match self {
