@@ -464,13 +464,31 @@ impl CodeKind {
     /// The network of run `r`, where its per-latent measure is recorded.
     pub(super) fn of(r: &FollowupRun) -> Option<CodeKind> {
         let (b, d) = r.per_latent.as_ref()?;
-        Some(if is_disentangled(&r.kl_per_latent, b, d) {
+        Some(CodeKind::from_measures(
+            &r.kl_per_latent,
+            b,
+            d,
+            r.knn_ball,
+            r.knn_distractor,
+        ))
+    }
+
+    /// A network's kind from its measures: the per-latent KL, the per-latent R² of each
+    /// object ([`is_disentangled`]) and the whole code's k-NN R² of each ([`holds_both`]).
+    pub(super) fn from_measures(
+        kl: &[f64],
+        ball: &[f64],
+        distractor: &[f64],
+        knn_ball: Option<f64>,
+        knn_distractor: Option<f64>,
+    ) -> CodeKind {
+        if is_disentangled(kl, ball, distractor) {
             CodeKind::Disentangled
-        } else if holds_both(r.knn_ball, r.knn_distractor) {
+        } else if holds_both(knn_ball, knn_distractor) {
             CodeKind::Entangled
         } else {
             CodeKind::Partial
-        })
+        }
     }
 
     /// What a network of this kind has, in words (the claims' premise counts them).

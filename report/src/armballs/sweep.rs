@@ -4,8 +4,8 @@
 //! `docs/neural.md`, "The sweep"), and the table there is this function's output on the
 //! committed sweep (`data/sweeps/conv`), checked by a test.
 //!
-//! The columns use the ArmBalls page's rules ([`ACTIVE_NATS`], [`active_roles`]), so that a network is
-//! called disentangled by one definition wherever it is shown.
+//! The columns use the ArmBalls page's rules ([`ACTIVE_NATS`], [`active_roles`], [`CodeKind`]),
+//! so that a network is called disentangled by one definition wherever it is shown.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -13,12 +13,12 @@ use std::path::Path;
 use ugl_types::{ConvInit, Manifest};
 
 use super::labels::f2;
-use super::runs::{ACTIVE_NATS, LatentRole, active_roles, count_role};
+use super::runs::{ACTIVE_NATS, CodeKind, LatentRole, active_roles, count_role};
 use crate::error::ReportError;
 
 /// The header of [`table`]: what each column holds.
 const HEADER: &str = "| setting | seed | trained | loss fraction | KL total | per-latent KL, sorted | \
-                      active | ball | distractor | both | ball k-NN R² | distractor k-NN R² | \
+                      active | ball | distractor | both | code | ball k-NN R² | distractor k-NN R² | \
                       ball linear R² | distractor linear R² | MIG | SAP |";
 
 /// A network's setting in words, from the training configuration its manifest records: the
@@ -121,10 +121,8 @@ fn row(m: &Manifest) -> (String, String) {
     let count = |kind| count_role(&roles, kind);
     let mut sorted = kl.clone();
     sorted.sort_by(|a, b| b.total_cmp(a));
-    let knn = |group: &str| {
-        q.and_then(|q| q.group(group))
-            .map_or("n/a".into(), |g| f2(g.knn_r2))
-    };
+    let knn_r2 = |group: &str| q.and_then(|q| q.group(group)).map(|g| g.knn_r2);
+    let knn = |group: &str| knn_r2(group).map_or("n/a".into(), f2);
     // The linear R² beside the k-NN one: a code that holds an object's position folded (each
     // latent non-monotone in it) has the second near 1 and the first well below.
     let linear = |group: &str| {
@@ -133,7 +131,7 @@ fn row(m: &Manifest) -> (String, String) {
     };
     let dis = q.and_then(|q| q.disentanglement.as_ref());
     let cells = format!(
-        "{} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+        "{} | {} | {} | {} | {} | {active} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
         m.seed,
         match evidence.map(|e| e.trained) {
             Some(true) => "yes",
@@ -154,6 +152,18 @@ fn row(m: &Manifest) -> (String, String) {
         count(LatentRole::Ball),
         count(LatentRole::Distractor),
         count(LatentRole::Both),
+        if q.is_some() {
+            CodeKind::from_measures(
+                &kl,
+                &ball,
+                &distractor,
+                knn_r2("position"),
+                knn_r2("distractor"),
+            )
+            .label()
+        } else {
+            "n/a"
+        },
         knn("position"),
         knn("distractor"),
         linear("position"),
@@ -257,6 +267,48 @@ mod tests {
             "{out}"
         );
         assert!(first_cell(rows[3]).starts_with("conv β-VAE, β 16"), "{out}");
+    }
+
+    /// The code column is the follow-up page's rule ([`CodeKind`]): the chosen β-VAE's five
+    /// networks are disentangled, the blurred VAE entangled, the sharp β 30 on the plateau
+    /// neither (its code holds neither object).
+    #[test]
+    fn the_code_column_is_the_pages_rule() {
+        let sweep = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../data/sweeps/conv"));
+        let dir = tempfile::tempdir().unwrap();
+        for name in [
+            "beta-30_capacity-12_capacity_iterations-5000_blur-16_blur_until-6000_iterations-\
+             10000_init-torch",
+            "beta-30_capacity-12_capacity_iterations-5000_iterations-8000_init-torch",
+            "vae_blur-16_blur_until-6000_iterations-12000_init-torch",
+        ] {
+            let to = dir.path().join(name);
+            std::fs::create_dir(&to).unwrap();
+            for f in std::fs::read_dir(sweep.join(name)).unwrap() {
+                let f = f.unwrap().path();
+                std::fs::copy(&f, to.join(f.file_name().unwrap())).unwrap();
+            }
+        }
+        let out = table(dir.path()).unwrap();
+        let column = HEADER.split(" | ").position(|c| c == "code").unwrap();
+        let codes: Vec<&str> = out
+            .lines()
+            .skip(2)
+            .map(|r| r.split(" | ").nth(column).unwrap())
+            .collect();
+        assert_eq!(
+            codes,
+            [
+                "disentangled",
+                "disentangled",
+                "disentangled",
+                "disentangled",
+                "disentangled",
+                "not both objects",
+                "entangled"
+            ],
+            "{out}"
+        );
     }
 
     /// The setting names the KL delay, the phase's KL weight (its factor times β) where the
