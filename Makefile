@@ -79,8 +79,10 @@ test-slurm: check-toolchain
 # store, of the current results version (a rerun fills data/results-pending/ first), and the
 # `ugl compare` example of a Rust learner (its runs all trained networks: one is rerun). Each
 # entry is DIR or DIR:N (N runs instead of VERIFY_SAMPLE). Not `compare-random-projection`: its
-# learner is a Python program whose numpy products depend on the machine's BLAS.
-VERIFY_STORES ?= data/results/paper data/results/compare-bvae:1
+# learner is a Python program whose numpy products depend on the machine's BLAS. And the
+# follow-up's `followup-still` (the authors' ArmBalls, no network: RPE, RGE-EFR and MGE-EFR with
+# learning progress, one run each), complete while `followup` is still running.
+VERIFY_STORES ?= data/results/paper data/results/compare-bvae:1 data/results-pending/followup-still
 VERIFY_SAMPLE ?= 3
 verify-store: check-toolchain
 	@for e in $(VERIFY_STORES); do d=$${e%%:*}; n=$${e#*:}; [ "$$n" = "$$e" ] && n=$(VERIFY_SAMPLE); \
