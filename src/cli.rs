@@ -180,7 +180,7 @@ pub(crate) enum Command {
     },
     /// Check a store against the code: every run's files against its manifest's digests, then
     /// rerun a sample of its runs (stratified over the conditions, at least one trained
-    /// network) from the campaign's profile into a scratch directory, fitting afresh, and
+    /// network unless --without-networks) from the campaign's profile into a scratch directory, fitting afresh, and
     /// compare their bytes with the committed ones. Exits with an error on any difference.
     /// Each sampled run is recomputed whole: a trained network is retrained from scratch, with
     /// its progress on stderr (a `paper-long` network takes hours). The first Ctrl-C stops after
@@ -199,6 +199,11 @@ pub(crate) enum Command {
         /// conditions.
         #[arg(long, default_value_t = 4)]
         sample: usize,
+        /// Rerun only runs whose goal space trains no network (RPE, engineered features,
+        /// PCA, ...): a quick check of a store whose networks take long to retrain. Its
+        /// networks are then checked only against their manifests' digests.
+        #[arg(long)]
+        without_networks: bool,
     },
     /// Merge run files from several results directories (e.g. one per machine) into one store.
     Merge {

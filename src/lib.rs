@@ -189,7 +189,17 @@ fn dispatch(cmd: Command) -> Result<()> {
             results,
             config,
             sample,
-        } => commands::verify::verify(&results, config.as_deref(), sample),
+            without_networks,
+        } => commands::verify::verify(
+            &results,
+            config.as_deref(),
+            sample,
+            if without_networks {
+                commands::verify::Networks::Excluded
+            } else {
+                commands::verify::Networks::Included
+            },
+        ),
         Command::Learners => learners(),
         Command::Compare(a) => compare(a),
         Command::Embed(a) => embed(a),

@@ -85,6 +85,22 @@ fn verify_reruns_a_stratified_sample_and_finds_a_forged_run() {
     assert_eq!(same.len(), 2, "{t}");
     assert!(same[0].contains("armball.rge-efr."), "{t}");
     assert!(same[1].contains("armball.rge-vae."), "{t}");
+    // Without networks: the four network-free conditions, no VAE.
+    let o = ugl(&[
+        "verify",
+        "--results",
+        out_s,
+        "--config",
+        cfg,
+        "--sample",
+        "100",
+        "--without-networks",
+    ]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    let same: Vec<&str> = t.lines().filter(|l| l.starts_with("same bytes")).collect();
+    assert_eq!(same.len(), 4, "{t}");
+    assert!(!same.iter().any(|l| l.contains(".rge-vae.")), "{t}");
 
     // Every condition once; then one run's curve swapped for another's, digests forged.
     let (ok, t) = verify(out_s, cfg, "100");

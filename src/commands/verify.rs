@@ -41,20 +41,36 @@ fn condition(spec: &RunSpec) -> String {
     .run_id()
 }
 
+/// Which conditions a sample may draw from.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Networks {
+    /// Every condition, with a trained network among the picks where the store has one.
+    Included,
+    /// Only the conditions whose runs train no network (a cheap check of a store whose
+    /// networks take long to retrain).
+    Excluded,
+}
+
 /// `n` runs stratified over the conditions: conditions evenly spaced in their sorted order, one
 /// run each (the repetition and replicate from a hash of the condition, so the same runs every
-/// time); if none of them is a trained network and `n >= 2`, the last is replaced by the
-/// trained network with the fewest iterations (the cheapest to retrain).
-fn sample(runs: Vec<Pick>, n: usize) -> Vec<Pick> {
+/// time); with networks included, if none of them is a trained network and `n >= 2`, the last
+/// is replaced by the trained network with the fewest iterations (the cheapest to retrain).
+fn sample(runs: Vec<Pick>, n: usize, networks: Networks) -> Vec<Pick> {
     let mut by_condition: BTreeMap<String, Vec<Pick>> = BTreeMap::new();
     for p in runs {
         by_condition.entry(condition(&p.spec)).or_default().push(p);
     }
-    let mut groups: Vec<Vec<Pick>> = by_condition.into_values().collect();
+    let trained = |g: &Vec<Pick>| g.iter().map(|p| trained_iterations(&p.manifest)).max();
+    let mut groups: Vec<Vec<Pick>> = by_condition
+        .into_values()
+        .filter(|g| networks == Networks::Included || trained(g) == Some(0))
+        .collect();
     let n = n.min(groups.len());
     let mut chosen: Vec<usize> = (0..n).map(|i| i * groups.len() / n).collect();
-    let trained = |g: &Vec<Pick>| g.iter().map(|p| trained_iterations(&p.manifest)).min();
-    if n >= 2 && !chosen.iter().any(|&i| trained(&groups[i]).unwrap_or(0) > 0) {
+    if networks == Networks::Included
+        && n >= 2
+        && !chosen.iter().any(|&i| trained(&groups[i]).unwrap_or(0) > 0)
+    {
         let cheapest = (0..groups.len())
             .filter_map(|i| trained(&groups[i]).filter(|&it| it > 0).map(|it| (it, i)))
             .min();
@@ -111,7 +127,12 @@ fn differences(committed: &Manifest, rerun: &Manifest) -> Vec<String> {
     out
 }
 
-pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result<()> {
+pub(crate) fn verify(
+    results: &Path,
+    profile: Option<&Path>,
+    n: usize,
+    networks: Networks,
+) -> Result<()> {
     if n == 0 {
         bail!("--sample must be at least 1");
     }
@@ -159,7 +180,14 @@ pub(crate) fn verify(results: &Path, profile: Option<&Path>, n: usize) -> Result
         );
     }
     let of_version = runs.len();
-    let picks = sample(runs, n);
+    let picks = sample(runs, n, networks);
+    if picks.is_empty() {
+        bail!(
+            "{}: every condition of its {of_version} runs of version {RESULTS_VERSION} trains a \
+             network, and --without-networks leaves none to rerun",
+            results.display()
+        );
+    }
     outln!(
         "{}: {checked} runs match their recorded digests ({older} of an older results version); \
          rerunning {} of the {of_version} of version {RESULTS_VERSION} (at most one per condition)",
