@@ -174,8 +174,8 @@ pub enum Finding {
 #[serde(deny_unknown_fields)]
 pub struct Premise {
     /// The repetition's network of this learner is disentangled: it has an active latent that
-    /// encodes only the controllable object and one that encodes only the distractor
-    /// (ArmBalls).
+    /// encodes only the controllable object, one that encodes only the distractor, and none
+    /// that encodes both (ArmBalls).
     #[serde(default)]
     pub disentangled: Option<String>,
     /// The repetition's network of this learner is the entangled control: its code holds both

@@ -435,8 +435,9 @@ pub(super) fn active_roles(kl: &[f64], ball: &[f64], distractor: &[f64]) -> Vec<
 /// each latent variable is sensitive to a single degree of freedom" (its abstract): one of its
 /// active latents ([`active_roles`]) encodes the ball alone, another the distractor alone, and
 /// none encodes both. An active latent of both objects entangles the modules that hold it (a
-/// plain VAE can have a ball-only and a distractor-only latent beside six of both).
-pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> bool {
+/// plain VAE can have an active ball-only and an active distractor-only latent beside four or
+/// five active latents of both).
+fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> bool {
     let roles = active_roles(kl, ball, distractor);
     roles.contains(&LatentRole::Ball)
         && roles.contains(&LatentRole::Distractor)
@@ -445,7 +446,7 @@ pub(super) fn is_disentangled(kl: &[f64], ball: &[f64], distractor: &[f64]) -> b
 
 /// Whether a network's whole code holds both objects: the held-out k-NN R² of each object's
 /// position at least [`ENCODES`] (None: not measured, so not).
-pub(super) fn holds_both(knn_ball: Option<f64>, knn_distractor: Option<f64>) -> bool {
+fn holds_both(knn_ball: Option<f64>, knn_distractor: Option<f64>) -> bool {
     knn_ball.is_some_and(|b| b >= ENCODES) && knn_distractor.is_some_and(|d| d >= ENCODES)
 }
 
