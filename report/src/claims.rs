@@ -474,7 +474,7 @@ impl Statistic {
             Statistic::MovedKlc => "final KLC of the episodes that moved the object",
             Statistic::GoalError => "goal-reaching error (mean)",
             Statistic::GoalErrorP90 => "goal-reaching error (90th percentile)",
-            Statistic::BallRatio => "final exploration ratio of the ball",
+            Statistic::BallRatio => "exploration ratio of the ball",
             Statistic::BallModuleGoals => "share of goals in the ball's module",
         }
     }

@@ -50,7 +50,7 @@ fn name(runs: &[FollowupRun], k: &ConditionKey) -> String {
 
 impl FollowupObservations<'_> {
     /// The authors' curves, where some of our runs are of their environment.
-    fn comparable_authors(&self) -> Option<&Authors> {
+    pub(super) fn comparable_authors(&self) -> Option<&Authors> {
         self.authors
             .filter(|a| self.runs.iter().any(|r| r.key.env == a.env))
     }

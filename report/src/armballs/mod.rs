@@ -52,6 +52,10 @@ pub enum FollowupClaims<'a> {
         path: &'a Path,
         confidence: f64,
         results: Vec<ClaimResult>,
+        /// Where the ball's ratio is read when some runs are of the authors' environment: our
+        /// last evaluation at or before their last point, these rollouts (None: the last
+        /// epoch).
+        ratio_at: Option<i64>,
     },
     /// No claims file where the report looked.
     Missing(&'a Path),
@@ -94,6 +98,7 @@ pub fn render(
             path: &path,
             confidence: file.settings.confidence,
             results,
+            ratio_at: obs.comparable_authors().map(|a| a.last_rollouts),
         }
     } else {
         FollowupClaims::Missing(&path)
@@ -165,6 +170,31 @@ mod tests {
             "no authors' curve"
         );
         assert!(text.contains("Thin lines: the authors"));
+    }
+
+    /// The claims' section says where the ball's ratio is read: at the authors' last point
+    /// where some runs are of their environment, else at the last epoch.
+    #[test]
+    fn the_claims_say_where_the_ratio_is_read() {
+        let campaign = empty_campaign("followup");
+        let r = run("rpe", "none", 0, 0, 0.2);
+        let page_at = |ratio_at| {
+            let claims = FollowupClaims::Evaluated {
+                path: Path::new("claims.toml"),
+                confidence: 0.95,
+                results: Vec::new(),
+                ratio_at,
+            };
+            page::write(&campaign, &[], std::slice::from_ref(&r), &[], &claims).0
+        };
+        let page = page_at(Some(9666));
+        assert!(page.contains("their last point (9666 rollouts)"), "{page}");
+        let page = page_at(None);
+        assert!(!page.contains("their last point"), "{page}");
+        assert!(
+            page.contains("exploration ratio and the goal-reaching error are read at the last"),
+            "{page}"
+        );
     }
 
     /// The disentanglement table gives MIG, SAP and the active latents with their kinds where

@@ -349,8 +349,20 @@ pub(super) fn write(
             path,
             confidence,
             results,
+            ratio_at,
         } => {
             let (yes, no, open, premise, not_run) = claims::counts(results);
+            let read_at = match ratio_at {
+                Some(at) => format!(
+                    " In the authors' ArmBalls the ball's exploration ratio is read at our last \
+                     evaluation at or before their last point ({at} rollouts), where their \
+                     curves end, so the claims' means sit a little below the final values of \
+                     the table above; the goal-reaching error is read at the last epoch."
+                ),
+                None => " The ball's exploration ratio and the goal-reaching error are read at \
+                         the last epoch."
+                    .into(),
+            };
             let not_run = if not_run > 0 {
                 format!(", {not_run} not run (their conditions are not in these results)")
             } else {
@@ -361,7 +373,7 @@ pub(super) fn write(
                     "The follow-up's text gives no number we could read \
                      (`docs/followup-paper-sources.md` section 5), so each claim is formalised \
                      here (our choice, `{}`, explained in `docs/armballs.md`) and evaluated by \
-                     the same engine as the paper's claims. {} **Premise not met** when the \
+                     the same engine as the paper's claims.{read_at} {} **Premise not met** when the \
                      claim is about a disentangled space (or the entangled control) and no \
                      repetition's network here is one. Of {} \
                      claims: {yes} reproduced, {no} not reproduced, {open} inconclusive, \
