@@ -8,7 +8,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
 use ugl_bench::env::cdge::{VALUES, normalise, render_rgb};
 use ugl_bench::repr::conv_net::{ConvArch, ConvInit, ConvNet};
@@ -48,6 +48,10 @@ fn bench(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("conv_step");
     g.sample_size(10);
+    // Criterion's "elem/s" are FLOP/s (`ConvArch::step_flops`).
+    g.throughput(Throughput::Elements(
+        ConvArch::followup(10).step_flops(BATCH),
+    ));
     g.warm_up_time(Duration::from_secs(2));
     g.measurement_time(Duration::from_secs(8));
     let mut rng = stream_named(1, "learner");

@@ -2,7 +2,7 @@
 //! transposed ones, 64x64 RGB, batch 64), forward and backward: what `scripts/conv_side_by_side.sh`
 //! times against PyTorch's same layers.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use ugl_kernels::{Conv2d, ConvTranspose2d};
 
@@ -51,6 +51,7 @@ struct Ops {
 /// A layer of the stack: a convolution or a transposed one (the same calls).
 trait Layer {
     fn lens(&self) -> (usize, usize, usize, usize);
+    fn flop(&self) -> u64;
     fn fwd(&self, x: &[f32], w: &[f32], y: &mut [f32]);
     fn bwd_input(&self, dy: &[f32], w: &[f32], dx: &mut [f32]);
     fn bwd_weight(&self, x: &[f32], dy: &[f32], dw: &mut [f32], db: &mut [f32]);
@@ -66,6 +67,9 @@ macro_rules! layer {
                     self.weight_len(),
                     self.channels_out,
                 )
+            }
+            fn flop(&self) -> u64 {
+                self.flops(BATCH)
             }
             fn fwd(&self, x: &[f32], w: &[f32], y: &mut [f32]) {
                 self.forward(BATCH, x, w, None, y)
@@ -150,7 +154,13 @@ fn bench(c: &mut Criterion) {
         input: false,
         weight: false,
     };
+    // Throughput in floating-point operations (criterion's "elem/s" are FLOP/s): one pass over
+    // the stack, forward or a gradient, does `pass` of them.
+    let pass: u64 =
+        enc.iter().map(Layer::flop).sum::<u64>() + dec.iter().map(Layer::flop).sum::<u64>();
+    g.throughput(Throughput::Elements(3 * pass));
     g.bench_function("encoder_decoder_forward_backward", |b| b.iter(|| run(all)));
+    g.throughput(Throughput::Elements(pass));
     // Each operation alone, over the whole stack (where the time goes).
     for (name, ops) in [
         (

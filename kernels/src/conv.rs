@@ -77,6 +77,13 @@ impl Conv2d {
         self.channels_out * self.patch()
     }
 
+    /// Floating-point operations of the forward pass on `n` images, a multiply and an add per
+    /// weight and output pixel (`2 out in k² pixels n`, biases left out). The input gradient
+    /// and the weight gradient each do as many.
+    pub fn flops(&self, n: usize) -> u64 {
+        2 * (self.weight_len() * self.pixels_out() * n) as u64
+    }
+
     /// Rows of the `im2col` matrix: `in * k * k`.
     fn patch(&self) -> usize {
         self.channels_in * self.kernel * self.kernel
@@ -477,6 +484,12 @@ impl ConvTranspose2d {
     /// Values of the weight, `[in, out, k, k]`.
     pub fn weight_len(&self) -> usize {
         self.channels_in * self.channels_out * self.kernel * self.kernel
+    }
+
+    /// Floating-point operations of the forward pass on `n` images (its adjoint's,
+    /// [`Conv2d::flops`]); each gradient does as many.
+    pub fn flops(&self, n: usize) -> u64 {
+        self.adjoint().flops(n)
     }
 
     /// The convolution whose adjoint this is: from this output's shape to this input's, with the

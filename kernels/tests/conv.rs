@@ -331,3 +331,30 @@ fn the_outputs_and_weight_gradients_are_the_documented_chains() {
         }
     }
 }
+
+/// The operation counts the benches report throughput with: the follow-up's first encoder
+/// layer (3 -> 32 channels, 64 -> 32 pixels a side) does 32 x 3 x 16 multiply-adds for each of
+/// its 32 x 32 outputs per image, and the decoder's last (its adjoint) as many.
+#[test]
+fn the_operation_count_is_two_per_multiply_add() {
+    let first = Conv2d {
+        channels_in: 3,
+        channels_out: 32,
+        kernel: 4,
+        stride: 2,
+        padding: 1,
+        height: 64,
+        width: 64,
+    };
+    assert_eq!(first.flops(64), 2 * 32 * 3 * 16 * 32 * 32 * 64);
+    let last = ConvTranspose2d {
+        channels_in: 32,
+        channels_out: 3,
+        kernel: 4,
+        stride: 2,
+        padding: 1,
+        height: 32,
+        width: 32,
+    };
+    assert_eq!(last.flops(64), first.flops(64));
+}

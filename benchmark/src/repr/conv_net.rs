@@ -134,6 +134,21 @@ impl ConvArch {
         }
     }
 
+    /// Floating-point operations of one training step on `batch` pictures, two per
+    /// multiply-add: every layer's forward pass, weight gradient and input gradient, but the
+    /// first convolution's input gradient (its input is the picture). Biases, activations, the
+    /// loss and Adam's update are left out (under 1% of it). The yardstick of the speed
+    /// measurements against the machine's FMA ceiling (`docs/neural.md`).
+    pub fn step_flops(&self, batch: usize) -> u64 {
+        let convs: u64 = (0..CONV_LAYERS)
+            .map(|i| 3 * (self.conv(i).flops(batch) + self.deconv(i).flops(batch)))
+            .sum::<u64>()
+            - self.conv(0).flops(batch);
+        let (flat, hidden, d) = (self.flat(), self.hidden, self.latents);
+        let dense = flat * hidden + hidden * hidden + hidden * 2 * d + d * hidden + hidden * flat;
+        convs + (6 * dense * batch) as u64
+    }
+
     /// The shape of decoder transposed convolution `i` (the last one: the picture's).
     pub fn deconv(&self, i: usize) -> ConvTranspose2d {
         let side = self.bottom_side() << i;
@@ -475,6 +490,16 @@ pub(super) struct DecoderActivations {
 mod tests {
     use super::*;
     use crate::seed::stream_named;
+
+    /// The follow-up's step at batch 64, counted by hand: the eight convolutions do
+    /// 28,311,552 operations per picture forward (3,145,728 + 8,388,608 + 2,097,152 + 524,288
+    /// each way), as many for the weight gradients and for the input gradients but the first
+    /// layer's; the dense layers 335,360 multiply-adds per pass.
+    #[test]
+    fn a_steps_operations_are_counted_layer_by_layer() {
+        let per_picture: u64 = 3 * 28_311_552 - 3_145_728 + 6 * 335_360;
+        assert_eq!(ConvArch::followup(10).step_flops(64), 64 * per_picture);
+    }
 
     #[test]
     fn the_followups_network_has_its_authors_shapes() {
