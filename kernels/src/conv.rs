@@ -15,6 +15,7 @@
 //! output gradient exchanged. The weights keep PyTorch's layouts: `[out, in, k, k]` for a
 //! convolution, `[in, out, k, k]` for a transposed one.
 
+use crate::conv_direct;
 use crate::matmul::{MatRef, matmul_on};
 use crate::path::{SimdPath, active_path};
 use rayon::prelude::*;
@@ -262,7 +263,26 @@ impl Conv2d {
         if n == 0 {
             return;
         }
+        let start = |out: &mut [f32]| match b {
+            Some(b) => {
+                for (row, bias) in out.chunks_exact_mut(pix).zip(b) {
+                    row.fill(*bias);
+                }
+            }
+            None => out.fill(0.0),
+        };
         // Image by image, in parallel: every output a chain over (c, ky, kx) from its bias.
+        if conv_direct::forward_applies(self, path) {
+            // The follow-up's shape on a SIMD path: the same chains without the im2col matrix.
+            let packed = conv_direct::pack_forward_weights(self, path, w);
+            y.par_chunks_mut(self.out_len())
+                .zip(x.par_chunks(self.in_len()))
+                .for_each_init(Vec::new, |phases, (out, img)| {
+                    start(out);
+                    conv_direct::forward_image(self, path, img, &packed, phases, out);
+                });
+            return;
+        }
         let wm = MatRef::row_major(w, co, patch);
         y.par_chunks_mut(self.out_len())
             .zip(x.par_chunks(self.in_len()))
@@ -272,14 +292,7 @@ impl Conv2d {
                     for (r, row) in cols.chunks_exact_mut(pix).enumerate() {
                         self.im2col_row(img, r, row);
                     }
-                    match b {
-                        Some(b) => {
-                            for (row, bias) in out.chunks_exact_mut(pix).zip(b) {
-                                row.fill(*bias);
-                            }
-                        }
-                        None => out.fill(0.0),
-                    }
+                    start(out);
                     matmul_on(path, out, wm, MatRef::row_major(cols, patch, pix), true);
                 },
             );
@@ -307,10 +320,24 @@ impl Conv2d {
         );
         assert_eq!(w.len(), self.weight_len(), "conv2d: weight length");
         assert_eq!(dx.len(), n * self.in_len(), "conv2d: input-gradient length");
-        dx.fill(0.0);
         if n == 0 {
             return;
         }
+        if conv_direct::input_applies(self, path) {
+            // The follow-up's shape on a SIMD path: the same chains and sums without the
+            // im2col-shaped matrix and its scatter.
+            let packed = conv_direct::pack_input_weights(self, path, w);
+            dx.par_chunks_mut(self.in_len())
+                .zip(dy.par_chunks(self.out_len()))
+                .for_each_init(
+                    || (Vec::new(), Vec::new()),
+                    |(padded, sums), (d, g)| {
+                        conv_direct::input_image(self, path, g, &packed, padded, sums, d);
+                    },
+                );
+            return;
+        }
+        dx.fill(0.0);
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
         // Image by image, in parallel: every value a chain over the output channels.
         let wt = MatRef::row_major(w, co, patch).t();

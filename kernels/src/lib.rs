@@ -5,6 +5,7 @@
 //! work with subnormal numbers flushed to zero, by x86-64 rules that every path obeys alike.
 
 mod conv;
+mod conv_direct;
 mod eigen;
 mod flush;
 mod matmul;

@@ -11,8 +11,10 @@ fn random(n: usize, seed: u64) -> Vec<f32> {
 }
 
 /// The follow-up's first encoder layer, a decoder-sized one, and odd shapes (no padding, stride
-/// 1, a kernel that does not tile the image).
-const SHAPES: [Conv2d; 4] = [
+/// 1, a kernel that does not tile the image), then the follow-up's second and third encoder
+/// layers (their outputs 16 and 8 pixels wide: the direct kernels of the SIMD paths, or the
+/// im2col product where a row is narrower than a vector).
+const SHAPES: [Conv2d; 6] = [
     Conv2d {
         channels_in: 3,
         channels_out: 32,
@@ -48,6 +50,24 @@ const SHAPES: [Conv2d; 4] = [
         padding: 2,
         height: 11,
         width: 9,
+    },
+    Conv2d {
+        channels_in: 32,
+        channels_out: 32,
+        kernel: 4,
+        stride: 2,
+        padding: 1,
+        height: 32,
+        width: 32,
+    },
+    Conv2d {
+        channels_in: 32,
+        channels_out: 32,
+        kernel: 4,
+        stride: 2,
+        padding: 1,
+        height: 16,
+        width: 16,
     },
 ];
 

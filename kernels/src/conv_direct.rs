@@ -1,0 +1,561 @@
+//! Direct kernels for the follow-up's convolution shape (kernel 4, stride 2, padding 1, even
+//! sides) on the SIMD paths: the same fused multiply-add chains as the `im2col` products of
+//! [`crate::conv`], in the same order, so the same bits, without building the `im2col` matrix
+//! (`kernels/tests/conv.rs` compares both on every path).
+//!
+//! Forward: output `(o, oy, ox)` is the chain over `(c, ky, kx)` of `w[o, c, ky, kx]` times the
+//! input at `(c, 2 oy + ky - 1, 2 ox + kx - 1)` (0 in the padding), from the bias. The input is
+//! first split by column parity into a padded layout ([`Phases`]) in which the inputs of
+//! consecutive output columns for one `(c, ky, kx)` are consecutive values: one vector load. A
+//! tile of `MR` output channels by `NV` vectors of `LANES` output pixels then runs its chains
+//! with one broadcast weight per channel and one load per vector, step after step.
+
+use crate::conv::Conv2d;
+use crate::path::SimdPath;
+
+/// The kernel side, stride and padding the direct kernels are written for.
+const KERNEL: usize = 4;
+const STRIDE: usize = 2;
+const PADDING: usize = 1;
+
+/// A path's forward tile: `MR` output channels by `NV` vectors of `LANES` pixels.
+#[derive(Clone, Copy)]
+struct Tile {
+    mr: usize,
+    nv: usize,
+    lanes: usize,
+}
+
+/// The forward tile of a SIMD path (None: the scalar path, which keeps the `im2col` product).
+fn forward_tile(path: SimdPath) -> Option<Tile> {
+    match path {
+        SimdPath::Scalar => None,
+        SimdPath::Avx2 => Some(Tile {
+            mr: 4,
+            nv: 2,
+            lanes: 8,
+        }),
+        SimdPath::Avx512 => Some(Tile {
+            mr: 4,
+            nv: 4,
+            lanes: 16,
+        }),
+    }
+}
+
+/// The padded, parity-split layout of one image: `[c][row + 1][parity][j]` for rows `-1..=H`
+/// and `j` in `0..=W/2`, holding the input at `(c, row, 2 j + parity - 1)` (0 outside the
+/// image). The input under kernel position `(ky, kx)` for output `(oy, ox)` is at row
+/// `2 oy + ky`, parity `kx % 2`, `j = ox + kx / 2` of the padded rows.
+struct Phases {
+    /// Values of one channel.
+    channel: usize,
+    /// Values of one padded row (both parities).
+    row: usize,
+    /// Values of one parity of a row.
+    parity: usize,
+}
+
+impl Phases {
+    fn of(conv: &Conv2d) -> Phases {
+        let parity = conv.width / 2 + 1;
+        let row = 2 * parity;
+        Phases {
+            channel: (conv.height + 2) * row,
+            row,
+            parity,
+        }
+    }
+
+    /// Writes image `img` (`[c][y][x]`) into `out` (`channels_in * channel` values).
+    fn fill(&self, conv: &Conv2d, img: &[f32], out: &mut [f32]) {
+        out.fill(0.0);
+        let (h, w) = (conv.height, conv.width);
+        for c in 0..conv.channels_in {
+            for y in 0..h {
+                let src = &img[(c * h + y) * w..][..w];
+                let dst = &mut out[c * self.channel + (y + 1) * self.row..][..self.row];
+                let (even, odd) = dst.split_at_mut(self.parity);
+                // Input column x is padded column x + 1: odd x to parity 0 at (x + 1) / 2, even
+                // x to parity 1 at x / 2.
+                for (j, pair) in src.chunks_exact(2).enumerate() {
+                    odd[j] = pair[0];
+                    even[j + 1] = pair[1];
+                }
+            }
+        }
+    }
+}
+
+/// Whether the direct forward kernel of `path` computes this convolution.
+pub(crate) fn forward_applies(conv: &Conv2d, path: SimdPath) -> bool {
+    let Some(t) = forward_tile(path) else {
+        return false;
+    };
+    let ow = conv.out_width();
+    conv.kernel == KERNEL
+        && conv.stride == STRIDE
+        && conv.padding == PADDING
+        && conv.height.is_multiple_of(2)
+        && conv.width.is_multiple_of(2)
+        && ow.is_multiple_of(t.lanes)
+        && conv.channels_out.is_multiple_of(t.mr)
+        && (conv.out_height() * ow / t.lanes).is_multiple_of(t.nv)
+}
+
+/// The weights `[out, in, k, k]` packed for the forward tiles: block `b` of `MR` output
+/// channels holds, for every `(c, ky, kx)` in order, the `MR` weights of its channels.
+pub(crate) fn pack_forward_weights(conv: &Conv2d, path: SimdPath, w: &[f32]) -> Vec<f32> {
+    let t = forward_tile(path).expect("a SIMD path");
+    let patch = conv.channels_in * KERNEL * KERNEL;
+    let mut out = Vec::with_capacity(w.len());
+    for o0 in (0..conv.channels_out).step_by(t.mr) {
+        for r in 0..patch {
+            for i in 0..t.mr {
+                out.push(w[(o0 + i) * patch + r]);
+            }
+        }
+    }
+    out
+}
+
+/// The forward pass of one image: `out` (`[o][oy][ox]`, holding the bias or 0) gets every
+/// chain; `phases` is scratch for [`Phases`]. Only where [`forward_applies`].
+pub(crate) fn forward_image(
+    conv: &Conv2d,
+    path: SimdPath,
+    img: &[f32],
+    packed: &[f32],
+    phases: &mut Vec<f32>,
+    out: &mut [f32],
+) {
+    let t = forward_tile(path).expect("a SIMD path");
+    let layout = Phases::of(conv);
+    phases.resize(conv.channels_in * layout.channel, 0.0);
+    layout.fill(conv, img, phases);
+    let (oh, ow) = (conv.out_height(), conv.out_width());
+    let pix = oh * ow;
+    let steps = conv.channels_in * KERNEL * KERNEL;
+    let vectors = pix / t.lanes;
+    for (b, o0) in (0..conv.channels_out).step_by(t.mr).enumerate() {
+        let wp = &packed[b * steps * t.mr..][..steps * t.mr];
+        for q0 in (0..vectors).step_by(t.nv) {
+            // Vector q: output row q * lanes / ow, columns from q * lanes % ow.
+            let at = |v: usize| {
+                let p = (q0 + v) * t.lanes;
+                (p / ow, p % ow)
+            };
+            let xs: [usize; 4] = std::array::from_fn(|v| {
+                let (oy, ox) = at(v.min(t.nv - 1));
+                2 * oy * layout.row + ox
+            });
+            let outs: [usize; 4] = std::array::from_fn(|v| {
+                let (oy, ox) = at(v.min(t.nv - 1));
+                o0 * pix + oy * ow + ox
+            });
+            // Every read and write of the tile inside its slice.
+            let last_read = (conv.channels_in - 1) * layout.channel
+                + (KERNEL - 1) * layout.row
+                + layout.parity
+                + 1
+                + t.lanes;
+            assert!(
+                wp.len() == steps * t.mr
+                    && (0..t.nv).all(|v| xs[v] + last_read <= phases.len())
+                    && (0..t.nv).all(|v| outs[v] + (t.mr - 1) * pix + t.lanes <= out.len()),
+                "conv2d: a direct tile outside its buffers: {conv:?}"
+            );
+            let args = ForwardArgs {
+                channels: conv.channels_in,
+                channel: layout.channel,
+                row: layout.row,
+                parity: layout.parity,
+                pix,
+            };
+            match path {
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the CPU runs the path (the caller checked); every offset lies inside
+                // `phases`, `wp` and `out` (the tile is inside the image, `forward_applies`).
+                SimdPath::Avx512 => unsafe { forward_avx512(&args, phases, &xs, wp, out, &outs) },
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: as above.
+                SimdPath::Avx2 => unsafe { forward_avx2(&args, phases, &xs, wp, out, &outs) },
+                _ => unreachable!("no direct kernel on the {path} path"),
+            }
+        }
+    }
+}
+
+/// The sizes a forward tile walks with.
+struct ForwardArgs {
+    channels: usize,
+    channel: usize,
+    row: usize,
+    parity: usize,
+    pix: usize,
+}
+
+#[cfg(target_arch = "x86_64")]
+macro_rules! forward_kernel {
+    ($name:ident, $feature:literal, $mr:literal, $nv:literal, $lanes:literal,
+     $zero:ident, $load:ident, $store:ident, $set1:ident, $fma:ident) => {
+        /// One tile of the forward pass: `$mr` output channels by `$nv` vectors.
+        ///
+        /// # Safety
+        /// On a CPU with the target feature; the tile's reads and writes inside the slices.
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            a: &ForwardArgs,
+            phases: &[f32],
+            xs: &[usize; 4],
+            wp: &[f32],
+            out: &mut [f32],
+            outs: &[usize; 4],
+        ) {
+            use std::arch::x86_64::*;
+            debug_assert_eq!(wp.len(), a.channels * KERNEL * KERNEL * $mr);
+            let xp = phases.as_ptr();
+            let op = out.as_mut_ptr();
+            let mut acc = [[$zero(); $nv]; $mr];
+            for i in 0..$mr {
+                for v in 0..$nv {
+                    // SAFETY: inside the image's output (the caller).
+                    acc[i][v] = unsafe { $load(op.add(outs[v] + i * a.pix)) };
+                }
+            }
+            // The four kernel columns: parity kx % 2, shift kx / 2.
+            let cols = [0, a.parity, 1, a.parity + 1];
+            let mut w = wp.as_ptr();
+            for c in 0..a.channels {
+                for ky in 0..KERNEL {
+                    let base = c * a.channel + ky * a.row;
+                    for col in cols {
+                        let mut x = [$zero(); $nv];
+                        for v in 0..$nv {
+                            // SAFETY: inside `phases` (the caller).
+                            x[v] = unsafe { $load(xp.add(xs[v] + base + col)) };
+                        }
+                        for i in 0..$mr {
+                            // SAFETY: `wp` holds a weight per channel and step.
+                            let wi = $set1(unsafe { *w.add(i) });
+                            for v in 0..$nv {
+                                acc[i][v] = $fma(wi, x[v], acc[i][v]);
+                            }
+                        }
+                        // SAFETY: the next step's weights (or one past the end).
+                        w = unsafe { w.add($mr) };
+                    }
+                }
+            }
+            for i in 0..$mr {
+                for v in 0..$nv {
+                    // SAFETY: as the loads.
+                    unsafe { $store(op.add(outs[v] + i * a.pix), acc[i][v]) };
+                }
+            }
+        }
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+forward_kernel!(
+    forward_avx512,
+    "avx512f",
+    4,
+    4,
+    16,
+    _mm512_setzero_ps,
+    _mm512_loadu_ps,
+    _mm512_storeu_ps,
+    _mm512_set1_ps,
+    _mm512_fmadd_ps
+);
+#[cfg(target_arch = "x86_64")]
+forward_kernel!(
+    forward_avx2,
+    "avx2,fma",
+    4,
+    2,
+    8,
+    _mm256_setzero_ps,
+    _mm256_loadu_ps,
+    _mm256_storeu_ps,
+    _mm256_set1_ps,
+    _mm256_fmadd_ps
+);
+
+/// The channel tile of the input gradient on `path` for `channels` input channels: the largest
+/// of 4, 3 and 1 that divides it (the follow-up's RGB decoder layer has 3).
+fn input_tile(path: SimdPath, channels: usize) -> Option<Tile> {
+    let (nv, lanes) = match path {
+        SimdPath::Scalar => return None,
+        SimdPath::Avx2 => (2, 8),
+        SimdPath::Avx512 => (4, 16),
+    };
+    let mr = [4, 3, 1]
+        .into_iter()
+        .find(|m| channels.is_multiple_of(*m))
+        .expect("1 divides");
+    Some(Tile { mr, nv, lanes })
+}
+
+/// Whether the direct input-gradient kernel of `path` computes this convolution's input
+/// gradient (the transposed convolution's forward pass).
+pub(crate) fn input_applies(conv: &Conv2d, path: SimdPath) -> bool {
+    let Some(t) = input_tile(path, conv.channels_in) else {
+        return false;
+    };
+    let ow = conv.out_width();
+    conv.kernel == KERNEL
+        && conv.stride == STRIDE
+        && conv.padding == PADDING
+        && conv.height.is_multiple_of(2)
+        && conv.width.is_multiple_of(2)
+        && ow.is_multiple_of(t.lanes)
+        && (conv.out_height() * ow / t.lanes).is_multiple_of(t.nv)
+}
+
+/// The weights `[out, in, k, k]` packed for the input-gradient tiles: block `b` of `MR` input
+/// channels holds, for every `(ky, kx)` and then every output channel `o` in order, the `MR`
+/// weights of its channels.
+pub(crate) fn pack_input_weights(conv: &Conv2d, path: SimdPath, w: &[f32]) -> Vec<f32> {
+    let t = input_tile(path, conv.channels_in).expect("a SIMD path");
+    let k2 = KERNEL * KERNEL;
+    let mut out = Vec::with_capacity(w.len());
+    for c0 in (0..conv.channels_in).step_by(t.mr) {
+        for r in 0..k2 {
+            for o in 0..conv.channels_out {
+                for i in 0..t.mr {
+                    out.push(w[(o * conv.channels_in + c0 + i) * k2 + r]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The kernel rows (or columns) that reach output row (column) parity `q`, in increasing
+/// order: an even output row `2 i` is reached by kernel rows 1 and 3, an odd one by 0 and 2.
+fn taps(q: usize) -> [usize; 2] {
+    if q == 0 { [1, 3] } else { [0, 2] }
+}
+
+/// The input gradient of one image, `dx` (`[c][y][x]`, overwritten), from its output gradient
+/// `dy` (`[o][oy][ox]`): for every input value, the terms of the kernel positions that reach
+/// it, in increasing `(ky, kx)`, each one chain over the output channels from 0, added from 0
+/// (what the im2col product and its `col2im` scatter compute). `padded` and `sums` are
+/// scratch. Only where [`input_applies`].
+pub(crate) fn input_image(
+    conv: &Conv2d,
+    path: SimdPath,
+    dy: &[f32],
+    packed: &[f32],
+    padded: &mut Vec<f32>,
+    sums: &mut Vec<f32>,
+    dx: &mut [f32],
+) {
+    let t = input_tile(path, conv.channels_in).expect("a SIMD path");
+    let (oh, ow, co) = (conv.out_height(), conv.out_width(), conv.channels_out);
+    let (h, w) = (conv.height, conv.width);
+    // The output gradient with a border of zeros: a kernel position past the edge reads 0 and
+    // adds +0, which changes no sum (a sum from +0 is never -0).
+    let prow = ow + 2;
+    let plane = (oh + 2) * prow;
+    padded.clear();
+    padded.resize(co * plane, 0.0);
+    for o in 0..co {
+        for oy in 0..oh {
+            padded[o * plane + (oy + 1) * prow + 1..][..ow]
+                .copy_from_slice(&dy[(o * oh + oy) * ow..][..ow]);
+        }
+    }
+    // The sums by column parity: [c][y][parity][j] for x = 2 j + parity.
+    let cstride = h * w;
+    sums.clear();
+    sums.resize(conv.channels_in * cstride, 0.0);
+    let per_row = ow / t.lanes;
+    let vectors = oh * per_row;
+    for (b, c0) in (0..conv.channels_in).step_by(t.mr).enumerate() {
+        for q in 0..2 {
+            for p in 0..2 {
+                for g0 in (0..vectors).step_by(t.nv) {
+                    // Vector g: row pair i = g / per_row (output row 2 i + q), columns
+                    // j0 = (g % per_row) * lanes.
+                    let at = |v: usize| {
+                        let g = g0 + v.min(t.nv - 1);
+                        (g / per_row, (g % per_row) * t.lanes)
+                    };
+                    let sout: [usize; 4] = std::array::from_fn(|v| {
+                        let (i, j0) = at(v);
+                        c0 * cstride + (2 * i + q) * w + p * ow + j0
+                    });
+                    for ky in taps(q) {
+                        for kx in taps(p) {
+                            // dy's padded row and column for this kernel position.
+                            let (dr, dc) = ((q + 3 - ky) / 2, (p + 3 - kx) / 2);
+                            let dys: [usize; 4] = std::array::from_fn(|v| {
+                                let (i, j0) = at(v);
+                                (i + dr) * prow + j0 + dc
+                            });
+                            let r = ky * KERNEL + kx;
+                            let wp = &packed[(b * KERNEL * KERNEL + r) * co * t.mr..][..co * t.mr];
+                            assert!(
+                                (0..t.nv)
+                                    .all(|v| dys[v] + (co - 1) * plane + t.lanes <= padded.len()
+                                        && sout[v] + (t.mr - 1) * cstride + t.lanes <= sums.len()),
+                                "conv2d: a direct tile outside its buffers: {conv:?}"
+                            );
+                            let args = InputArgs {
+                                chain: co,
+                                plane,
+                                cstride,
+                            };
+                            input_tile_call(path, t.mr, &args, padded, &dys, wp, sums, &sout);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Interleave the parities back into rows.
+    for (row, out) in sums.chunks_exact(w).zip(dx.chunks_exact_mut(w)) {
+        let (even, odd) = row.split_at(ow);
+        for (pair, (e, o)) in out.chunks_exact_mut(2).zip(even.iter().zip(odd)) {
+            pair[0] = *e;
+            pair[1] = *o;
+        }
+    }
+}
+
+/// The sizes an input-gradient tile walks with.
+struct InputArgs {
+    /// Output channels: the chain's length.
+    chain: usize,
+    /// Values of one padded output-gradient channel.
+    plane: usize,
+    /// Values of one channel of the sums.
+    cstride: usize,
+}
+
+/// One input-gradient term of a tile of `mr` channels on `path`.
+#[allow(clippy::too_many_arguments)]
+fn input_tile_call(
+    path: SimdPath,
+    mr: usize,
+    a: &InputArgs,
+    padded: &[f32],
+    dys: &[usize; 4],
+    wp: &[f32],
+    sums: &mut [f32],
+    sout: &[usize; 4],
+) {
+    // SAFETY (every arm): the CPU runs the path (the caller checked `input_applies` on the
+    // active or a checked path) and the tile lies inside the slices (asserted by the caller).
+    match (path, mr) {
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 4) => unsafe { input_avx512_4(a, padded, dys, wp, sums, sout) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 3) => unsafe { input_avx512_3(a, padded, dys, wp, sums, sout) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 1) => unsafe { input_avx512_1(a, padded, dys, wp, sums, sout) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx2, 4) => unsafe { input_avx2_4(a, padded, dys, wp, sums, sout) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx2, 3) => unsafe { input_avx2_3(a, padded, dys, wp, sums, sout) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx2, 1) => unsafe { input_avx2_1(a, padded, dys, wp, sums, sout) },
+        _ => unreachable!("no direct kernel on the {path} path with {mr} channels"),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+macro_rules! input_kernel {
+    ($name:ident, $feature:literal, $mr:literal, $nv:literal, $lanes:literal,
+     $zero:ident, $load:ident, $store:ident, $set1:ident, $fma:ident, $add:ident) => {
+        /// One term of an input-gradient tile: `$mr` channels by `$nv` vectors, each a chain
+        /// over the output channels from 0, then added to its sum.
+        ///
+        /// # Safety
+        /// On a CPU with the target feature; the tile's reads and writes inside the slices.
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            a: &InputArgs,
+            padded: &[f32],
+            dys: &[usize; 4],
+            wp: &[f32],
+            sums: &mut [f32],
+            sout: &[usize; 4],
+        ) {
+            use std::arch::x86_64::*;
+            debug_assert_eq!(wp.len(), a.chain * $mr);
+            let dp = padded.as_ptr();
+            let sp = sums.as_mut_ptr();
+            let mut acc = [[$zero(); $nv]; $mr];
+            let mut w = wp.as_ptr();
+            for o in 0..a.chain {
+                let mut d = [$zero(); $nv];
+                for v in 0..$nv {
+                    // SAFETY: inside `padded` (the caller).
+                    d[v] = unsafe { $load(dp.add(dys[v] + o * a.plane)) };
+                }
+                for i in 0..$mr {
+                    // SAFETY: `wp` holds a weight per channel and chain step.
+                    let wi = $set1(unsafe { *w.add(i) });
+                    for v in 0..$nv {
+                        acc[i][v] = $fma(wi, d[v], acc[i][v]);
+                    }
+                }
+                // SAFETY: the next step's weights (or one past the end).
+                w = unsafe { w.add($mr) };
+            }
+            for i in 0..$mr {
+                for v in 0..$nv {
+                    // SAFETY: inside `sums` (the caller).
+                    unsafe {
+                        let s = sp.add(sout[v] + i * a.cstride);
+                        $store(s, $add($load(s), acc[i][v]));
+                    }
+                }
+            }
+        }
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+macro_rules! input_kernels {
+    ($feature:literal, $nv:literal, $lanes:literal, $zero:ident, $load:ident, $store:ident,
+     $set1:ident, $fma:ident, $add:ident, $($name:ident = $mr:literal),+) => {
+        $(input_kernel!($name, $feature, $mr, $nv, $lanes, $zero, $load, $store, $set1, $fma, $add);)+
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+input_kernels!(
+    "avx512f",
+    4,
+    16,
+    _mm512_setzero_ps,
+    _mm512_loadu_ps,
+    _mm512_storeu_ps,
+    _mm512_set1_ps,
+    _mm512_fmadd_ps,
+    _mm512_add_ps,
+    input_avx512_4 = 4,
+    input_avx512_3 = 3,
+    input_avx512_1 = 1
+);
+#[cfg(target_arch = "x86_64")]
+input_kernels!(
+    "avx2,fma",
+    2,
+    8,
+    _mm256_setzero_ps,
+    _mm256_loadu_ps,
+    _mm256_storeu_ps,
+    _mm256_set1_ps,
+    _mm256_fmadd_ps,
+    _mm256_add_ps,
+    input_avx2_4 = 4,
+    input_avx2_3 = 3,
+    input_avx2_1 = 1
+);
