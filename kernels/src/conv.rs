@@ -157,13 +157,22 @@ impl Conv2d {
         let (oh, ow) = (self.out_height(), self.out_width());
         let (h, w) = (self.height as isize, self.width as isize);
         let width = segs.len() * k;
+        let (c0, ky0) = (segs.start / k, segs.start % k);
         for oy in 0..oh {
             for ox in 0..ow {
                 let dst = &mut out[(oy * ow + ox) * width..][..width];
                 let x0 = (ox * s) as isize - p;
                 let inside = x0 >= 0 && x0 + k as isize <= w;
-                for (j, sg) in segs.clone().enumerate() {
-                    let (c, ky) = (sg / k, sg % k);
+                // Segment j is (c, ky), counted on from the first without a division.
+                let (mut c, mut ky) = (c0, ky0);
+                for j in 0..segs.len() {
+                    if j > 0 {
+                        ky += 1;
+                        if ky == k {
+                            ky = 0;
+                            c += 1;
+                        }
+                    }
                     let seg = &mut dst[j * k..][..k];
                     let y = (oy * s + ky) as isize - p;
                     if y < 0 || y >= h {
@@ -387,6 +396,36 @@ impl Conv2d {
             self.weight_len(),
             "conv2d: weight-gradient length"
         );
+        let (pix, co) = (self.pixels_out(), self.channels_out);
+        if n > 0 && conv_direct::weight_applies(self, path) {
+            // The follow-up's shape on a SIMD path: the same chains without the im2row matrices.
+            conv_direct::weight_gradient(self, path, n, x, dy, dw);
+        } else {
+            self.weight_gradient_by_products(path, n, x, dy, dw);
+        }
+        if let Some(db) = db {
+            assert_eq!(db.len(), co, "conv2d: bias-gradient length");
+            for (o, d) in db.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for img in dy.chunks_exact(self.out_len()) {
+                    for v in &img[o * pix..][..pix] {
+                        s += v;
+                    }
+                }
+                *d = s;
+            }
+        }
+    }
+
+    /// The weight gradient by `im2row` products (every shape and path).
+    fn weight_gradient_by_products(
+        &self,
+        path: SimdPath,
+        n: usize,
+        x: &[f32],
+        dy: &[f32],
+        dw: &mut [f32],
+    ) {
         let (patch, pix, co) = (self.patch(), self.pixels_out(), self.channels_out);
         // Every weight's gradient is one chain over (image, pixel): image after image, each
         // product continuing the chains where the previous one stored them. The threads share
@@ -427,18 +466,6 @@ impl Conv2d {
             let cols = local.len() / co;
             for (o, row) in local.chunks_exact(cols).enumerate() {
                 dw[o * patch + c0..][..cols].copy_from_slice(row);
-            }
-        }
-        if let Some(db) = db {
-            assert_eq!(db.len(), co, "conv2d: bias-gradient length");
-            for (o, d) in db.iter_mut().enumerate() {
-                let mut s = 0.0;
-                for img in dy.chunks_exact(self.out_len()) {
-                    for v in &img[o * pix..][..pix] {
-                        s += v;
-                    }
-                }
-                *d = s;
             }
         }
     }

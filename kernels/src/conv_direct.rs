@@ -559,3 +559,325 @@ input_kernels!(
     input_avx2_3 = 3,
     input_avx2_1 = 1
 );
+
+/// The weight-gradient tile of `path` for `channels` input channels: `MR` output channels by
+/// `NV` vectors, a vector holding `LANES` of one input channel's 16 kernel positions (AVX-512:
+/// all of them; AVX2: two kernel rows). `NV` is the largest of 3, 2 and 1 (AVX-512) or of 2 and
+/// 1 (AVX2) that divides the channel's vectors.
+fn weight_tile(path: SimdPath, channels: usize) -> Option<Tile> {
+    let (mr, lanes, nvs): (usize, usize, &[usize]) = match path {
+        SimdPath::Scalar => return None,
+        SimdPath::Avx2 => (4, 8, &[2, 1]),
+        SimdPath::Avx512 => (8, 16, &[3, 2, 1]),
+    };
+    let vectors = channels * KERNEL * KERNEL / lanes;
+    let nv = *nvs
+        .iter()
+        .find(|v| vectors.is_multiple_of(**v))
+        .expect("1 divides");
+    Some(Tile { mr, nv, lanes })
+}
+
+/// Whether the direct weight-gradient kernel of `path` computes this convolution's weight
+/// gradient.
+pub(crate) fn weight_applies(conv: &Conv2d, path: SimdPath) -> bool {
+    let Some(t) = weight_tile(path, conv.channels_in) else {
+        return false;
+    };
+    conv.kernel == KERNEL
+        && conv.stride == STRIDE
+        && conv.padding == PADDING
+        && conv.height.is_multiple_of(2)
+        && conv.width.is_multiple_of(2)
+        && conv.channels_out.is_multiple_of(t.mr)
+}
+
+/// The weight gradient `dw` (`[out, in, k, k]`, overwritten) of a batch of `n` images: every
+/// weight one chain from 0 over `(image, oy, ox)` in that order of the output gradient times
+/// the input under the weight (0 in the padding), what the `im2row` products compute. The
+/// threads share the weights (tiles of output channels by kernel-position vectors), never a
+/// chain. Only where [`weight_applies`].
+pub(crate) fn weight_gradient(
+    conv: &Conv2d,
+    path: SimdPath,
+    n: usize,
+    x: &[f32],
+    dy: &[f32],
+    dw: &mut [f32],
+) {
+    use rayon::prelude::*;
+    let t = weight_tile(path, conv.channels_in).expect("a SIMD path");
+    let (h, w, ci, co) = (conv.height, conv.width, conv.channels_in, conv.channels_out);
+    let pix = conv.out_height() * conv.out_width();
+    // The input with a border of zeros: [image][c][h + 2][w + 2].
+    let (prow, pplane) = (w + 2, (h + 2) * (w + 2));
+    let mut padded = vec![0.0f32; n * ci * pplane];
+    padded
+        .par_chunks_mut(ci * pplane)
+        .zip(x.par_chunks(ci * h * w))
+        .for_each(|(dst, img)| {
+            for c in 0..ci {
+                for y in 0..h {
+                    dst[c * pplane + (y + 1) * prow + 1..][..w]
+                        .copy_from_slice(&img[(c * h + y) * w..][..w]);
+                }
+            }
+        });
+    // The output gradient by blocks of MR channels, pixel-major: [block][image][pixel][MR].
+    let blocks = co / t.mr;
+    let mut dyt = vec![0.0f32; n * co * pix];
+    dyt.par_chunks_mut(n * pix * t.mr)
+        .enumerate()
+        .for_each(|(b, dst)| {
+            for i in 0..n {
+                for m in 0..t.mr {
+                    let src = &dy[(i * co + b * t.mr + m) * pix..][..pix];
+                    for (p, v) in src.iter().enumerate() {
+                        dst[(i * pix + p) * t.mr + m] = *v;
+                    }
+                }
+            }
+        });
+    let per_channel = KERNEL * KERNEL / t.lanes;
+    let vectors = ci * per_channel;
+    let tiles: Vec<(usize, usize)> = (0..blocks)
+        .flat_map(|b| (0..vectors).step_by(t.nv).map(move |u| (b, u)))
+        .collect();
+    let args = WeightArgs {
+        n,
+        oh: conv.out_height(),
+        ow: conv.out_width(),
+        image: ci * pplane,
+        prow,
+    };
+    let results: Vec<Vec<f32>> = tiles
+        .par_iter()
+        .map(|&(b, u0)| {
+            // Vector u: channel u / per_channel, kernel rows from (u % per_channel) * rows.
+            let rows = t.lanes / KERNEL;
+            let xs: [usize; 3] = std::array::from_fn(|v| {
+                let u = u0 + v.min(t.nv - 1);
+                (u / per_channel) * pplane + (u % per_channel) * rows * prow
+            });
+            let dys = &dyt[b * n * pix * t.mr..][..n * pix * t.mr];
+            let mut out = vec![0.0f32; t.mr * t.nv * t.lanes];
+            // The last read of the tile inside `padded`.
+            let last = (n - 1) * args.image
+                + xs[t.nv - 1]
+                + (rows - 1 + 2 * (args.oh - 1)) * prow
+                + 2 * (args.ow - 1)
+                + KERNEL;
+            assert!(
+                last <= padded.len(),
+                "conv2d: a direct tile outside its buffers: {conv:?}"
+            );
+            weight_tile_call(path, t.nv, &args, &padded, &xs, dys, &mut out);
+            out
+        })
+        .collect();
+    // out[i][v][lane] is the weight (o = b MR + i, u = u0 + v, lane): kernel position
+    // (u % per_channel) * lanes + lane of channel u / per_channel.
+    let k2 = KERNEL * KERNEL;
+    for (&(b, u0), out) in tiles.iter().zip(&results) {
+        for i in 0..t.mr {
+            for v in 0..t.nv {
+                let u = u0 + v;
+                let (c, first) = (u / per_channel, (u % per_channel) * t.lanes);
+                dw[((b * t.mr + i) * ci + c) * k2 + first..][..t.lanes]
+                    .copy_from_slice(&out[(i * t.nv + v) * t.lanes..][..t.lanes]);
+            }
+        }
+    }
+}
+
+/// The sizes a weight-gradient tile walks with.
+struct WeightArgs {
+    /// Images.
+    n: usize,
+    oh: usize,
+    ow: usize,
+    /// Values of one padded image.
+    image: usize,
+    /// Values of one padded row.
+    prow: usize,
+}
+
+/// One weight-gradient tile of `nv` vectors on `path`.
+fn weight_tile_call(
+    path: SimdPath,
+    nv: usize,
+    a: &WeightArgs,
+    padded: &[f32],
+    xs: &[usize; 3],
+    dys: &[f32],
+    out: &mut [f32],
+) {
+    // SAFETY (every arm): the CPU runs the path (the caller checked `weight_applies` on the
+    // active or a checked path) and the tile lies inside the slices (asserted by the caller).
+    match (path, nv) {
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 3) => unsafe { weight_avx512_3(a, padded, xs, dys, out) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 2) => unsafe { weight_avx512_2(a, padded, xs, dys, out) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx512, 1) => unsafe { weight_avx512_1(a, padded, xs, dys, out) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx2, 2) => unsafe { weight_avx2_2(a, padded, xs, dys, out) },
+        #[cfg(target_arch = "x86_64")]
+        (SimdPath::Avx2, 1) => unsafe { weight_avx2_1(a, padded, xs, dys, out) },
+        _ => unreachable!("no direct kernel on the {path} path with {nv} vectors"),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+macro_rules! weight_kernel {
+    ($name:ident, $feature:literal, $mr:literal, $nv:literal, $lanes:literal,
+     $zero:ident, $storeu:ident, $set1:ident, $fma:ident, $window:ident) => {
+        /// A weight-gradient tile: `$mr` output channels by `$nv` vectors of kernel positions,
+        /// each lane one chain over every image's pixels.
+        ///
+        /// # Safety
+        /// On a CPU with the target feature; the tile's reads inside the slices.
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            a: &WeightArgs,
+            padded: &[f32],
+            xs: &[usize; 3],
+            dys: &[f32],
+            out: &mut [f32],
+        ) {
+            use std::arch::x86_64::*;
+            let xp = padded.as_ptr();
+            let mut g = dys.as_ptr();
+            let mut acc = [[$zero(); $nv]; $mr];
+            for img in 0..a.n {
+                for oy in 0..a.oh {
+                    for ox in 0..a.ow {
+                        let at = img * a.image + 2 * oy * a.prow + 2 * ox;
+                        let mut win = [$zero(); $nv];
+                        for v in 0..$nv {
+                            // SAFETY: inside `padded` (the caller).
+                            win[v] = unsafe { $window(xp.add(at + xs[v]), a.prow) };
+                        }
+                        for i in 0..$mr {
+                            // SAFETY: `dys` holds MR values per pixel of every image.
+                            let gi = $set1(unsafe { *g.add(i) });
+                            for v in 0..$nv {
+                                acc[i][v] = $fma(gi, win[v], acc[i][v]);
+                            }
+                        }
+                        // SAFETY: the next pixel's values (or one past the end).
+                        g = unsafe { g.add($mr) };
+                    }
+                }
+            }
+            let op = out.as_mut_ptr();
+            for i in 0..$mr {
+                for v in 0..$nv {
+                    // SAFETY: `out` holds MR x NV vectors.
+                    unsafe { $storeu(op.add((i * $nv + v) * $lanes), acc[i][v]) };
+                }
+            }
+        }
+    };
+}
+
+/// Four rows of four values from `p` (row stride `stride`), as one vector.
+///
+/// # Safety
+/// On a CPU with AVX-512F; the four rows readable.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn window_avx512(p: *const f32, stride: usize) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's.
+    unsafe {
+        let v = _mm512_castps128_ps512(_mm_loadu_ps(p));
+        let v = _mm512_insertf32x4::<1>(v, _mm_loadu_ps(p.add(stride)));
+        let v = _mm512_insertf32x4::<2>(v, _mm_loadu_ps(p.add(2 * stride)));
+        _mm512_insertf32x4::<3>(v, _mm_loadu_ps(p.add(3 * stride)))
+    }
+}
+
+/// Two rows of four values from `p` (row stride `stride`), as one vector.
+///
+/// # Safety
+/// On a CPU with AVX2; the two rows readable.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn window_avx2(p: *const f32, stride: usize) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's.
+    unsafe {
+        let v = _mm256_castps128_ps256(_mm_loadu_ps(p));
+        _mm256_insertf128_ps::<1>(v, _mm_loadu_ps(p.add(stride)))
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+weight_kernel!(
+    weight_avx512_3,
+    "avx512f",
+    8,
+    3,
+    16,
+    _mm512_setzero_ps,
+    _mm512_storeu_ps,
+    _mm512_set1_ps,
+    _mm512_fmadd_ps,
+    window_avx512
+);
+#[cfg(target_arch = "x86_64")]
+weight_kernel!(
+    weight_avx512_2,
+    "avx512f",
+    8,
+    2,
+    16,
+    _mm512_setzero_ps,
+    _mm512_storeu_ps,
+    _mm512_set1_ps,
+    _mm512_fmadd_ps,
+    window_avx512
+);
+#[cfg(target_arch = "x86_64")]
+weight_kernel!(
+    weight_avx512_1,
+    "avx512f",
+    8,
+    1,
+    16,
+    _mm512_setzero_ps,
+    _mm512_storeu_ps,
+    _mm512_set1_ps,
+    _mm512_fmadd_ps,
+    window_avx512
+);
+#[cfg(target_arch = "x86_64")]
+weight_kernel!(
+    weight_avx2_2,
+    "avx2,fma",
+    4,
+    2,
+    8,
+    _mm256_setzero_ps,
+    _mm256_storeu_ps,
+    _mm256_set1_ps,
+    _mm256_fmadd_ps,
+    window_avx2
+);
+#[cfg(target_arch = "x86_64")]
+weight_kernel!(
+    weight_avx2_1,
+    "avx2,fma",
+    4,
+    1,
+    8,
+    _mm256_setzero_ps,
+    _mm256_storeu_ps,
+    _mm256_set1_ps,
+    _mm256_fmadd_ps,
+    window_avx2
+);
