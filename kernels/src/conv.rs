@@ -32,6 +32,27 @@ fn inside(off: isize, stride: usize, n: usize, len: usize) -> (usize, usize) {
     (lo, hi)
 }
 
+/// The bias gradient `db` (overwritten) of output gradients `dy` (`[image][channel][pixel]`,
+/// `pix` pixels, `db.len()` channels): each channel's sum from 0 over `(image, pixel)` in that
+/// order, plain additions. Eight channels' sums advance side by side (each its own chain, so
+/// the same bits), which hides the additions' latency.
+fn bias_gradient(dy: &[f32], pix: usize, db: &mut [f32]) {
+    const SIDE: usize = 8;
+    let co = db.len();
+    for o0 in (0..co).step_by(SIDE) {
+        let m = SIDE.min(co - o0);
+        let mut s = [0.0f32; SIDE];
+        for img in dy.chunks_exact(co * pix) {
+            for p in 0..pix {
+                for (k, sk) in s[..m].iter_mut().enumerate() {
+                    *sk += img[(o0 + k) * pix + p];
+                }
+            }
+        }
+        db[o0..o0 + m].copy_from_slice(&s[..m]);
+    }
+}
+
 /// The shape of a convolution: `channels_in` images of `height x width`, a square kernel,
 /// a stride and a zero padding on every side.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -405,15 +426,7 @@ impl Conv2d {
         }
         if let Some(db) = db {
             assert_eq!(db.len(), co, "conv2d: bias-gradient length");
-            for (o, d) in db.iter_mut().enumerate() {
-                let mut s = 0.0;
-                for img in dy.chunks_exact(self.out_len()) {
-                    for v in &img[o * pix..][..pix] {
-                        s += v;
-                    }
-                }
-                *d = s;
-            }
+            bias_gradient(dy, pix, db);
         }
     }
 
@@ -610,16 +623,7 @@ impl ConvTranspose2d {
                 self.channels_out,
                 "conv-transpose: bias-gradient length"
             );
-            let pix = self.out_height() * self.out_width();
-            for (o, d) in db.iter_mut().enumerate() {
-                let mut s = 0.0;
-                for img in dy.chunks_exact(self.out_len()) {
-                    for v in &img[o * pix..][..pix] {
-                        s += v;
-                    }
-                }
-                *d = s;
-            }
+            bias_gradient(dy, self.out_height() * self.out_width(), db);
         }
     }
 }

@@ -18,7 +18,7 @@ const KERNEL: usize = 4;
 const STRIDE: usize = 2;
 const PADDING: usize = 1;
 
-/// A path's forward tile: `MR` output channels by `NV` vectors of `LANES` pixels.
+/// A direct kernel's tile: `MR` channels by `NV` vectors of `LANES` values.
 #[derive(Clone, Copy)]
 struct Tile {
     mr: usize,
@@ -26,21 +26,45 @@ struct Tile {
     lanes: usize,
 }
 
-/// The forward tile of a SIMD path (None: the scalar path, which keeps the `im2col` product).
-fn forward_tile(path: SimdPath) -> Option<Tile> {
+/// The vector widths a path's direct kernels may use, widest first: AVX-512 also runs the
+/// 8-lane (AVX2) kernels where a 16-lane vector does not fit an output row (8 pixels wide).
+/// Lanes compute what `mul_add` computes at any width, so the width never changes a bit.
+fn widths(path: SimdPath) -> &'static [usize] {
     match path {
-        SimdPath::Scalar => None,
-        SimdPath::Avx2 => Some(Tile {
-            mr: 4,
-            nv: 2,
-            lanes: 8,
-        }),
-        SimdPath::Avx512 => Some(Tile {
-            mr: 4,
-            nv: 4,
-            lanes: 16,
-        }),
+        SimdPath::Scalar => &[],
+        SimdPath::Avx2 => &[8],
+        SimdPath::Avx512 if SimdPath::Avx2.available() => &[16, 8],
+        SimdPath::Avx512 => &[16],
     }
+}
+
+/// Whether the direct kernels are written for this convolution's kernel, stride, padding and
+/// sides.
+fn direct_shape(conv: &Conv2d) -> bool {
+    conv.kernel == KERNEL
+        && conv.stride == STRIDE
+        && conv.padding == PADDING
+        && conv.height.is_multiple_of(2)
+        && conv.width.is_multiple_of(2)
+}
+
+/// The forward tile of `path` for this convolution (None: the `im2col` product): 4 output
+/// channels by 4 vectors of 16 pixels, or by 2 vectors of 8; a vector lies in one output row.
+fn forward_tile(conv: &Conv2d, path: SimdPath) -> Option<Tile> {
+    let (ow, pix) = (conv.out_width(), conv.out_height() * conv.out_width());
+    widths(path)
+        .iter()
+        .map(|&lanes| Tile {
+            mr: 4,
+            nv: if lanes == 16 { 4 } else { 2 },
+            lanes,
+        })
+        .find(|t| {
+            direct_shape(conv)
+                && ow.is_multiple_of(t.lanes)
+                && conv.channels_out.is_multiple_of(t.mr)
+                && (pix / t.lanes).is_multiple_of(t.nv)
+        })
 }
 
 /// The padded, parity-split layout of one image: `[c][row + 1][parity][j]` for rows `-1..=H`
@@ -89,24 +113,13 @@ impl Phases {
 
 /// Whether the direct forward kernel of `path` computes this convolution.
 pub(crate) fn forward_applies(conv: &Conv2d, path: SimdPath) -> bool {
-    let Some(t) = forward_tile(path) else {
-        return false;
-    };
-    let ow = conv.out_width();
-    conv.kernel == KERNEL
-        && conv.stride == STRIDE
-        && conv.padding == PADDING
-        && conv.height.is_multiple_of(2)
-        && conv.width.is_multiple_of(2)
-        && ow.is_multiple_of(t.lanes)
-        && conv.channels_out.is_multiple_of(t.mr)
-        && (conv.out_height() * ow / t.lanes).is_multiple_of(t.nv)
+    forward_tile(conv, path).is_some()
 }
 
 /// The weights `[out, in, k, k]` packed for the forward tiles: block `b` of `MR` output
 /// channels holds, for every `(c, ky, kx)` in order, the `MR` weights of its channels.
 pub(crate) fn pack_forward_weights(conv: &Conv2d, path: SimdPath, w: &[f32]) -> Vec<f32> {
-    let t = forward_tile(path).expect("a SIMD path");
+    let t = forward_tile(conv, path).expect("a direct shape");
     let patch = conv.channels_in * KERNEL * KERNEL;
     let mut out = Vec::with_capacity(w.len());
     for o0 in (0..conv.channels_out).step_by(t.mr) {
@@ -129,7 +142,7 @@ pub(crate) fn forward_image(
     phases: &mut Vec<f32>,
     out: &mut [f32],
 ) {
-    let t = forward_tile(path).expect("a SIMD path");
+    let t = forward_tile(conv, path).expect("a direct shape");
     let layout = Phases::of(conv);
     phases.resize(conv.channels_in * layout.channel, 0.0);
     layout.fill(conv, img, phases);
@@ -172,15 +185,15 @@ pub(crate) fn forward_image(
                 parity: layout.parity,
                 pix,
             };
-            match path {
+            match t.lanes {
                 #[cfg(target_arch = "x86_64")]
-                // SAFETY: the CPU runs the path (the caller checked); every offset lies inside
-                // `phases`, `wp` and `out` (the tile is inside the image, `forward_applies`).
-                SimdPath::Avx512 => unsafe { forward_avx512(&args, phases, &xs, wp, out, &outs) },
+                // SAFETY: the CPU runs the width (`widths`); every offset lies inside `phases`,
+                // `wp` and `out` (asserted above).
+                16 => unsafe { forward_avx512(&args, phases, &xs, wp, out, &outs) },
                 #[cfg(target_arch = "x86_64")]
                 // SAFETY: as above.
-                SimdPath::Avx2 => unsafe { forward_avx2(&args, phases, &xs, wp, out, &outs) },
-                _ => unreachable!("no direct kernel on the {path} path"),
+                8 => unsafe { forward_avx2(&args, phases, &xs, wp, out, &outs) },
+                _ => unreachable!("no direct kernel of {} lanes", t.lanes),
             }
         }
     }
@@ -284,42 +297,38 @@ forward_kernel!(
     _mm256_fmadd_ps
 );
 
-/// The channel tile of the input gradient on `path` for `channels` input channels: the largest
-/// of 4, 3 and 1 that divides it (the follow-up's RGB decoder layer has 3).
-fn input_tile(path: SimdPath, channels: usize) -> Option<Tile> {
-    let (nv, lanes) = match path {
-        SimdPath::Scalar => return None,
-        SimdPath::Avx2 => (2, 8),
-        SimdPath::Avx512 => (4, 16),
-    };
+/// The input-gradient tile of `path` for this convolution (None: the `im2col` product and
+/// its scatter): the largest of 4, 3 and 1 input channels that divides them (the follow-up's
+/// RGB decoder layer has 3), by 4 vectors of 16 pixels or 2 of 8; a vector lies in one row.
+fn input_tile(conv: &Conv2d, path: SimdPath) -> Option<Tile> {
     let mr = [4, 3, 1]
         .into_iter()
-        .find(|m| channels.is_multiple_of(*m))
+        .find(|m| conv.channels_in.is_multiple_of(*m))
         .expect("1 divides");
-    Some(Tile { mr, nv, lanes })
+    let (ow, pix) = (conv.out_width(), conv.out_height() * conv.out_width());
+    widths(path)
+        .iter()
+        .map(|&lanes| Tile {
+            mr,
+            nv: if lanes == 16 { 4 } else { 2 },
+            lanes,
+        })
+        .find(|t| {
+            direct_shape(conv) && ow.is_multiple_of(t.lanes) && (pix / t.lanes).is_multiple_of(t.nv)
+        })
 }
 
 /// Whether the direct input-gradient kernel of `path` computes this convolution's input
 /// gradient (the transposed convolution's forward pass).
 pub(crate) fn input_applies(conv: &Conv2d, path: SimdPath) -> bool {
-    let Some(t) = input_tile(path, conv.channels_in) else {
-        return false;
-    };
-    let ow = conv.out_width();
-    conv.kernel == KERNEL
-        && conv.stride == STRIDE
-        && conv.padding == PADDING
-        && conv.height.is_multiple_of(2)
-        && conv.width.is_multiple_of(2)
-        && ow.is_multiple_of(t.lanes)
-        && (conv.out_height() * ow / t.lanes).is_multiple_of(t.nv)
+    input_tile(conv, path).is_some()
 }
 
 /// The weights `[out, in, k, k]` packed for the input-gradient tiles: block `b` of `MR` input
 /// channels holds, for every `(ky, kx)` and then every output channel `o` in order, the `MR`
 /// weights of its channels.
 pub(crate) fn pack_input_weights(conv: &Conv2d, path: SimdPath, w: &[f32]) -> Vec<f32> {
-    let t = input_tile(path, conv.channels_in).expect("a SIMD path");
+    let t = input_tile(conv, path).expect("a direct shape");
     let k2 = KERNEL * KERNEL;
     let mut out = Vec::with_capacity(w.len());
     for c0 in (0..conv.channels_in).step_by(t.mr) {
@@ -343,8 +352,8 @@ fn taps(q: usize) -> [usize; 2] {
 /// The input gradient of one image, `dx` (`[c][y][x]`, overwritten), from its output gradient
 /// `dy` (`[o][oy][ox]`): for every input value, the terms of the kernel positions that reach
 /// it, in increasing `(ky, kx)`, each one chain over the output channels from 0, added from 0
-/// (what the im2col product and its `col2im` scatter compute). `padded` and `sums` are
-/// scratch. Only where [`input_applies`].
+/// (what the im2col product and its `col2im` scatter compute; a position past dy's edge adds
+/// nothing). `padded` and `sums` are scratch. Only where [`input_applies`].
 pub(crate) fn input_image(
     conv: &Conv2d,
     path: SimdPath,
@@ -354,11 +363,11 @@ pub(crate) fn input_image(
     sums: &mut Vec<f32>,
     dx: &mut [f32],
 ) {
-    let t = input_tile(path, conv.channels_in).expect("a SIMD path");
+    let t = input_tile(conv, path).expect("a direct shape");
     let (oh, ow, co) = (conv.out_height(), conv.out_width(), conv.channels_out);
     let (h, w) = (conv.height, conv.width);
     // The output gradient with a border of zeros: a kernel position past the edge reads 0 and
-    // adds +0, which changes no sum (a sum from +0 is never -0).
+    // its lanes are left out of the sums.
     let prow = ow + 2;
     let plane = (oh + 2) * prow;
     padded.clear();
@@ -397,6 +406,18 @@ pub(crate) fn input_image(
                                 let (i, j0) = at(v);
                                 (i + dr) * prow + j0 + dc
                             });
+                            // The lanes whose kernel position lies inside dy: a position
+                            // past its edge is skipped, not added as a zero (with subnormals
+                            // flushed, a sum can be -0, which adding +0 would turn to +0).
+                            let valid: [u32; 4] = std::array::from_fn(|v| {
+                                let (i, j0) = at(v);
+                                if i + dr == 0 || i + dr > oh {
+                                    return 0;
+                                }
+                                (0..t.lanes)
+                                    .filter(|l| (1..=ow).contains(&(j0 + l + dc)))
+                                    .fold(0, |m, l| m | (1 << l))
+                            });
                             let r = ky * KERNEL + kx;
                             let wp = &packed[(b * KERNEL * KERNEL + r) * co * t.mr..][..co * t.mr];
                             assert!(
@@ -410,7 +431,7 @@ pub(crate) fn input_image(
                                 plane,
                                 cstride,
                             };
-                            input_tile_call(path, t.mr, &args, padded, &dys, wp, sums, &sout);
+                            input_tile_call(t, &args, padded, &dys, &valid, wp, sums, &sout);
                         }
                     }
                 }
@@ -437,34 +458,34 @@ struct InputArgs {
     cstride: usize,
 }
 
-/// One input-gradient term of a tile of `mr` channels on `path`.
+/// One input-gradient term of tile `t`.
 #[allow(clippy::too_many_arguments)]
 fn input_tile_call(
-    path: SimdPath,
-    mr: usize,
+    t: Tile,
     a: &InputArgs,
     padded: &[f32],
     dys: &[usize; 4],
+    valid: &[u32; 4],
     wp: &[f32],
     sums: &mut [f32],
     sout: &[usize; 4],
 ) {
-    // SAFETY (every arm): the CPU runs the path (the caller checked `input_applies` on the
-    // active or a checked path) and the tile lies inside the slices (asserted by the caller).
-    match (path, mr) {
+    // SAFETY (every arm): the CPU runs the width (`widths`) and the tile lies inside the
+    // slices (asserted by the caller).
+    match (t.lanes, t.mr) {
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx512, 4) => unsafe { input_avx512_4(a, padded, dys, wp, sums, sout) },
+        (16, 4) => unsafe { input_avx512_4(a, padded, dys, valid, wp, sums, sout) },
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx512, 3) => unsafe { input_avx512_3(a, padded, dys, wp, sums, sout) },
+        (16, 3) => unsafe { input_avx512_3(a, padded, dys, valid, wp, sums, sout) },
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx512, 1) => unsafe { input_avx512_1(a, padded, dys, wp, sums, sout) },
+        (16, 1) => unsafe { input_avx512_1(a, padded, dys, valid, wp, sums, sout) },
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx2, 4) => unsafe { input_avx2_4(a, padded, dys, wp, sums, sout) },
+        (8, 4) => unsafe { input_avx2_4(a, padded, dys, valid, wp, sums, sout) },
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx2, 3) => unsafe { input_avx2_3(a, padded, dys, wp, sums, sout) },
+        (8, 3) => unsafe { input_avx2_3(a, padded, dys, valid, wp, sums, sout) },
         #[cfg(target_arch = "x86_64")]
-        (SimdPath::Avx2, 1) => unsafe { input_avx2_1(a, padded, dys, wp, sums, sout) },
-        _ => unreachable!("no direct kernel on the {path} path with {mr} channels"),
+        (8, 1) => unsafe { input_avx2_1(a, padded, dys, valid, wp, sums, sout) },
+        (lanes, mr) => unreachable!("no direct kernel of {lanes} lanes and {mr} channels"),
     }
 }
 
@@ -473,7 +494,7 @@ macro_rules! input_kernel {
     ($name:ident, $feature:literal, $mr:literal, $nv:literal, $lanes:literal,
      $zero:ident, $load:ident, $store:ident, $set1:ident, $fma:ident, $add:ident) => {
         /// One term of an input-gradient tile: `$mr` channels by `$nv` vectors, each a chain
-        /// over the output channels from 0, then added to its sum.
+        /// over the output channels from 0, then added to its sum in the lanes of `valid`.
         ///
         /// # Safety
         /// On a CPU with the target feature; the tile's reads and writes inside the slices.
@@ -482,6 +503,7 @@ macro_rules! input_kernel {
             a: &InputArgs,
             padded: &[f32],
             dys: &[usize; 4],
+            valid: &[u32; 4],
             wp: &[f32],
             sums: &mut [f32],
             sout: &[usize; 4],
@@ -513,12 +535,46 @@ macro_rules! input_kernel {
                     // SAFETY: inside `sums` (the caller).
                     unsafe {
                         let s = sp.add(sout[v] + i * a.cstride);
-                        $store(s, $add($load(s), acc[i][v]));
+                        $store(s, $add($load(s), acc[i][v], valid[v]));
                     }
                 }
             }
         }
     };
+}
+
+/// `s + t` in the lanes of `mask`, `s` elsewhere.
+///
+/// # Safety
+/// On a CPU with AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn masked_add_avx512(
+    s: std::arch::x86_64::__m512,
+    t: std::arch::x86_64::__m512,
+    mask: u32,
+) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    _mm512_mask_add_ps(s, mask as __mmask16, s, t)
+}
+
+/// `s + t` in the lanes of `mask`, `s` elsewhere.
+///
+/// # Safety
+/// On a CPU with AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn masked_add_avx2(
+    s: std::arch::x86_64::__m256,
+    t: std::arch::x86_64::__m256,
+    mask: u32,
+) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    let on = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), bit), bit);
+    _mm256_blendv_ps(s, _mm256_add_ps(s, t), _mm256_castsi256_ps(on))
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -539,7 +595,7 @@ input_kernels!(
     _mm512_storeu_ps,
     _mm512_set1_ps,
     _mm512_fmadd_ps,
-    _mm512_add_ps,
+    masked_add_avx512,
     input_avx512_4 = 4,
     input_avx512_3 = 3,
     input_avx512_1 = 1
@@ -554,7 +610,7 @@ input_kernels!(
     _mm256_storeu_ps,
     _mm256_set1_ps,
     _mm256_fmadd_ps,
-    _mm256_add_ps,
+    masked_add_avx2,
     input_avx2_4 = 4,
     input_avx2_3 = 3,
     input_avx2_1 = 1
