@@ -43,9 +43,18 @@ fn bias_gradient(dy: &[f32], pix: usize, db: &mut [f32]) {
         let m = SIDE.min(co - o0);
         let mut s = [0.0f32; SIDE];
         for img in dy.chunks_exact(co * pix) {
-            for p in 0..pix {
-                for (k, sk) in s[..m].iter_mut().enumerate() {
-                    *sk += img[(o0 + k) * pix + p];
+            if m == SIDE {
+                let rows: [&[f32]; SIDE] = std::array::from_fn(|k| &img[(o0 + k) * pix..][..pix]);
+                for p in 0..pix {
+                    for k in 0..SIDE {
+                        s[k] += rows[k][p];
+                    }
+                }
+            } else {
+                for p in 0..pix {
+                    for (k, sk) in s[..m].iter_mut().enumerate() {
+                        *sk += img[(o0 + k) * pix + p];
+                    }
                 }
             }
         }

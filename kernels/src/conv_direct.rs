@@ -414,9 +414,11 @@ pub(crate) fn input_image(
                                 if i + dr == 0 || i + dr > oh {
                                     return 0;
                                 }
-                                (0..t.lanes)
-                                    .filter(|l| (1..=ow).contains(&(j0 + l + dc)))
-                                    .fold(0, |m, l| m | (1 << l))
+                                // Lanes l with 1 <= j0 + l + dc <= ow: a contiguous run.
+                                let start = j0 + dc;
+                                let lo = 1usize.saturating_sub(start);
+                                let hi = (ow + 1 - start).min(t.lanes);
+                                ((1u32 << hi) - 1) & !((1u32 << lo) - 1)
                             });
                             let r = ky * KERNEL + kx;
                             let wp = &packed[(b * KERNEL * KERNEL + r) * co * t.mr..][..co * t.mr];
