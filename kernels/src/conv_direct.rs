@@ -92,16 +92,20 @@ impl Phases {
     }
 
     /// Writes image `img` (`[c][y][x]`) into `out` (`channels_in * channel` values).
+    /// Every value of `out` is written: the image's, and zeros in the padding.
     fn fill(&self, conv: &Conv2d, img: &[f32], out: &mut [f32]) {
-        out.fill(0.0);
         let (h, w) = (conv.height, conv.width);
-        for c in 0..conv.channels_in {
+        for (c, plane) in out.chunks_exact_mut(self.channel).enumerate() {
+            plane[..self.row].fill(0.0);
+            plane[(h + 1) * self.row..].fill(0.0);
             for y in 0..h {
                 let src = &img[(c * h + y) * w..][..w];
-                let dst = &mut out[c * self.channel + (y + 1) * self.row..][..self.row];
+                let dst = &mut plane[(y + 1) * self.row..][..self.row];
                 let (even, odd) = dst.split_at_mut(self.parity);
                 // Input column x is padded column x + 1: odd x to parity 0 at (x + 1) / 2, even
-                // x to parity 1 at x / 2.
+                // x to parity 1 at x / 2; padded columns 0 and w + 1 are zeros.
+                even[0] = 0.0;
+                odd[self.parity - 1] = 0.0;
                 for (j, pair) in src.chunks_exact(2).enumerate() {
                     odd[j] = pair[0];
                     even[j + 1] = pair[1];
@@ -370,12 +374,15 @@ pub(crate) fn input_image(
     // its lanes are left out of the sums.
     let prow = ow + 2;
     let plane = (oh + 2) * prow;
-    padded.clear();
     padded.resize(co * plane, 0.0);
-    for o in 0..co {
+    for (o, pl) in padded.chunks_exact_mut(plane).enumerate() {
+        pl[..prow].fill(0.0);
+        pl[(oh + 1) * prow..].fill(0.0);
         for oy in 0..oh {
-            padded[o * plane + (oy + 1) * prow + 1..][..ow]
-                .copy_from_slice(&dy[(o * oh + oy) * ow..][..ow]);
+            let row = &mut pl[(oy + 1) * prow..][..prow];
+            row[0] = 0.0;
+            row[prow - 1] = 0.0;
+            row[1..=ow].copy_from_slice(&dy[(o * oh + oy) * ow..][..ow]);
         }
     }
     // The sums by column parity: [c][y][parity][j] for x = 2 j + parity.
@@ -681,21 +688,7 @@ pub(crate) fn weight_gradient(
                 }
             }
         });
-    // The output gradient by blocks of MR channels, pixel-major: [block][image][pixel][MR].
     let blocks = co / t.mr;
-    let mut dyt = vec![0.0f32; n * co * pix];
-    dyt.par_chunks_mut(n * pix * t.mr)
-        .enumerate()
-        .for_each(|(b, dst)| {
-            for i in 0..n {
-                for m in 0..t.mr {
-                    let src = &dy[(i * co + b * t.mr + m) * pix..][..pix];
-                    for (p, v) in src.iter().enumerate() {
-                        dst[(i * pix + p) * t.mr + m] = *v;
-                    }
-                }
-            }
-        });
     let per_channel = KERNEL * KERNEL / t.lanes;
     let vectors = ci * per_channel;
     let tiles: Vec<(usize, usize)> = (0..blocks)
@@ -707,6 +700,7 @@ pub(crate) fn weight_gradient(
         ow: conv.out_width(),
         image: ci * pplane,
         prow,
+        co,
     };
     let results: Vec<Vec<f32>> = tiles
         .par_iter()
@@ -717,7 +711,13 @@ pub(crate) fn weight_gradient(
                 let u = u0 + v.min(t.nv - 1);
                 (u / per_channel) * pplane + (u % per_channel) * rows * prow
             });
-            let dys = &dyt[b * n * pix * t.mr..][..n * pix * t.mr];
+            // The block's first output channel in dy; the tile reads MR channel rows of every
+            // image from there.
+            let g0 = b * t.mr * pix;
+            assert!(
+                (n - 1) * co * pix + g0 + t.mr * pix <= dy.len(),
+                "conv2d: a direct tile outside its buffers: {conv:?}"
+            );
             let mut out = vec![0.0f32; t.mr * t.nv * t.lanes];
             // The last read of the tile inside `padded`.
             let last = (n - 1) * args.image
@@ -729,7 +729,7 @@ pub(crate) fn weight_gradient(
                 last <= padded.len(),
                 "conv2d: a direct tile outside its buffers: {conv:?}"
             );
-            weight_tile_call(path, t.nv, &args, &padded, &xs, dys, &mut out);
+            weight_tile_call(path, t.nv, &args, &padded, &xs, &dy[g0..], &mut out);
             out
         })
         .collect();
@@ -758,6 +758,8 @@ struct WeightArgs {
     image: usize,
     /// Values of one padded row.
     prow: usize,
+    /// Output channels (dy's channels per image).
+    co: usize,
 }
 
 /// One weight-gradient tile of `nv` vectors on `path`.
@@ -806,9 +808,11 @@ macro_rules! weight_kernel {
         ) {
             use std::arch::x86_64::*;
             let xp = padded.as_ptr();
-            let mut g = dys.as_ptr();
+            let pix = a.oh * a.ow;
             let mut acc = [[$zero(); $nv]; $mr];
             for img in 0..a.n {
+                // SAFETY: this image's first channel row of the tile (the caller).
+                let mut g = unsafe { dys.as_ptr().add(img * a.co * pix) };
                 for oy in 0..a.oh {
                     for ox in 0..a.ow {
                         let at = img * a.image + 2 * oy * a.prow + 2 * ox;
@@ -818,14 +822,14 @@ macro_rules! weight_kernel {
                             win[v] = unsafe { $window(xp.add(at + xs[v]), a.prow) };
                         }
                         for i in 0..$mr {
-                            // SAFETY: `dys` holds MR values per pixel of every image.
-                            let gi = $set1(unsafe { *g.add(i) });
+                            // SAFETY: channel row i of the tile, this pixel (the caller).
+                            let gi = $set1(unsafe { *g.add(i * pix) });
                             for v in 0..$nv {
                                 acc[i][v] = $fma(gi, win[v], acc[i][v]);
                             }
                         }
-                        // SAFETY: the next pixel's values (or one past the end).
-                        g = unsafe { g.add($mr) };
+                        // SAFETY: the next pixel (or one past the row's end).
+                        g = unsafe { g.add(1) };
                     }
                 }
             }
