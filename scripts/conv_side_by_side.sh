@@ -7,7 +7,8 @@
 #   step:            one training iteration of the convolutional beta-VAE (criterion bench
 #                    `conv_step` of ugl-bench; scripts/torch_conv_vae_step.py).
 #
-# Usage: scripts/conv_side_by_side.sh [stack|step] [ROUNDS (default 2)]. Needs python3 with torch.
+# Usage: scripts/conv_side_by_side.sh [stack|step] [ROUNDS (default 2)]. Needs a Python with torch:
+# $PYTHON (default python3).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=stack
@@ -27,7 +28,7 @@ ugl_ms() {
                    print v; exit }'
 }
 torch_ms() {
-  python3 "$torch_script" --threads "$1" --iters "$iters" | sed -n 's/.*median \([0-9.]*\) ms.*/\1/p'
+  "${PYTHON:-python3}" "$torch_script" --threads "$1" --iters "$iters" | sed -n 's/.*median \([0-9.]*\) ms.*/\1/p'
 }
 printf '%7s %5s %10s %10s %9s\n' threads round ugl_ms torch_ms torch/ugl
 for r in $(seq 1 "$rounds"); do
