@@ -879,67 +879,37 @@ unsafe fn window_avx2(p: *const f32, stride: usize) -> std::arch::x86_64::__m256
 }
 
 #[cfg(target_arch = "x86_64")]
-weight_kernel!(
-    weight_avx512_3,
+macro_rules! weight_kernels {
+    ($feature:literal, $mr:literal, $lanes:literal, $zero:ident, $storeu:ident, $set1:ident,
+     $fma:ident, $window:ident, $($name:ident = $nv:literal),+) => {
+        $(weight_kernel!($name, $feature, $mr, $nv, $lanes, $zero, $storeu, $set1, $fma, $window);)+
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+weight_kernels!(
     "avx512f",
     8,
-    3,
     16,
     _mm512_setzero_ps,
     _mm512_storeu_ps,
     _mm512_set1_ps,
     _mm512_fmadd_ps,
-    window_avx512
+    window_avx512,
+    weight_avx512_3 = 3,
+    weight_avx512_2 = 2,
+    weight_avx512_1 = 1
 );
 #[cfg(target_arch = "x86_64")]
-weight_kernel!(
-    weight_avx512_2,
-    "avx512f",
-    8,
-    2,
-    16,
-    _mm512_setzero_ps,
-    _mm512_storeu_ps,
-    _mm512_set1_ps,
-    _mm512_fmadd_ps,
-    window_avx512
-);
-#[cfg(target_arch = "x86_64")]
-weight_kernel!(
-    weight_avx512_1,
-    "avx512f",
-    8,
-    1,
-    16,
-    _mm512_setzero_ps,
-    _mm512_storeu_ps,
-    _mm512_set1_ps,
-    _mm512_fmadd_ps,
-    window_avx512
-);
-#[cfg(target_arch = "x86_64")]
-weight_kernel!(
-    weight_avx2_2,
+weight_kernels!(
     "avx2,fma",
     4,
-    2,
     8,
     _mm256_setzero_ps,
     _mm256_storeu_ps,
     _mm256_set1_ps,
     _mm256_fmadd_ps,
-    window_avx2
-);
-#[cfg(target_arch = "x86_64")]
-weight_kernel!(
-    weight_avx2_1,
-    "avx2,fma",
-    4,
-    1,
-    8,
-    _mm256_setzero_ps,
-    _mm256_storeu_ps,
-    _mm256_set1_ps,
-    _mm256_fmadd_ps,
-    window_avx2
+    window_avx2,
+    weight_avx2_2 = 2,
+    weight_avx2_1 = 1
 );
