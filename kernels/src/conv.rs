@@ -16,6 +16,7 @@
 //! convolution, `[in, out, k, k]` for a transposed one.
 
 use crate::conv_direct;
+pub use crate::conv_shape::Conv2d;
 use crate::matmul::{MatRef, matmul_on};
 use crate::path::{SimdPath, active_path};
 use rayon::prelude::*;
@@ -62,84 +63,7 @@ fn bias_gradient(dy: &[f32], pix: usize, db: &mut [f32]) {
     }
 }
 
-/// The shape of a convolution: `channels_in` images of `height x width`, a square kernel,
-/// a stride and a zero padding on every side.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Conv2d {
-    /// Input channels.
-    pub channels_in: usize,
-    /// Output channels.
-    pub channels_out: usize,
-    /// Kernel side.
-    pub kernel: usize,
-    /// Stride.
-    pub stride: usize,
-    /// Zero padding on each side.
-    pub padding: usize,
-    /// Input rows.
-    pub height: usize,
-    /// Input columns.
-    pub width: usize,
-}
-
 impl Conv2d {
-    /// Output rows: `(height + 2 padding - kernel) / stride + 1`.
-    pub fn out_height(&self) -> usize {
-        (self.height + 2 * self.padding - self.kernel) / self.stride + 1
-    }
-
-    /// Output columns.
-    pub fn out_width(&self) -> usize {
-        (self.width + 2 * self.padding - self.kernel) / self.stride + 1
-    }
-
-    /// Values of one input image (all channels).
-    pub fn in_len(&self) -> usize {
-        self.channels_in * self.height * self.width
-    }
-
-    /// Values of one output image.
-    pub fn out_len(&self) -> usize {
-        self.channels_out * self.out_height() * self.out_width()
-    }
-
-    /// Values of the weight, `[out, in, k, k]`.
-    pub fn weight_len(&self) -> usize {
-        self.channels_out * self.patch()
-    }
-
-    /// Floating-point operations of the forward pass on `n` images, a multiply and an add per
-    /// weight and output pixel (`2 out in k² pixels n`, biases left out). The input gradient
-    /// and the weight gradient each do as many.
-    pub fn flops(&self, n: usize) -> u64 {
-        2 * (self.weight_len() * self.pixels_out() * n) as u64
-    }
-
-    /// Rows of the `im2col` matrix: `in * k * k`.
-    fn patch(&self) -> usize {
-        self.channels_in * self.kernel * self.kernel
-    }
-
-    fn pixels_out(&self) -> usize {
-        self.out_height() * self.out_width()
-    }
-
-    fn check(&self) {
-        assert!(
-            self.kernel >= 1 && self.stride >= 1,
-            "conv2d: kernel and stride must be at least 1: {self:?}"
-        );
-        assert!(
-            self.channels_in >= 1 && self.channels_out >= 1 && self.height >= 1 && self.width >= 1,
-            "conv2d: channels and image sides must be at least 1: {self:?}"
-        );
-        assert!(
-            self.height + 2 * self.padding >= self.kernel
-                && self.width + 2 * self.padding >= self.kernel,
-            "conv2d: the kernel is larger than the padded image: {self:?}"
-        );
-    }
-
     /// Row `r = (c, ky, kx)` of the `im2col` matrix of one image, `[patch, pixels]`: the input
     /// value under kernel position `r` for every output pixel (0 in the padding).
     fn im2col_row(&self, x: &[f32], r: usize, row: &mut [f32]) {

@@ -10,7 +10,7 @@
 //! tile of `MR` output channels by `NV` vectors of `LANES` output pixels then runs its chains
 //! with one broadcast weight per channel and one load per vector, step after step.
 
-use crate::conv::Conv2d;
+use crate::conv_shape::Conv2d;
 use crate::path::SimdPath;
 
 /// The kernel side, stride and padding the direct kernels are written for.

@@ -6,6 +6,7 @@
 
 mod conv;
 mod conv_direct;
+mod conv_shape;
 mod eigen;
 mod flush;
 mod matmul;
