@@ -9,6 +9,13 @@
 //! consecutive output columns for one `(c, ky, kx)` are consecutive values: one vector load. A
 //! tile of `MR` output channels by `NV` vectors of `LANES` output pixels then runs its chains
 //! with one broadcast weight per channel and one load per vector, step after step.
+//!
+//! Input gradient ([`input_image`]): each input pixel is reached by two kernel rows and two
+//! kernel columns (by the parities of its row and column); each term is a chain over the output
+//! channels from 0, added to the pixel's sum in increasing `(ky, kx)`, and a position past dy's
+//! edge is left out, as the `col2im` scatter does. Weight gradient ([`weight_gradient`]): each
+//! weight is one chain over `(image, oy, ox)`; a vector holds one input channel's 4 x 4 window
+//! (AVX2: two rows of it) under an output pixel, and dy is broadcast.
 
 use crate::conv_shape::Conv2d;
 use crate::path::SimdPath;
@@ -646,15 +653,8 @@ fn weight_tile(path: SimdPath, channels: usize) -> Option<Tile> {
 /// Whether the direct weight-gradient kernel of `path` computes this convolution's weight
 /// gradient.
 pub(crate) fn weight_applies(conv: &Conv2d, path: SimdPath) -> bool {
-    let Some(t) = weight_tile(path, conv.channels_in) else {
-        return false;
-    };
-    conv.kernel == KERNEL
-        && conv.stride == STRIDE
-        && conv.padding == PADDING
-        && conv.height.is_multiple_of(2)
-        && conv.width.is_multiple_of(2)
-        && conv.channels_out.is_multiple_of(t.mr)
+    weight_tile(path, conv.channels_in)
+        .is_some_and(|t| direct_shape(conv) && conv.channels_out.is_multiple_of(t.mr))
 }
 
 /// The weight gradient `dw` (`[out, in, k, k]`, overwritten) of a batch of `n` images: every
